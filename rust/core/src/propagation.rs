@@ -1,0 +1,179 @@
+//! CR3BP propagation with optional STM, events and output; batches on all cores.
+
+use rayon::prelude::*;
+
+use crate::cr3bp::{check_mu, Cr3bp, Cr3bpStm, STM_DIM};
+use crate::error::{check_finite, invalid, Result};
+use crate::integrate::{solve, Event, EventFn, Options, Output, State, Stats, Status};
+
+/// Scalar event functions on a CR3BP state (the first six components).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum EventKind {
+    /// g = state[index] - value (index 0..6: x, y, z, xd, yd, zd).
+    Crossing { index: usize, value: f64 },
+    /// g = |r - center| - radius: reaching a sphere about a point (e.g. a primary's surface).
+    Distance { center: [f64; 3], radius: f64 },
+}
+
+impl<S: State> EventFn<S> for EventKind {
+    #[inline]
+    fn value(&self, _t: f64, y: &S) -> f64 {
+        let s = y.as_slice();
+        match *self {
+            EventKind::Crossing { index, value } => s[index] - value,
+            EventKind::Distance { center, radius } => {
+                ((s[0] - center[0]).powi(2) + (s[1] - center[1]).powi(2) + (s[2] - center[2]).powi(2)).sqrt() - radius
+            }
+        }
+    }
+}
+
+/// An event to locate during a CR3BP propagation.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EventSpec {
+    pub kind: EventKind,
+    /// +1 increasing, -1 decreasing, 0 both.
+    pub direction: i8,
+    pub terminal: bool,
+}
+
+impl EventSpec {
+    fn validate(&self, i: usize) -> Result<()> {
+        match self.kind {
+            EventKind::Crossing { index, value } => {
+                if index >= 6 {
+                    return Err(invalid("events", format!("event {i}: component index must be in 0..6, got {index}")));
+                }
+                check_finite("events", &[value])?;
+            }
+            EventKind::Distance { center, radius } => {
+                check_finite("events", &center)?;
+                if !(radius.is_finite() && radius >= 0.0) {
+                    return Err(invalid("events", format!("event {i}: radius must be finite and >= 0, got {radius}")));
+                }
+            }
+        }
+        if !(-1..=1).contains(&self.direction) {
+            return Err(invalid("events", format!("event {i}: direction must be -1, 0 or +1, got {}", self.direction)));
+        }
+        Ok(())
+    }
+}
+
+/// A located event: which one, when, the state and (when propagated) the STM.
+#[derive(Debug, Clone, PartialEq)]
+pub struct EventHit {
+    pub index: usize,
+    pub t: f64,
+    pub state: [f64; 6],
+    pub stm: Option<[[f64; 6]; 6]>,
+}
+
+/// Result of [`propagate`].
+#[derive(Debug, Clone)]
+pub struct Trajectory {
+    pub t: Vec<f64>,
+    /// Row-major n x 6.
+    pub states: Vec<f64>,
+    pub t_final: f64,
+    pub state_final: [f64; 6],
+    /// STM from t0 to t_final, when asked for.
+    pub stm_final: Option<[[f64; 6]; 6]>,
+    pub events: Vec<EventHit>,
+    pub status: Status,
+    pub stats: Stats,
+}
+
+/// Propagate one CR3BP state from t0 to tf (either direction).
+#[allow(clippy::too_many_arguments)]
+pub fn propagate(
+    mu: f64,
+    state: &[f64; 6],
+    t0: f64,
+    tf: f64,
+    opts: &Options,
+    with_stm: bool,
+    output: Output<'_>,
+    events: &[EventSpec],
+) -> Result<Trajectory> {
+    check_mu(mu)?;
+    check_finite("state", state)?;
+    for (i, e) in events.iter().enumerate() {
+        e.validate(i)?;
+    }
+    if with_stm {
+        let sys = Cr3bpStm { mu };
+        let evs: Vec<Event<[f64; STM_DIM]>> = events.iter().map(|e| Event::new(&e.kind, e.direction, e.terminal)).collect();
+        let sol = solve(&sys, t0, &Cr3bpStm::initial(state), tf, opts, output, &evs)?;
+        let (state_final, stm) = Cr3bpStm::split(&sol.y_final);
+        let mut states = Vec::with_capacity(sol.t.len() * 6);
+        for row in sol.y.chunks_exact(STM_DIM) {
+            states.extend_from_slice(&row[..6]);
+        }
+        let events = sol
+            .events
+            .iter()
+            .map(|r| {
+                let (s, m) = Cr3bpStm::split(&r.y);
+                EventHit { index: r.index, t: r.t, state: s, stm: Some(m) }
+            })
+            .collect();
+        Ok(Trajectory { t: sol.t, states, t_final: sol.t_final, state_final, stm_final: Some(stm), events, status: sol.status, stats: sol.stats })
+    } else {
+        let sys = Cr3bp { mu };
+        let evs: Vec<Event<[f64; 6]>> = events.iter().map(|e| Event::new(&e.kind, e.direction, e.terminal)).collect();
+        let sol = solve(&sys, t0, state, tf, opts, output, &evs)?;
+        let events = sol.events.iter().map(|r| EventHit { index: r.index, t: r.t, state: r.y, stm: None }).collect();
+        Ok(Trajectory { t: sol.t, states: sol.y, t_final: sol.t_final, state_final: sol.y_final, stm_final: None, events, status: sol.status, stats: sol.stats })
+    }
+}
+
+/// Final state of one member of a batch.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FinalState {
+    pub state: [f64; 6],
+    pub stm: Option<[[f64; 6]; 6]>,
+    pub stats: Stats,
+}
+
+/// Run `f` on a rayon pool of `threads` workers (`None`: the global pool, all cores).
+pub fn with_threads<R: Send>(threads: Option<usize>, f: impl FnOnce() -> R + Send) -> Result<R> {
+    match threads {
+        None => Ok(f()),
+        Some(0) => Err(invalid("threads", "must be >= 1 (or None for all cores)")),
+        Some(n) => {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(n)
+                .build()
+                .map_err(|e| invalid("threads", format!("could not start {n} threads: {e}")))?;
+            Ok(pool.install(f))
+        }
+    }
+}
+
+/// Propagate many states from t0 to their final times (one shared, or one per state) on all
+/// cores. Each member is integrated exactly as [`propagate`] would, independently of the
+/// others, so the results are bit-identical to one-at-a-time calls whatever the thread count.
+/// One member failing does not lose the others: each carries its own `Result`.
+pub fn propagate_many(
+    mu: f64,
+    states: &[[f64; 6]],
+    t0: f64,
+    t_final: &[f64],
+    opts: &Options,
+    with_stm: bool,
+    threads: Option<usize>,
+) -> Result<Vec<Result<FinalState>>> {
+    check_mu(mu)?;
+    opts.validate()?;
+    if t_final.len() != 1 && t_final.len() != states.len() {
+        return Err(invalid("t_final", format!("must be one time or one per state ({}), got {}", states.len(), t_final.len())));
+    }
+    check_finite("t_final", t_final)?;
+    let run = |i: usize| -> Result<FinalState> {
+        let tf = if t_final.len() == 1 { t_final[0] } else { t_final[i] };
+        let tr = propagate(mu, &states[i], t0, tf, opts, with_stm, Output::Final, &[])?;
+        Ok(FinalState { state: tr.state_final, stm: tr.stm_final, stats: tr.stats })
+    };
+    with_threads(threads, || (0..states.len()).into_par_iter().map(run).collect())
+}
