@@ -1,1 +1,290 @@
+//! `librate._core`: thin PyO3 bindings over librate-core. Each function converts its arguments,
+//! calls the core with the GIL released, and converts the result; no numerics live here.
+//! The public, documented API is the `librate` Python package, which wraps these.
 
+use librate_core::cr3bp::{self, SystemConstants, PRESETS};
+use librate_core::error::Error;
+use librate_core::integrate::{Options, Output, Status};
+use librate_core::periodic;
+use librate_core::propagation::{self, EventKind, EventSpec};
+use numpy::ndarray::Array2;
+use numpy::{IntoPyArray, PyArray1, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
+use pyo3::create_exception;
+use pyo3::exceptions::{PyException, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+create_exception!(librate, LibrateError, PyException, "Base class of librate's errors.");
+create_exception!(
+    librate,
+    IntegrationError,
+    LibrateError,
+    "An integration stopped before its final time (step-size underflow, too many steps, non-finite state). Attributes: t, steps."
+);
+create_exception!(
+    librate,
+    ConvergenceError,
+    LibrateError,
+    "An iterative solver did not converge. Attributes: iterations, residual, tolerance."
+);
+
+/// Core error -> typed Python exception carrying its context as attributes.
+fn to_py(e: Error) -> PyErr {
+    Python::attach(|py| match &e {
+        Error::InvalidArgument { .. } => PyValueError::new_err(e.to_string()),
+        Error::Integration(ie) => {
+            let err = IntegrationError::new_err(e.to_string());
+            let v = err.value(py);
+            let kind = match ie {
+                librate_core::IntegrationError::StepSizeUnderflow { .. } => "step_size_underflow",
+                librate_core::IntegrationError::MaxStepsExceeded { .. } => "max_steps_exceeded",
+                librate_core::IntegrationError::NonFinite { .. } => "non_finite",
+            };
+            let _ = v.setattr("t", ie.t());
+            let _ = v.setattr("steps", ie.steps());
+            let _ = v.setattr("kind", kind);
+            err
+        }
+        Error::Convergence { iterations, residual, tolerance, .. } => {
+            let err = ConvergenceError::new_err(e.to_string());
+            let v = err.value(py);
+            let _ = v.setattr("iterations", *iterations);
+            let _ = v.setattr("residual", *residual);
+            let _ = v.setattr("tolerance", *tolerance);
+            err
+        }
+    })
+}
+
+#[allow(clippy::too_many_arguments)]
+fn options(rtol: f64, atol: f64, h0: Option<f64>, h_min: f64, h_max: f64, max_steps: usize, safety: f64, fixed_step: Option<f64>) -> Options {
+    Options { rtol, atol, h0, h_min, h_max, max_steps, safety, fixed_step, ..Options::default() }
+}
+
+fn state6(name: &'static str, v: &[f64]) -> PyResult<[f64; 6]> {
+    <[f64; 6]>::try_from(v).map_err(|_| PyValueError::new_err(format!("invalid argument `{name}`: must have 6 components (x, y, z, xd, yd, zd), got {}", v.len())))
+}
+
+fn mat6<'py>(py: Python<'py>, m: &[[f64; 6]; 6]) -> Bound<'py, PyAny> {
+    Array2::from_shape_fn((6, 6), |(i, j)| m[i][j]).into_pyarray(py).into_any()
+}
+
+fn event_specs(events: Vec<(String, Vec<f64>, i8, bool)>) -> PyResult<Vec<EventSpec>> {
+    events
+        .into_iter()
+        .enumerate()
+        .map(|(i, (kind, p, direction, terminal))| {
+            let kind = match (kind.as_str(), p.as_slice()) {
+                ("crossing", &[index, value]) if index >= 0.0 && index.fract() == 0.0 => EventKind::Crossing { index: index as usize, value },
+                ("distance", &[cx, cy, cz, radius]) => EventKind::Distance { center: [cx, cy, cz], radius },
+                _ => return Err(PyValueError::new_err(format!("invalid argument `events`: event {i} has kind {kind:?} with parameters {p:?}; expected ('crossing', [index, value]) or ('distance', [cx, cy, cz, radius])"))),
+            };
+            Ok(EventSpec { kind, direction, terminal })
+        })
+        .collect()
+}
+
+/// Propagate one CR3BP state; returns a dict of arrays (see `librate.propagate`).
+#[pyfunction]
+#[pyo3(signature = (mu, state, t0, tf, *, rtol, atol, stm, h0, h_min, h_max, max_steps, safety, fixed_step, t_eval, events))]
+#[allow(clippy::too_many_arguments)]
+fn propagate<'py>(
+    py: Python<'py>,
+    mu: f64,
+    state: PyReadonlyArray1<'py, f64>,
+    t0: f64,
+    tf: f64,
+    rtol: f64,
+    atol: f64,
+    stm: bool,
+    h0: Option<f64>,
+    h_min: f64,
+    h_max: f64,
+    max_steps: usize,
+    safety: f64,
+    fixed_step: Option<f64>,
+    t_eval: Option<PyReadonlyArray1<'py, f64>>,
+    events: Vec<(String, Vec<f64>, i8, bool)>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let s = state6("state", state.as_slice()?)?;
+    let opts = options(rtol, atol, h0, h_min, h_max, max_steps, safety, fixed_step);
+    let specs = event_specs(events)?;
+    let times: Option<Vec<f64>> = t_eval.map(|a| a.as_array().to_vec());
+    let tr = py
+        .detach(|| {
+            let output = match &times {
+                Some(t) => Output::At(t),
+                None => Output::Steps,
+            };
+            propagation::propagate(mu, &s, t0, tf, &opts, stm, output, &specs)
+        })
+        .map_err(to_py)?;
+    let n = tr.t.len();
+    let out = PyDict::new(py);
+    out.set_item("t", tr.t.into_pyarray(py))?;
+    out.set_item("y", tr.states.into_pyarray(py).reshape([n, 6])?)?;
+    out.set_item("t_final", tr.t_final)?;
+    out.set_item("y_final", tr.state_final.to_vec().into_pyarray(py))?;
+    out.set_item("stm", tr.stm_final.as_ref().map(|m| mat6(py, m)))?;
+    let evs: Vec<(usize, f64, Bound<'py, PyArray1<f64>>, Option<Bound<'py, PyAny>>)> = tr
+        .events
+        .iter()
+        .map(|e| (e.index, e.t, e.state.to_vec().into_pyarray(py), e.stm.as_ref().map(|m| mat6(py, m))))
+        .collect();
+    out.set_item("events", evs)?;
+    let (status, event_index) = match tr.status {
+        Status::Completed => ("completed", None),
+        Status::Terminated { event } => ("event", Some(event)),
+    };
+    out.set_item("status", status)?;
+    out.set_item("event_index", event_index)?;
+    out.set_item("stats", (tr.stats.accepted, tr.stats.rejected, tr.stats.rhs_evals))?;
+    Ok(out)
+}
+
+/// Propagate many states to their final times on all cores; failed members are reported, not raised.
+#[pyfunction]
+#[pyo3(signature = (mu, states, t0, t_final, *, rtol, atol, stm, h0, h_min, h_max, max_steps, safety, fixed_step, threads))]
+#[allow(clippy::too_many_arguments)]
+fn propagate_many<'py>(
+    py: Python<'py>,
+    mu: f64,
+    states: PyReadonlyArray2<'py, f64>,
+    t0: f64,
+    t_final: PyReadonlyArray1<'py, f64>,
+    rtol: f64,
+    atol: f64,
+    stm: bool,
+    h0: Option<f64>,
+    h_min: f64,
+    h_max: f64,
+    max_steps: usize,
+    safety: f64,
+    fixed_step: Option<f64>,
+    threads: Option<usize>,
+) -> PyResult<Bound<'py, PyDict>> {
+    if states.shape()[1] != 6 {
+        return Err(PyValueError::new_err(format!("invalid argument `states`: must have shape (n, 6), got {:?}", states.shape())));
+    }
+    let rows: Vec<[f64; 6]> = states.as_array().rows().into_iter().map(|r| std::array::from_fn(|j| r[j])).collect();
+    let tf: Vec<f64> = t_final.as_array().to_vec();
+    let opts = options(rtol, atol, h0, h_min, h_max, max_steps, safety, fixed_step);
+    let results = py.detach(|| propagation::propagate_many(mu, &rows, t0, &tf, &opts, stm, threads)).map_err(to_py)?;
+    let n = results.len();
+    let mut y = Vec::with_capacity(n * 6);
+    let mut m = Vec::with_capacity(if stm { n * 36 } else { 0 });
+    let mut ok = Vec::with_capacity(n);
+    let mut stats = Vec::with_capacity(n * 3);
+    let errors = pyo3::types::PyList::empty(py);
+    for (i, r) in results.iter().enumerate() {
+        match r {
+            Ok(f) => {
+                y.extend_from_slice(&f.state);
+                if let Some(p) = &f.stm {
+                    m.extend(p.iter().flatten());
+                }
+                ok.push(true);
+                stats.extend([f.stats.accepted as u64, f.stats.rejected as u64, f.stats.rhs_evals as u64]);
+            }
+            Err(e) => {
+                y.extend([f64::NAN; 6]);
+                if stm {
+                    m.extend([f64::NAN; 36]);
+                }
+                ok.push(false);
+                stats.extend([0u64; 3]);
+                errors.append((i, to_py(e.clone()).into_value(py)))?;
+            }
+        }
+    }
+    let out = PyDict::new(py);
+    out.set_item("y", y.into_pyarray(py).reshape([n, 6])?)?;
+    out.set_item("stm", if stm { Some(m.into_pyarray(py).reshape([n, 6, 6])?) } else { None })?;
+    out.set_item("ok", ok.into_pyarray(py))?;
+    out.set_item("errors", errors)?;
+    out.set_item("stats", stats.into_pyarray(py).reshape([n, 3])?)?;
+    Ok(out)
+}
+
+/// Jacobi constant of each row of an (n, 6) array.
+#[pyfunction]
+fn jacobi<'py>(py: Python<'py>, mu: f64, states: PyReadonlyArray2<'py, f64>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    cr3bp::check_mu(mu).map_err(to_py)?;
+    if states.shape()[1] != 6 {
+        return Err(PyValueError::new_err(format!("invalid argument `states`: must have shape (n, 6) or (6,), got {:?}", states.shape())));
+    }
+    let a = states.as_array();
+    let c: Vec<f64> = a.rows().into_iter().map(|r| cr3bp::jacobi(mu, &[r[0], r[1], r[2], r[3], r[4], r[5]])).collect();
+    Ok(c.into_pyarray(py))
+}
+
+/// L1..L5 as a (5, 3) array.
+#[pyfunction]
+fn lagrange_points<'py>(py: Python<'py>, mu: f64) -> PyResult<Bound<'py, PyAny>> {
+    let lp = cr3bp::lagrange_points(mu).map_err(to_py)?;
+    Ok(Array2::from_shape_fn((5, 3), |(i, j)| lp[i][j]).into_pyarray(py).into_any())
+}
+
+type SystemTuple = (String, f64, f64, f64, f64, f64);
+
+fn system_tuple(s: SystemConstants) -> SystemTuple {
+    (s.name, s.mu, s.lu_km, s.tu_s, s.r1_km, s.r2_km)
+}
+
+/// (name, mu, lu_km, tu_s, r1_km, r2_km) of a preset.
+#[pyfunction]
+fn system_preset(name: &str) -> PyResult<SystemTuple> {
+    SystemConstants::preset(name).map(system_tuple).map_err(to_py)
+}
+
+/// Validate user-defined system constants (raises ValueError naming the bad one).
+#[pyfunction]
+fn system_validate(name: String, mu: f64, lu_km: f64, tu_s: f64, r1_km: f64, r2_km: f64) -> PyResult<SystemTuple> {
+    SystemConstants::new(name, mu, lu_km, tu_s, r1_km, r2_km).map(system_tuple).map_err(to_py)
+}
+
+/// Names of the system presets.
+#[pyfunction]
+fn preset_names() -> Vec<&'static str> {
+    PRESETS.iter().map(|p| p.0).collect()
+}
+
+/// Half-period single shooting for a planar x-symmetric orbit: (state0, period, jacobi, iterations, residual).
+#[pyfunction]
+#[pyo3(signature = (mu, x0, ydot0, *, crossing_direction, tol, max_iter, rtol, atol))]
+#[allow(clippy::too_many_arguments)]
+fn correct_planar_symmetric<'py>(
+    py: Python<'py>,
+    mu: f64,
+    x0: f64,
+    ydot0: f64,
+    crossing_direction: i8,
+    tol: f64,
+    max_iter: usize,
+    rtol: f64,
+    atol: f64,
+) -> PyResult<(Bound<'py, PyArray1<f64>>, f64, f64, usize, f64)> {
+    let opts = Options::with_tolerances(rtol, atol);
+    let o = py
+        .detach(|| periodic::correct_planar_symmetric(mu, x0, ydot0, crossing_direction, tol, max_iter, &opts))
+        .map_err(to_py)?;
+    Ok((o.state0.to_vec().into_pyarray(py), o.period, o.jacobi, o.iterations, o.residual))
+}
+
+#[pymodule]
+fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    let py = m.py();
+    m.add("LibrateError", py.get_type::<LibrateError>())?;
+    m.add("IntegrationError", py.get_type::<IntegrationError>())?;
+    m.add("ConvergenceError", py.get_type::<ConvergenceError>())?;
+    m.add_function(wrap_pyfunction!(propagate, m)?)?;
+    m.add_function(wrap_pyfunction!(propagate_many, m)?)?;
+    m.add_function(wrap_pyfunction!(jacobi, m)?)?;
+    m.add_function(wrap_pyfunction!(lagrange_points, m)?)?;
+    m.add_function(wrap_pyfunction!(system_preset, m)?)?;
+    m.add_function(wrap_pyfunction!(system_validate, m)?)?;
+    m.add_function(wrap_pyfunction!(preset_names, m)?)?;
+    m.add_function(wrap_pyfunction!(correct_planar_symmetric, m)?)?;
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    Ok(())
+}

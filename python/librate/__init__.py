@@ -1,0 +1,29 @@
+"""librate: coupled orbit-attitude dynamics of large spacecraft in the Earth-Moon CR3BP.
+
+The numerics live in the Rust extension ``librate._core``; this package is the documented API.
+All quantities are nondimensional (CR3BP units) unless a name says otherwise
+(``period_days``, ``distance_km``).
+"""
+
+from ._core import __version__
+from ._errors import ConvergenceError, IntegrationError, LibrateError
+from .orbits import PeriodicOrbit, correct_dro
+from .propagation import BatchResult, Event, EventHit, Stats, Trajectory, propagate, propagate_many
+from .system import System
+
+__all__ = [
+    "__version__",
+    "LibrateError",
+    "IntegrationError",
+    "ConvergenceError",
+    "System",
+    "Event",
+    "EventHit",
+    "Stats",
+    "Trajectory",
+    "BatchResult",
+    "propagate",
+    "propagate_many",
+    "PeriodicOrbit",
+    "correct_dro",
+]

@@ -1,0 +1,45 @@
+"""Argument conversion with errors that name the parameter and what is allowed."""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+def as_state(value, name: str = "state") -> np.ndarray:
+    """A (6,) float array (x, y, z, xd, yd, zd); a planar (4,) (x, y, xd, yd) is not accepted."""
+    arr = np.ascontiguousarray(value, dtype=np.float64)
+    if arr.shape != (6,):
+        raise ValueError(f"invalid argument `{name}`: must have shape (6,) = (x, y, z, xd, yd, zd), got shape {arr.shape}")
+    if not np.all(np.isfinite(arr)):
+        raise ValueError(f"invalid argument `{name}`: must be finite, got {arr.tolist()}")
+    return arr
+
+
+def as_states(value, name: str = "states") -> np.ndarray:
+    """An (n, 6) float array; a single (6,) state becomes (1, 6)."""
+    arr = np.ascontiguousarray(value, dtype=np.float64)
+    if arr.ndim == 1 and arr.shape == (6,):
+        arr = arr.reshape(1, 6)
+    if arr.ndim != 2 or arr.shape[1] != 6:
+        raise ValueError(f"invalid argument `{name}`: must have shape (n, 6), got shape {arr.shape}")
+    return arr
+
+
+def as_time_span(t_span, name: str = "t_span") -> tuple[float, float]:
+    """(t0, tf) from a pair, or (0, tf) from a single number."""
+    if np.ndim(t_span) == 0:
+        t0, tf = 0.0, float(t_span)
+    else:
+        ts = np.asarray(t_span, dtype=np.float64).ravel()
+        if ts.shape != (2,):
+            raise ValueError(f"invalid argument `{name}`: must be tf or a pair (t0, tf), got {t_span!r}")
+        t0, tf = float(ts[0]), float(ts[1])
+    if not (np.isfinite(t0) and np.isfinite(tf)):
+        raise ValueError(f"invalid argument `{name}`: times must be finite, got ({t0}, {tf})")
+    return t0, tf
+
+
+def as_direction(direction, name: str = "direction") -> int:
+    if direction not in (-1, 0, 1):
+        raise ValueError(f"invalid argument `{name}`: must be -1 (decreasing), 0 (both) or +1 (increasing), got {direction!r}")
+    return int(direction)

@@ -1,0 +1,66 @@
+"""Type stubs of the private Rust extension. Use the `librate` package API instead."""
+
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+__version__: str
+
+class LibrateError(Exception): ...
+
+class IntegrationError(LibrateError):
+    t: float
+    steps: int
+    kind: str
+
+class ConvergenceError(LibrateError):
+    iterations: int
+    residual: float
+    tolerance: float
+
+_F64 = npt.NDArray[np.float64]
+
+def propagate(
+    mu: float,
+    state: _F64,
+    t0: float,
+    tf: float,
+    *,
+    rtol: float,
+    atol: float,
+    stm: bool,
+    h0: float | None,
+    h_min: float,
+    h_max: float,
+    max_steps: int,
+    safety: float,
+    fixed_step: float | None,
+    t_eval: _F64 | None,
+    events: list[tuple[str, list[float], int, bool]],
+) -> dict[str, Any]: ...
+def propagate_many(
+    mu: float,
+    states: _F64,
+    t0: float,
+    t_final: _F64,
+    *,
+    rtol: float,
+    atol: float,
+    stm: bool,
+    h0: float | None,
+    h_min: float,
+    h_max: float,
+    max_steps: int,
+    safety: float,
+    fixed_step: float | None,
+    threads: int | None,
+) -> dict[str, Any]: ...
+def jacobi(mu: float, states: _F64) -> _F64: ...
+def lagrange_points(mu: float) -> _F64: ...
+def system_preset(name: str) -> tuple[str, float, float, float, float, float]: ...
+def system_validate(name: str, mu: float, lu_km: float, tu_s: float, r1_km: float, r2_km: float) -> tuple[str, float, float, float, float, float]: ...
+def preset_names() -> list[str]: ...
+def correct_planar_symmetric(
+    mu: float, x0: float, ydot0: float, *, crossing_direction: int, tol: float, max_iter: int, rtol: float, atol: float
+) -> tuple[_F64, float, float, int, float]: ...

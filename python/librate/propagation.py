@@ -1,0 +1,256 @@
+"""CR3BP propagation: one state with STM, events and output; many states on all cores."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Literal, Sequence
+
+import numpy as np
+
+from . import _core
+from ._checks import as_direction, as_state, as_states, as_time_span
+from .system import System, resolve_system
+
+__all__ = ["Event", "EventHit", "Stats", "Trajectory", "BatchResult", "propagate", "propagate_many"]
+
+_COORDS = {"x": 0, "y": 1, "z": 2, "xd": 3, "yd": 4, "zd": 5, "vx": 3, "vy": 4, "vz": 5}
+_PRIMARIES = {"earth": 0, "moon": 1, "primary1": 0, "primary2": 1, 1: 0, 2: 1}
+
+
+@dataclass(frozen=True)
+class Event:
+    """An event located to about 1e-12 in time during :func:`propagate`.
+
+    Build one with :meth:`crossing`, :meth:`distance` or :meth:`surface`. ``direction`` is +1
+    (g increasing), -1 (decreasing) or 0 (both); a ``terminal`` event stops the integration at
+    its first occurrence. A start exactly on the surface (g = 0) is not an occurrence.
+    """
+
+    kind: Literal["crossing", "distance", "surface"]
+    params: tuple[float, ...]
+    direction: int = 0
+    terminal: bool = False
+
+    @classmethod
+    def crossing(cls, coordinate: str | int, value: float = 0.0, *, direction: int = 0, terminal: bool = False) -> Event:
+        """``state[coordinate] == value``; coordinate is one of x, y, z, xd, yd, zd or 0..5."""
+        index = _COORDS.get(coordinate, coordinate) if isinstance(coordinate, str) else coordinate
+        if not isinstance(index, (int, np.integer)) or not 0 <= int(index) < 6:
+            raise ValueError(f"invalid argument `coordinate`: must be one of x, y, z, xd, yd, zd or 0..5, got {coordinate!r}")
+        return cls("crossing", (float(index), float(value)), as_direction(direction), bool(terminal))
+
+    @classmethod
+    def distance(cls, center: Sequence[float], radius: float, *, direction: int = 0, terminal: bool = False) -> Event:
+        """``|r - center| == radius`` (nondimensional)."""
+        c = np.asarray(center, dtype=np.float64).ravel()
+        if c.shape != (3,) or not np.all(np.isfinite(c)):
+            raise ValueError(f"invalid argument `center`: must be 3 finite numbers, got {center!r}")
+        if not (math.isfinite(radius) and radius >= 0):
+            raise ValueError(f"invalid argument `radius`: must be finite and >= 0, got {radius!r}")
+        return cls("distance", (*map(float, c), float(radius)), as_direction(direction), bool(terminal))
+
+    @classmethod
+    def surface(cls, primary: str | int = "moon", *, terminal: bool = True) -> Event:
+        """Reaching the surface of a primary ("earth"/"moon", or 1/2), using the system's radius;
+        terminal by default (the CR3BP itself treats primaries as points)."""
+        if primary not in _PRIMARIES:
+            raise ValueError(f"invalid argument `primary`: must be 'earth', 'moon', 1 or 2, got {primary!r}")
+        return cls("surface", (float(_PRIMARIES[primary]),), -1, bool(terminal))
+
+    def _spec(self, system: System) -> tuple[str, list[float], int, bool]:
+        if self.kind != "surface":
+            return (self.kind, list(self.params), self.direction, self.terminal)
+        k = int(self.params[0])
+        radius_km = (system.r1_km, system.r2_km)[k]
+        if radius_km <= 0:
+            raise ValueError(f"invalid argument `events`: Event.surface needs the system's radius r{k + 1}_km > 0")
+        center = system.primary_positions()[k]
+        return ("distance", [*center, radius_km / system.lu_km], self.direction, self.terminal)
+
+
+@dataclass(frozen=True)
+class EventHit:
+    """One located event: its index in the ``events`` list, time, state and STM (when propagated)."""
+
+    index: int
+    t: float
+    y: np.ndarray
+    stm: np.ndarray | None = None
+
+
+@dataclass(frozen=True)
+class Stats:
+    """Integrator counters."""
+
+    accepted: int
+    rejected: int
+    rhs_evals: int
+
+
+@dataclass(frozen=True)
+class Trajectory:
+    """Result of :func:`propagate`.
+
+    ``t`` (n,) and ``y`` (n, 6) hold every accepted step (or the ``t_eval`` times); ``stm`` is
+    the 6x6 state transition matrix from t0 to ``t_final`` when asked for; ``status`` is
+    ``"completed"`` or ``"event"`` (a terminal event stopped it: ``event_index``).
+    """
+
+    system: System
+    t: np.ndarray
+    y: np.ndarray
+    t_final: float
+    y_final: np.ndarray
+    stm: np.ndarray | None
+    events: list[EventHit]
+    status: str
+    event_index: int | None
+    stats: Stats
+
+    def events_of(self, index: int) -> list[EventHit]:
+        """The hits of one event of the ``events`` list."""
+        return [e for e in self.events if e.index == index]
+
+    @property
+    def jacobi(self) -> np.ndarray:
+        """Jacobi constant at every output point."""
+        return self.system.jacobi(self.y) if len(self.y) else np.empty(0)
+
+
+@dataclass(frozen=True)
+class BatchResult:
+    """Result of :func:`propagate_many`: final states ``y`` (n, 6), ``stm`` (n, 6, 6) when asked,
+    ``ok`` (n,) and, for members that failed, ``errors`` {index: exception} (their rows are NaN,
+    flagged by ``ok``); ``stats`` (n, 3): accepted, rejected steps and RHS evaluations."""
+
+    y: np.ndarray
+    stm: np.ndarray | None
+    ok: np.ndarray
+    errors: dict[int, Exception] = field(default_factory=dict)
+    stats: np.ndarray | None = None
+
+
+def _options(rtol, atol, h0, h_min, h_max, max_steps, safety, fixed_step) -> dict:
+    if not isinstance(max_steps, (int, np.integer)) or max_steps < 1:
+        raise ValueError(f"invalid argument `max_steps`: must be an integer >= 1, got {max_steps!r}")
+    return dict(
+        rtol=float(rtol),
+        atol=float(atol),
+        h0=None if h0 is None else float(h0),
+        h_min=float(h_min),
+        h_max=float(h_max),
+        max_steps=int(max_steps),
+        safety=float(safety),
+        fixed_step=None if fixed_step is None else float(fixed_step),
+    )
+
+
+def propagate(
+    system: System | str,
+    state,
+    t_span,
+    *,
+    rtol: float = 1e-12,
+    atol: float = 1e-12,
+    stm: bool = False,
+    events: Sequence[Event] | None = None,
+    t_eval=None,
+    h0: float | None = None,
+    h_min: float = 0.0,
+    h_max: float = math.inf,
+    max_steps: int = 1_000_000,
+    safety: float = 0.8,
+    fixed_step: float | None = None,
+) -> Trajectory:
+    """Propagate a CR3BP state with the adaptive RKF7(8) integrator (8th-order solution
+    propagated), forward or backward in time.
+
+    Parameters
+    ----------
+    system: a :class:`System` or a preset name.
+    state: (6,) initial state (x, y, z, xd, yd, zd), nondimensional.
+    t_span: final time tf, or (t0, tf); tf < t0 integrates backward.
+    rtol, atol: error tolerances per step (> 0).
+    stm: also integrate the 6x6 state transition matrix (returned at the final time and at events).
+    events: :class:`Event` objects to locate.
+    t_eval: output times (monotonic, inside the span) instead of every accepted step.
+    h0, h_min, h_max, max_steps, safety: step control; ``fixed_step`` switches to fixed steps.
+
+    Raises ``ValueError`` for bad arguments and :class:`librate.IntegrationError` (with ``t``
+    and ``steps``) when the integration cannot reach tf.
+    """
+    sys_ = resolve_system(system)
+    s = as_state(state)
+    t0, tf = as_time_span(t_span)
+    evs = list(events or [])
+    for e in evs:
+        if not isinstance(e, Event):
+            raise ValueError(f"invalid argument `events`: must be librate.Event objects, got {e!r}")
+    te = None if t_eval is None else np.ascontiguousarray(t_eval, dtype=np.float64).ravel()
+    r = _core.propagate(
+        sys_.mu, s, t0, tf, stm=bool(stm), t_eval=te, events=[e._spec(sys_) for e in evs],
+        **_options(rtol, atol, h0, h_min, h_max, max_steps, safety, fixed_step),
+    )
+    return Trajectory(
+        system=sys_,
+        t=r["t"],
+        y=r["y"],
+        t_final=r["t_final"],
+        y_final=r["y_final"],
+        stm=r["stm"],
+        events=[EventHit(i, t, y, m) for (i, t, y, m) in r["events"]],
+        status=r["status"],
+        event_index=r["event_index"],
+        stats=Stats(*r["stats"]),
+    )
+
+
+def propagate_many(
+    system: System | str,
+    states,
+    t_final,
+    *,
+    t0: float = 0.0,
+    stm: bool = False,
+    rtol: float = 1e-12,
+    atol: float = 1e-12,
+    h0: float | None = None,
+    h_min: float = 0.0,
+    h_max: float = math.inf,
+    max_steps: int = 1_000_000,
+    safety: float = 0.8,
+    fixed_step: float | None = None,
+    threads: int | None = None,
+    on_error: Literal["raise", "mask"] = "raise",
+) -> BatchResult:
+    """Propagate (n, 6) states from ``t0`` to ``t_final`` (one time, or one per state) on all
+    cores, with the GIL released. Each member is integrated exactly as :func:`propagate` would,
+    so results are bit-identical to one-at-a-time calls whatever ``threads`` is.
+
+    ``on_error="raise"`` raises the first member's error (its ``batch_result`` attribute keeps
+    every finished member); ``"mask"`` returns NaN rows flagged by ``ok`` and listed in ``errors``.
+    """
+    sys_ = resolve_system(system)
+    arr = as_states(states)
+    if not np.all(np.isfinite(arr)) and on_error == "raise":
+        bad = int(np.argwhere(~np.isfinite(arr))[0][0])
+        raise ValueError(f"invalid argument `states`: row {bad} is not finite")
+    tf = np.ascontiguousarray(np.atleast_1d(np.asarray(t_final, dtype=np.float64)).ravel())
+    if tf.size not in (1, arr.shape[0]):
+        raise ValueError(f"invalid argument `t_final`: must be one time or one per state ({arr.shape[0]}), got {tf.size}")
+    if on_error not in ("raise", "mask"):
+        raise ValueError(f"invalid argument `on_error`: must be 'raise' or 'mask', got {on_error!r}")
+    if threads is not None and (not isinstance(threads, (int, np.integer)) or threads < 1):
+        raise ValueError(f"invalid argument `threads`: must be an integer >= 1 or None (all cores), got {threads!r}")
+    r = _core.propagate_many(
+        sys_.mu, arr, float(t0), tf, stm=bool(stm), threads=None if threads is None else int(threads),
+        **_options(rtol, atol, h0, h_min, h_max, max_steps, safety, fixed_step),
+    )
+    result = BatchResult(y=r["y"], stm=r["stm"], ok=r["ok"], errors=dict(r["errors"]), stats=r["stats"])
+    if result.errors and on_error == "raise":
+        index, err = next(iter(result.errors.items()))
+        err.add_note(f"in member {index} of propagate_many ({len(result.errors)} of {arr.shape[0]} members failed)") if hasattr(err, "add_note") else None
+        err.batch_result = result
+        raise err
+    return result

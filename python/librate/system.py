@@ -1,0 +1,119 @@
+"""CR3BP systems: mass parameter, units, Lagrange points, Jacobi constant, conversions."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from . import _core
+from ._checks import as_states
+
+__all__ = ["System"]
+
+
+@dataclass(frozen=True)
+class System:
+    """A circular restricted three-body system in nondimensional units.
+
+    Mass unit m1 + m2, length unit ``lu_km`` (the primaries' distance), time unit ``tu_s``
+    (1 / mean motion), so G = 1 and the synodic frame turns at rate 1. The larger primary sits at
+    (-mu, 0, 0), the smaller at (1 - mu, 0, 0).
+
+    >>> em = System.preset("earth-moon")
+    >>> round(em.period_days(2 * 3.141592653589793), 3)   # one synodic revolution
+    27.284
+    """
+
+    mu: float
+    lu_km: float
+    tu_s: float
+    r1_km: float = 0.0
+    r2_km: float = 0.0
+    name: str = "custom"
+
+    def __post_init__(self) -> None:
+        # Validated by the core; raises ValueError naming the offending constant.
+        name, mu, lu, tu, r1, r2 = _core.system_validate(
+            str(self.name), float(self.mu), float(self.lu_km), float(self.tu_s), float(self.r1_km), float(self.r2_km)
+        )
+        for field, value in (("mu", mu), ("lu_km", lu), ("tu_s", tu), ("r1_km", r1), ("r2_km", r2)):
+            object.__setattr__(self, field, value)
+
+    @classmethod
+    def preset(cls, name: str = "earth-moon") -> System:
+        """A named system: ``"earth-moon"`` (the thesis's, mu = 0.01215) or ``"earth-moon-jpl"``
+        (the JPL periodic-orbit catalog's constants)."""
+        n, mu, lu, tu, r1, r2 = _core.system_preset(name)
+        return cls(mu=mu, lu_km=lu, tu_s=tu, r1_km=r1, r2_km=r2, name=n)
+
+    @staticmethod
+    def presets() -> list[str]:
+        """Names accepted by :meth:`preset`."""
+        return list(_core.preset_names())
+
+    # --- geometry -------------------------------------------------------------------------
+    def primary_positions(self) -> np.ndarray:
+        """(2, 3): the larger primary at (-mu, 0, 0), the smaller at (1 - mu, 0, 0)."""
+        return np.array([[-self.mu, 0.0, 0.0], [1.0 - self.mu, 0.0, 0.0]])
+
+    def lagrange_points(self) -> np.ndarray:
+        """(5, 3) array of L1..L5 (L1 between the primaries, L2 beyond the smaller, L3 beyond the larger)."""
+        return _core.lagrange_points(self.mu)
+
+    def jacobi(self, states) -> np.ndarray | float:
+        """Jacobi constant C = 2U - |v|^2 of a (6,) state (a float) or of (n, 6) states."""
+        arr = np.asarray(states, dtype=np.float64)
+        c = _core.jacobi(self.mu, as_states(arr))
+        return float(c[0]) if arr.ndim == 1 else c
+
+    # --- units ----------------------------------------------------------------------------
+    @property
+    def vu_km_s(self) -> float:
+        """Velocity unit, km/s."""
+        return self.lu_km / self.tu_s
+
+    @property
+    def tu_days(self) -> float:
+        """Time unit, days."""
+        return self.tu_s / 86400.0
+
+    def distance_km(self, length):
+        """Nondimensional length(s) to km."""
+        return np.asarray(length) * self.lu_km if np.ndim(length) else float(length) * self.lu_km
+
+    def speed_km_s(self, speed):
+        """Nondimensional speed(s) to km/s."""
+        return np.asarray(speed) * self.vu_km_s if np.ndim(speed) else float(speed) * self.vu_km_s
+
+    def time_s(self, t):
+        """Nondimensional time(s) to seconds."""
+        return np.asarray(t) * self.tu_s if np.ndim(t) else float(t) * self.tu_s
+
+    def period_days(self, t):
+        """Nondimensional time(s) to days."""
+        return np.asarray(t) * self.tu_days if np.ndim(t) else float(t) * self.tu_days
+
+    def from_km(self, distance_km):
+        """km to nondimensional length."""
+        return np.asarray(distance_km) / self.lu_km if np.ndim(distance_km) else float(distance_km) / self.lu_km
+
+    def from_days(self, days):
+        """Days to nondimensional time."""
+        return np.asarray(days) / self.tu_days if np.ndim(days) else float(days) / self.tu_days
+
+    def to_dimensional(self, states) -> np.ndarray:
+        """(…, 6) states to km and km/s."""
+        s = np.array(states, dtype=np.float64)
+        s[..., :3] *= self.lu_km
+        s[..., 3:] *= self.vu_km_s
+        return s
+
+
+def resolve_system(system) -> System:
+    """A :class:`System` from a System or a preset name."""
+    if isinstance(system, System):
+        return system
+    if isinstance(system, str):
+        return System.preset(system)
+    raise ValueError(f"invalid argument `system`: must be a librate.System or a preset name ({', '.join(System.presets())}), got {system!r}")
