@@ -1,0 +1,14 @@
+import numpy as np
+import pytest
+
+import librate
+
+
+@pytest.fixture(scope="session")
+def em():
+    return librate.System.preset("earth-moon")
+
+
+@pytest.fixture(scope="session")
+def dro_085(em):
+    return librate.correct_dro(em, 0.85)
