@@ -7,7 +7,8 @@ All quantities are nondimensional (CR3BP units) unless a name says otherwise
 
 from ._core import __version__
 from ._errors import ConvergenceError, IntegrationError, LibrateError
-from .orbits import PeriodicOrbit, correct_dro
+from .families import OrbitFamily, dro, dro_family, halo, halo_family, lyapunov, lyapunov_family
+from .orbits import PeriodicOrbit, correct_dro, correct_symmetric
 from .propagation import BatchResult, Event, EventHit, Stats, Trajectory, propagate, propagate_many
 from .system import System
 
@@ -26,4 +27,12 @@ __all__ = [
     "propagate_many",
     "PeriodicOrbit",
     "correct_dro",
+    "correct_symmetric",
+    "OrbitFamily",
+    "dro",
+    "dro_family",
+    "lyapunov",
+    "lyapunov_family",
+    "halo",
+    "halo_family",
 ]

@@ -1,37 +1,154 @@
-"""Periodic orbits. For now: planar x-symmetric orbits (DROs) by half-period shooting."""
+"""Periodic orbits: corrected members of symmetric families and their stability."""
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from functools import cached_property
 
 import numpy as np
 
 from . import _core
 from .system import System, resolve_system
 
-__all__ = ["PeriodicOrbit", "correct_dro"]
+__all__ = ["PeriodicOrbit", "correct_dro", "correct_symmetric"]
+
+_VARS = {"x0": 0, "z0": 1, "vy0": 2}
+# Tolerances of the shooting propagations: the 8th-order solution at 1e-13 puts the
+# closure of a corrected member near 1e-12.
+SHOOT_RTOL = 1e-13
+SHOOT_ATOL = 1e-13
 
 
 @dataclass(frozen=True)
 class PeriodicOrbit:
-    """A corrected periodic orbit: initial state, period (TU), Jacobi constant, and how the
-    correction ended (Newton iterations, final residual |xdot| at the half-period crossing)."""
+    """A corrected periodic orbit.
+
+    ``state0`` (6,) starts on the x-z plane, perpendicular to it; ``period`` is in TU
+    (``period_days`` in days); ``jacobi`` the Jacobi constant. ``monodromy``,
+    ``eigenvalues`` and ``stability_indices`` are computed on first use (one propagation
+    over the period with the STM). Stability indices are nu = (lambda + 1/lambda)/2 of the
+    non-trivial pairs: [in-plane, out-of-plane] for planar orbits; stable when |nu| <= 1.
+    """
 
     system: System
     state0: np.ndarray
     period: float
     jacobi: float
-    iterations: int
-    residual: float
+    family: str = "symmetric"
+    iterations: int = 0
+    residual: float = 0.0
+    _evaluation: dict | None = field(default=None, repr=False, compare=False)
 
     @property
     def x0(self) -> float:
         return float(self.state0[0])
 
     @property
+    def z0(self) -> float:
+        return float(self.state0[2])
+
+    @property
+    def vy0(self) -> float:
+        return float(self.state0[4])
+
+    @property
+    def planar(self) -> bool:
+        return self.state0[2] == 0.0 and self.state0[5] == 0.0
+
+    @property
     def period_days(self) -> float:
         return self.system.period_days(self.period)
+
+    @cached_property
+    def monodromy(self) -> np.ndarray:
+        """Monodromy matrix Phi(T, 0) (6, 6)."""
+        from .propagation import propagate
+
+        return propagate(self.system, self.state0, self.period, stm=True, rtol=SHOOT_RTOL, atol=SHOOT_ATOL).stm
+
+    @cached_property
+    def _stability(self):
+        return _core.stability(np.ascontiguousarray(self.monodromy), self.planar)
+
+    @property
+    def eigenvalues(self) -> np.ndarray:
+        """Eigenvalues (6,) of the monodromy matrix (complex)."""
+        return self._stability[0]
+
+    @property
+    def stability_indices(self) -> np.ndarray:
+        """The two non-trivial stability indices (complex; real for a stable orbit)."""
+        return self._stability[1]
+
+    @property
+    def is_stable(self) -> bool:
+        nu = self.stability_indices
+        return bool(np.all(np.abs(nu.imag) < 1e-9) and np.all(np.abs(nu.real) <= 1 + 1e-9))
+
+    def propagate(self, n_periods: float = 1.0, **kwargs):
+        """Propagate the orbit over ``n_periods`` periods (keyword arguments go to
+        :func:`librate.propagate`; default tolerances 1e-13)."""
+        from .propagation import propagate
+
+        kwargs.setdefault("rtol", SHOOT_RTOL)
+        kwargs.setdefault("atol", SHOOT_ATOL)
+        return propagate(self.system, self.state0, n_periods * self.period, **kwargs)
+
+
+def correct_symmetric(
+    system: System | str,
+    guess,
+    *,
+    spatial: bool = False,
+    fix: str | None = "x0",
+    period: float | None = None,
+    jacobi: float | None = None,
+    family: str = "symmetric",
+    tol: float = 1e-11,
+    max_iter: int = 40,
+    t_max: float = 50.0,
+    rtol: float = SHOOT_RTOL,
+    atol: float = SHOOT_ATOL,
+) -> PeriodicOrbit:
+    """Correct an orbit symmetric about the x-z plane by half-period single shooting.
+
+    ``guess`` is (x0, z0, vy0) (or a full (6,) state on the plane). The unknowns are (x0, vy0)
+    for planar orbits and (x0, z0, vy0) in 3-D; one extra condition closes the Newton system:
+    ``fix`` one unknown ("x0", "z0" or "vy0") at its guessed value, or a target ``period`` (TU),
+    or a target ``jacobi`` constant. Raises :class:`librate.ConvergenceError` on failure.
+    """
+    sys_ = resolve_system(system)
+    g = np.asarray(guess, dtype=np.float64).ravel()
+    if g.shape == (6,):
+        g = g[[0, 2, 4]]
+    if g.shape != (3,) or not np.all(np.isfinite(g)):
+        raise ValueError(f"invalid argument `guess`: must be finite (x0, z0, vy0) or a (6,) state, got {guess!r}")
+    given = [c for c in (("fix", fix), ("period", period), ("jacobi", jacobi)) if c[1] is not None]
+    if period is not None or jacobi is not None:
+        given = [c for c in given if c[0] != "fix"]
+    if len(given) != 1:
+        raise ValueError("invalid argument: give exactly one of `fix`, `period` or `jacobi`")
+    kind, value = given[0]
+    if kind == "fix":
+        if value not in _VARS:
+            raise ValueError(f"invalid argument `fix`: must be one of x0, z0, vy0, got {value!r}")
+        if value == "z0" and not spatial:
+            raise ValueError("invalid argument `fix`: z0 is zero for planar orbits; fix x0 or vy0")
+        values = [float(_VARS[value]), float(g[_VARS[value]])]
+    else:
+        if not (math.isfinite(value) and (kind == "jacobi" or value > 0)):
+            raise ValueError(f"invalid argument `{kind}`: must be finite{' and > 0' if kind == 'period' else ''}, got {value!r}")
+        values = [float(value)]
+    r = _core.symmetric_correct(
+        sys_.mu, [float(v) for v in g], spatial=bool(spatial), constraint=kind, values=values,
+        tol=float(tol), max_iter=int(max_iter), t_max=float(t_max), rtol=float(rtol), atol=float(atol),
+    )
+    return _orbit_from(sys_, r, family)
+
+
+def _orbit_from(system: System, r: dict, family: str) -> PeriodicOrbit:
+    return PeriodicOrbit(system, r["state0"], r["period"], r["jacobi"], family, r["iterations"], r["residual"], r["evaluation"])
 
 
 def correct_dro(
@@ -41,19 +158,17 @@ def correct_dro(
     *,
     tol: float = 1e-12,
     max_iter: int = 30,
-    rtol: float = 1e-13,
-    atol: float = 1e-13,
+    rtol: float = SHOOT_RTOL,
+    atol: float = SHOOT_ATOL,
 ) -> PeriodicOrbit:
     """Correct the distant retrograde orbit through (x0, 0, 0) with ydot0 > 0 (PHYSICS.md sec. 3).
 
     Single shooting on the half period (thesis eq. 19): integrate with the STM to the next
-    y = 0 crossing, located in time, and drive xdot there to zero by correcting ydot0.
-    ``x0`` must lie between the primaries (-mu < x0 < 1 - mu). Without ``ydot0`` the guess is
-    a retrograde circle about the Moon seen in the rotating frame, sqrt(mu/d) + d with
-    d = 1 - mu - x0: good near the Moon (d below about 0.2); farther out, pass a guess (for
-    instance from a neighbouring member).
-
-    Raises :class:`librate.ConvergenceError` if the correction does not converge.
+    y = 0 crossing, located in time, and drive xdot there to zero by correcting ydot0 with x0
+    fixed. ``x0`` must lie between the primaries (-mu < x0 < 1 - mu). Without ``ydot0`` the
+    guess is a retrograde circle about the Moon seen in the rotating frame, sqrt(mu/d) + d with
+    d = 1 - mu - x0: good near the Moon (d below about 0.2); farther out use :func:`librate.dro`,
+    which continues the family.
     """
     sys_ = resolve_system(system)
     mu = sys_.mu
@@ -66,7 +181,11 @@ def correct_dro(
         raise ValueError(f"invalid argument `ydot0`: must be finite and > 0 (retrograde about the Moon), got {ydot0!r}")
     if not isinstance(max_iter, int) or max_iter < 1:
         raise ValueError(f"invalid argument `max_iter`: must be an integer >= 1, got {max_iter!r}")
-    state0, period, jc, iterations, residual = _core.correct_planar_symmetric(
-        mu, float(x0), float(ydot0), crossing_direction=-1, tol=float(tol), max_iter=max_iter, rtol=float(rtol), atol=float(atol)
-    )
-    return PeriodicOrbit(sys_, state0, period, jc, iterations, residual)
+    if not (math.isfinite(tol) and tol > 0):
+        raise ValueError(f"invalid argument `tol`: must be a finite number > 0, got {tol!r}")
+    orbit = correct_symmetric(sys_, (x0, 0.0, ydot0), fix="x0", family="dro", tol=tol, max_iter=max_iter, rtol=rtol, atol=atol)
+    if orbit.vy0 <= 0:
+        from ._errors import ConvergenceError
+
+        raise ConvergenceError(f"DRO correction at x0 = {x0} converged to a prograde orbit (ydot0 = {orbit.vy0:.6g}); give a better ydot0 guess")
+    return orbit

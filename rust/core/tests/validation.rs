@@ -181,7 +181,7 @@ fn val_integration_errors_carry_context() {
 fn dro(x0: f64) -> SymmetricOrbit {
     let d = 1.0 - MU - x0;
     let guess = (MU / d).sqrt() + d;
-    correct_planar_symmetric(MU, x0, guess, -1, 1e-12, 30, &Options::with_tolerances(1e-13, 1e-13)).unwrap()
+    correct_planar_symmetric(MU, x0, guess, 1e-12, 30, &Options::with_tolerances(1e-13, 1e-13)).unwrap()
 }
 
 /// Jacobi constant conserved along ten periods of a Moon-bound DRO (x0 = 0.9) at

@@ -5,7 +5,8 @@
 use librate_core::cr3bp::{self, SystemConstants, PRESETS};
 use librate_core::error::Error;
 use librate_core::integrate::{Options, Output, Status};
-use librate_core::periodic;
+use librate_core::periodic::{Constraint, Evaluation, Stability, SymmetricShooting, Var};
+use numpy::Complex64;
 use librate_core::propagation::{self, EventKind, EventSpec};
 use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray1, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
@@ -249,26 +250,97 @@ fn preset_names() -> Vec<&'static str> {
     PRESETS.iter().map(|p| p.0).collect()
 }
 
-/// Half-period single shooting for a planar x-symmetric orbit: (state0, period, jacobi, iterations, residual).
+fn constraint(kind: &str, v: &[f64]) -> PyResult<Constraint> {
+    Ok(match (kind, v) {
+        ("fix", &[var, value]) => {
+            let var = match var as i64 {
+                0 => Var::X0,
+                1 => Var::Z0,
+                2 => Var::Vy0,
+                _ => return Err(PyValueError::new_err("invalid argument `constraint`: fixed unknown must be 0 (x0), 1 (z0) or 2 (vy0)")),
+            };
+            Constraint::Fix(var, value)
+        }
+        ("period", &[t]) => Constraint::Period(t),
+        ("jacobi", &[c]) => Constraint::Jacobi(c),
+        ("arclength", &[p0, p1, p2, t0, t1, t2, ds]) => Constraint::Arclength { prev: [p0, p1, p2], tangent: [t0, t1, t2], ds },
+        _ => return Err(PyValueError::new_err(format!("invalid argument `constraint`: unknown kind {kind:?} with values {v:?}"))),
+    })
+}
+
+fn evaluation_dict<'py>(py: Python<'py>, e: &Evaluation) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    d.set_item("p", e.p.to_vec())?;
+    d.set_item("cond", e.cond.to_vec())?;
+    d.set_item("dcond", e.dcond.iter().map(|r| r.to_vec()).collect::<Vec<_>>())?;
+    d.set_item("half_period", e.half_period)?;
+    d.set_item("dhalf", e.dhalf.to_vec())?;
+    d.set_item("jacobi", e.jacobi)?;
+    d.set_item("djacobi", e.djacobi.to_vec())?;
+    d.set_item("crossing", e.crossing.to_vec())?;
+    Ok(d)
+}
+
+fn shooting(mu: f64, spatial: bool, tol: f64, max_iter: usize, t_max: f64, rtol: f64, atol: f64) -> SymmetricShooting {
+    let mut sh = SymmetricShooting::new(mu, spatial, Options::with_tolerances(rtol, atol));
+    sh.tol = tol;
+    sh.max_iter = max_iter;
+    sh.t_max = t_max;
+    sh
+}
+
+/// Newton correction of an x-z-symmetric orbit from p = (x0, z0, vy0) under one extra constraint.
 #[pyfunction]
-#[pyo3(signature = (mu, x0, ydot0, *, crossing_direction, tol, max_iter, rtol, atol))]
+#[pyo3(signature = (mu, p, *, spatial, constraint, values, tol, max_iter, t_max, rtol, atol))]
 #[allow(clippy::too_many_arguments)]
-fn correct_planar_symmetric<'py>(
+fn symmetric_correct<'py>(
     py: Python<'py>,
     mu: f64,
-    x0: f64,
-    ydot0: f64,
-    crossing_direction: i8,
+    p: [f64; 3],
+    spatial: bool,
+    constraint: &str,
+    values: Vec<f64>,
     tol: f64,
     max_iter: usize,
+    t_max: f64,
     rtol: f64,
     atol: f64,
-) -> PyResult<(Bound<'py, PyArray1<f64>>, f64, f64, usize, f64)> {
-    let opts = Options::with_tolerances(rtol, atol);
-    let o = py
-        .detach(|| periodic::correct_planar_symmetric(mu, x0, ydot0, crossing_direction, tol, max_iter, &opts))
-        .map_err(to_py)?;
-    Ok((o.state0.to_vec().into_pyarray(py), o.period, o.jacobi, o.iterations, o.residual))
+) -> PyResult<Bound<'py, PyDict>> {
+    let c = self::constraint(constraint, &values)?;
+    let sh = shooting(mu, spatial, tol, max_iter, t_max, rtol, atol);
+    let o = py.detach(|| sh.correct(p, c)).map_err(to_py)?;
+    let d = PyDict::new(py);
+    d.set_item("state0", o.state0.to_vec().into_pyarray(py))?;
+    d.set_item("period", o.period)?;
+    d.set_item("jacobi", o.jacobi)?;
+    d.set_item("iterations", o.iterations)?;
+    d.set_item("residual", o.residual)?;
+    d.set_item("evaluation", evaluation_dict(py, &o.evaluation)?)?;
+    Ok(d)
+}
+
+/// Residuals and sensitivities of the symmetric conditions at p = (x0, z0, vy0).
+#[pyfunction]
+#[pyo3(signature = (mu, p, *, spatial, t_max, rtol, atol))]
+fn symmetric_evaluate<'py>(py: Python<'py>, mu: f64, p: [f64; 3], spatial: bool, t_max: f64, rtol: f64, atol: f64) -> PyResult<Bound<'py, PyDict>> {
+    let sh = shooting(mu, spatial, 1e-12, 1, t_max, rtol, atol);
+    let e = py.detach(|| sh.evaluate(p)).map_err(to_py)?;
+    evaluation_dict(py, &e)
+}
+
+/// Eigenvalues (6,) and the two stability indices (2,) of a monodromy matrix, both complex.
+#[pyfunction]
+fn stability<'py>(py: Python<'py>, m: PyReadonlyArray2<'py, f64>, planar: bool) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
+    if m.shape() != [6, 6] {
+        return Err(PyValueError::new_err(format!("invalid argument `monodromy`: must have shape (6, 6), got {:?}", m.shape())));
+    }
+    let a = m.as_array();
+    librate_core::error::check_finite("monodromy", a.as_slice().unwrap_or(&a.iter().copied().collect::<Vec<_>>())).map_err(to_py)?;
+    let mat = nalgebra::Matrix6::from_fn(|i, j| a[(i, j)]);
+    let st = Stability::new(&mat, planar);
+    let ev: Vec<Complex64> = st.eigenvalues.iter().map(|z| Complex64::new(z.re, z.im)).collect();
+    let nu: Vec<Complex64> = st.indices.iter().map(|z| Complex64::new(z.re, z.im)).collect();
+    Ok((ev.into_pyarray(py).into_any(), nu.into_pyarray(py).into_any()))
 }
 
 #[pymodule]
@@ -284,7 +356,9 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(system_preset, m)?)?;
     m.add_function(wrap_pyfunction!(system_validate, m)?)?;
     m.add_function(wrap_pyfunction!(preset_names, m)?)?;
-    m.add_function(wrap_pyfunction!(correct_planar_symmetric, m)?)?;
+    m.add_function(wrap_pyfunction!(symmetric_correct, m)?)?;
+    m.add_function(wrap_pyfunction!(symmetric_evaluate, m)?)?;
+    m.add_function(wrap_pyfunction!(stability, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

@@ -1,0 +1,435 @@
+"""Families of symmetric periodic orbits: DROs, planar Lyapunov orbits, halos and NRHOs.
+
+A family is computed by continuation (``librate.continuation``), every member's stability from
+its monodromy matrix (batch-propagated on all cores), and bifurcations located where a
+stability index crosses +1 or -1. :class:`OrbitFamily` holds the members, finds members by x0,
+z0, period or Jacobi constant by root finding on the family (returning a corrected orbit),
+and saves to / loads from a self-describing netCDF or Zarr file (xarray Dataset).
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from . import _core
+from ._errors import LibrateError
+from .constants import SUN_SYNODIC_PERIOD
+from .continuation import continue_arclength, continue_natural
+from .orbits import SHOOT_ATOL, SHOOT_RTOL, PeriodicOrbit, correct_dro, correct_symmetric
+from .propagation import propagate_many
+from .system import System, resolve_system
+
+__all__ = ["OrbitFamily", "dro", "dro_family", "lyapunov", "lyapunov_family", "halo", "halo_family"]
+
+
+@dataclass
+class OrbitFamily:
+    """Members of one family of x-z-symmetric periodic orbits.
+
+    Arrays over members: ``state0`` (n, 6) initial states on the x-z plane, ``state_half`` (n, 6)
+    the states at the half-period crossing (the other symmetric point of the same orbit),
+    ``period`` (TU), ``jacobi``, ``eigenvalues`` (n, 6) complex, ``stability_indices`` (n, 2)
+    complex ([in-plane, out-of-plane] for planar families). ``end_reason`` says why the
+    continuation stopped; ``bifurcations`` lists the members where an index crosses +1 or -1.
+    """
+
+    system: System
+    kind: str
+    spatial: bool
+    state0: np.ndarray
+    state_half: np.ndarray
+    period: np.ndarray
+    jacobi: np.ndarray
+    eigenvalues: np.ndarray
+    stability_indices: np.ndarray
+    end_reason: str = ""
+    bifurcations: list[dict] = field(default_factory=list)
+    parameters: dict = field(default_factory=dict)
+
+    # --- construction ----------------------------------------------------------------------
+    @classmethod
+    def from_members(cls, system: System, kind: str, spatial: bool, members: list[PeriodicOrbit], end_reason: str, parameters=None) -> OrbitFamily:
+        if not members:
+            raise LibrateError(f"the {kind} family has no member ({end_reason})")
+        state0 = np.array([m.state0 for m in members])
+        half = np.array([m._evaluation["crossing"] for m in members])
+        period = np.array([m.period for m in members])
+        batch = propagate_many(system, state0, period, stm=True, rtol=SHOOT_RTOL, atol=SHOOT_ATOL, on_error="mask")
+        eig = np.full((len(members), 6), np.nan + 0j)
+        nu = np.full((len(members), 2), np.nan + 0j)
+        for i in range(len(members)):
+            if batch.ok[i]:
+                eig[i], nu[i] = _core.stability(np.ascontiguousarray(batch.stm[i]), not spatial)
+        fam = cls(system, kind, spatial, state0, half, period, np.array([m.jacobi for m in members]), eig, nu, end_reason, [], dict(parameters or {}))
+        fam.bifurcations = fam._find_bifurcations()
+        return fam
+
+    def _find_bifurcations(self) -> list[dict]:
+        names = ("in-plane", "out-of-plane") if not self.spatial else ("index 1", "index 2")
+        out = []
+        for j in range(2):
+            nu = self.stability_indices[:, j]
+            for i in range(len(nu) - 1):
+                a, b = nu[i], nu[i + 1]
+                if abs(a.imag) > 1e-6 or abs(b.imag) > 1e-6 or not (np.isfinite(a) and np.isfinite(b)):
+                    continue
+                for level, kind in ((1.0, "tangent (+1): a new family branches off, or a fold"), (-1.0, "period-doubling (-1)")):
+                    if (a.real - level) * (b.real - level) < 0:
+                        w = (level - a.real) / (b.real - a.real)
+                        out.append(
+                            {"member": i, "index": names[j], "type": kind, "level": level,
+                             "x0": float(self.state0[i, 0] + w * (self.state0[i + 1, 0] - self.state0[i, 0]))}
+                        )
+        return out
+
+    # --- access ----------------------------------------------------------------------------
+    def __len__(self) -> int:
+        return len(self.period)
+
+    def __getitem__(self, i: int) -> PeriodicOrbit:
+        i = range(len(self))[i]
+        return PeriodicOrbit(self.system, self.state0[i].copy(), float(self.period[i]), float(self.jacobi[i]), self.kind)
+
+    def __iter__(self):
+        return (self[i] for i in range(len(self)))
+
+    @property
+    def x0(self) -> np.ndarray:
+        return self.state0[:, 0]
+
+    @property
+    def z0(self) -> np.ndarray:
+        return self.state0[:, 2]
+
+    @property
+    def period_days(self) -> np.ndarray:
+        return self.system.period_days(self.period)
+
+    @property
+    def stable(self) -> np.ndarray:
+        """Linearly stable members (both indices real with |nu| <= 1)."""
+        nu = self.stability_indices
+        return np.all((np.abs(nu.imag) < 1e-9) & (np.abs(nu.real) <= 1 + 1e-9), axis=1)
+
+    # --- lookup ----------------------------------------------------------------------------
+    def member(self, *, x0: float | None = None, z0: float | None = None, period: float | None = None,
+               period_days: float | None = None, jacobi: float | None = None, which: int = 0) -> PeriodicOrbit:
+        """The corrected member with the given x0, z0, period (TU or days) or Jacobi constant.
+
+        Root finding on the family: the target is bracketed between two members (for halos,
+        also among the half-period crossing states), the guess interpolated linearly, and the
+        orbit corrected with that quantity imposed. ``which`` picks among several brackets.
+        Raises ``ValueError`` when the value is outside the family's range.
+        """
+        given = {k: v for k, v in dict(x0=x0, z0=z0, period=period, period_days=period_days, jacobi=jacobi).items() if v is not None}
+        if len(given) != 1:
+            raise ValueError("invalid argument: give exactly one of x0, z0, period, period_days, jacobi")
+        (name, value), = given.items()
+        if not math.isfinite(value):
+            raise ValueError(f"invalid argument `{name}`: must be finite, got {value!r}")
+        if name == "period_days":
+            name, value = "period", self.system.from_days(value)
+        if name == "z0" and not self.spatial:
+            raise ValueError("invalid argument `z0`: this family is planar (z0 = 0)")
+        sets = [self.state0] + ([self.state_half] if self.spatial else [])
+        brackets = []
+        for states in sets:
+            q = {"x0": states[:, 0], "z0": states[:, 2], "period": self.period, "jacobi": self.jacobi}[name]
+            d = q - value
+            for i in range(len(d) - 1):
+                if d[i] == 0 or d[i] * d[i + 1] < 0:
+                    w = 0.0 if d[i] == 0 else d[i] / (d[i] - d[i + 1])
+                    brackets.append((states[i] + w * (states[i + 1] - states[i]), i))
+            if d[-1] == 0:
+                brackets.append((states[-1], len(d) - 1))
+        if not brackets:
+            q = {"x0": self.state0[:, 0], "z0": self.state0[:, 2], "period": self.period, "jacobi": self.jacobi}[name]
+            raise ValueError(
+                f"invalid argument `{name}`: {value!r} is outside the {self.kind} family's range "
+                f"[{np.min(q):.10g}, {np.max(q):.10g}] (family end: {self.end_reason})"
+            )
+        if not 0 <= which < len(brackets):
+            raise ValueError(f"invalid argument `which`: the value is bracketed {len(brackets)} time(s); which must be in 0..{len(brackets) - 1}")
+        guess, _ = brackets[which]
+        kw = {"x0": dict(fix="x0"), "z0": dict(fix="z0"), "period": dict(period=value), "jacobi": dict(jacobi=value)}[name]
+        g = guess.copy()
+        if name == "x0":
+            g[0] = value
+        elif name == "z0":
+            g[2] = value
+        return correct_symmetric(self.system, g, spatial=self.spatial, family=self.kind, **kw)
+
+    def resonant(self, k: int, kind: str = "synodic") -> PeriodicOrbit:
+        """The 1:k resonant member: synodic T = 2 pi / k, or Sun-resonant T = Ts / k
+        (Ts = 2 pi / (1 - n_sun), the apparent solar period in the synodic frame)."""
+        if not isinstance(k, (int, np.integer)) or k < 1:
+            raise ValueError(f"invalid argument `k`: must be an integer >= 1, got {k!r}")
+        if kind not in ("synodic", "sun"):
+            raise ValueError(f"invalid argument `kind`: must be 'synodic' or 'sun', got {kind!r}")
+        base = 2 * math.pi if kind == "synodic" else SUN_SYNODIC_PERIOD
+        return self.member(period=base / k)
+
+    # --- I/O -------------------------------------------------------------------------------
+    def to_dataset(self):
+        """The family as an xarray Dataset with units and the system's constants as attributes."""
+        import xarray as xr
+
+        from . import __version__
+
+        comp = ["x", "y", "z", "xd", "yd", "zd"]
+        ds = xr.Dataset(
+            {
+                "state0": (("member", "component"), self.state0, {"units": "LU, LU/TU", "long_name": "initial state on the x-z plane"}),
+                "state_half": (("member", "component"), self.state_half, {"units": "LU, LU/TU", "long_name": "state at the half-period crossing"}),
+                "period": ("member", self.period, {"units": "TU"}),
+                "period_days": ("member", self.period_days, {"units": "d"}),
+                "jacobi": ("member", self.jacobi, {"units": "LU^2/TU^2", "long_name": "Jacobi constant"}),
+                "eigenvalues_real": (("member", "eig"), self.eigenvalues.real),
+                "eigenvalues_imag": (("member", "eig"), self.eigenvalues.imag),
+                "stability_real": (("member", "pair"), self.stability_indices.real, {"long_name": "stability index (lambda + 1/lambda)/2, real part"}),
+                "stability_imag": (("member", "pair"), self.stability_indices.imag),
+            },
+            coords={"member": np.arange(len(self)), "component": comp, "pair": [0, 1], "eig": np.arange(6)},
+            attrs={
+                "title": f"librate {self.kind} family",
+                "kind": self.kind,
+                "spatial": int(self.spatial),
+                "end_reason": self.end_reason,
+                "system_name": self.system.name,
+                "mu": self.system.mu,
+                "lu_km": self.system.lu_km,
+                "tu_s": self.system.tu_s,
+                "r1_km": self.system.r1_km,
+                "r2_km": self.system.r2_km,
+                "librate_version": __version__,
+                "bifurcations": repr(self.bifurcations),
+                "parameters": repr(self.parameters),
+                "conventions": "CR3BP synodic frame, nondimensional; Earth at (-mu,0,0), Moon at (1-mu,0,0)",
+            },
+        )
+        return ds
+
+    def save(self, path) -> None:
+        """Write to netCDF (``.nc``) or Zarr (``.zarr``)."""
+        path = str(path)
+        ds = self.to_dataset()
+        if path.endswith(".zarr"):
+            ds.to_zarr(path, mode="w")
+        elif path.endswith(".nc"):
+            ds.to_netcdf(path, engine="scipy")
+        else:
+            raise ValueError(f"invalid argument `path`: must end in .nc (netCDF) or .zarr (Zarr), got {path!r}")
+
+    @classmethod
+    def load(cls, path) -> OrbitFamily:
+        """Read a family written by :meth:`save`; the numbers are identical."""
+        import ast
+
+        import xarray as xr
+
+        path = str(path)
+        ds = xr.open_zarr(path) if path.endswith(".zarr") else xr.open_dataset(path, engine="scipy")
+        with ds:
+            a = ds.attrs
+            system = System(mu=float(a["mu"]), lu_km=float(a["lu_km"]), tu_s=float(a["tu_s"]), r1_km=float(a["r1_km"]), r2_km=float(a["r2_km"]), name=str(a["system_name"]))
+            return cls(
+                system, str(a["kind"]), bool(int(a["spatial"])),
+                ds["state0"].values.copy(), ds["state_half"].values.copy(), ds["period"].values.copy(), ds["jacobi"].values.copy(),
+                ds["eigenvalues_real"].values + 1j * ds["eigenvalues_imag"].values,
+                ds["stability_real"].values + 1j * ds["stability_imag"].values,
+                str(a["end_reason"]), ast.literal_eval(str(a["bifurcations"])), ast.literal_eval(str(a["parameters"])),
+            )
+
+
+# --- DROs ------------------------------------------------------------------------------------
+def _collision_stop(system: System, radii_km: tuple[float, float]):
+    """Stop reason when the orbit passes within a primary's radius (point-mass model: only
+    radii > 0 count, and only if the first member was outside)."""
+    radii = [r / system.lu_km for r in radii_km]
+    state = {"inside": None}
+
+    def stop(orbit, g):
+        if g is None:
+            return None
+        inside = [r > 0 and d < r for d, r in zip(g.min_distance, radii)]
+        if state["inside"] is None:
+            state["inside"] = inside
+            return None
+        for k, name in ((0, "larger primary (Earth)"), (1, "smaller primary (Moon)")):
+            if inside[k] and not state["inside"][k]:
+                return f"collision: the orbit passes within the {name}'s radius ({radii_km[k]} km)"
+        return None
+
+    return stop
+
+
+def dro_family(system: System | str = "earth-moon", x0=None, *, check_geometry: bool = True) -> OrbitFamily:
+    """The planar DRO family by natural-parameter continuation in x0 (thesis eq. 20-22).
+
+    ``x0``: the members wanted (any order along the family; default the whole family from
+    0.985 near the Moon to 0.005 near the Earth, every 0.005). Each step is guarded against
+    silent jumps (Jacobi constant and period continuity, winding numbers about both primaries)
+    and halved when needed; the run ends cleanly, with ``end_reason``, at a collision with the
+    Earth's surface or a step floor, keeping every member found.
+    """
+    sys_ = resolve_system(system)
+    mu = sys_.mu
+    xs = np.round(np.arange(0.985, 0.0049, -0.005), 10) if x0 is None else np.atleast_1d(np.asarray(x0, dtype=float))
+    if xs.size == 0 or not np.all(np.isfinite(xs)) or np.any(xs <= -mu) or np.any(xs >= 1 - mu):
+        raise ValueError(f"invalid argument `x0`: DROs start between the primaries, -mu < x0 < 1 - mu = ({-mu}, {1 - mu}); got {x0!r}")
+    start = 0.95 if xs[0] < 0.9 else float(xs[0])
+    first = correct_dro(sys_, start)
+    stop = _collision_stop(sys_, (sys_.r1_km, 0.0))
+    if start != xs[0]:
+        lead = continue_natural(sys_, first, "x0", np.linspace(start, xs[0], 9)[1:], family="dro", check_geometry=False)
+        if len(lead.members) < 8:
+            raise LibrateError(f"could not reach the first requested DRO at x0 = {xs[0]}: {lead.end_reason}")
+        first = lead.members[-1]
+    res = continue_natural(sys_, first, "x0", xs, family="dro", check_geometry=check_geometry, stop=stop)
+    return OrbitFamily.from_members(sys_, "dro", False, res.members, res.end_reason, {"rejected_jumps": res.rejected_jumps})
+
+
+@functools.lru_cache(maxsize=8)
+def _default_dro_family(system: System) -> OrbitFamily:
+    return dro_family(system)
+
+
+def _one_target(kw: dict) -> tuple[str, float]:
+    given = {k: v for k, v in kw.items() if v is not None}
+    if len(given) != 1:
+        raise ValueError(f"invalid argument: give exactly one of {', '.join(kw)}")
+    return next(iter(given.items()))
+
+
+def dro(system: System | str = "earth-moon", *, x0: float | None = None, period: float | None = None,
+        period_days: float | None = None, jacobi: float | None = None) -> PeriodicOrbit:
+    """One corrected DRO, chosen by x0, period (TU or days) or Jacobi constant.
+
+    Near the Moon (x0 >= 0.8) x0 is corrected directly; otherwise the member is found on the
+    whole family (computed once per system and cached)."""
+    sys_ = resolve_system(system)
+    name, value = _one_target(dict(x0=x0, period=period, period_days=period_days, jacobi=jacobi))
+    if name == "x0":
+        if not (math.isfinite(value) and -sys_.mu < value < 1 - sys_.mu):
+            raise ValueError(f"invalid argument `x0`: DROs start between the primaries, -mu < x0 < 1 - mu; got {value!r}")
+        if value >= 0.8:
+            return correct_dro(sys_, value)
+    return _default_dro_family(sys_).member(**{name: value})
+
+
+# --- Lyapunov and halo orbits -----------------------------------------------------------------
+def _check_point(point) -> int:
+    if point not in (1, 2):
+        raise ValueError(f"invalid argument `point`: must be 1 (L1) or 2 (L2), got {point!r}")
+    return int(point)
+
+
+def _lyapunov_start(sys_: System, point: int, amplitude: float) -> PeriodicOrbit:
+    """Small planar Lyapunov orbit from the linearisation at L1/L2: x = L - A cos(w t),
+    ydot0 = (w^2 + Uxx) A / 2, with w the in-plane centre frequency."""
+    mu = sys_.mu
+    xl = float(sys_.lagrange_points()[point - 1, 0])
+    c2 = (1 - mu) / abs(xl + mu) ** 3 + mu / abs(xl - 1 + mu) ** 3
+    uxx, uyy = 1 + 2 * c2, 1 - c2
+    b = 4 - uxx - uyy
+    w2 = 0.5 * (b + math.sqrt(b * b - 4 * uxx * uyy))
+    a = -amplitude
+    vy0 = -(w2 + uxx) * a / 2
+    return correct_symmetric(sys_, (xl + a, 0.0, vy0), fix="x0", family=f"lyapunov-L{point}")
+
+
+def lyapunov_family(system: System | str = "earth-moon", point: int = 1, *, max_members: int = 150,
+                    ds_max: float = 0.02, check_geometry: bool = True) -> OrbitFamily:
+    """Planar Lyapunov family at L1 or L2 by pseudo-arclength continuation from a small
+    orbit (x0 = L - 0.002, on the side of L toward the larger primary), growing in amplitude.
+    Ends at a collision with the Moon's surface, a step floor or ``max_members``."""
+    sys_ = resolve_system(system)
+    point = _check_point(point)
+    first = _lyapunov_start(sys_, point, 2e-3)
+    res = continue_arclength(
+        sys_, first, spatial=False, orient=np.array([-1.0, 0.0, 0.0]), ds=2e-3, ds_max=ds_max, max_members=max_members,
+        family=f"lyapunov-L{point}", check_geometry=check_geometry, stop=_collision_stop(sys_, (sys_.r1_km, sys_.r2_km)),
+    )
+    return OrbitFamily.from_members(sys_, f"lyapunov-L{point}", False, res.members, res.end_reason, {"point": point})
+
+
+@functools.lru_cache(maxsize=8)
+def _cached_lyapunov(system: System, point: int) -> OrbitFamily:
+    return lyapunov_family(system, point)
+
+
+def lyapunov(system: System | str = "earth-moon", point: int = 1, *, x0: float | None = None,
+             period: float | None = None, period_days: float | None = None, jacobi: float | None = None) -> PeriodicOrbit:
+    """One planar Lyapunov orbit at L1/L2, by x0, period (TU or days) or Jacobi constant."""
+    sys_ = resolve_system(system)
+    name, value = _one_target(dict(x0=x0, period=period, period_days=period_days, jacobi=jacobi))
+    return _cached_lyapunov(sys_, _check_point(point)).member(**{name: value})
+
+
+def _check_branch(branch) -> float:
+    if branch not in ("north", "south"):
+        raise ValueError(f"invalid argument `branch`: must be 'north' or 'south', got {branch!r}")
+    return 1.0 if branch == "north" else -1.0
+
+
+def halo_family(system: System | str = "earth-moon", point: int = 2, branch: str = "south", *, max_members: int = 400,
+                ds_max: float = 0.02, check_geometry: bool = True) -> OrbitFamily:
+    """Halo family at L1/L2, started at its bifurcation from the planar Lyapunov family (where
+    the out-of-plane stability index crosses +1) and continued by pseudo-arclength in
+    (x0, z0, vy0) into the near-rectilinear halo orbits (NRHOs), until the orbit reaches the
+    Moon's surface, a step floor or ``max_members``.
+
+    ``branch`` follows the usual convention (and the JPL catalog's): a southern halo has its
+    largest excursion from the x-y plane (apolune, for L2) below it, z < 0; a northern one
+    above. The two are mirror images under z -> -z, so one is computed and mirrored. ``state0``
+    is the symmetric crossing continued from the Lyapunov start (the side of L toward the
+    larger primary); ``state_half`` the other one.
+    """
+    sys_ = resolve_system(system)
+    point = _check_point(point)
+    sign = _check_branch(branch)
+    lyap = _cached_lyapunov(sys_, point)
+    cands = [b for b in lyap.bifurcations if b["index"] == "out-of-plane" and b["level"] == 1.0]
+    if not cands:
+        raise LibrateError(f"no halo bifurcation found on the L{point} Lyapunov family ({len(lyap)} members, end: {lyap.end_reason})")
+    bif = cands[0]
+    i = bif["member"]
+    w = (bif["x0"] - lyap.x0[i]) / (lyap.x0[i + 1] - lyap.x0[i])
+    p = lyap.state0[i] + w * (lyap.state0[i + 1] - lyap.state0[i])
+    planar = correct_symmetric(sys_, p, fix="x0", family=f"lyapunov-L{point}")
+    name = f"halo-L{point}-{branch}"
+    first = correct_symmetric(sys_, (planar.x0, 2e-3, planar.vy0), spatial=True, fix="z0", family=name)
+    res = continue_arclength(
+        sys_, first, spatial=True, orient=np.array([0.0, 1.0, 0.0]), ds=2e-3, ds_max=ds_max, max_members=max_members,
+        family=name, check_geometry=check_geometry, stop=_collision_stop(sys_, (sys_.r1_km, sys_.r2_km)),
+    )
+    fam = OrbitFamily.from_members(sys_, name, True, res.members, res.end_reason,
+                                   {"point": point, "branch": branch, "bifurcation_x0": bif["x0"]})
+    # Name the branch by the sign of z where |z| is largest along the family (apolune).
+    both = np.concatenate([fam.state0[:, 2], fam.state_half[:, 2]])
+    if np.sign(both[np.argmax(np.abs(both))]) != sign:
+        flip = np.array([1.0, 1.0, -1.0, 1.0, 1.0, -1.0])
+        fam.state0 = fam.state0 * flip
+        fam.state_half = fam.state_half * flip
+    return fam
+
+
+@functools.lru_cache(maxsize=8)
+def _cached_halo(system: System, point: int, branch: str) -> OrbitFamily:
+    return halo_family(system, point, branch)
+
+
+def halo(system: System | str = "earth-moon", point: int = 2, branch: str = "south", *, x0: float | None = None,
+         z0: float | None = None, period: float | None = None, period_days: float | None = None,
+         jacobi: float | None = None, which: int = 0) -> PeriodicOrbit:
+    """One halo orbit at L1/L2 (north or south branch) by x0, z0, period (TU or days) or Jacobi
+    constant, found on the family (computed once per system and cached)."""
+    sys_ = resolve_system(system)
+    point = _check_point(point)
+    _check_branch(branch)
+    name, value = _one_target(dict(x0=x0, z0=z0, period=period, period_days=period_days, jacobi=jacobi))
+    return _cached_halo(sys_, point, branch).member(**{name: value}, which=which)
