@@ -218,7 +218,7 @@ class OrbitFamily:
         path = str(path)
         ds = self.to_dataset()
         if path.endswith(".zarr"):
-            ds.to_zarr(path, mode="w")
+            ds.to_zarr(path, mode="w", zarr_format=2, consolidated=True)
         elif path.endswith(".nc"):
             ds.to_netcdf(path, engine="scipy")
         else:

@@ -1,0 +1,158 @@
+"""Periodic-orbit families against the thesis (ch. 2), PHYSICS.md section 3 and the JPL catalog."""
+
+import math
+
+import numpy as np
+import pytest
+
+import librate
+from librate.continuation import geometry
+
+
+@pytest.fixture(scope="module")
+def dros(em):
+    return librate.dro_family(em)
+
+
+def test_dro_family_spans_moon_to_earth(dros, em):
+    """The whole family from x0 = 0.985 to 0.005, monotone in period and Jacobi constant; every
+    member winds once clockwise about the Moon and not about the Earth (no silent jump)."""
+    assert dros.x0[0] == 0.985 and dros.x0[-1] == pytest.approx(0.005)
+    assert len(dros) == 197 and dros.end_reason.startswith("completed")
+    assert np.all(np.diff(dros.period) > 0) and np.all(np.diff(dros.jacobi) < 0)
+    for i in range(0, len(dros), 24):
+        assert geometry(dros[i]).winding == (0, -1)
+
+
+def test_dro_stability_facts(dros):
+    """PHYSICS.md sec. 3 / thesis Fig. 5: the planar (in-plane) family is linearly stable for
+    0.02 <= x0 <= 0.985; the out-of-plane index crosses +1 near x0 = 0.27 (bifurcation to 3-D
+    DROs), detected and reported. Tolerance on the crossing: 0.01 (the thesis reads it off a plot)."""
+    sel = (dros.x0 >= 0.02) & (dros.x0 <= 0.985)
+    nu_in = dros.stability_indices[sel, 0]
+    assert np.all(np.abs(nu_in.imag) < 1e-9) and np.all(np.abs(nu_in.real) <= 1 + 1e-9)
+    out = [b for b in dros.bifurcations if b["index"] == "out-of-plane" and b["level"] == 1.0]
+    assert len(out) == 1 and out[0]["x0"] == pytest.approx(0.27, abs=0.01)
+    nu_out = dros.stability_indices[:, 1].real
+    assert np.all(np.abs(nu_out[dros.x0 > 0.28]) <= 1) and np.all(nu_out[dros.x0 < 0.26] > 1)
+
+
+def test_dro_period_tends_to_the_limit_near_the_earth(dros, em):
+    """PHYSICS.md: the period tends to 2 pi / sqrt(1 - mu) (27.45 d) as x0 -> -mu; at x0 = 0.005
+    it is within 0.5 % and still increasing towards it."""
+    limit = 2 * math.pi / math.sqrt(1 - em.mu)
+    assert em.period_days(limit) == pytest.approx(27.45, abs=0.01)
+    assert dros.period[-1] < limit and dros.period[-1] == pytest.approx(limit, rel=5e-3)
+
+
+def test_members_close_and_conserve_jacobi(dros, em):
+    """Every sampled member closes on itself to 1e-10 after one period at rtol = atol = 1e-14 and
+    its Jacobi constant stays constant (1e-11) along it: DROs, L1/L2 Lyapunov and the L2
+    halo/NRHO family. Closure is relative to max(1, |state0|) and, for unstable members, to the
+    largest monodromy multiplier |lambda| (a shooting residual of 1e-11 grows by |lambda|, up to
+    ~500 on the Lyapunov families, over one period). Exception, measured and documented: members
+    that pass within 2 Earth radii of the Earth's centre (DROs with x0 < 0.03: speed ~10 LU/TU
+    at perigee) are corrected just as accurately (|xdot| at the half period ~1e-13) but the
+    integration through the flyby limits their full-period closure to ~1e-8."""
+    fams = [dros, librate.lyapunov_family(em, 1), librate.lyapunov_family(em, 2), librate.halo_family(em, 2, "south")]
+    earth = em.primary_positions()[0]
+    for fam in fams:
+        for i in np.linspace(0, len(fam) - 1, 9).astype(int):
+            o = fam[i]
+            tr = o.propagate(rtol=1e-14, atol=1e-14)
+            scale = max(1.0, np.linalg.norm(o.state0)) * max(1.0, np.max(np.abs(fam.eigenvalues[i])))
+            closure = np.max(np.abs(tr.y_final - o.state0)) / scale
+            perigee = np.min(np.linalg.norm(tr.y[:, :3] - earth, axis=1))
+            bound = 1e-10 if perigee > 2 * em.r1_km / em.lu_km else 1e-8
+            assert closure < bound, (fam.kind, i, closure)
+            assert np.max(np.abs(tr.jacobi - o.jacobi)) < 1e-11, (fam.kind, i)
+
+
+def test_one_to_one_resonant_member(dros, em):
+    """Thesis Table 1 / Fig. 7: the 1:1 synodic-resonant DRO (T = 2 pi) starts at x0 = 0.1521."""
+    o = dros.resonant(1)
+    assert o.period == pytest.approx(2 * math.pi, abs=1e-10)
+    assert round(o.x0, 4) == 0.1521
+
+
+def test_member_lookup_round_trips(dros, em):
+    """Lookup by period in days (the thesis's 12.66-day DRO, Fig. 23), by Jacobi constant and by
+    x0 returns corrected members with the requested value (1e-10), between its neighbours."""
+    o = librate.dro(em, period_days=12.66)
+    assert o.period_days == pytest.approx(12.66, abs=1e-9)
+    i = np.searchsorted(dros.period, o.period)
+    assert dros.x0[i - 1] > o.x0 > dros.x0[i]
+    c = dros.member(jacobi=3.0)
+    assert c.jacobi == pytest.approx(3.0, abs=1e-10)
+    x = librate.dro(em, x0=0.3333)
+    assert x.x0 == 0.3333 and x.residual < 1e-10
+    # Sun-resonant members exist on the family: T = Ts / K
+    for k in (2, 4):
+        s = dros.resonant(k, "sun")
+        assert s.period == pytest.approx(librate.constants.SUN_SYNODIC_PERIOD / k, abs=1e-10)
+
+
+def test_jpl_catalog_l2_southern_halo():
+    """JPL three-body periodic-orbit catalog, Earth-Moon L2 southern halo: the member with
+    x0 = 1.0829551779304256 has z0 = -0.20231744561698364, vy0 = -0.20102644884016102, period
+    2.3834910105144469 and Jacobi constant 3.01517767456737. Tolerance 1e-8."""
+    jpl = librate.System.preset("earth-moon-jpl")
+    fam = librate.halo_family(jpl, 2, "south")
+    hits = [fam.member(x0=1.0829551779304256, which=w) for w in range(2)]
+    o = min(hits, key=lambda h: abs(h.z0 + 0.2023))
+    assert o.z0 == pytest.approx(-0.20231744561698364, abs=1e-8)
+    assert o.vy0 == pytest.approx(-0.20102644884016102, abs=1e-8)
+    assert o.period == pytest.approx(2.3834910105144469, abs=1e-8)
+    assert o.jacobi == pytest.approx(3.01517767456737, abs=1e-8)
+    # The family reaches the near-rectilinear regime: it ends at the Moon's surface, with
+    # members of period below 7 days (NRHOs).
+    assert fam.end_reason.startswith("collision") and fam.period_days.min() < 7.0
+    # North and south are mirror images.
+    north = librate.halo_family(jpl, 2, "north")
+    np.testing.assert_allclose(north.state0[:, 2], -fam.state0[:, 2])
+
+
+def test_halo_bifurcates_from_lyapunov(em):
+    """The halo family starts where the L2 Lyapunov family's out-of-plane index crosses +1: its
+    first member (z0 = 2e-3) lies within 1e-4 in x0 of the bifurcating Lyapunov orbit."""
+    lyap = librate.lyapunov_family(em, 2)
+    bif = [b for b in lyap.bifurcations if b["index"] == "out-of-plane"][0]
+    halo = librate.halo_family(em, 2, "north")
+    assert abs(halo.x0[0] - bif["x0"]) < 1e-4
+    assert halo.parameters["bifurcation_x0"] == bif["x0"]
+    # Lyapunov orbits circulate about their point: their initial x0 lies on L's Earth side.
+    assert np.all(lyap.x0 < em.lagrange_points()[1, 0])
+
+
+def test_save_and_load_identical(dros, tmp_path):
+    """netCDF and Zarr round trips give identical numbers and keep units and constants."""
+    for name in ("fam.nc", "fam.zarr"):
+        path = tmp_path / name
+        dros.save(path)
+        back = librate.OrbitFamily.load(path)
+        np.testing.assert_array_equal(back.state0, dros.state0)
+        np.testing.assert_array_equal(back.period, dros.period)
+        np.testing.assert_array_equal(back.stability_indices, dros.stability_indices)
+        assert back.system == dros.system and back.end_reason == dros.end_reason
+        assert back.bifurcations == dros.bifurcations
+    ds = dros.to_dataset()
+    assert ds["period"].attrs["units"] == "TU" and ds.attrs["mu"] == 0.01215
+
+
+BAD = [
+    ("x0 on the Moon", lambda em: librate.dro(em, x0=1 - em.mu), ValueError, "x0"),
+    ("x0 on the Earth", lambda em: librate.dro_family(em, x0=[-em.mu]), ValueError, "x0"),
+    ("period beyond the family", lambda em: librate.dro(em, period_days=40.0), ValueError, "outside"),
+    ("two targets", lambda em: librate.dro(em, x0=0.9, period=1.0), ValueError, "exactly one"),
+    ("L3 Lyapunov", lambda em: librate.lyapunov(em, 3, x0=-1.0), ValueError, "point"),
+    ("bad branch", lambda em: librate.halo(em, 2, "east", z0=0.01), ValueError, "branch"),
+    ("resonance k = 0", lambda em: librate.dro_family(em, x0=[0.9, 0.8]).resonant(0), ValueError, "k"),
+    ("family that cannot start", lambda em: librate.correct_symmetric(em, (0.5, 0, 0.0), fix="x0", max_iter=3), librate.ConvergenceError, "converge"),
+]
+
+
+@pytest.mark.parametrize("desc, call, exc, text", BAD, ids=[b[0] for b in BAD])
+def test_bad_requests(em, desc, call, exc, text):
+    with pytest.raises(exc) as info:
+        call(em)
+    assert text in str(info.value)
