@@ -156,3 +156,25 @@ def test_bad_requests(em, desc, call, exc, text):
     with pytest.raises(exc) as info:
         call(em)
     assert text in str(info.value)
+
+
+def test_multiple_shooting_on_an_unstable_lyapunov_orbit(em):
+    """General corrector (no symmetry assumed, free period, Poincare phase condition) with 8
+    patches on an L1 Lyapunov orbit with |lambda| ~ 450: from patches perturbed by 1e-6 it
+    converges to continuity residuals below 1e-11, with the symmetric-shooting period (1e-9) at
+    the imposed Jacobi constant; with the period fixed instead, it recovers that Jacobi constant."""
+    fam = librate.lyapunov_family(em, 1)
+    i = int(np.argmax(np.abs(fam.eigenvalues).max(axis=1) > 300))
+    ref = fam[i]
+    pts = ref.propagate(t_eval=np.arange(8) * ref.period / 8).y
+    pts = pts + 1e-6 * np.sin(np.arange(48)).reshape(8, 6) * np.array([1, 1, 0, 1, 1, 0])
+    shot = librate.correct_periodic(em, pts, ref.period * (1 + 1e-6), jacobi=ref.jacobi)
+    assert shot.residual < 1e-11
+    assert shot.period == pytest.approx(ref.period, abs=1e-9)
+    assert shot.jacobi == pytest.approx(ref.jacobi, abs=1e-12)
+    fixed = librate.correct_periodic(em, pts, ref.period, fixed_period=True)
+    assert fixed.period == ref.period and fixed.jacobi == pytest.approx(ref.jacobi, abs=1e-8)
+    with pytest.raises(ValueError, match="states"):
+        librate.correct_periodic(em, np.zeros((3, 5)), 1.0)
+    with pytest.raises(ValueError, match="period"):
+        librate.correct_periodic(em, pts, -1.0)

@@ -8,7 +8,7 @@ All quantities are nondimensional (CR3BP units) unless a name says otherwise
 from ._core import __version__
 from ._errors import ConvergenceError, IntegrationError, LibrateError
 from .families import OrbitFamily, dro, dro_family, halo, halo_family, lyapunov, lyapunov_family
-from .orbits import PeriodicOrbit, correct_dro, correct_symmetric
+from .orbits import PeriodicOrbit, correct_dro, correct_periodic, correct_symmetric
 from .propagation import BatchResult, Event, EventHit, Stats, Trajectory, propagate, propagate_many
 from .system import System
 
@@ -28,6 +28,7 @@ __all__ = [
     "PeriodicOrbit",
     "correct_dro",
     "correct_symmetric",
+    "correct_periodic",
     "OrbitFamily",
     "dro",
     "dro_family",

@@ -11,7 +11,7 @@ import numpy as np
 from . import _core
 from .system import System, resolve_system
 
-__all__ = ["PeriodicOrbit", "correct_dro", "correct_symmetric"]
+__all__ = ["PeriodicOrbit", "correct_dro", "correct_symmetric", "correct_periodic"]
 
 _VARS = {"x0": 0, "z0": 1, "vy0": 2}
 # Tolerances of the shooting propagations: the 8th-order solution at 1e-13 puts the
@@ -189,3 +189,44 @@ def correct_dro(
 
         raise ConvergenceError(f"DRO correction at x0 = {x0} converged to a prograde orbit (ydot0 = {orbit.vy0:.6g}); give a better ydot0 guess")
     return orbit
+
+
+def correct_periodic(
+    system: System | str,
+    states,
+    period: float,
+    *,
+    jacobi: float | None = None,
+    fixed_period: bool = False,
+    family: str = "periodic",
+    tol: float = 1e-10,
+    max_iter: int = 25,
+    rtol: float = SHOOT_RTOL,
+    atol: float = SHOOT_ATOL,
+) -> PeriodicOrbit:
+    """Correct a periodic orbit with no symmetry assumed, by single (one state) or multiple
+    shooting (patch states equally spaced in time over the period guess).
+
+    The period is free and a Poincare phase condition pins the first patch near its guess.
+    The member of the family is selected by its Jacobi constant (``jacobi``; default: the
+    first patch's) or, with ``fixed_period=True``, by the period. Multiple shooting is the
+    remedy for long or strongly unstable orbits: each segment's sensitivity stays moderate.
+    The least-squares Newton step absorbs the conserved Jacobi constant's redundant equation.
+    """
+    sys_ = resolve_system(system)
+    patches = np.ascontiguousarray(np.atleast_2d(np.asarray(states, dtype=np.float64)))
+    if patches.ndim != 2 or patches.shape[1] != 6:
+        raise ValueError(f"invalid argument `states`: must be (6,) or (n, 6), got shape {np.shape(states)}")
+    if not np.all(np.isfinite(patches)):
+        raise ValueError("invalid argument `states`: must be finite")
+    if not (math.isfinite(period) and period > 0):
+        raise ValueError(f"invalid argument `period`: must be finite and > 0, got {period!r}")
+    if fixed_period and jacobi is not None:
+        raise ValueError("invalid argument: give `jacobi` or `fixed_period=True`, not both")
+    if fixed_period:
+        cond, value = "period", float(period)
+    else:
+        cond, value = "jacobi", float(sys_.jacobi(patches[0]) if jacobi is None else jacobi)
+    r = _core.multiple_shooting(sys_.mu, patches, float(period), condition=cond, value=value, tol=float(tol),
+                                max_iter=int(max_iter), rtol=float(rtol), atol=float(atol))
+    return PeriodicOrbit(sys_, r["patches"][0].copy(), r["period"], r["jacobi"], family, r["iterations"], r["residual"])

@@ -5,7 +5,7 @@
 use librate_core::cr3bp::{self, SystemConstants, PRESETS};
 use librate_core::error::Error;
 use librate_core::integrate::{Options, Output, Status};
-use librate_core::periodic::{Constraint, Evaluation, Stability, SymmetricShooting, Var};
+use librate_core::periodic::{correct_multiple_shooting, MemberCondition, Constraint, Evaluation, Stability, SymmetricShooting, Var};
 use numpy::Complex64;
 use librate_core::propagation::{self, EventKind, EventSpec};
 use numpy::ndarray::Array2;
@@ -343,6 +343,44 @@ fn stability<'py>(py: Python<'py>, m: PyReadonlyArray2<'py, f64>, planar: bool) 
     Ok((ev.into_pyarray(py).into_any(), nu.into_pyarray(py).into_any()))
 }
 
+/// Multiple shooting: patches (n, 6), period guess, member condition ("jacobi" or "period", value).
+#[pyfunction]
+#[pyo3(signature = (mu, patches, period, *, condition, value, tol, max_iter, rtol, atol))]
+#[allow(clippy::too_many_arguments)]
+fn multiple_shooting<'py>(
+    py: Python<'py>,
+    mu: f64,
+    patches: PyReadonlyArray2<'py, f64>,
+    period: f64,
+    condition: &str,
+    value: f64,
+    tol: f64,
+    max_iter: usize,
+    rtol: f64,
+    atol: f64,
+) -> PyResult<Bound<'py, PyDict>> {
+    if patches.shape()[1] != 6 || patches.shape()[0] == 0 {
+        return Err(PyValueError::new_err(format!("invalid argument `states`: must have shape (n, 6) with n >= 1, got {:?}", patches.shape())));
+    }
+    let rows: Vec<[f64; 6]> = patches.as_array().rows().into_iter().map(|r| std::array::from_fn(|j| r[j])).collect();
+    let cond = match condition {
+        "jacobi" => MemberCondition::Jacobi(value),
+        "period" => MemberCondition::Period(value),
+        _ => return Err(PyValueError::new_err(format!("invalid argument `condition`: must be 'jacobi' or 'period', got {condition:?}"))),
+    };
+    let opts = Options::with_tolerances(rtol, atol);
+    let o = py.detach(|| correct_multiple_shooting(mu, &rows, period, cond, tol, max_iter, &opts)).map_err(to_py)?;
+    let n = o.patches.len();
+    let flat: Vec<f64> = o.patches.iter().flatten().copied().collect();
+    let d = PyDict::new(py);
+    d.set_item("patches", flat.into_pyarray(py).reshape([n, 6])?)?;
+    d.set_item("period", o.period)?;
+    d.set_item("jacobi", o.jacobi)?;
+    d.set_item("iterations", o.iterations)?;
+    d.set_item("residual", o.residual)?;
+    Ok(d)
+}
+
 #[pymodule]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     let py = m.py();
@@ -359,6 +397,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(symmetric_correct, m)?)?;
     m.add_function(wrap_pyfunction!(symmetric_evaluate, m)?)?;
     m.add_function(wrap_pyfunction!(stability, m)?)?;
+    m.add_function(wrap_pyfunction!(multiple_shooting, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

@@ -1,0 +1,168 @@
+//! General periodic-orbit correction by multiple shooting (single shooting is N = 1), for
+//! orbits without the x-z mirror symmetry and for long or strongly unstable orbits.
+//!
+//! Unknowns: N patch states X_0..X_{N-1} (6 each) and the period T; segment i runs from X_i for
+//! T/N. Conditions: continuity phi(X_i, T/N) = X_{i+1}, closure phi(X_{N-1}, T/N) = X_0, the
+//! Poincare phase condition f(X_ref) . (X_0 - X_ref) = 0 (removes the shift along the orbit),
+//! and either a target Jacobi constant C(X_0) = C* or a fixed period T = T* (selects the member
+//! of the family). The system has 6N + 2 equations in 6N + 1 unknowns and is consistent (the
+//! Jacobi constant is conserved, so one closure equation is redundant); Newton steps solve it
+//! in the least-squares sense by SVD. Segments are propagated in parallel on rayon.
+
+use nalgebra::{DMatrix, DVector};
+use rayon::prelude::*;
+
+use crate::cr3bp::{check_mu, jacobi, potential_gradient, Cr3bp};
+use crate::error::{check_finite, check_positive, invalid, Error, Result};
+use crate::integrate::{Options, Output, System};
+use crate::propagation::propagate;
+
+/// Which member of the family to converge to.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum MemberCondition {
+    /// Jacobi constant equal to this value (the period is free).
+    Jacobi(f64),
+    /// Period fixed at this value (the Jacobi constant is free).
+    Period(f64),
+}
+
+/// A periodic orbit corrected by multiple shooting.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ShotOrbit {
+    /// Patch states (N x 6); the first is the orbit's initial state.
+    pub patches: Vec<[f64; 6]>,
+    pub period: f64,
+    pub jacobi: f64,
+    pub iterations: usize,
+    /// Max-norm of the continuity, closure and member conditions at the end.
+    pub residual: f64,
+}
+
+/// Correct a periodic orbit from patch states (N >= 1) and a period guess.
+pub fn correct_multiple_shooting(
+    mu: f64,
+    patches: &[[f64; 6]],
+    period: f64,
+    condition: MemberCondition,
+    tol: f64,
+    max_iter: usize,
+    opts: &Options,
+) -> Result<ShotOrbit> {
+    check_mu(mu)?;
+    opts.validate()?;
+    check_positive("period", period)?;
+    check_positive("tol", tol)?;
+    if patches.is_empty() {
+        return Err(invalid("states", "at least one patch state is needed"));
+    }
+    for p in patches {
+        check_finite("states", p)?;
+    }
+    match condition {
+        MemberCondition::Jacobi(c) => check_finite("jacobi", &[c])?,
+        MemberCondition::Period(t) => check_positive("period", t)?,
+    }
+    let n = patches.len();
+    let nu = 6 * n + 1;
+    let ne = 6 * n + 2;
+    let mut x = DVector::from_fn(nu, |k, _| if k < 6 * n { patches[k / 6][k % 6] } else { period });
+    let x_ref: [f64; 6] = patches[0];
+    let mut f_ref = [0.0; 6];
+    Cr3bp { mu }.derivative(0.0, &x_ref, &mut f_ref);
+    let sys = Cr3bp { mu };
+
+    let residual_and_jacobian = |x: &DVector<f64>| -> Result<(DVector<f64>, DMatrix<f64>)> {
+        let t_seg = x[6 * n] / n as f64;
+        let segs: Vec<Result<([f64; 6], [[f64; 6]; 6])>> = (0..n)
+            .into_par_iter()
+            .map(|i| {
+                let s: [f64; 6] = std::array::from_fn(|j| x[6 * i + j]);
+                let tr = propagate(mu, &s, 0.0, t_seg, opts, true, Output::Final, &[])?;
+                Ok((tr.state_final, tr.stm_final.expect("with STM")))
+            })
+            .collect();
+        let mut r = DVector::zeros(ne);
+        let mut jm = DMatrix::zeros(ne, nu);
+        for (i, seg) in segs.into_iter().enumerate() {
+            let (end, phi) = seg?;
+            let next = (i + 1) % n;
+            let mut fe = [0.0; 6];
+            sys.derivative(0.0, &end, &mut fe);
+            for a in 0..6 {
+                r[6 * i + a] = end[a] - x[6 * next + a];
+                for b in 0..6 {
+                    jm[(6 * i + a, 6 * i + b)] += phi[a][b];
+                }
+                jm[(6 * i + a, 6 * next + a)] -= 1.0;
+                jm[(6 * i + a, 6 * n)] = fe[a] / n as f64;
+            }
+        }
+        // Phase condition.
+        let row = 6 * n;
+        r[row] = (0..6).map(|a| f_ref[a] * (x[a] - x_ref[a])).sum();
+        for a in 0..6 {
+            jm[(row, a)] = f_ref[a];
+        }
+        // Member condition.
+        let row = 6 * n + 1;
+        match condition {
+            MemberCondition::Jacobi(c) => {
+                let s0: [f64; 6] = std::array::from_fn(|a| x[a]);
+                r[row] = jacobi(mu, &s0) - c;
+                let g = potential_gradient(mu, &s0);
+                for a in 0..3 {
+                    jm[(row, a)] = 2.0 * g[a];
+                    jm[(row, 3 + a)] = -2.0 * s0[3 + a];
+                }
+            }
+            MemberCondition::Period(t) => {
+                r[row] = x[6 * n] - t;
+                jm[(row, 6 * n)] = 1.0;
+            }
+        }
+        Ok((r, jm))
+    };
+
+    let (mut r, mut jm) = residual_and_jacobian(&x)?;
+    let mut norm = r.amax();
+    for it in 0..=max_iter {
+        if norm <= tol {
+            let patches = (0..n).map(|i| std::array::from_fn(|j| x[6 * i + j])).collect::<Vec<[f64; 6]>>();
+            let jc = jacobi(mu, &patches[0]);
+            return Ok(ShotOrbit { patches, period: x[6 * n], jacobi: jc, iterations: it, residual: norm });
+        }
+        if it == max_iter {
+            break;
+        }
+        let svd = jm.clone().svd(true, true);
+        let dx = svd.solve(&(-&r), 1e-13).map_err(|_| Error::Convergence {
+            what: "multiple shooting (least-squares Newton step failed)",
+            iterations: it,
+            residual: norm,
+            tolerance: tol,
+        })?;
+        let mut lambda = 1.0;
+        let mut accepted = false;
+        for _ in 0..8 {
+            let xt = &x + &dx * lambda;
+            if xt[6 * n] > 0.0 {
+                if let Ok((rt, jt)) = residual_and_jacobian(&xt) {
+                    let nt = rt.amax();
+                    if nt.is_finite() && (nt < norm || lambda < 0.01) {
+                        x = xt;
+                        r = rt;
+                        jm = jt;
+                        norm = nt;
+                        accepted = true;
+                        break;
+                    }
+                }
+            }
+            lambda *= 0.5;
+        }
+        if !accepted {
+            return Err(Error::Convergence { what: "multiple shooting (no step reduces the residual)", iterations: it, residual: norm, tolerance: tol });
+        }
+    }
+    Err(Error::Convergence { what: "multiple shooting", iterations: max_iter, residual: norm, tolerance: tol })
+}
