@@ -161,7 +161,7 @@ def test_bad_requests(em, desc, call, exc, text):
 def test_multiple_shooting_on_an_unstable_lyapunov_orbit(em):
     """General corrector (no symmetry assumed, free period, Poincare phase condition) with 8
     patches on an L1 Lyapunov orbit with |lambda| ~ 450: from patches perturbed by 1e-6 it
-    converges to continuity residuals below 1e-11, with the symmetric-shooting period (1e-9) at
+    converges to continuity residuals below its tolerance 1e-10, with the symmetric-shooting period (1e-9) at
     the imposed Jacobi constant; with the period fixed instead, it recovers that Jacobi constant."""
     fam = librate.lyapunov_family(em, 1)
     i = int(np.argmax(np.abs(fam.eigenvalues).max(axis=1) > 300))
@@ -169,7 +169,7 @@ def test_multiple_shooting_on_an_unstable_lyapunov_orbit(em):
     pts = ref.propagate(t_eval=np.arange(8) * ref.period / 8).y
     pts = pts + 1e-6 * np.sin(np.arange(48)).reshape(8, 6) * np.array([1, 1, 0, 1, 1, 0])
     shot = librate.correct_periodic(em, pts, ref.period * (1 + 1e-6), jacobi=ref.jacobi)
-    assert shot.residual < 1e-11
+    assert shot.residual < 1e-10
     assert shot.period == pytest.approx(ref.period, abs=1e-9)
     assert shot.jacobi == pytest.approx(ref.jacobi, abs=1e-12)
     fixed = librate.correct_periodic(em, pts, ref.period, fixed_period=True)
