@@ -7,6 +7,7 @@ All quantities are nondimensional (CR3BP units) unless a name says otherwise
 
 from ._core import __version__
 from ._errors import ConvergenceError, IntegrationError, LibrateError
+from .fourier import FourierOrbit, fit_fourier
 from .orbits import PeriodicOrbit, correct_dro
 from .propagation import BatchResult, Event, EventHit, Stats, Trajectory, propagate, propagate_many
 from .system import System
@@ -26,4 +27,6 @@ __all__ = [
     "propagate_many",
     "PeriodicOrbit",
     "correct_dro",
+    "FourierOrbit",
+    "fit_fourier",
 ]
