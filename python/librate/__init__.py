@@ -7,6 +7,7 @@ All quantities are nondimensional (CR3BP units) unless a name says otherwise
 
 from ._core import __version__
 from ._errors import ConvergenceError, IntegrationError, LibrateError
+from .frames import MeanElements, OsculatingElements, eci_to_synodic, mean_elements, osculating_elements, synodic_to_eci
 from .fourier import FourierOrbit, fit_fourier
 from .orbits import PeriodicOrbit, correct_dro
 from .propagation import BatchResult, Event, EventHit, Stats, Trajectory, propagate, propagate_many
@@ -29,4 +30,10 @@ __all__ = [
     "correct_dro",
     "FourierOrbit",
     "fit_fourier",
+    "synodic_to_eci",
+    "eci_to_synodic",
+    "OsculatingElements",
+    "osculating_elements",
+    "MeanElements",
+    "mean_elements",
 ]
