@@ -274,6 +274,7 @@ mod tests {
     /// Reference: the same series evaluated term by term (direct sin/cos of n w t, no
     /// recurrence, no phase reduction); tolerance 1e-13 absolute for |t| up to 20 periods.
     #[test]
+    #[allow(clippy::needless_range_loop)]
     fn matches_term_by_term_evaluation() {
         let f = sample();
         for i in -40..=200 {

@@ -38,7 +38,7 @@ fn fourier_evaluate<'py>(
     let out = py
         .detach(|| FourierOrbit::from_flat(period, a0, &c, &s).and_then(|f| f.evaluate_many(&ts, q)))
         .map_err(to_py)?;
-    Ok(out.into_pyarray(py).reshape([ts.len(), q.width()])?)
+    out.into_pyarray(py).reshape([ts.len(), q.width()])
 }
 
 /// Add this module's functions to `librate._core`.
