@@ -32,3 +32,26 @@ def cr3bp_rhs(mu):
         ]
 
     return f
+
+
+def dro_with_period(system, period, xs):
+    """The DRO of the given period (TU): continue DROs over the decreasing x0 grid ``xs`` (the
+    period grows as x0 decreases), bracket ``period`` and refine x0 by the secant method on
+    T(x0) - period, each member corrected from an extrapolated ydot0, until |T - period| < 1e-12."""
+    import numpy as np
+
+    orbits = continue_dros(system, xs)
+    periods = np.array([o.period for o in orbits])
+    if not periods[0] < period < periods[-1]:
+        raise ValueError(f"period {period} is outside the continued range [{periods[0]}, {periods[-1]}]")
+    k = int(np.argmax(periods > period))
+    (xa, va, ta), (xb, vb, tb) = [(o.x0, o.state0[4], o.period) for o in orbits[k - 1 : k + 1]]
+    o = orbits[k]
+    for _ in range(30):
+        x = xb + (period - tb) * (xb - xa) / (tb - ta)
+        guess = vb + (vb - va) / (xb - xa) * (x - xb)
+        o = librate.correct_dro(system, x, guess)
+        (xa, va, ta), (xb, vb, tb) = (xb, vb, tb), (x, o.state0[4], o.period)
+        if abs(tb - period) < 1e-12:
+            return o
+    raise RuntimeError(f"secant on the DRO period did not converge: |T - {period}| = {abs(tb - period):.2e}")

@@ -8,6 +8,8 @@ All quantities are nondimensional (CR3BP units) unless a name says otherwise
 from ._core import __version__
 from ._errors import ConvergenceError, IntegrationError, LibrateError
 from .families import OrbitFamily, dro, dro_family, halo, halo_family, lyapunov, lyapunov_family
+from .fourier import FourierOrbit, fit_fourier
+from .frames import MeanElements, OsculatingElements, eci_to_synodic, mean_elements, osculating_elements, synodic_to_eci
 from .orbits import PeriodicOrbit, correct_dro, correct_periodic, correct_symmetric
 from .propagation import BatchResult, Event, EventHit, Stats, Trajectory, propagate, propagate_many
 from .system import System
@@ -36,4 +38,12 @@ __all__ = [
     "lyapunov_family",
     "halo",
     "halo_family",
+    "FourierOrbit",
+    "fit_fourier",
+    "synodic_to_eci",
+    "eci_to_synodic",
+    "OsculatingElements",
+    "osculating_elements",
+    "MeanElements",
+    "mean_elements",
 ]

@@ -69,3 +69,6 @@ def stability(m: _F64, planar: bool) -> tuple[npt.NDArray[np.complex128], npt.ND
 def multiple_shooting(
     mu: float, patches: _F64, period: float, *, condition: str, value: float, tol: float, max_iter: int, rtol: float, atol: float
 ) -> dict[str, Any]: ...
+def fourier_evaluate(
+    period: float, a0: _F64, cos: _F64, sin: _F64, t: _F64, *, quantity: str
+) -> _F64: ...

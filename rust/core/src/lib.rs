@@ -4,9 +4,11 @@
 //! - [`cr3bp`]: CR3BP dynamics, variational equations, Jacobi constant, Lagrange points, systems.
 //! - [`propagation`]: CR3BP propagation with the STM and events; batches on all cores.
 //! - [`periodic`]: symmetric periodic orbits by half-period shooting.
+//! - [`fourier`]: periodic orbits as truncated Fourier series, with analytic derivatives.
 
 pub mod cr3bp;
 pub mod error;
+pub mod fourier;
 pub mod integrate;
 pub mod periodic;
 pub mod propagation;
