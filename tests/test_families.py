@@ -178,3 +178,29 @@ def test_multiple_shooting_on_an_unstable_lyapunov_orbit(em):
         librate.correct_periodic(em, np.zeros((3, 5)), 1.0)
     with pytest.raises(ValueError, match="period"):
         librate.correct_periodic(em, pts, -1.0)
+
+
+def test_dro_family_in_the_jpl_preset():
+    """Both presets: in earth-moon-jpl the whole family is found too, with the out-of-plane
+    bifurcation still near x0 = 0.27 and the 1:1 member near x0 = 0.1521 (mu differs by 5e-7)."""
+    jpl = librate.System.preset("earth-moon-jpl")
+    fam = librate.dro_family(jpl)
+    assert len(fam) == 197 and fam.end_reason.startswith("completed")
+    assert fam.bifurcations[0]["x0"] == pytest.approx(0.27, abs=0.01)
+    assert fam.resonant(1).x0 == pytest.approx(0.1521, abs=1e-4)
+
+
+def test_l1_northern_halo_family(em):
+    """L1 northern halos: largest excursion above the plane (z > 0), continued from the Lyapunov
+    bifurcation until the perilune reaches the Moon's surface (the L1 NRHOs, periods of 8 to 12
+    days); every member closes (relative to its largest multiplier, as above)."""
+    fam = librate.halo_family(em, 1, "north")
+    both = np.concatenate([fam.state0[:, 2], fam.state_half[:, 2]])
+    assert both[np.argmax(np.abs(both))] > 0
+    assert fam.end_reason.startswith("collision") and "Moon" in fam.end_reason
+    assert 7.0 < fam.period_days.min() < 9.0 and fam.period_days.max() < 13.0
+    for i in (0, len(fam) // 2, len(fam) - 1):
+        o = fam[i]
+        tr = o.propagate(rtol=1e-14, atol=1e-14)
+        scale = max(1.0, np.linalg.norm(o.state0)) * max(1.0, np.max(np.abs(fam.eigenvalues[i])))
+        assert np.max(np.abs(tr.y_final - o.state0)) / scale < 1e-10
