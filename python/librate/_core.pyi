@@ -1,6 +1,6 @@
 """Type stubs of the private Rust extension. Use the `librate` package API instead."""
 
-from typing import Any
+from typing import Any, TypedDict
 
 import numpy as np
 import numpy.typing as npt
@@ -21,21 +21,24 @@ class ConvergenceError(LibrateError):
 
 _F64 = npt.NDArray[np.float64]
 
+class _Options(TypedDict):
+    rtol: float
+    atol: float
+    h0: float | None
+    h_min: float
+    h_max: float
+    max_steps: int
+    safety: float
+    fixed_step: float | None
+
 def propagate(
     mu: float,
     state: _F64,
     t0: float,
     tf: float,
     *,
-    rtol: float,
-    atol: float,
+    options: _Options,
     stm: bool,
-    h0: float | None,
-    h_min: float,
-    h_max: float,
-    max_steps: int,
-    safety: float,
-    fixed_step: float | None,
     t_eval: _F64 | None,
     events: list[tuple[str, list[float], int, bool]],
 ) -> dict[str, Any]: ...
@@ -45,15 +48,8 @@ def propagate_many(
     t0: float,
     t_final: _F64,
     *,
-    rtol: float,
-    atol: float,
+    options: _Options,
     stm: bool,
-    h0: float | None,
-    h_min: float,
-    h_max: float,
-    max_steps: int,
-    safety: float,
-    fixed_step: float | None,
     threads: int | None,
 ) -> dict[str, Any]: ...
 def jacobi(mu: float, states: _F64) -> _F64: ...

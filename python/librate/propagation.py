@@ -190,7 +190,7 @@ def propagate(
     te = None if t_eval is None else np.ascontiguousarray(t_eval, dtype=np.float64).ravel()
     r = _core.propagate(
         sys_.mu, s, t0, tf, stm=bool(stm), t_eval=te, events=[e._spec(sys_) for e in evs],
-        **_options(rtol, atol, h0, h_min, h_max, max_steps, safety, fixed_step),
+        options=_options(rtol, atol, h0, h_min, h_max, max_steps, safety, fixed_step),
     )
     return Trajectory(
         system=sys_,
@@ -245,7 +245,7 @@ def propagate_many(
         raise ValueError(f"invalid argument `threads`: must be an integer >= 1 or None (all cores), got {threads!r}")
     r = _core.propagate_many(
         sys_.mu, arr, float(t0), tf, stm=bool(stm), threads=None if threads is None else int(threads),
-        **_options(rtol, atol, h0, h_min, h_max, max_steps, safety, fixed_step),
+        options=_options(rtol, atol, h0, h_min, h_max, max_steps, safety, fixed_step),
     )
     result = BatchResult(y=r["y"], stm=r["stm"], ok=r["ok"], errors=dict(r["errors"]), stats=r["stats"])
     if result.errors and on_error == "raise":

@@ -59,9 +59,24 @@ fn to_py(e: Error) -> PyErr {
     })
 }
 
-#[allow(clippy::too_many_arguments)]
-fn options(rtol: f64, atol: f64, h0: Option<f64>, h_min: f64, h_max: f64, max_steps: usize, safety: f64, fixed_step: Option<f64>) -> Options {
-    Options { rtol, atol, h0, h_min, h_max, max_steps, safety, fixed_step, ..Options::default() }
+/// Integrator settings as the Python facade passes them: a dict with these keys.
+#[derive(FromPyObject)]
+#[pyo3(from_item_all)]
+struct OptionsArg {
+    rtol: f64,
+    atol: f64,
+    h0: Option<f64>,
+    h_min: f64,
+    h_max: f64,
+    max_steps: usize,
+    safety: f64,
+    fixed_step: Option<f64>,
+}
+
+impl From<OptionsArg> for Options {
+    fn from(o: OptionsArg) -> Self {
+        Options { rtol: o.rtol, atol: o.atol, h0: o.h0, h_min: o.h_min, h_max: o.h_max, max_steps: o.max_steps, safety: o.safety, fixed_step: o.fixed_step, ..Options::default() }
+    }
 }
 
 fn state6(name: &'static str, v: &[f64]) -> PyResult<[f64; 6]> {
@@ -89,7 +104,7 @@ fn event_specs(events: Vec<(String, Vec<f64>, i8, bool)>) -> PyResult<Vec<EventS
 
 /// Propagate one CR3BP state; returns a dict of arrays (see `librate.propagate`).
 #[pyfunction]
-#[pyo3(signature = (mu, state, t0, tf, *, rtol, atol, stm, h0, h_min, h_max, max_steps, safety, fixed_step, t_eval, events))]
+#[pyo3(signature = (mu, state, t0, tf, *, options, stm, t_eval, events))]
 #[allow(clippy::too_many_arguments)]
 fn propagate<'py>(
     py: Python<'py>,
@@ -97,20 +112,13 @@ fn propagate<'py>(
     state: PyReadonlyArray1<'py, f64>,
     t0: f64,
     tf: f64,
-    rtol: f64,
-    atol: f64,
+    options: OptionsArg,
     stm: bool,
-    h0: Option<f64>,
-    h_min: f64,
-    h_max: f64,
-    max_steps: usize,
-    safety: f64,
-    fixed_step: Option<f64>,
     t_eval: Option<PyReadonlyArray1<'py, f64>>,
     events: Vec<(String, Vec<f64>, i8, bool)>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let s = state6("state", state.as_slice()?)?;
-    let opts = options(rtol, atol, h0, h_min, h_max, max_steps, safety, fixed_step);
+    let opts = Options::from(options);
     let specs = event_specs(events)?;
     let times: Option<Vec<f64>> = t_eval.map(|a| a.as_array().to_vec());
     let tr = py
@@ -147,7 +155,7 @@ fn propagate<'py>(
 
 /// Propagate many states to their final times on all cores; failed members are reported, not raised.
 #[pyfunction]
-#[pyo3(signature = (mu, states, t0, t_final, *, rtol, atol, stm, h0, h_min, h_max, max_steps, safety, fixed_step, threads))]
+#[pyo3(signature = (mu, states, t0, t_final, *, options, stm, threads))]
 #[allow(clippy::too_many_arguments)]
 fn propagate_many<'py>(
     py: Python<'py>,
@@ -155,15 +163,8 @@ fn propagate_many<'py>(
     states: PyReadonlyArray2<'py, f64>,
     t0: f64,
     t_final: PyReadonlyArray1<'py, f64>,
-    rtol: f64,
-    atol: f64,
+    options: OptionsArg,
     stm: bool,
-    h0: Option<f64>,
-    h_min: f64,
-    h_max: f64,
-    max_steps: usize,
-    safety: f64,
-    fixed_step: Option<f64>,
     threads: Option<usize>,
 ) -> PyResult<Bound<'py, PyDict>> {
     if states.shape()[1] != 6 {
@@ -171,7 +172,7 @@ fn propagate_many<'py>(
     }
     let rows: Vec<[f64; 6]> = states.as_array().rows().into_iter().map(|r| std::array::from_fn(|j| r[j])).collect();
     let tf: Vec<f64> = t_final.as_array().to_vec();
-    let opts = options(rtol, atol, h0, h_min, h_max, max_steps, safety, fixed_step);
+    let opts = Options::from(options);
     let results = py.detach(|| propagation::propagate_many(mu, &rows, t0, &tf, &opts, stm, threads)).map_err(to_py)?;
     let n = results.len();
     let mut y = Vec::with_capacity(n * 6);
