@@ -6,6 +6,7 @@
 //! - [`periodic`]: symmetric periodic orbits by half-period shooting.
 //! - [`fourier`]: periodic orbits as truncated Fourier series, with analytic derivatives.
 
+pub mod attitude;
 pub mod cr3bp;
 pub mod error;
 pub mod fourier;

@@ -1,0 +1,201 @@
+//! Coupled orbit-attitude equations of motion (PHYSICS.md sec. 4).
+//!
+//! State (13): synodic position and velocity (6), the quaternion q = (q1, q2, q3, q4) of the
+//! body relative to the synodic frame, scalar last (4), and the inertial angular velocity w in
+//! body axes (3). A(q) maps synodic components to body components. Equations:
+//!   orbit: the CR3BP, plus (optionally) the second-order extended-body acceleration (thesis
+//!          eq. 37), or held fixed (a body artificially kept at a point, as at the L-points);
+//!   qdot = 1/2 Xi(q) (w - A e_Z)   (the synodic frame turns at rate 1 about Z);
+//!   I wdot = T - w x I w.
+//! The quaternion is not renormalised inside the dynamics (the exact flow preserves |q|); A(q)
+//! is evaluated as A(q)/|q|^2 so that a small drift of |q| does not distort the rotation.
+
+use super::body::RigidBody;
+use super::dual::{Dual, Real};
+use super::torque::{cross, mat_vec, Torque, TorqueInput, D13};
+use crate::integrate::System;
+
+/// Dimension of the coupled state and of the state with its 13x13 STM.
+pub const DIM: usize = 13;
+pub const STM_DIM: usize = DIM + DIM * DIM;
+
+/// How the orbit is treated.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum OrbitMode {
+    /// Integrated with the attitude (point-mass CR3BP).
+    Integrate,
+    /// Integrated, with the second-order extended-body acceleration of both primaries
+    /// (thesis eq. 37; MacCullagh). `inertia_nd` = principal moments / (m LU^2).
+    Coupled { inertia_nd: [f64; 3] },
+    /// Held at its initial state (zero derivative).
+    Held,
+}
+
+/// The coupled 3-D model.
+pub struct Coupled<'a> {
+    pub mu: f64,
+    pub body: RigidBody,
+    pub torques: Vec<&'a dyn Torque>,
+    pub orbit: OrbitMode,
+}
+
+/// Attitude matrix A(q)/|q|^2 (synodic -> body), scalar-last quaternion.
+#[inline(always)]
+pub fn dcm<R: Real>(q: &[R; 4]) -> [[R; 3]; 3] {
+    let [q1, q2, q3, q4] = *q;
+    let n = R::cst(1.0) / (q1 * q1 + q2 * q2 + q3 * q3 + q4 * q4);
+    let (a, b, c, d) = (q1 * q1, q2 * q2, q3 * q3, q4 * q4);
+    let two = |x: R| x.scale(2.0) * n;
+    [
+        [(a - b - c + d) * n, two(q1 * q2 + q3 * q4), two(q1 * q3 - q2 * q4)],
+        [two(q1 * q2 - q3 * q4), (-a + b - c + d) * n, two(q2 * q3 + q1 * q4)],
+        [two(q1 * q3 + q2 * q4), two(q2 * q3 - q1 * q4), (-a - b + c + d) * n],
+    ]
+}
+
+impl Coupled<'_> {
+    /// The right-hand side over any [`Real`] scalar.
+    #[inline(always)]
+    fn rhs<R: Real>(&self, t: f64, y: &[R; DIM], dy: &mut [R; DIM], torque: impl Fn(&dyn Torque, &TorqueInput<R>) -> [R; 3]) {
+        let mu = self.mu;
+        let pos = [y[0], y[1], y[2]];
+        let vel = [y[3], y[4], y[5]];
+        let q = [y[6], y[7], y[8], y[9]];
+        let w = [y[10], y[11], y[12]];
+        let a = dcm(&q);
+        let inertia = self.body.moments();
+
+        // Orbit.
+        match self.orbit {
+            OrbitMode::Held => {
+                for d in dy.iter_mut().take(6) {
+                    *d = R::cst(0.0);
+                }
+            }
+            OrbitMode::Integrate | OrbitMode::Coupled { .. } => {
+                let mut acc = cr3bp_acc(mu, &pos, &vel);
+                if let OrbitMode::Coupled { inertia_nd } = self.orbit {
+                    let extra = extended_body_acc(mu, &pos, &a, inertia_nd);
+                    for i in 0..3 {
+                        acc[i] = acc[i] + extra[i];
+                    }
+                }
+                dy[0] = vel[0];
+                dy[1] = vel[1];
+                dy[2] = vel[2];
+                dy[3] = acc[0];
+                dy[4] = acc[1];
+                dy[5] = acc[2];
+            }
+        }
+
+        // Kinematics: w_rel = w - A e_Z.
+        let wr = [w[0] - a[0][2], w[1] - a[1][2], w[2] - a[2][2]];
+        let [q1, q2, q3, q4] = q;
+        dy[6] = (q4 * wr[0] - q3 * wr[1] + q2 * wr[2]).scale(0.5);
+        dy[7] = (q3 * wr[0] + q4 * wr[1] - q1 * wr[2]).scale(0.5);
+        dy[8] = (-q2 * wr[0] + q1 * wr[1] + q4 * wr[2]).scale(0.5);
+        dy[9] = (-q1 * wr[0] - q2 * wr[1] - q3 * wr[2]).scale(0.5);
+
+        // Euler's equations.
+        let input = TorqueInput { t, mu, pos, vel, a, w, inertia };
+        let mut tq = [R::cst(0.0); 3];
+        for m in &self.torques {
+            let ti = torque(*m, &input);
+            for i in 0..3 {
+                tq[i] = tq[i] + ti[i];
+            }
+        }
+        let iw = [w[0].scale(inertia[0]), w[1].scale(inertia[1]), w[2].scale(inertia[2])];
+        let gyro = cross(&w, &iw);
+        for i in 0..3 {
+            dy[10 + i] = (tq[i] - gyro[i]).scale(1.0 / inertia[i]);
+        }
+    }
+}
+
+/// CR3BP acceleration over any scalar (same formula as `cr3bp::Cr3bp`).
+#[inline(always)]
+fn cr3bp_acc<R: Real>(mu: f64, p: &[R; 3], v: &[R; 3]) -> [R; 3] {
+    let d1 = p[0] + R::cst(mu);
+    let d2 = p[0] - R::cst(1.0 - mu);
+    let yz = p[1] * p[1] + p[2] * p[2];
+    let r1s = d1 * d1 + yz;
+    let r2s = d2 * d2 + yz;
+    let c1 = R::cst(1.0 - mu) / (r1s * r1s.sqrt());
+    let c2 = R::cst(mu) / (r2s * r2s.sqrt());
+    [
+        v[1].scale(2.0) + p[0] - c1 * d1 - c2 * d2,
+        -v[0].scale(2.0) + p[1] - (c1 + c2) * p[1],
+        -(c1 + c2) * p[2],
+    ]
+}
+
+/// Second-order extended-body acceleration of both primaries (thesis eq. 37):
+/// a2 = -sum_i mu_i / r^4 [ (3/2)(tr I - 5 rhat' I_S rhat) rhat + 3 I_S rhat ], I_S = A' I A,
+/// with I the principal moments / (m LU^2) and rhat the unit vector from primary i.
+fn extended_body_acc<R: Real>(mu: f64, p: &[R; 3], a: &[[R; 3]; 3], inertia_nd: [f64; 3]) -> [R; 3] {
+    let tr = inertia_nd[0] + inertia_nd[1] + inertia_nd[2];
+    let mut out = [R::cst(0.0); 3];
+    for (cx, gm) in [(-mu, 1.0 - mu), (1.0 - mu, mu)] {
+        let rs = [p[0] - R::cst(cx), p[1], p[2]];
+        let r2 = rs[0] * rs[0] + rs[1] * rs[1] + rs[2] * rs[2];
+        let r = r2.sqrt();
+        let u = [rs[0] / r, rs[1] / r, rs[2] / r];
+        let ub = mat_vec(a, &u);
+        let iub = [ub[0].scale(inertia_nd[0]), ub[1].scale(inertia_nd[1]), ub[2].scale(inertia_nd[2])];
+        let quad = ub[0] * iub[0] + ub[1] * iub[1] + ub[2] * iub[2];
+        let coef = (R::cst(tr) - quad.scale(5.0)).scale(1.5);
+        // I_S rhat = A' (I (A rhat)).
+        let is_u: [R; 3] = std::array::from_fn(|j| a[0][j] * iub[0] + a[1][j] * iub[1] + a[2][j] * iub[2]);
+        let k = R::cst(-gm) / (r2 * r2);
+        for j in 0..3 {
+            out[j] = out[j] + k * (coef * u[j] + is_u[j].scale(3.0));
+        }
+    }
+    out
+}
+
+impl System<[f64; DIM]> for Coupled<'_> {
+    #[inline]
+    fn derivative(&self, t: f64, y: &[f64; DIM], dy: &mut [f64; DIM]) {
+        self.rhs(t, y, dy, |m, x| m.torque(x));
+    }
+}
+
+/// The coupled model with its 13x13 state transition matrix (row-major after the state); the
+/// Jacobian of the right-hand side is exact, by forward-mode dual numbers.
+pub struct CoupledStm<'a>(pub Coupled<'a>);
+
+impl CoupledStm<'_> {
+    pub fn initial(state: &[f64; DIM]) -> [f64; STM_DIM] {
+        let mut y = [0.0; STM_DIM];
+        y[..DIM].copy_from_slice(state);
+        for i in 0..DIM {
+            y[DIM + i * DIM + i] = 1.0;
+        }
+        y
+    }
+}
+
+impl System<[f64; STM_DIM]> for CoupledStm<'_> {
+    fn derivative(&self, t: f64, y: &[f64; STM_DIM], dy: &mut [f64; STM_DIM]) {
+        let yd: [D13; DIM] = std::array::from_fn(|k| Dual::var(y[k], k));
+        let mut fd = [D13::cst(0.0); DIM];
+        self.0.rhs(t, &yd, &mut fd, |m, x| m.torque_dual(x));
+        for i in 0..DIM {
+            dy[i] = fd[i].re;
+        }
+        let phi = &y[DIM..];
+        for i in 0..DIM {
+            let ji = &fd[i].eps;
+            for j in 0..DIM {
+                let mut s = 0.0;
+                for k in 0..DIM {
+                    s += ji[k] * phi[k * DIM + j];
+                }
+                dy[DIM + i * DIM + j] = s;
+            }
+        }
+    }
+}

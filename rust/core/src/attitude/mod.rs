@@ -1,0 +1,16 @@
+//! Rigid-body attitude coupled with the CR3BP orbit (thesis ch. 3.1-3.2, PHYSICS.md sec. 4):
+//! the 3-D model (quaternion + Euler's equations, torques as plug-in models, optional orbital
+//! coupling and 13x13 STM) and the planar reduced model (phi, wz) along an orbit.
+
+pub mod body;
+pub mod dual;
+pub mod dynamics;
+pub mod planar;
+pub mod propagate;
+pub mod torque;
+
+pub use body::RigidBody;
+pub use dynamics::{dcm, Coupled, CoupledStm, OrbitMode};
+pub use planar::{forcing_sc, Forcing, FourierForcing, PlanarAlongOrbit, PlanarForced};
+pub use propagate::{propagate_attitude, propagate_planar, propagate_planar_forced, AttitudeTrajectory, PlanarTrajectory};
+pub use torque::{GravityGradient, Torque, TorqueInput};

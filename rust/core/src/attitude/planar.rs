@@ -1,0 +1,136 @@
+//! The planar reduced attitude model along an orbit (PHYSICS.md sec. 4, thesis eq. 31, 33):
+//!   phidot = wz - 1,   wzdot = (3/2) Kz [S(t) cos 2phi - C(t) sin 2phi],
+//!   S = sum_i mu_i sin(2 theta_i) / r_i^3 = sum_i mu_i 2 x_i y_i / r_i^5,
+//!   C = sum_i mu_i cos(2 theta_i) / r_i^3 = sum_i mu_i (x_i^2 - y_i^2) / r_i^5,
+//! with (x_i, y_i) the position relative to primary i (the atan2-free form). S and C depend on
+//! the orbit only: the orbit is integrated with the attitude, held at a point, or supplied
+//! precomputed through the [`Forcing`] trait (e.g. a Fourier series of the orbit).
+//! Optional 2x2 attitude STM: d/dt [dphi, dwz] = [[0, 1], [-3 Kz (S sin 2phi + C cos 2phi), 0]].
+
+use crate::cr3bp::Cr3bp;
+use crate::fourier::FourierOrbit;
+use crate::integrate::System;
+
+/// S and C at a synodic position, for the enabled primaries [larger, smaller].
+#[inline(always)]
+pub fn forcing_sc(mu: f64, pos: &[f64], primaries: [bool; 2]) -> (f64, f64) {
+    let mut s = 0.0;
+    let mut c = 0.0;
+    for (k, (cx, gm)) in [(-mu, 1.0 - mu), (1.0 - mu, mu)].into_iter().enumerate() {
+        if !primaries[k] {
+            continue;
+        }
+        let x = pos[0] - cx;
+        let y = pos[1];
+        let r2 = x * x + y * y + pos[2] * pos[2];
+        let inv5 = gm / (r2 * r2 * r2.sqrt());
+        s += 2.0 * x * y * inv5;
+        c += (x * x - y * y) * inv5;
+    }
+    (s, c)
+}
+
+/// A precomputed orbit's S(t), C(t).
+pub trait Forcing: Sync {
+    fn sc(&self, t: f64) -> (f64, f64);
+}
+
+/// S, C from a Fourier-series orbit.
+pub struct FourierForcing<'a> {
+    pub mu: f64,
+    pub orbit: &'a FourierOrbit,
+    pub primaries: [bool; 2],
+}
+
+impl Forcing for FourierForcing<'_> {
+    fn sc(&self, t: f64) -> (f64, f64) {
+        forcing_sc(self.mu, &self.orbit.position(t), self.primaries)
+    }
+}
+
+/// (phidot, wzdot) and the STM coefficient from S, C.
+#[inline(always)]
+fn attitude_rhs(kz: f64, s: f64, c: f64, phi: f64, wz: f64) -> (f64, f64, f64) {
+    let (s2, c2) = (2.0 * phi).sin_cos();
+    (wz - 1.0, 1.5 * kz * (s * c2 - c * s2), -3.0 * kz * (s * s2 + c * c2))
+}
+
+/// Planar attitude with the orbit integrated alongside (or held): state (x, y, z, xd, yd, zd,
+/// phi, wz) (8), or with the 2x2 STM appended row-major (12).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PlanarAlongOrbit {
+    pub mu: f64,
+    pub kz: f64,
+    pub primaries: [bool; 2],
+    pub held: bool,
+}
+
+impl PlanarAlongOrbit {
+    #[inline(always)]
+    fn orbit_and_attitude(&self, t: f64, y: &[f64], dy: &mut [f64]) -> f64 {
+        if self.held {
+            dy[..6].fill(0.0);
+        } else {
+            let s: [f64; 6] = std::array::from_fn(|i| y[i]);
+            let mut d = [0.0; 6];
+            Cr3bp { mu: self.mu }.derivative(t, &s, &mut d);
+            dy[..6].copy_from_slice(&d);
+        }
+        let (s, c) = forcing_sc(self.mu, &y[..3], self.primaries);
+        let (dphi, dwz, k) = attitude_rhs(self.kz, s, c, y[6], y[7]);
+        dy[6] = dphi;
+        dy[7] = dwz;
+        k
+    }
+}
+
+impl System<[f64; 8]> for PlanarAlongOrbit {
+    #[inline]
+    fn derivative(&self, t: f64, y: &[f64; 8], dy: &mut [f64; 8]) {
+        self.orbit_and_attitude(t, y, dy);
+    }
+}
+
+impl System<[f64; 12]> for PlanarAlongOrbit {
+    #[inline]
+    fn derivative(&self, t: f64, y: &[f64; 12], dy: &mut [f64; 12]) {
+        let k = self.orbit_and_attitude(t, y, dy);
+        stm2(k, &y[8..12], &mut dy[8..12]);
+    }
+}
+
+#[inline(always)]
+fn stm2(k: f64, p: &[f64], d: &mut [f64]) {
+    // [[0, 1], [k, 0]] * [[p0, p1], [p2, p3]]
+    d[0] = p[2];
+    d[1] = p[3];
+    d[2] = k * p[0];
+    d[3] = k * p[1];
+}
+
+/// Planar attitude driven by a precomputed forcing: state (phi, wz), or with the STM (6).
+pub struct PlanarForced<'a> {
+    pub kz: f64,
+    pub forcing: &'a dyn Forcing,
+}
+
+impl System<[f64; 2]> for PlanarForced<'_> {
+    #[inline]
+    fn derivative(&self, t: f64, y: &[f64; 2], dy: &mut [f64; 2]) {
+        let (s, c) = self.forcing.sc(t);
+        let (a, b, _) = attitude_rhs(self.kz, s, c, y[0], y[1]);
+        dy[0] = a;
+        dy[1] = b;
+    }
+}
+
+impl System<[f64; 6]> for PlanarForced<'_> {
+    #[inline]
+    fn derivative(&self, t: f64, y: &[f64; 6], dy: &mut [f64; 6]) {
+        let (s, c) = self.forcing.sc(t);
+        let (a, b, k) = attitude_rhs(self.kz, s, c, y[0], y[1]);
+        dy[0] = a;
+        dy[1] = b;
+        stm2(k, &y[2..6], &mut dy[2..6]);
+    }
+}

@@ -1,0 +1,159 @@
+//! Propagation drivers of the attitude models.
+
+use super::body::RigidBody;
+use super::dynamics::{Coupled, CoupledStm, OrbitMode, DIM, STM_DIM};
+use super::planar::{Forcing, PlanarAlongOrbit, PlanarForced};
+use super::torque::Torque;
+use crate::cr3bp::check_mu;
+use crate::error::{check_finite, invalid, Result};
+use crate::integrate::{solve, Options, Output, Stats};
+
+/// Result of [`propagate_attitude`].
+#[derive(Debug, Clone)]
+pub struct AttitudeTrajectory {
+    pub t: Vec<f64>,
+    /// Row-major n x 13: orbit (6), quaternion (4, scalar last), inertial rate in body axes (3).
+    pub states: Vec<f64>,
+    /// 13x13 STM (row-major) from t0 to the final time, when asked.
+    pub stm_final: Option<Vec<f64>>,
+    pub stats: Stats,
+}
+
+/// Propagate the coupled 3-D model.
+#[allow(clippy::too_many_arguments)]
+pub fn propagate_attitude(
+    mu: f64,
+    body: RigidBody,
+    torques: &[&dyn Torque],
+    orbit: OrbitMode,
+    state0: &[f64; DIM],
+    t0: f64,
+    tf: f64,
+    opts: &Options,
+    with_stm: bool,
+    output: Output<'_>,
+) -> Result<AttitudeTrajectory> {
+    check_mu(mu)?;
+    RigidBody::new(body.ix, body.iy, body.iz)?;
+    check_finite("state", state0)?;
+    let qn = (state0[6..10].iter().map(|v| v * v).sum::<f64>()).sqrt();
+    if (qn - 1.0).abs() > 1e-9 {
+        return Err(invalid("q", format!("must be a unit quaternion (scalar last), |q| = {qn}")));
+    }
+    if let OrbitMode::Coupled { inertia_nd } = orbit {
+        check_finite("inertia_nd", &inertia_nd)?;
+    }
+    let model = Coupled { mu, body, torques: torques.to_vec(), orbit };
+    if with_stm {
+        let sys = CoupledStm(model);
+        let sol = solve(&sys, t0, &CoupledStm::initial(state0), tf, opts, output, &[])?;
+        let mut states = Vec::with_capacity(sol.t.len() * DIM);
+        for row in sol.y.chunks_exact(STM_DIM) {
+            states.extend_from_slice(&row[..DIM]);
+        }
+        Ok(AttitudeTrajectory { t: sol.t, states, stm_final: Some(sol.y_final[DIM..].to_vec()), stats: sol.stats })
+    } else {
+        let sol = solve(&model, t0, state0, tf, opts, output, &[])?;
+        Ok(AttitudeTrajectory { t: sol.t, states: sol.y, stm_final: None, stats: sol.stats })
+    }
+}
+
+/// Result of [`propagate_planar`] and [`propagate_planar_forced`].
+#[derive(Debug, Clone)]
+pub struct PlanarTrajectory {
+    pub t: Vec<f64>,
+    /// Row-major n x 6 (empty when the orbit was supplied precomputed).
+    pub orbit: Vec<f64>,
+    pub phi: Vec<f64>,
+    pub wz: Vec<f64>,
+    /// 2x2 attitude STM d(phi, wz)(tf) / d(phi, wz)(t0), row-major, when asked.
+    pub stm_final: Option<[f64; 4]>,
+    pub stats: Stats,
+}
+
+fn check_kz(kz: f64) -> Result<()> {
+    if kz.is_finite() && (-1.0..=1.0).contains(&kz) {
+        Ok(())
+    } else {
+        Err(invalid("kz", format!("must be in [-1, 1], got {kz}")))
+    }
+}
+
+/// Planar attitude (phi, wz) with the orbit integrated alongside (or held at its start).
+#[allow(clippy::too_many_arguments)]
+pub fn propagate_planar(
+    mu: f64,
+    kz: f64,
+    primaries: [bool; 2],
+    held: bool,
+    orbit0: &[f64; 6],
+    phi0: f64,
+    wz0: f64,
+    t0: f64,
+    tf: f64,
+    opts: &Options,
+    with_stm: bool,
+    output: Output<'_>,
+) -> Result<PlanarTrajectory> {
+    check_mu(mu)?;
+    check_kz(kz)?;
+    check_finite("orbit_state", orbit0)?;
+    check_finite("attitude", &[phi0, wz0])?;
+    if orbit0[2] != 0.0 || orbit0[5] != 0.0 {
+        return Err(invalid("orbit_state", format!("the planar model needs a planar orbit (z = zd = 0), got z = {}, zd = {}", orbit0[2], orbit0[5])));
+    }
+    let sys = PlanarAlongOrbit { mu, kz, primaries, held };
+    let mut y0 = [0.0; 12];
+    y0[..6].copy_from_slice(orbit0);
+    y0[6] = phi0;
+    y0[7] = wz0;
+    let (t, rows, width, stm, stats) = if with_stm {
+        y0[8] = 1.0;
+        y0[11] = 1.0;
+        let sol = solve(&sys, t0, &y0, tf, opts, output, &[])?;
+        let f = sol.y_final;
+        (sol.t, sol.y, 12, Some([f[8], f[9], f[10], f[11]]), sol.stats)
+    } else {
+        let y8: [f64; 8] = std::array::from_fn(|i| y0[i]);
+        let sol = solve(&sys, t0, &y8, tf, opts, output, &[])?;
+        (sol.t, sol.y, 8, None, sol.stats)
+    };
+    let n = t.len();
+    let mut orbit = Vec::with_capacity(6 * n);
+    let (mut phi, mut wz) = (Vec::with_capacity(n), Vec::with_capacity(n));
+    for row in rows.chunks_exact(width) {
+        orbit.extend_from_slice(&row[..6]);
+        phi.push(row[6]);
+        wz.push(row[7]);
+    }
+    Ok(PlanarTrajectory { t, orbit, phi, wz, stm_final: stm, stats })
+}
+
+/// Planar attitude driven by a precomputed orbit forcing S(t), C(t).
+#[allow(clippy::too_many_arguments)]
+pub fn propagate_planar_forced(
+    kz: f64,
+    forcing: &dyn Forcing,
+    phi0: f64,
+    wz0: f64,
+    t0: f64,
+    tf: f64,
+    opts: &Options,
+    with_stm: bool,
+    output: Output<'_>,
+) -> Result<PlanarTrajectory> {
+    check_kz(kz)?;
+    check_finite("attitude", &[phi0, wz0])?;
+    let sys = PlanarForced { kz, forcing };
+    let (t, rows, width, stm, stats) = if with_stm {
+        let sol = solve(&sys, t0, &[phi0, wz0, 1.0, 0.0, 0.0, 1.0], tf, opts, output, &[])?;
+        let f = sol.y_final;
+        (sol.t, sol.y, 6, Some([f[2], f[3], f[4], f[5]]), sol.stats)
+    } else {
+        let sol = solve(&sys, t0, &[phi0, wz0], tf, opts, output, &[])?;
+        (sol.t, sol.y, 2, None, sol.stats)
+    };
+    let phi = rows.chunks_exact(width).map(|r| r[0]).collect();
+    let wz = rows.chunks_exact(width).map(|r| r[1]).collect();
+    Ok(PlanarTrajectory { t, orbit: Vec::new(), phi, wz, stm_final: stm, stats })
+}
