@@ -6,6 +6,7 @@ All quantities are nondimensional (CR3BP units) unless a name says otherwise
 """
 
 from ._core import __version__
+from .attitude import AttitudeTrajectory, RigidBody, propagate_attitude, quaternion_from_euler
 from ._errors import ConvergenceError, IntegrationError, LibrateError
 from .families import OrbitFamily, dro, dro_family, halo, halo_family, lyapunov, lyapunov_family
 from .fourier import FourierOrbit, fit_fourier
@@ -31,6 +32,10 @@ __all__ = [
     "correct_dro",
     "correct_symmetric",
     "correct_periodic",
+    "RigidBody",
+    "AttitudeTrajectory",
+    "propagate_attitude",
+    "quaternion_from_euler",
     "OrbitFamily",
     "dro",
     "dro_family",

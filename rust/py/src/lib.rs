@@ -15,6 +15,7 @@ use pyo3::exceptions::{PyException, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
+mod attitude;
 mod fourier;
 
 create_exception!(librate, LibrateError, PyException, "Base class of librate's errors.");
@@ -32,7 +33,7 @@ create_exception!(
 );
 
 /// Core error -> typed Python exception carrying its context as attributes.
-fn to_py(e: Error) -> PyErr {
+pub(crate) fn to_py(e: Error) -> PyErr {
     Python::attach(|py| match &e {
         Error::InvalidArgument { .. } => PyValueError::new_err(e.to_string()),
         Error::Integration(ie) => {
@@ -62,7 +63,7 @@ fn to_py(e: Error) -> PyErr {
 /// Integrator settings as the Python facade passes them: a dict with these keys.
 #[derive(FromPyObject)]
 #[pyo3(from_item_all)]
-struct OptionsArg {
+pub(crate) struct OptionsArg {
     rtol: f64,
     atol: f64,
     h0: Option<f64>,
@@ -402,6 +403,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(stability, m)?)?;
     m.add_function(wrap_pyfunction!(multiple_shooting, m)?)?;
     fourier::register(m)?;
+    attitude::register(m)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

@@ -12,5 +12,5 @@ pub mod torque;
 pub use body::RigidBody;
 pub use dynamics::{dcm, Coupled, CoupledStm, OrbitMode};
 pub use planar::{forcing_sc, Forcing, FourierForcing, PlanarAlongOrbit, PlanarForced};
-pub use propagate::{propagate_attitude, propagate_planar, propagate_planar_forced, AttitudeTrajectory, PlanarTrajectory};
-pub use torque::{GravityGradient, Torque, TorqueInput};
+pub use propagate::{evaluate_torques, propagate_attitude, propagate_planar, propagate_planar_forced, AttitudeTrajectory, PlanarTrajectory};
+pub use torque::{gravity_gradient_by_name, GravityGradient, Torque, TorqueInput};

@@ -157,3 +157,35 @@ pub fn propagate_planar_forced(
     let wz = rows.chunks_exact(width).map(|r| r[1]).collect();
     Ok(PlanarTrajectory { t, orbit: Vec::new(), phi, wz, stm_final: stm, stats })
 }
+
+/// The total torque of `torques` (body axes) at each coupled state (rows of 13).
+pub fn evaluate_torques(mu: f64, body: RigidBody, torques: &[&dyn Torque], t: &[f64], states: &[f64]) -> Result<Vec<[f64; 3]>> {
+    check_mu(mu)?;
+    if states.len() != 13 * t.len() {
+        return Err(invalid("states", format!("need one row of 13 per time: {} values for {} times", states.len(), t.len())));
+    }
+    Ok(states
+        .chunks_exact(13)
+        .zip(t)
+        .map(|(s, &ti)| {
+            let q = [s[6], s[7], s[8], s[9]];
+            let input = super::torque::TorqueInput {
+                t: ti,
+                mu,
+                pos: [s[0], s[1], s[2]],
+                vel: [s[3], s[4], s[5]],
+                a: super::dynamics::dcm(&q),
+                w: [s[10], s[11], s[12]],
+                inertia: body.moments(),
+            };
+            let mut out = [0.0; 3];
+            for m in torques {
+                let v = m.torque(&input);
+                for i in 0..3 {
+                    out[i] += v[i];
+                }
+            }
+            out
+        })
+        .collect())
+}

@@ -83,3 +83,21 @@ impl Torque for GravityGradient {
         self.eval(x)
     }
 }
+
+/// Torque models by name, for the bindings and configuration files: "gravity_gradient" (both
+/// primaries), "gravity_gradient_earth" / "gravity_gradient_primary1" (the larger only),
+/// "gravity_gradient_moon" / "gravity_gradient_primary2" (the smaller only).
+pub fn gravity_gradient_by_name(name: &str) -> crate::error::Result<GravityGradient> {
+    let primaries = match name {
+        "gravity_gradient" => [true, true],
+        "gravity_gradient_earth" | "gravity_gradient_primary1" => [true, false],
+        "gravity_gradient_moon" | "gravity_gradient_primary2" => [false, true],
+        _ => {
+            return Err(crate::error::invalid(
+                "torques",
+                format!("unknown torque {name:?}; known: gravity_gradient, gravity_gradient_earth, gravity_gradient_moon"),
+            ))
+        }
+    };
+    Ok(GravityGradient { primaries })
+}

@@ -1,0 +1,227 @@
+"""Rigid-body attitude coupled with the CR3BP orbit (thesis ch. 3.1-3.2, PHYSICS.md sec. 4).
+
+The 3-D model integrates the orbit (6), the quaternion q of the body relative to the synodic
+frame (scalar last) and the inertial angular velocity w in body axes; the planar reduced model
+integrates (phi, wz), phi the angle from the synodic X axis to the body x axis and wz the
+inertial rate, along the orbit. Torques: gravity gradient of both primaries (switchable per
+primary). All quantities nondimensional (rates in 1/TU).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Sequence
+
+import numpy as np
+
+from . import _core
+from ._checks import as_state, as_time_span
+from .propagation import Stats, _options
+from .system import System, resolve_system
+
+__all__ = ["RigidBody", "AttitudeTrajectory", "propagate_attitude", "quaternion_from_euler", "TORQUES"]
+
+#: Torque model names accepted by ``torques=``.
+TORQUES = ("gravity_gradient", "gravity_gradient_earth", "gravity_gradient_moon")
+_EULER = {"123": "XYZ", "321": "ZYX", "313": "ZXZ"}
+
+
+@dataclass(frozen=True)
+class RigidBody:
+    """Principal moments of inertia about the body axes x, y, z (kg m^2, or normalised: only
+    ratios matter for gravity-gradient dynamics). ``mass_kg`` is needed only for the orbital
+    coupling term (thesis eq. 37). Validated: positive, triangle inequality."""
+
+    ix: float
+    iy: float
+    iz: float
+    mass_kg: float | None = None
+
+    def __post_init__(self) -> None:
+        _core.rigid_body_kz(float(self.ix), float(self.iy), float(self.iz))
+        if self.mass_kg is not None and not (math.isfinite(self.mass_kg) and self.mass_kg > 0):
+            raise ValueError(f"invalid argument `mass_kg`: must be finite and > 0, got {self.mass_kg!r}")
+
+    @classmethod
+    def from_kz(cls, kz: float) -> RigidBody:
+        """A planar body with Kz = (Iy - Ix)/Iz in [-1, 1] (Iz = 1, Ix + Iy = 1)."""
+        if not (math.isfinite(kz) and -1 <= kz <= 1):
+            raise ValueError(f"invalid argument `kz`: must be in [-1, 1], got {kz!r}")
+        return cls(0.5 * (1 - kz), 0.5 * (1 + kz), 1.0)
+
+    @property
+    def kz(self) -> float:
+        """Kz = (Iy - Ix) / Iz."""
+        return (self.iy - self.ix) / self.iz
+
+    @property
+    def moments(self) -> tuple[float, float, float]:
+        return (float(self.ix), float(self.iy), float(self.iz))
+
+
+def quaternion_from_euler(angles: Sequence[float], sequence: str = "123") -> np.ndarray:
+    """Scalar-last quaternion of the body relative to the synodic frame from Euler angles
+    (rad) in a named sequence ("123" = rotations about x, then the new y, then the new z, the
+    thesis's convention; also "321", "313" or any scipy sequence)."""
+    from scipy.spatial.transform import Rotation
+
+    return Rotation.from_euler(_EULER.get(sequence, sequence), angles).as_quat()
+
+
+@dataclass(frozen=True)
+class AttitudeTrajectory:
+    """Result of :func:`propagate_attitude`: ``t`` (n,), ``orbit`` (n, 6), ``q`` (n, 4, scalar
+    last), ``w`` (n, 3, inertial rate in body axes); planar runs also ``phi`` and ``wz`` (n,).
+    ``stm``: 13x13 (3-D) or 2x2 (planar, d(phi, wz)) at the final time, when asked."""
+
+    system: System
+    body: RigidBody
+    torque_models: tuple[str, ...]
+    planar: bool
+    t: np.ndarray
+    orbit: np.ndarray
+    q: np.ndarray
+    w: np.ndarray
+    phi: np.ndarray | None
+    wz: np.ndarray | None
+    stm: np.ndarray | None
+    stats: Stats
+
+    def dcm(self) -> np.ndarray:
+        """(n, 3, 3) attitude matrices A (synodic -> body components)."""
+        from scipy.spatial.transform import Rotation
+
+        return np.transpose(Rotation.from_quat(self.q).as_matrix(), (0, 2, 1))
+
+    def euler_angles(self, sequence: str = "123") -> np.ndarray:
+        """(n, 3) Euler angles of the body relative to the synodic frame (rad)."""
+        from scipy.spatial.transform import Rotation
+
+        return Rotation.from_quat(self.q).as_euler(_EULER.get(sequence, sequence))
+
+    def local_vertical_frame(self, primary: str | int = "earth") -> np.ndarray:
+        """(n, 3, 3) matrices whose columns are the local-vertical axes of ``primary`` in synodic
+        components: x radial (from the primary), z along the orbit normal about that primary
+        (inertial velocity), y completing the triad."""
+        k = {"earth": 0, "moon": 1, 1: 0, 2: 1}.get(primary)
+        if k is None:
+            raise ValueError(f"invalid argument `primary`: must be 'earth', 'moon', 1 or 2, got {primary!r}")
+        r = self.orbit[:, :3] - self.system.primary_positions()[k]
+        v = self.orbit[:, 3:] + np.cross([0.0, 0.0, 1.0], r)
+        x = r / np.linalg.norm(r, axis=1, keepdims=True)
+        z = np.cross(r, v)
+        z /= np.linalg.norm(z, axis=1, keepdims=True)
+        y = np.cross(z, x)
+        return np.stack([x, y, z], axis=2)
+
+    def relative_to_vertical(self, primary: str | int = "earth", sequence: str = "123") -> np.ndarray:
+        """(n, 3) Euler angles of the body relative to the local vertical of a primary (roll,
+        pitch, yaw about the radial, along-track and normal axes for "123")."""
+        from scipy.spatial.transform import Rotation
+
+        a_bl = self.dcm() @ self.local_vertical_frame(primary)
+        return Rotation.from_matrix(np.transpose(a_bl, (0, 2, 1))).as_euler(_EULER.get(sequence, sequence))
+
+    def torques(self) -> np.ndarray:
+        """(n, 3) total torque of the run's torque models in body axes (inertia units / TU^2)."""
+        states = np.ascontiguousarray(np.hstack([self.orbit, self.q, self.w]))
+        return _core.attitude_torques(self.system.mu, list(self.body.moments), list(self.torque_models), np.ascontiguousarray(self.t), states)
+
+
+def propagate_attitude(
+    system: System | str,
+    orbit_state,
+    attitude,
+    body: RigidBody,
+    t_span,
+    *,
+    torques: Sequence[str] = ("gravity_gradient",),
+    planar: bool = False,
+    orbit: str = "integrate",
+    stm: bool = False,
+    t_eval=None,
+    rtol: float = 1e-12,
+    atol: float = 1e-12,
+    h0: float | None = None,
+    h_min: float = 0.0,
+    h_max: float = math.inf,
+    max_steps: int = 1_000_000,
+    safety: float = 0.8,
+    fixed_step: float | None = None,
+) -> AttitudeTrajectory:
+    """Propagate the attitude of a rigid body along its CR3BP orbit.
+
+    ``attitude`` is ``(q, w)`` in 3-D (q scalar-last unit quaternion of the body relative to the
+    synodic frame, w the inertial angular velocity in body axes) or ``(phi0, wz0)`` when
+    ``planar`` (the reduced model; wz inertial, phidot = wz - 1). ``torques``: names from
+    :data:`TORQUES` ("gravity_gradient_earth" alone is the two-body limit). ``orbit``:
+    "integrate" (point-mass CR3BP), "held" (the body kept at its initial position, as at the
+    Lagrange points) or "coupled" (with the second-order extended-body acceleration, thesis
+    eq. 37, which needs ``body.mass_kg``; inertia in kg m^2 and the system's LU).
+    """
+    sys_ = resolve_system(system)
+    s = as_state(orbit_state, "orbit_state")
+    t0, tf = as_time_span(t_span)
+    if not isinstance(body, RigidBody):
+        raise ValueError(f"invalid argument `body`: must be a librate.RigidBody, got {body!r}")
+    names = tuple(torques)
+    for n in names:
+        if n not in TORQUES:
+            raise ValueError(f"invalid argument `torques`: unknown torque {n!r}; known: {', '.join(TORQUES)}")
+    if orbit not in ("integrate", "held", "coupled"):
+        raise ValueError(f"invalid argument `orbit`: must be 'integrate', 'held' or 'coupled', got {orbit!r}")
+    opts = _options(rtol, atol, h0, h_min, h_max, max_steps, safety, fixed_step)
+    te = None if t_eval is None else np.ascontiguousarray(t_eval, dtype=np.float64).ravel()
+
+    if planar:
+        if orbit == "coupled":
+            raise ValueError("invalid argument `orbit`: the planar reduced model has no orbital coupling; use planar=False")
+        phi0, wz0 = _pair(attitude)
+        primaries = [any(n in ("gravity_gradient", "gravity_gradient_earth") for n in names),
+                     any(n in ("gravity_gradient", "gravity_gradient_moon") for n in names)]
+        r = _core.planar_propagate(sys_.mu, body.kz, primaries, orbit == "held", [float(v) for v in s], phi0, wz0, t0, tf,
+                                   options=opts, stm=bool(stm), t_eval=te)
+        phi, wz = r["phi"], r["wz"]
+        zero = np.zeros_like(phi)
+        q = np.stack([zero, zero, np.sin(0.5 * phi), np.cos(0.5 * phi)], axis=1)
+        w = np.stack([zero, zero, wz], axis=1)
+        return AttitudeTrajectory(sys_, body, names, True, r["t"], r["orbit"], q, w, phi, wz, r["stm"], Stats(*r["stats"]))
+
+    q0, w0 = _quaternion_and_rate(attitude)
+    inertia_nd = None
+    if orbit == "coupled":
+        if body.mass_kg is None:
+            raise ValueError("invalid argument `body`: orbit='coupled' needs body.mass_kg (kg) and the inertia in kg m^2")
+        lu_m = sys_.lu_km * 1e3
+        inertia_nd = [m / (body.mass_kg * lu_m * lu_m) for m in body.moments]
+    state0 = [*map(float, s), *map(float, q0), *map(float, w0)]
+    r = _core.attitude_propagate(sys_.mu, list(body.moments), list(names), orbit, state0, t0, tf,
+                                 options=opts, stm=bool(stm), t_eval=te, inertia_nd=inertia_nd)
+    st = r["states"]
+    return AttitudeTrajectory(sys_, body, names, False, r["t"], st[:, :6], st[:, 6:10], st[:, 10:], None, None, r["stm"], Stats(*r["stats"]))
+
+
+def _pair(attitude) -> tuple[float, float]:
+    try:
+        phi0, wz0 = (float(v) for v in attitude)
+    except (TypeError, ValueError):
+        raise ValueError(f"invalid argument `attitude`: planar runs take (phi0, wz0), got {attitude!r}") from None
+    if not (math.isfinite(phi0) and math.isfinite(wz0)):
+        raise ValueError(f"invalid argument `attitude`: (phi0, wz0) must be finite, got {attitude!r}")
+    return phi0, wz0
+
+
+def _quaternion_and_rate(attitude) -> tuple[np.ndarray, np.ndarray]:
+    try:
+        q, w = attitude
+        q = np.asarray(q, dtype=np.float64).ravel()
+        w = np.asarray(w, dtype=np.float64).ravel()
+    except (TypeError, ValueError):
+        raise ValueError(f"invalid argument `attitude`: 3-D runs take (q, w), q of 4 (scalar last) and w of 3 components, got {attitude!r}") from None
+    if q.shape != (4,) or w.shape != (3,) or not (np.all(np.isfinite(q)) and np.all(np.isfinite(w))):
+        raise ValueError(f"invalid argument `attitude`: q must have 4 finite components (scalar last) and w 3, got shapes {q.shape}, {w.shape}")
+    n = np.linalg.norm(q)
+    if abs(n - 1) > 1e-6:
+        raise ValueError(f"invalid argument `attitude`: q must be a unit quaternion, |q| = {n}")
+    return q / n, w

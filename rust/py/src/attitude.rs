@@ -1,0 +1,128 @@
+//! Bindings of the attitude models: convert, call the core with the GIL released, convert.
+
+use librate_core::attitude::{self, gravity_gradient_by_name, GravityGradient, OrbitMode, RigidBody, Torque};
+use librate_core::integrate::{Options, Output};
+use numpy::{IntoPyArray, PyArrayMethods, PyReadonlyArray1};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+use crate::{to_py, OptionsArg};
+
+fn output<'a>(t_eval: &'a Option<Vec<f64>>) -> Output<'a> {
+    match t_eval {
+        Some(t) => Output::At(t),
+        None => Output::Steps,
+    }
+}
+
+/// Coupled 3-D orbit-attitude propagation.
+#[pyfunction]
+#[pyo3(signature = (mu, inertia, torques, orbit_mode, state0, t0, tf, *, options, stm, t_eval, inertia_nd=None))]
+#[allow(clippy::too_many_arguments)]
+fn attitude_propagate<'py>(
+    py: Python<'py>,
+    mu: f64,
+    inertia: [f64; 3],
+    torques: Vec<String>,
+    orbit_mode: &str,
+    state0: [f64; 13],
+    t0: f64,
+    tf: f64,
+    options: OptionsArg,
+    stm: bool,
+    t_eval: Option<PyReadonlyArray1<'py, f64>>,
+    inertia_nd: Option<[f64; 3]>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let body = RigidBody::new(inertia[0], inertia[1], inertia[2]).map_err(to_py)?;
+    let models: Vec<GravityGradient> = torques.iter().map(|n| gravity_gradient_by_name(n)).collect::<Result<_, _>>().map_err(to_py)?;
+    let mode = match (orbit_mode, inertia_nd) {
+        ("integrate", _) => OrbitMode::Integrate,
+        ("held", _) => OrbitMode::Held,
+        ("coupled", Some(i)) => OrbitMode::Coupled { inertia_nd: i },
+        _ => return Err(PyValueError::new_err(format!("invalid argument `orbit`: {orbit_mode:?} (coupling needs the body's mass)"))),
+    };
+    let opts = Options::from(options);
+    let times = t_eval.map(|a| a.as_array().to_vec());
+    let tr = py
+        .detach(|| {
+            let refs: Vec<&dyn Torque> = models.iter().map(|m| m as &dyn Torque).collect();
+            attitude::propagate_attitude(mu, body, &refs, mode, &state0, t0, tf, &opts, stm, output(&times))
+        })
+        .map_err(to_py)?;
+    let n = tr.t.len();
+    let d = PyDict::new(py);
+    d.set_item("t", tr.t.into_pyarray(py))?;
+    d.set_item("states", tr.states.into_pyarray(py).reshape([n, 13])?)?;
+    d.set_item("stm", match tr.stm_final { Some(m) => Some(m.into_pyarray(py).reshape([13, 13])?), None => None })?;
+    d.set_item("stats", (tr.stats.accepted, tr.stats.rejected, tr.stats.rhs_evals))?;
+    Ok(d)
+}
+
+/// Planar reduced attitude model along an integrated (or held) orbit.
+#[pyfunction]
+#[pyo3(signature = (mu, kz, primaries, held, orbit0, phi0, wz0, t0, tf, *, options, stm, t_eval))]
+#[allow(clippy::too_many_arguments)]
+fn planar_propagate<'py>(
+    py: Python<'py>,
+    mu: f64,
+    kz: f64,
+    primaries: [bool; 2],
+    held: bool,
+    orbit0: [f64; 6],
+    phi0: f64,
+    wz0: f64,
+    t0: f64,
+    tf: f64,
+    options: OptionsArg,
+    stm: bool,
+    t_eval: Option<PyReadonlyArray1<'py, f64>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let opts = Options::from(options);
+    let times = t_eval.map(|a| a.as_array().to_vec());
+    let tr = py
+        .detach(|| attitude::propagate_planar(mu, kz, primaries, held, &orbit0, phi0, wz0, t0, tf, &opts, stm, output(&times)))
+        .map_err(to_py)?;
+    let n = tr.t.len();
+    let d = PyDict::new(py);
+    d.set_item("t", tr.t.into_pyarray(py))?;
+    d.set_item("orbit", tr.orbit.into_pyarray(py).reshape([n, 6])?)?;
+    d.set_item("phi", tr.phi.into_pyarray(py))?;
+    d.set_item("wz", tr.wz.into_pyarray(py))?;
+    d.set_item("stm", match tr.stm_final { Some(m) => Some(m.to_vec().into_pyarray(py).reshape([2, 2])?), None => None })?;
+    d.set_item("stats", (tr.stats.accepted, tr.stats.rejected, tr.stats.rhs_evals))?;
+    Ok(d)
+}
+
+/// Total torque (body axes, inertia units / TU^2) at coupled states (n, 13).
+#[pyfunction]
+fn attitude_torques<'py>(
+    py: Python<'py>,
+    mu: f64,
+    inertia: [f64; 3],
+    torques: Vec<String>,
+    t: PyReadonlyArray1<'py, f64>,
+    states: numpy::PyReadonlyArray2<'py, f64>,
+) -> PyResult<Bound<'py, PyAny>> {
+    let body = RigidBody::new(inertia[0], inertia[1], inertia[2]).map_err(to_py)?;
+    let models: Vec<GravityGradient> = torques.iter().map(|n| gravity_gradient_by_name(n)).collect::<Result<_, _>>().map_err(to_py)?;
+    let refs: Vec<&dyn Torque> = models.iter().map(|m| m as &dyn Torque).collect();
+    let flat: Vec<f64> = states.as_array().iter().copied().collect();
+    let out = attitude::evaluate_torques(mu, body, &refs, t.as_slice()?, &flat).map_err(to_py)?;
+    let n = out.len();
+    Ok(out.into_iter().flatten().collect::<Vec<f64>>().into_pyarray(py).reshape([n, 3])?.into_any())
+}
+
+/// Validate principal moments (ValueError naming the bad one); returns Kz.
+#[pyfunction]
+fn rigid_body_kz(ix: f64, iy: f64, iz: f64) -> PyResult<f64> {
+    RigidBody::new(ix, iy, iz).map(|b| b.kz()).map_err(to_py)
+}
+
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(attitude_propagate, m)?)?;
+    m.add_function(wrap_pyfunction!(planar_propagate, m)?)?;
+    m.add_function(wrap_pyfunction!(rigid_body_kz, m)?)?;
+    m.add_function(wrap_pyfunction!(attitude_torques, m)?)?;
+    Ok(())
+}
