@@ -1,0 +1,512 @@
+"""Figures of periodic-orbit families and orbits (thesis ch. 2), drawn with matplotlib.
+
+This module is the only part of librate that uses matplotlib, and ``import librate`` does not
+import it: import it explicitly, ``import librate.plotting as lp`` (install with
+``pip install "librate[plot]"``). ``matplotlib.pyplot`` itself is imported only when a function
+has to create a figure.
+
+Every ``plot_*`` function takes the data (an :class:`~librate.OrbitFamily` or
+:class:`~librate.PeriodicOrbit` objects) and an optional ``ax``: with ``ax=None`` it creates a
+new figure (through ``pyplot``, so ``plt.show()`` displays it; close it with ``plt.close(fig)``
+when drawing many), otherwise it draws into the given Axes (a sequence of Axes where a
+function draws several panels). **Every function returns the matplotlib Figure** it drew
+into; it never calls ``plt.show()``. Axes are labelled with units: LU (the primaries'
+distance, ``system.lu_km``), TU, days or km. Artists carry a ``gid`` naming what they show
+(``"orbit"``, ``"earth"``, ``"resonance-synodic-2"``, ...), so figures can be inspected.
+
+- :func:`plot_family`: a family's orbits in the synodic frame, coloured by Jacobi constant (Fig. 3)
+- :func:`plot_period`: period against x0 with synodic and Sun resonances (Fig. 6)
+- :func:`plot_stability`: stability indices against x0 with bifurcations (Fig. 5)
+- :func:`plot_eci`: orbits in the Earth-centred inertial frame, in km (Figs. 7a, 10, 11)
+- :func:`save_figure`: write a figure to a file
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable, Sequence
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+try:
+    import matplotlib
+    from matplotlib.axes import Axes
+    from matplotlib.cm import ScalarMappable
+    from matplotlib.colors import Normalize
+    from matplotlib.lines import Line2D
+    from matplotlib.ticker import FuncFormatter
+    from matplotlib.transforms import blended_transform_factory
+except ImportError as exc:  # pragma: no cover - depends on the environment
+    raise ImportError('librate.plotting needs matplotlib >= 3.6: pip install "librate[plot]"') from exc
+
+from .constants import SUN_SYNODIC_PERIOD
+from .families import OrbitFamily
+from .frames import synodic_to_eci
+from .orbits import PeriodicOrbit
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
+
+__all__ = ["plot_family", "plot_period", "plot_stability", "plot_eci", "save_figure"]
+
+_EARTH = dict(marker="o", color="tab:blue", markersize=9, markeredgecolor="k", linestyle="none")
+_MOON = dict(marker="o", color="0.6", markersize=6, markeredgecolor="k", linestyle="none")
+_LPOINT = dict(marker="x", color="k", markersize=6, linestyle="none")
+# Label offsets (points) and alignment, so that L1, the Moon and L2 do not overlap.
+_LABEL_OFFSETS = {"Earth": (-6, 6, "right"), "Moon": (0, -13, "center"), "L1": (-4, 5, "right"),
+                  "L2": (4, 5, "left"), "L3": (-4, 5, "right")}
+_PROJECTIONS = ("xy", "xz", "yz", "3d")
+_QUANTITIES = {
+    "x0": "$x_0$ (LU)",
+    "z0": "$z_0$ (LU)",
+    "jacobi": "Jacobi constant $C$ (LU$^2$/TU$^2$)",
+}
+
+
+# --- helpers -----------------------------------------------------------------------------------
+def _check_family(family) -> OrbitFamily:
+    if not isinstance(family, OrbitFamily):
+        raise ValueError(f"invalid argument `family`: must be a librate.OrbitFamily, got {type(family).__name__}")
+    return family
+
+
+def _axes(ax, n: int, *, three_d: Sequence[bool] | None = None, figsize=None) -> tuple[Figure, list[Axes]]:
+    """The figure and a list of ``n`` Axes: new ones (up to three per row, constrained layout)
+    when ``ax`` is None, else the given Axes (one, or a sequence of ``n``)."""
+    three_d = list(three_d or [False] * n)
+    if ax is None:
+        import matplotlib.pyplot as plt
+
+        ncols = min(n, 3)
+        nrows = math.ceil(n / ncols)
+        fig = plt.figure(figsize=figsize or (5.2 * ncols, 4.8 * nrows), layout="constrained")
+        axs = [fig.add_subplot(nrows, ncols, i + 1, projection="3d" if three_d[i] else None) for i in range(n)]
+        return fig, axs
+    axs = [ax] if isinstance(ax, Axes) else list(ax)
+    if len(axs) != n or not all(isinstance(a, Axes) for a in axs):
+        raise ValueError(f"invalid argument `ax`: this figure needs {n} matplotlib Axes, got {ax!r}")
+    for a, want in zip(axs, three_d):
+        if want and a.name != "3d":
+            raise ValueError("invalid argument `ax`: a 3-D projection needs Axes created with projection='3d'")
+    return axs[0].figure, axs
+
+
+def _pick(n: int, n_orbits: int | None) -> np.ndarray:
+    """Indices of ``n_orbits`` members evenly spread over ``n`` (first and last included)."""
+    if n_orbits is None or n_orbits >= n:
+        return np.arange(n)
+    if isinstance(n_orbits, bool) or not isinstance(n_orbits, (int, np.integer)) or n_orbits < 1:
+        raise ValueError(f"invalid argument `n_orbits`: must be an integer >= 1 or None (all members), got {n_orbits!r}")
+    return np.round(np.linspace(0, n - 1, int(n_orbits))).astype(int)
+
+
+def _against(family: OrbitFamily, against: str) -> tuple[np.ndarray, str]:
+    if against not in _QUANTITIES:
+        raise ValueError(f"invalid argument `against`: must be one of {', '.join(_QUANTITIES)}, got {against!r}")
+    q = {"x0": family.x0, "z0": family.z0, "jacobi": family.jacobi}[against]
+    return np.asarray(q, dtype=float), _QUANTITIES[against]
+
+
+def _length_scale(system, units: str) -> tuple[float, str]:
+    if units == "LU":
+        return 1.0, "LU"
+    if units == "km":
+        return system.lu_km, "km"
+    raise ValueError(f"invalid argument `units`: must be 'LU' or 'km', got {units!r}")
+
+
+def _time_scale(system, units: str) -> tuple[float, str]:
+    if units == "days":
+        return system.tu_days, "days"
+    if units == "TU":
+        return 1.0, "TU"
+    raise ValueError(f"invalid argument `units`: must be 'days' or 'TU', got {units!r}")
+
+
+def _crossings(x: np.ndarray, y: np.ndarray, level: float) -> list[float]:
+    """x where the polyline (x, y) crosses y = level (linear interpolation)."""
+    out = []
+    d = y - level
+    for i in range(len(d) - 1):
+        if not (np.isfinite(d[i]) and np.isfinite(d[i + 1])):
+            continue
+        if d[i] == 0:
+            out.append(float(x[i]))
+        elif d[i] * d[i + 1] < 0:
+            w = d[i] / (d[i] - d[i + 1])
+            out.append(float(x[i] + w * (x[i + 1] - x[i])))
+    if len(d) and d[-1] == 0:
+        out.append(float(x[-1]))
+    return out
+
+
+def _resonance_label(orbit: PeriodicOrbit, tol: float = 1e-6) -> str | None:
+    """'1:K' when T = 2 pi / K, '1:K Sun' when T = Ts / K (relative tolerance ``tol``)."""
+    for base, suffix in ((2 * math.pi, ""), (SUN_SYNODIC_PERIOD, " Sun")):
+        k = base / orbit.period
+        if round(k) >= 1 and abs(k - round(k)) < tol * k:
+            return f"1:{round(k)}{suffix}"
+    return None
+
+
+# --- synodic-frame family (Fig. 3) ------------------------------------------------------------
+def plot_family(
+    family: OrbitFamily,
+    ax=None,
+    *,
+    n_orbits: int | None = 30,
+    color_by: str | None = "jacobi",
+    projection: str | Sequence[str] | None = None,
+    units: str = "LU",
+    samples: int = 600,
+    primaries: bool = True,
+    lagrange_points: Iterable[int] = (1, 2),
+    cmap: str = "turbo",
+    clim: tuple[float, float] | None = None,
+    colorbar: bool = True,
+    linewidth: float = 0.8,
+) -> Figure:
+    """The orbits of a family in the synodic frame, coloured by Jacobi constant (thesis Fig. 3).
+
+    ``n_orbits`` members evenly spread along the family (the first and last included; None:
+    all) are propagated over one period and drawn with ``samples`` points each, one line per
+    orbit (``gid="orbit"``, in family order). ``color_by``: ``"jacobi"``, ``"period"`` (days),
+    ``"x0"`` or None (one colour); the colour scale spans the whole family's range (or
+    ``clim=(vmin, vmax)``) and a colorbar shows it. ``projection``: ``"xy"``, ``"xz"``,
+    ``"yz"``, ``"3d"`` or a sequence of them, one panel each; default ``"xy"`` for planar
+    families and ``("xy", "xz")`` for spatial ones. ``ax``: one Axes per panel (3-D panels need
+    ``projection="3d"`` Axes). ``units``: ``"LU"`` or ``"km"``. ``primaries`` marks the Earth
+    and the Moon, ``lagrange_points`` the listed L-points (``()`` for none); a marker far from
+    the orbits does not widen the view. Returns the Figure.
+    """
+    fam = _check_family(family)
+    sys_ = fam.system
+    if projection is None:
+        projection = ("xy", "xz") if fam.spatial else "xy"
+    projs = [projection] if isinstance(projection, str) else list(projection)
+    if not projs or any(p not in _PROJECTIONS for p in projs):
+        raise ValueError(f"invalid argument `projection`: must be one of {', '.join(_PROJECTIONS)} or a sequence of them, got {projection!r}")
+    if isinstance(samples, bool) or not isinstance(samples, (int, np.integer)) or samples < 2:
+        raise ValueError(f"invalid argument `samples`: must be an integer >= 2, got {samples!r}")
+    scale, unit = _length_scale(sys_, units)
+    colors = {"jacobi": (fam.jacobi, "Jacobi constant $C$ (LU$^2$/TU$^2$)"),
+              "period": (fam.period_days, "period $T$ (days)"),
+              "x0": (fam.x0, "$x_0$ (LU)")}
+    if color_by is not None and color_by not in colors:
+        raise ValueError(f"invalid argument `color_by`: must be one of {', '.join(colors)} or None, got {color_by!r}")
+    if clim is not None and not (len(clim) == 2 and all(math.isfinite(float(c)) for c in clim) and clim[0] < clim[1]):
+        raise ValueError(f"invalid argument `clim`: must be (vmin, vmax) with vmin < vmax, got {clim!r}")
+    lpoints = [int(k) for k in lagrange_points]
+    if any(k not in (1, 2, 3, 4, 5) for k in lpoints):
+        raise ValueError(f"invalid argument `lagrange_points`: must list L-point numbers 1..5, got {lagrange_points!r}")
+
+    created = ax is None
+    fig, axs = _axes(ax, len(projs), three_d=[p == "3d" for p in projs],
+                     figsize=(7.0, 5.6) if len(projs) == 1 else None)
+    sel = _pick(len(fam), n_orbits)
+    if color_by is not None:
+        values, clabel = colors[color_by]
+        finite = np.asarray(values)[np.isfinite(values)]
+        vmin, vmax = (float(finite.min()), float(finite.max())) if clim is None else (float(clim[0]), float(clim[1]))
+        norm = Normalize(vmin=vmin, vmax=vmax)
+        cm = matplotlib.colormaps[cmap]
+
+    paths = []
+    for i in sel:
+        orbit = fam[int(i)]
+        tr = orbit.propagate(t_eval=np.linspace(0.0, orbit.period, int(samples)))
+        paths.append(tr.y[:, :3] * scale)
+    comps = {"x": 0, "y": 1, "z": 2}
+    for a, proj in zip(axs, projs):
+        for i, p in zip(sel, paths):
+            color = cm(norm(float(values[i]))) if color_by is not None else "tab:blue"
+            if proj == "3d":
+                (line,) = a.plot(p[:, 0], p[:, 1], p[:, 2], color=color, linewidth=linewidth)
+            else:
+                (line,) = a.plot(p[:, comps[proj[0]]], p[:, comps[proj[1]]], color=color, linewidth=linewidth)
+            line.set_gid("orbit")
+        allp = np.vstack(paths)
+        lo, hi = allp.min(axis=0), allp.max(axis=0)
+        pad = 0.25 * np.max(hi - lo)
+        marks = []
+        if primaries:
+            e, m = sys_.primary_positions() * scale
+            marks += [(e, "Earth", _EARTH, "earth"), (m, "Moon", _MOON, "moon")]
+        if lpoints:
+            lp = sys_.lagrange_points() * scale
+            for k in lpoints:
+                marks.append((lp[k - 1], f"L{k}", _LPOINT, f"L{k}"))
+        for pos, name, style, gid in marks:
+            # A marker far outside the orbits (the Earth, for halos about L2) does not zoom out.
+            shown = [0, 1, 2] if proj == "3d" else [comps[proj[0]], comps[proj[1]]]
+            near = bool(np.all((pos[shown] >= lo[shown] - pad) & (pos[shown] <= hi[shown] + pad)))
+            if proj == "3d":
+                if not near:
+                    continue
+                (h,) = a.plot([pos[0]], [pos[1]], [pos[2]], **style)
+                a.text(pos[0], pos[1], pos[2], f"  {name}", fontsize=8)
+            else:
+                u, v = pos[comps[proj[0]]], pos[comps[proj[1]]]
+                if near:
+                    (h,) = a.plot([u], [v], **style)
+                else:  # drawn, but kept out of the data limits
+                    h = a.add_artist(Line2D([u], [v], **style))
+                dx, dy, ha = _LABEL_OFFSETS.get(name, (4, 5, "left"))
+                a.annotate(name, (u, v), xytext=(dx, dy), textcoords="offset points", fontsize=8, ha=ha)
+            h.set_gid(gid)
+        if proj == "3d":
+            a.set_xlabel(f"x ({unit})")
+            a.set_ylabel(f"y ({unit})")
+            a.set_zlabel(f"z ({unit})")
+            a.set_box_aspect(np.maximum(np.ptp(allp, axis=0), 1e-3 * np.ptp(allp)))
+        else:
+            a.set_xlabel(f"{proj[0]} ({unit})")
+            a.set_ylabel(f"{proj[1]} ({unit})")
+            a.set_aspect("equal", adjustable="datalim")
+            a.grid(True, linewidth=0.3, alpha=0.5)
+    if color_by is not None and colorbar:
+        sm = ScalarMappable(norm=norm, cmap=cm)
+        sm.set_array(np.asarray(values))
+        fig.colorbar(sm, ax=axs, label=clabel, shrink=0.9)
+    if created:
+        axs[0].set_title(f"{fam.kind} family, synodic frame ({len(sel)} of {len(fam)} members)")
+    return fig
+
+
+# --- period and resonances (Fig. 6) ------------------------------------------------------------
+def plot_period(
+    family: OrbitFamily,
+    ax=None,
+    *,
+    resonances: Iterable[int] = (1, 2, 3, 4),
+    sun_resonances: Iterable[int] = (2, 4),
+    units: str = "days",
+    against: str = "x0",
+    primaries: bool = True,
+    markers: bool = True,
+) -> Figure:
+    """The period of a family's members against x0 (thesis Fig. 6), with the resonances.
+
+    The family's period is the line ``gid="period"``; horizontal lines mark the synodic 1:K
+    resonances, T = 2 pi / K (``gid="resonance-synodic-K"``, dashed), and the Sun-resonant 1:K,
+    T = Ts / K with Ts = :data:`librate.constants.SUN_SYNODIC_PERIOD` the apparent solar period
+    in the synodic frame (``gid="resonance-sun-K"``, dotted), each labelled in the legend; with
+    ``markers``, a labelled dot marks where the family crosses each line (interpolated between
+    members). ``units``: ``"days"`` (via the system's TU) or ``"TU"``. ``against``: ``"x0"``,
+    ``"z0"`` or ``"jacobi"``; for x0, ``primaries`` draws vertical lines at the Earth (-mu) and
+    the Moon (1 - mu). Returns the Figure.
+    """
+    fam = _check_family(family)
+    sys_ = fam.system
+    tscale, tunit = _time_scale(sys_, units)
+    x, xlabel = _against(fam, against)
+    res, sres = list(resonances), list(sun_resonances)
+    if not all(isinstance(k, (int, np.integer)) and not isinstance(k, bool) and k >= 1 for k in res + sres):
+        raise ValueError(f"invalid argument: resonance orders must be integers >= 1, got {tuple(res)} and {tuple(sres)}")
+    res, sres = [int(k) for k in res], [int(k) for k in sres]
+    created = ax is None
+    fig, (a,) = _axes(ax, 1, figsize=(7.0, 5.0))
+    period = fam.period * tscale
+    (line,) = a.plot(x, period, color="k", linewidth=1.6, label=f"{fam.kind} period")
+    line.set_gid("period")
+    groups = [(k, 2 * math.pi / k, "synodic", "tab:red", "--", f"1:{k}") for k in res]
+    groups += [(k, SUN_SYNODIC_PERIOD / k, "sun", "tab:orange", ":", f"1:{k} Sun") for k in sres]
+    tname = "d" if tunit == "days" else "TU"
+    for k, t_tu, kind, color, ls, short in groups:
+        level = t_tu * tscale
+        formula = f"2\\pi/{k}" if kind == "synodic" else f"T_s/{k}"
+        label = f"{short} {'synodic ' if kind == 'synodic' else ''}resonance, $T = {formula}$ = {level:.2f} {tname}"
+        h = a.axhline(level, color=color, linestyle=ls, linewidth=1.1, label=label)
+        h.set_gid(f"resonance-{kind}-{k}")
+        if markers:
+            xs = _crossings(x, period, level)
+            if xs:
+                (m,) = a.plot(xs, [level] * len(xs), "o", color=color, markersize=5, markeredgecolor="k")
+                m.set_gid(f"resonant-member-{kind}-{k}")
+                for xc in xs:
+                    a.annotate(short, (xc, level), xytext=(-7, 0), textcoords="offset points", ha="right", va="center",
+                               fontsize=7.5, color=color)
+    if primaries and against == "x0":
+        for xp, name, color in ((-sys_.mu, "Earth position ($-\\mu$)", "tab:blue"), (1 - sys_.mu, "Moon position ($1-\\mu$)", "0.4")):
+            v = a.axvline(xp, color=color, linestyle="-.", linewidth=1.0, label=name)
+            v.set_gid("earth" if name.startswith("Earth") else "moon")
+    a.set_xlabel(xlabel)
+    a.set_ylabel(f"period $T$ ({tunit})")
+    a.set_ylim(bottom=0)
+    a.grid(True, linewidth=0.3, alpha=0.5)
+    a.legend(loc="lower left", fontsize=7.5)
+    if created:
+        a.set_title(f"{fam.kind} family: period and resonances")
+    return fig
+
+
+# --- stability (Fig. 5) ------------------------------------------------------------------------
+def plot_stability(
+    family: OrbitFamily,
+    ax=None,
+    *,
+    against: str = "x0",
+    imag: bool = False,
+    band: bool = True,
+    bifurcations: bool = True,
+    yscale: str | None = None,
+) -> Figure:
+    """The two stability indices nu = (lambda + 1/lambda) / 2 of a family's members against x0
+    (thesis Fig. 5), real parts: ``gid="stability-0"`` (in-plane for planar families) and
+    ``"stability-1"`` (out-of-plane), their y data equal to ``family.stability_indices.real``.
+    A member is linearly stable when both are real with |nu| <= 1: the band -1 <= nu <= 1 is
+    shaded (``band``). For a stable pair lambda = exp(+-i phi), nu = cos phi = Re(lambda), so
+    the curves are the real parts of the eigenvalues the thesis plots. ``bifurcations``: a
+    vertical line (``gid="bifurcation"``) and a label at each crossing of +1 or -1 listed in
+    ``family.bifurcations``. ``imag`` adds the imaginary parts dashed (``"stability-imag-j"``).
+    ``yscale``: ``"linear"``, ``"symlog"`` or None (symlog when some |nu| exceeds 10).
+    Returns the Figure.
+    """
+    fam = _check_family(family)
+    x, xlabel = _against(fam, against)
+    nu = np.asarray(fam.stability_indices)
+    names = ("in-plane $\\nu_1$", "out-of-plane $\\nu_2$") if not fam.spatial else ("$\\nu_1$", "$\\nu_2$")
+    created = ax is None
+    fig, (a,) = _axes(ax, 1, figsize=(7.0, 5.0))
+    if band:
+        s = a.axhspan(-1.0, 1.0, color="tab:green", alpha=0.08, label="$|\\nu| \\leq 1$ (stable)")
+        s.set_gid("stable-band")
+        for lv in (-1.0, 1.0):
+            a.axhline(lv, color="tab:green", linewidth=0.8)
+    colors = ("tab:blue", "tab:red")
+    for j in range(2):
+        (h,) = a.plot(x, nu[:, j].real, color=colors[j], linewidth=1.5, label=f"Re {names[j]}")
+        h.set_gid(f"stability-{j}")
+        if imag:
+            (h,) = a.plot(x, nu[:, j].imag, color=colors[j], linewidth=1.0, linestyle="--", label=f"Im {names[j]}")
+            h.set_gid(f"stability-imag-{j}")
+    if bifurcations:
+        trans = blended_transform_factory(a.transData, a.transAxes)
+        for n, b in enumerate(fam.bifurcations):
+            i = int(b["member"])
+            if against == "x0":
+                xb = float(b["x0"])
+            else:
+                w = (b["x0"] - fam.x0[i]) / (fam.x0[i + 1] - fam.x0[i]) if fam.x0[i + 1] != fam.x0[i] else 0.0
+                xb = float(x[i] + w * (x[i + 1] - x[i]))
+            v = a.axvline(xb, color="0.3", linestyle=":", linewidth=1.0)
+            v.set_gid("bifurcation")
+            a.text(xb, 0.02 if n % 2 == 0 else 0.98, f" {b['index']} $\\nu = {b['level']:+g}$ at $x_0$ = {b['x0']:.4f} ",
+                   transform=trans, rotation=90, ha="right", va="bottom" if n % 2 == 0 else "top", fontsize=7.5, color="0.2")
+    finite = np.abs(nu[np.isfinite(nu)])
+    if yscale is None:
+        yscale = "symlog" if finite.size and finite.max() > 10 else "linear"
+    if yscale not in ("linear", "symlog"):
+        raise ValueError(f"invalid argument `yscale`: must be 'linear', 'symlog' or None, got {yscale!r}")
+    if yscale == "symlog":
+        a.set_yscale("symlog", linthresh=1.0)
+    a.set_xlabel(xlabel)
+    a.set_ylabel("stability index $\\nu$ (nondimensional)")
+    a.grid(True, linewidth=0.3, alpha=0.5)
+    a.legend(loc="best", fontsize=8)
+    if created:
+        a.set_title(f"{fam.kind} family: stability indices")
+    return fig
+
+
+# --- Earth-centred inertial frame (Figs. 7, 10, 11) --------------------------------------------
+def plot_eci(
+    orbits: PeriodicOrbit | Iterable[PeriodicOrbit],
+    ax=None,
+    *,
+    n_periods: float | None = None,
+    samples_per_period: int = 2000,
+    theta0: float = 0.0,
+    units: str = "km",
+    separate: bool = False,
+    labels: Sequence[str] | None = None,
+    moon_path: bool = True,
+) -> Figure:
+    """Periodic orbits in the Earth-centred inertial frame (thesis Figs. 7a, 10, 11), X-Y plane.
+
+    Each orbit is propagated in the synodic frame from its ``state0`` (``samples_per_period``
+    points per period) and mapped with :func:`librate.synodic_to_eci` (``theta0``: the synodic x
+    axis' angle from X at t = 0), one line per orbit (``gid="orbit"``), starting at
+    |r0 - r_earth| LU from the Earth (origin, ``gid="earth"``); ``moon_path`` draws the Moon's
+    circle of radius 1 LU (``gid="moon-path"``). ``n_periods``: default (None) the whole
+    number of periods covering one synodic revolution 2 pi, ceil(2 pi / T): a 1:K resonant
+    orbit (get it with ``family.resonant(K)``) then closes after K periods, while a
+    non-resonant one shows its apsidal rotation. ``separate``: one panel per orbit instead of
+    all in one (``ax`` a sequence of that many Axes). ``labels``: one per orbit; default "1:K"
+    for resonant orbits, else x0 and the period. ``units``: ``"km"`` or ``"LU"``. Returns the
+    Figure.
+    """
+    if isinstance(orbits, PeriodicOrbit):
+        orbits = [orbits]
+    orbits = list(orbits)
+    if not orbits or not all(isinstance(o, PeriodicOrbit) for o in orbits):
+        raise ValueError("invalid argument `orbits`: must be a librate.PeriodicOrbit or a non-empty sequence of them")
+    if n_periods is not None and not (isinstance(n_periods, (int, float, np.integer, np.floating)) and math.isfinite(n_periods) and n_periods > 0):
+        raise ValueError(f"invalid argument `n_periods`: must be a number > 0 or None, got {n_periods!r}")
+    if isinstance(samples_per_period, bool) or not isinstance(samples_per_period, (int, np.integer)) or samples_per_period < 8:
+        raise ValueError(f"invalid argument `samples_per_period`: must be an integer >= 8, got {samples_per_period!r}")
+    if labels is not None and len(labels) != len(orbits):
+        raise ValueError(f"invalid argument `labels`: need one per orbit ({len(orbits)}), got {len(labels)}")
+    if labels is None:
+        labels = [_resonance_label(o) or f"$x_0$ = {o.x0:.4f}, T = {o.period_days:.2f} d" for o in orbits]
+    sys_ = orbits[0].system
+    scale, unit = _length_scale(sys_, units)
+    created = ax is None
+    npanels = len(orbits) if separate else 1
+    fig, axs = _axes(ax, npanels, figsize=(6.4, 6.0) if npanels == 1 else None)
+    cycle = matplotlib.rcParams["axes.prop_cycle"].by_key().get("color", ["tab:blue"])
+    for j, (orbit, label) in enumerate(zip(orbits, labels)):
+        a = axs[j] if separate else axs[0]
+        n = n_periods if n_periods is not None else max(1, math.ceil(2 * math.pi / orbit.period - 1e-9))
+        m = max(2, int(round(samples_per_period * n)) + 1)
+        tr = orbit.propagate(n, t_eval=np.linspace(0.0, n * orbit.period, m))
+        r = synodic_to_eci(orbit.system, tr.t, tr.y, theta0=theta0)[:, :3] / orbit.system.lu_km * scale
+        (h,) = a.plot(r[:, 0], r[:, 1], color=cycle[j % len(cycle)] if not separate else "tab:blue", linewidth=1.0, label=label)
+        h.set_gid("orbit")
+        (s,) = a.plot([r[0, 0]], [r[0, 1]], "o", color=h.get_color(), markersize=3.5)
+        s.set_gid("start")
+        if separate:
+            a.set_title(label)
+    for a in axs:
+        if moon_path:
+            th = np.linspace(0, 2 * math.pi, 721)
+            (c,) = a.plot(scale * np.cos(th), scale * np.sin(th), color="0.5", linestyle=":", linewidth=1.0, label="Moon path")
+            c.set_gid("moon-path")
+        (e,) = a.plot([0.0], [0.0], label="Earth", **_EARTH)
+        e.set_gid("earth")
+        if units == "km":
+            # Data in km, ticks in thousands of km.
+            for axis in (a.xaxis, a.yaxis):
+                axis.set_major_formatter(FuncFormatter(lambda v, _: f"{v / 1000:g}"))
+        tick_unit = "10$^3$ km" if units == "km" else unit
+        a.set_xlabel(f"X ({tick_unit}), Earth-centred inertial")
+        a.set_ylabel(f"Y ({tick_unit})")
+        a.set_aspect("equal", adjustable="datalim")
+        a.grid(True, linewidth=0.3, alpha=0.5)
+        a.legend(loc="upper right", fontsize=8)
+    if created and not separate:
+        axs[0].set_title("Earth-centred inertial frame")
+    return fig
+
+
+# --- output --------------------------------------------------------------------------------------
+def save_figure(fig, path, *, dpi: int = 150, close: bool = False, **kwargs) -> Path:
+    """Write ``fig`` (a Figure, or an Axes: its figure) to ``path`` (format from the suffix:
+    .png, .pdf, .svg, ...), creating missing directories; ``bbox_inches="tight"`` unless given
+    in ``kwargs`` (passed to ``Figure.savefig``). ``close`` closes it in pyplot afterwards.
+    Returns the path."""
+    if isinstance(fig, Axes):
+        fig = fig.figure
+    if not hasattr(fig, "savefig"):
+        raise ValueError(f"invalid argument `fig`: must be a matplotlib Figure or Axes, got {type(fig).__name__}")
+    p = Path(path)
+    p.parent.mkdir(parents=True, exist_ok=True)
+    kwargs.setdefault("bbox_inches", "tight")
+    fig.savefig(p, dpi=dpi, **kwargs)
+    if close:
+        import matplotlib.pyplot as plt
+
+        plt.close(fig)
+    return p

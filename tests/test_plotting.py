@@ -1,0 +1,264 @@
+"""librate.plotting: the thesis ch. 2 figures, rendered with Agg and checked against the data.
+
+Each figure is written to a PNG (non-trivial: over 10 kB, not one colour) and its artists are
+compared with the numbers they show: one line per requested orbit starting at the member's x0,
+the colour scale spanning the family's Jacobi range, resonance lines at 2 pi / K and Ts / K in
+days through the system's TU, stability curves equal to the family's indices, ECI curves
+starting |r0 - r_earth| LU from the Earth and 1:K resonant orbits closing after K periods.
+"""
+
+import math
+import subprocess
+import sys
+
+import matplotlib
+
+matplotlib.use("Agg")
+
+import matplotlib.image as mpimg  # noqa: E402
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+import pytest  # noqa: E402
+
+import librate  # noqa: E402
+import librate.plotting as lp  # noqa: E402
+from librate.constants import SUN_SYNODIC_PERIOD  # noqa: E402
+
+
+@pytest.fixture(scope="module")
+def fam(em):
+    """17 DROs, x0 = 0.95 ... 0.15 (the 1:1 resonance at x0 = 0.1521 and the out-of-plane
+    bifurcation near 0.27 inside)."""
+    return librate.dro_family(em, x0=np.arange(0.95, 0.1, -0.05))
+
+
+@pytest.fixture(scope="module")
+def halos(em):
+    return librate.halo_family(em, 2, "south")
+
+
+@pytest.fixture(autouse=True)
+def _close_figures():
+    yield
+    plt.close("all")
+
+
+def gid(ax, name):
+    return [a for a in ax.get_children() if getattr(a, "get_gid", lambda: None)() == name]
+
+
+def assert_png(fig, path):
+    out = lp.save_figure(fig, path)
+    assert out == path and path.is_file() and path.stat().st_size > 10_000
+    img = mpimg.imread(path)
+    assert img.ndim == 3 and img.shape[0] > 200 and img.shape[1] > 200 and float(img[..., :3].std()) > 0.02
+
+
+def colorbar_axes(fig):
+    return [a for a in fig.axes if a.get_label() == "<colorbar>"]
+
+
+def test_import_librate_does_not_import_matplotlib():
+    """Fresh interpreter: ``import librate`` leaves matplotlib out; ``import librate.plotting``
+    imports matplotlib but not pyplot (only creating a figure does)."""
+    code = (
+        "import sys, librate; assert 'matplotlib' not in sys.modules, 'librate imported matplotlib'; "
+        "import librate.plotting; assert 'matplotlib' in sys.modules; "
+        "assert 'matplotlib.pyplot' not in sys.modules, 'librate.plotting imported pyplot'; print('ok')"
+    )
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert r.returncode == 0 and r.stdout.strip() == "ok", r.stderr
+
+
+def test_plot_family_lines_colours_and_markers(fam, tmp_path):
+    """Thesis Fig. 3: n_orbits lines spread over the family (first and last members included),
+    each starting at its member's (x0, 0) and closing after one period; colours from the family's
+    Jacobi range, which the colorbar spans; Earth, Moon, L1 and L2 marked."""
+    fig = lp.plot_family(fam, n_orbits=6)
+    assert_png(fig, tmp_path / "family.png")
+    ax = fig.axes[0]
+    lines = gid(ax, "orbit")
+    assert len(lines) == 6
+    starts = np.array([[ln.get_xdata()[0], ln.get_ydata()[0]] for ln in lines])
+    sel = np.round(np.linspace(0, len(fam) - 1, 6)).astype(int)
+    assert sel[0] == 0 and sel[-1] == len(fam) - 1
+    np.testing.assert_allclose(starts[:, 0], fam.x0[sel], atol=1e-12)
+    np.testing.assert_allclose(starts[:, 1], 0.0, atol=1e-12)
+    for ln in lines:  # one closed period
+        assert math.hypot(ln.get_xdata()[-1] - ln.get_xdata()[0], ln.get_ydata()[-1] - ln.get_ydata()[0]) < 1e-9
+    (cax,) = colorbar_axes(fig)
+    assert cax.get_ylim() == pytest.approx((fam.jacobi.min(), fam.jacobi.max()), rel=1e-12)
+    cmap = matplotlib.colormaps["turbo"]
+    c = fam.jacobi[sel]
+    want = [cmap((ci - fam.jacobi.min()) / (fam.jacobi.max() - fam.jacobi.min())) for ci in c]
+    np.testing.assert_allclose([matplotlib.colors.to_rgba(ln.get_color()) for ln in lines], want, atol=1e-12)
+    assert "Jacobi" in cax.get_ylabel()
+    assert ax.get_xlabel() == "x (LU)" and ax.get_ylabel() == "y (LU)"
+    (earth,) = gid(ax, "earth")
+    (moon,) = gid(ax, "moon")
+    assert earth.get_xdata()[0] == pytest.approx(-fam.system.mu) and moon.get_xdata()[0] == pytest.approx(1 - fam.system.mu)
+    (l1,) = gid(ax, "L1")
+    assert l1.get_xdata()[0] == pytest.approx(fam.system.lagrange_points()[0, 0])
+
+
+def test_plot_family_all_members_into_given_axes_in_km(fam):
+    fig0, ax = plt.subplots()
+    fig = lp.plot_family(fam, ax, n_orbits=None, units="km", color_by="period", lagrange_points=())
+    assert fig is fig0 and ax.get_title() == ""  # no title forced on the caller's axes
+    lines = gid(ax, "orbit")
+    assert len(lines) == len(fam)
+    np.testing.assert_allclose([ln.get_xdata()[0] for ln in lines], fam.x0 * fam.system.lu_km, rtol=1e-12)
+    assert ax.get_xlabel() == "x (km)" and not gid(ax, "L1")
+    (cax,) = colorbar_axes(fig)
+    assert cax.get_ylim() == pytest.approx((fam.period_days.min(), fam.period_days.max()), rel=1e-12)
+
+
+def test_plot_family_spatial_projections(halos, tmp_path):
+    """A spatial family gets x-y and x-z panels by default; the Earth, far from the L2 halos,
+    is marked without widening the view; the 3-D option draws (x, y, z)."""
+    fig = lp.plot_family(halos, n_orbits=8)
+    assert_png(fig, tmp_path / "halo.png")
+    ax_xy, ax_xz = [a for a in fig.axes if a.get_label() != "<colorbar>"]
+    assert len(gid(ax_xy, "orbit")) == 8 and len(gid(ax_xz, "orbit")) == 8
+    assert ax_xz.get_ylabel() == "z (LU)"
+    z = np.concatenate([ln.get_ydata() for ln in gid(ax_xz, "orbit")])
+    assert np.ptp(z) > 0.1  # the halos leave the plane
+    assert ax_xy.get_xlim()[0] > 0.5  # the Earth at -mu is outside
+    fig3 = lp.plot_family(halos, n_orbits=5, projection="3d")
+    assert_png(fig3, tmp_path / "halo3d.png")
+    ax3 = fig3.axes[0]
+    assert ax3.name == "3d" and len(gid(ax3, "orbit")) == 5
+    x, y, zz = gid(ax3, "orbit")[0].get_data_3d()
+    np.testing.assert_allclose([x[0], y[0], zz[0]], halos.state0[0, :3], atol=1e-12)
+
+
+def test_plot_period_resonances(fam, em, tmp_path):
+    """Thesis Fig. 6: the period in days against x0, synodic resonances at 2 pi / K and
+    Sun-resonant ones at Ts / K converted with the system's TU; the 1:1 marker at the resonant
+    member's x0 (0.1521) to the linear interpolation's accuracy on a 0.05 grid (1e-3)."""
+    fig = lp.plot_period(fam)
+    assert_png(fig, tmp_path / "period.png")
+    ax = fig.axes[0]
+    (per,) = gid(ax, "period")
+    np.testing.assert_allclose(per.get_xdata(), fam.x0)
+    np.testing.assert_allclose(per.get_ydata(), fam.period * em.tu_s / 86400.0, rtol=1e-14)
+    for k in (1, 2, 3, 4):
+        (h,) = gid(ax, f"resonance-synodic-{k}")
+        assert h.get_ydata()[0] == pytest.approx(2 * math.pi / k * em.tu_s / 86400.0, rel=1e-14)
+    assert gid(ax, "resonance-synodic-1")[0].get_ydata()[0] == pytest.approx(27.28, abs=0.01)
+    for k in (2, 4):
+        (h,) = gid(ax, f"resonance-sun-{k}")
+        assert h.get_ydata()[0] == pytest.approx(SUN_SYNODIC_PERIOD / k * em.tu_days, rel=1e-14)
+    assert not gid(ax, "resonance-synodic-5") and not gid(ax, "resonance-sun-1")
+    (m1,) = gid(ax, "resonant-member-synodic-1")
+    assert m1.get_xdata()[0] == pytest.approx(fam.resonant(1).x0, abs=1e-3)
+    assert m1.get_xdata()[0] == pytest.approx(0.1521, abs=1e-3)
+    legend = [t.get_text() for t in ax.get_legend().get_texts()]
+    assert any(t.startswith("1:2 synodic") for t in legend) and any(t.startswith("1:4 Sun") for t in legend)
+    assert ax.get_ylabel() == "period $T$ (days)"
+    (earth,) = gid(ax, "earth")
+    assert earth.get_xdata()[0] == pytest.approx(-em.mu)
+
+    ax_tu = lp.plot_period(fam, units="TU", resonances=(3,), sun_resonances=()).axes[0]
+    assert gid(ax_tu, "resonance-synodic-3")[0].get_ydata()[0] == pytest.approx(2 * math.pi / 3)
+    assert not gid(ax_tu, "resonance-sun-2") and ax_tu.get_ylabel() == "period $T$ (TU)"
+
+
+def test_plot_stability_curves_and_bifurcation(fam, tmp_path):
+    """Thesis Fig. 5: the curves are the family's stability indices (real parts) against x0,
+    the stable band is |nu| <= 1, and the out-of-plane +1 crossing near x0 = 0.27 is marked."""
+    fig = lp.plot_stability(fam)
+    assert_png(fig, tmp_path / "stability.png")
+    ax = fig.axes[0]
+    for j in (0, 1):
+        (h,) = gid(ax, f"stability-{j}")
+        np.testing.assert_array_equal(h.get_xdata(), fam.x0)
+        np.testing.assert_array_equal(h.get_ydata(), fam.stability_indices[:, j].real)
+    assert "in-plane" in gid(ax, "stability-0")[0].get_label() and "out-of-plane" in gid(ax, "stability-1")[0].get_label()
+    (band,) = gid(ax, "stable-band")
+    ys = ax.transData.inverted().transform(band.get_transform().transform(band.get_path().vertices))[:, 1]
+    assert min(ys) == pytest.approx(-1.0) and max(ys) == pytest.approx(1.0)
+    bif = gid(ax, "bifurcation")
+    assert len(bif) == len(fam.bifurcations) == 1
+    assert bif[0].get_xdata()[0] == pytest.approx(fam.bifurcations[0]["x0"]) == pytest.approx(0.27, abs=0.01)
+    assert not gid(ax, "stability-imag-0") and ax.get_yscale() == "linear"
+    ax_i = lp.plot_stability(fam, imag=True).axes[0]
+    np.testing.assert_array_equal(gid(ax_i, "stability-imag-1")[0].get_ydata(), fam.stability_indices[:, 1].imag)
+
+
+def test_plot_stability_symlog_for_large_indices(halos):
+    ax = lp.plot_stability(halos, against="jacobi").axes[0]
+    assert ax.get_yscale() == "symlog"
+    np.testing.assert_array_equal(gid(ax, "stability-0")[0].get_xdata(), halos.jacobi)
+    assert len(gid(ax, "bifurcation")) == len(halos.bifurcations)
+
+
+def test_plot_eci_resonant_dros(fam, em, tmp_path):
+    """Thesis Figs. 7a and 10: the 1:1, 1:2, 1:3 resonant DROs in the Earth-centred inertial
+    frame, in km: each curve starts |r0 - r_earth| * LU from the Earth, a 1:K orbit covers K
+    periods (one synodic revolution) and closes on itself (to 1 km); the 1:1 orbit reaches
+    about a (1 + e) = 392070 * 1.8312 km (thesis Table 1) at apogee."""
+    orbits = [fam.resonant(k) for k in (1, 2, 3)]
+    fig = lp.plot_eci(orbits)
+    assert_png(fig, tmp_path / "eci.png")
+    ax = fig.axes[0]
+    lines = gid(ax, "orbit")
+    assert len(lines) == 3 and [ln.get_label() for ln in lines] == ["1:1", "1:2", "1:3"]
+    earth = np.array([-em.mu, 0.0, 0.0])
+    for ln, o in zip(lines, orbits):
+        x, y = ln.get_xdata(), ln.get_ydata()
+        assert math.hypot(x[0], y[0]) == pytest.approx(np.linalg.norm(o.state0[:3] - earth) * em.lu_km, rel=1e-12)
+        assert math.hypot(x[-1] - x[0], y[-1] - y[0]) < 1.0
+    r1 = np.hypot(lines[0].get_xdata(), lines[0].get_ydata())
+    assert r1.max() == pytest.approx(392070 * (1 + 0.8312), rel=0.02)
+    (moon,) = gid(ax, "moon-path")
+    np.testing.assert_allclose(np.hypot(moon.get_xdata(), moon.get_ydata()), em.lu_km, rtol=1e-12)
+    assert gid(ax, "earth")[0].get_xdata()[0] == 0.0
+    assert "km" in ax.get_xlabel() and "km" in ax.get_ylabel()
+
+
+def test_plot_eci_separate_panels_and_lu(fam, em, tmp_path):
+    near = fam[len(fam) - 2]  # x0 = 0.2: not resonant, labelled by x0 and period
+    fig = lp.plot_eci([fam.resonant(4), near], separate=True, units="LU", n_periods=2)
+    assert_png(fig, tmp_path / "eci2.png")
+    a4, an = fig.axes
+    assert len(gid(a4, "orbit")) == 1 and len(gid(an, "orbit")) == 1
+    assert a4.get_title() == "1:4" and an.get_title().startswith("$x_0$ = 0.2000")
+    x, y = gid(an, "orbit")[0].get_xdata(), gid(an, "orbit")[0].get_ydata()
+    assert math.hypot(x[0], y[0]) == pytest.approx(near.x0 + em.mu, rel=1e-12)
+    t_end = 2 * near.period  # n_periods = 2: the last point is the ECI state after two periods
+    end = near.propagate(2.0).y_final
+    want = librate.synodic_to_eci(em, t_end, end)[:2] / em.lu_km
+    np.testing.assert_allclose([x[-1], y[-1]], want, atol=1e-9)
+
+
+def test_save_figure_paths_and_axes(fam, tmp_path):
+    ax = lp.plot_period(fam).axes[0]
+    out = lp.save_figure(ax, tmp_path / "deep" / "dir" / "p.pdf", close=True)
+    assert out.is_file() and out.read_bytes()[:4] == b"%PDF"
+    assert not plt.get_fignums()
+
+
+@pytest.mark.parametrize(
+    "call, text",
+    [
+        (lambda f: lp.plot_family("dro"), "`family`"),
+        (lambda f: lp.plot_family(f, n_orbits=0), "`n_orbits`"),
+        (lambda f: lp.plot_family(f, projection="xw"), "`projection`"),
+        (lambda f: lp.plot_family(f, color_by="energy"), "`color_by`"),
+        (lambda f: lp.plot_family(f, units="mi"), "`units`"),
+        (lambda f: lp.plot_family(f, plt.subplots(1, 2)[1], projection="xy"), "`ax`"),
+        (lambda f: lp.plot_family(f, plt.subplots()[1], projection="3d"), "`ax`"),
+        (lambda f: lp.plot_period(f, units="weeks"), "`units`"),
+        (lambda f: lp.plot_period(f, resonances=(0,)), "resonance"),
+        (lambda f: lp.plot_period(f, sun_resonances=(2.5,)), "resonance"),
+        (lambda f: lp.plot_stability(f, against="y0"), "`against`"),
+        (lambda f: lp.plot_eci([]), "`orbits`"),
+        (lambda f: lp.plot_eci(f[0], n_periods=-1), "`n_periods`"),
+        (lambda f: lp.plot_eci([f[0]], labels=["a", "b"]), "`labels`"),
+        (lambda f: lp.save_figure("fig", "x.png"), "`fig`"),
+    ],
+)
+def test_bad_arguments(fam, call, text):
+    with pytest.raises(ValueError, match=text):
+        call(fam)
