@@ -262,3 +262,29 @@ def test_save_figure_paths_and_axes(fam, tmp_path):
 def test_bad_arguments(fam, call, text):
     with pytest.raises(ValueError, match=text):
         call(fam)
+
+
+def test_plot_attitude_response(tmp_path):
+    """Attitude response (thesis Fig. 16-18 layout): rate and angle curves carry the
+    trajectory's data, against revolutions."""
+    import librate.plotting as lp
+
+    em = librate.System.preset("earth-moon")
+    a = 10050.0 / em.lu_km
+    n = math.sqrt((1 - em.mu) / a**3)
+    s0 = [-em.mu + a, 0, 0, 0, math.sqrt((1 - em.mu) / a) - a, 0]
+    T = 2 * math.pi / n
+    q0 = librate.quaternion_from_euler([0.0, 0.0, 0.01])
+    tr = librate.propagate_attitude(em, s0, (q0, [0, 0, n]), librate.RigidBody(12.12e6, 89.68e6, 96.95e6), 3 * T,
+                                    torques=("gravity_gradient_earth",), t_eval=np.linspace(0, 3 * T, 300))
+    fig = lp.plot_attitude(tr, period=T, relative_to="earth")
+    lines = {l.get_gid(): l for a in fig.axes for l in a.get_lines() if l.get_gid()}
+    np.testing.assert_allclose(lines["rate-2"].get_ydata(), tr.w[:, 2])
+    np.testing.assert_allclose(lines["angle-2"].get_xdata()[-1], 3.0)
+    pitch = np.degrees(np.unwrap(tr.relative_to_vertical("earth")[:, 2]))
+    np.testing.assert_allclose(lines["angle-2"].get_ydata(), pitch)
+    assert abs(pitch[0] - np.degrees(0.01)) < 1e-9
+    path = lp.save_figure(fig, tmp_path / "att.png")
+    assert path.stat().st_size > 10_000
+    with pytest.raises(ValueError, match="traj"):
+        lp.plot_attitude("nope")

@@ -49,7 +49,7 @@ from .orbits import PeriodicOrbit
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
-__all__ = ["plot_family", "plot_period", "plot_stability", "plot_eci", "save_figure"]
+__all__ = ["plot_family", "plot_period", "plot_stability", "plot_eci", "plot_attitude", "save_figure"]
 
 _EARTH = dict(marker="o", color="tab:blue", markersize=9, markeredgecolor="k", linestyle="none")
 _MOON = dict(marker="o", color="0.6", markersize=6, markeredgecolor="k", linestyle="none")
@@ -492,6 +492,46 @@ def plot_eci(
 
 
 # --- output --------------------------------------------------------------------------------------
+def plot_attitude(traj, ax=None, *, period: float | None = None, relative_to: str | None = None, degrees: bool = True) -> Figure:
+    """Attitude response of an :class:`librate.AttitudeTrajectory` against revolutions (thesis
+    Fig. 16-21): the angular rates (left) and the 1-2-3 Euler angles (right) for roll, pitch and
+    yaw about the body x, y, z axes.
+
+    ``period``: time of one revolution (TU) for the horizontal axis (default: time in TU).
+    ``relative_to``: "earth" or "moon" to show the angles relative to that primary's local
+    vertical (the two-body convention of Fig. 16-18), else relative to the synodic frame.
+    Rates are the inertial angular velocity components in body axes (1/TU).
+    """
+    from .attitude import AttitudeTrajectory
+
+    if not isinstance(traj, AttitudeTrajectory):
+        raise ValueError(f"invalid argument `traj`: must be a librate.AttitudeTrajectory, got {type(traj).__name__}")
+    if period is not None and not (math.isfinite(period) and period > 0):
+        raise ValueError(f"invalid argument `period`: must be finite and > 0, got {period!r}")
+    fig, (a_rate, a_ang) = _axes(ax, 2, figsize=(11, 4.2))
+    x = traj.t / period if period else traj.t
+    xlabel = "revolutions (-)" if period else "t (TU)"
+    ang = traj.relative_to_vertical(relative_to) if relative_to else traj.euler_angles("123")
+    ang = np.unwrap(ang, axis=0)
+    k = 180.0 / math.pi if degrees else 1.0
+    for i, name in enumerate(("roll (x)", "pitch (y)", "yaw (z)")):
+        (line,) = a_rate.plot(x, traj.w[:, i], label=f"$\\omega_{'xyz'[i]}$ {name}")
+        line.set_gid(f"rate-{i}")
+        (line,) = a_ang.plot(x, k * ang[:, i], label=name)
+        line.set_gid(f"angle-{i}")
+    a_rate.set_xlabel(xlabel)
+    a_rate.set_ylabel("inertial angular rate, body axes (1/TU)")
+    a_ang.set_xlabel(xlabel)
+    frame = f"{relative_to}'s local vertical" if relative_to else "synodic frame"
+    a_ang.set_ylabel(f"Euler angles 1-2-3 from the {frame} ({'deg' if degrees else 'rad'})")
+    for a in (a_rate, a_ang):
+        a.grid(alpha=0.3)
+        a.legend(fontsize=8)
+    if ax is None:
+        fig.suptitle("attitude response")
+    return fig
+
+
 def save_figure(fig, path, *, dpi: int = 150, close: bool = False, **kwargs) -> Path:
     """Write ``fig`` (a Figure, or an Axes: its figure) to ``path`` (format from the suffix:
     .png, .pdf, .svg, ...), creating missing directories; ``bbox_inches="tight"`` unless given
