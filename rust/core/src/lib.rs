@@ -11,6 +11,7 @@ pub mod cr3bp;
 pub mod error;
 pub mod fourier;
 pub mod integrate;
+pub mod map;
 pub mod periodic;
 pub mod propagation;
 

@@ -1,0 +1,183 @@
+//! Orbit data computed once per orbit and shared by every attitude trajectory on it: the
+//! gravity-gradient forcing S(t), C(t) of the planar model (PHYSICS.md sec. 4, atan2-free form)
+//! as piecewise Chebyshev series over one period.
+//!
+//! The orbit is integrated once at tight tolerance and sampled at the Chebyshev nodes of every
+//! segment (each sample an RK step from the enclosing accepted step); the coefficients are the
+//! exact interpolants at those nodes. The number of segments doubles until S and C at the
+//! segment quarter points, also sampled from the orbit, match the series to `tol` relative to
+//! max(|S|, |C|).
+
+use wide::f64x4;
+
+use crate::attitude::{forcing_sc, Forcing};
+use crate::cr3bp::check_mu;
+use crate::error::{check_finite, check_positive, invalid, Error, Result};
+use crate::integrate::{Options, Output};
+use crate::propagation::propagate;
+
+/// Chebyshev degree per segment.
+pub const DEGREE: usize = 12;
+const NC: usize = DEGREE + 1;
+
+/// Piecewise Chebyshev representation of S(t), C(t) over one orbit period (periodic in t).
+#[derive(Debug, Clone, PartialEq)]
+pub struct OrbitForcing {
+    pub period: f64,
+    segments: usize,
+    seg_len: f64,
+    /// [segment][k][S, C].
+    coef: Vec<f64>,
+    /// Largest relative error measured at the check points.
+    pub max_error: f64,
+    /// max(|S|, |C|) over the samples.
+    pub scale: f64,
+}
+
+fn cheb_nodes() -> [f64; NC] {
+    std::array::from_fn(|j| (std::f64::consts::PI * (j as f64 + 0.5) / NC as f64).cos())
+}
+
+impl OrbitForcing {
+    /// Tabulate the forcing of the planar orbit `state0` with period `period`; `primaries`
+    /// selects the gravity-gradient sources [larger, smaller].
+    pub fn new(mu: f64, state0: &[f64; 6], period: f64, primaries: [bool; 2], tol: f64) -> Result<Self> {
+        check_mu(mu)?;
+        check_finite("orbit_state", state0)?;
+        check_positive("period", period)?;
+        check_positive("tol", tol)?;
+        if state0[2] != 0.0 || state0[5] != 0.0 {
+            return Err(invalid("orbit_state", "the planar attitude model needs a planar orbit (z = zd = 0)"));
+        }
+        let opts = Options::with_tolerances(1e-14, 1e-14);
+        let nodes = cheb_nodes();
+        let mut segments = 16;
+        loop {
+            let seg_len = period / segments as f64;
+            // sample times: nodes of every segment, then the check points (1/4, 1/2, 3/4)
+            let mut times = Vec::with_capacity(segments * (NC + 3));
+            for s in 0..segments {
+                let a = s as f64 * seg_len;
+                for j in (0..NC).rev() {
+                    times.push(a + 0.5 * seg_len * (nodes[j] + 1.0));
+                }
+            }
+            let n_fit = times.len();
+            for s in 0..segments {
+                let a = s as f64 * seg_len;
+                for q in [0.25, 0.5, 0.75] {
+                    times.push(a + q * seg_len);
+                }
+            }
+            let (mut fit_t, mut check_t): (Vec<f64>, Vec<f64>) = (times[..n_fit].to_vec(), times[n_fit..].to_vec());
+            fit_t.sort_by(f64::total_cmp);
+            check_t.sort_by(f64::total_cmp);
+            let sample = |ts: &[f64]| -> Result<Vec<(f64, f64)>> {
+                let tr = propagate(mu, state0, 0.0, period, &opts, false, Output::At(ts), &[])?;
+                Ok(tr.states.chunks_exact(6).map(|s| forcing_sc(mu, s, primaries)).collect())
+            };
+            let fit = sample(&fit_t)?;
+            let check = sample(&check_t)?;
+            let mut coef = vec![0.0; segments * NC * 2];
+            for s in 0..segments {
+                // fit_t is sorted: segment s holds samples s*NC .. (s+1)*NC in increasing time,
+                // i.e. nodes j = NC-1 .. 0 (x increasing).
+                for k in 0..NC {
+                    let (mut cs, mut cc) = (0.0, 0.0);
+                    for jj in 0..NC {
+                        let j = NC - 1 - jj;
+                        let (sv, cv) = fit[s * NC + jj];
+                        let w = (std::f64::consts::PI * k as f64 * (j as f64 + 0.5) / NC as f64).cos();
+                        cs += sv * w;
+                        cc += cv * w;
+                    }
+                    let f = if k == 0 { 1.0 } else { 2.0 } / NC as f64;
+                    coef[(s * NC + k) * 2] = cs * f;
+                    coef[(s * NC + k) * 2 + 1] = cc * f;
+                }
+            }
+            let scale = fit.iter().chain(check.iter()).fold(0.0f64, |m, &(a, b)| m.max(a.abs()).max(b.abs()));
+            let mut table = Self { period, segments, seg_len, coef, max_error: 0.0, scale };
+            let mut err = 0.0f64;
+            for (t, &(sv, cv)) in check_t.iter().zip(&check) {
+                let (a, b) = table.sc(*t);
+                err = err.max((a - sv).abs()).max((b - cv).abs());
+            }
+            table.max_error = err / scale;
+            if table.max_error <= tol {
+                return Ok(table);
+            }
+            if segments >= 1 << 16 {
+                return Err(Error::Convergence { what: "orbit forcing table (segments)", iterations: segments, residual: table.max_error, tolerance: tol });
+            }
+            segments *= 2;
+        }
+    }
+
+    pub fn segments(&self) -> usize {
+        self.segments
+    }
+
+    /// Segment index and local coordinate in [-1, 1] of time t (reduced modulo the period).
+    #[inline(always)]
+    fn locate(&self, t: f64) -> (usize, f64) {
+        let tm = t - (t / self.period).floor() * self.period;
+        let u = tm / self.seg_len;
+        let s = (u as usize).min(self.segments - 1);
+        (s, 2.0 * (u - s as f64) - 1.0)
+    }
+
+    /// S(t), C(t).
+    #[inline]
+    pub fn sc(&self, t: f64) -> (f64, f64) {
+        let (s, x) = self.locate(t);
+        let c = &self.coef[s * NC * 2..(s + 1) * NC * 2];
+        let (mut b1s, mut b2s, mut b1c, mut b2c) = (0.0, 0.0, 0.0, 0.0);
+        let x2 = 2.0 * x;
+        for k in (1..NC).rev() {
+            let ts = x2.mul_add(b1s, c[2 * k] - b2s);
+            let tc = x2.mul_add(b1c, c[2 * k + 1] - b2c);
+            b2s = b1s;
+            b1s = ts;
+            b2c = b1c;
+            b1c = tc;
+        }
+        (x.mul_add(b1s, c[0] - b2s), x.mul_add(b1c, c[1] - b2c))
+    }
+
+    /// S, C at four times at once (each lane its own time and segment).
+    #[inline(always)]
+    pub fn sc4(&self, t: f64x4) -> (f64x4, f64x4) {
+        let ta = t.to_array();
+        let mut seg = [0usize; 4];
+        let mut xs = [0.0; 4];
+        for l in 0..4 {
+            let (s, x) = self.locate(ta[l]);
+            seg[l] = s;
+            xs[l] = x;
+        }
+        let x = f64x4::new(xs);
+        let x2 = x + x;
+        let (mut b1s, mut b2s, mut b1c, mut b2c) = (f64x4::ZERO, f64x4::ZERO, f64x4::ZERO, f64x4::ZERO);
+        let base = seg.map(|s| s * NC * 2);
+        for k in (1..NC).rev() {
+            let cs = f64x4::new(std::array::from_fn(|l| self.coef[base[l] + 2 * k]));
+            let cc = f64x4::new(std::array::from_fn(|l| self.coef[base[l] + 2 * k + 1]));
+            let ts = x2.mul_add(b1s, cs - b2s);
+            let tc = x2.mul_add(b1c, cc - b2c);
+            b2s = b1s;
+            b1s = ts;
+            b2c = b1c;
+            b1c = tc;
+        }
+        let c0s = f64x4::new(std::array::from_fn(|l| self.coef[base[l]]));
+        let c0c = f64x4::new(std::array::from_fn(|l| self.coef[base[l] + 1]));
+        (x.mul_add(b1s, c0s - b2s), x.mul_add(b1c, c0c - b2c))
+    }
+}
+
+impl Forcing for OrbitForcing {
+    fn sc(&self, t: f64) -> (f64, f64) {
+        OrbitForcing::sc(self, t)
+    }
+}

@@ -1,0 +1,272 @@
+//! The attitude periodicity engine's integrator: RKF7(8) on four trajectories at once in SIMD
+//! lanes (`wide::f64x4`), each lane with its own time, step size and Kz, refilled with the next
+//! trajectory as soon as its own finishes.
+//!
+//! State per lane: (phi, wz, cos 2phi, sin 2phi) and, with the STM, the 2x2 d(phi, wz)/d(phi0,
+//! wz0) row-major. Carrying (cos 2phi, sin 2phi) as states (d/dt = -+2 phidot (sin, cos))
+//! removes every trigonometric call from the right-hand side; phi itself is integrated
+//! (phidot = wz - 1) and gives the unwrapped phi(T).
+//!
+//! Every operation is lane-wise, so a trajectory's result does not depend on which lane it
+//! ran in or on its neighbours: results are bit-identical for any chunking and thread count.
+
+use wide::f64x4;
+
+use super::forcing::OrbitForcing;
+use crate::integrate::tableau::{A, B8, C, ERR};
+
+type V = f64x4;
+
+/// One attitude trajectory of a sweep.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Case {
+    pub phi0: f64,
+    /// Inertial initial rate.
+    pub wz0: f64,
+    pub kz: f64,
+}
+
+/// How a trajectory ended.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[repr(u8)]
+pub enum LaneStatus {
+    Ok = 0,
+    MaxSteps = 1,
+    /// Non-finite state or step-size underflow.
+    Failed = 2,
+}
+
+/// The end state of one trajectory.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Outcome {
+    /// Unwrapped phi at the final time.
+    pub phi_t: f64,
+    pub wz_t: f64,
+    /// d(phi, wz)(T) / d(phi0, wz0), row-major (NaN when not computed).
+    pub stm: [f64; 4],
+    pub accepted: u32,
+    pub rejected: u32,
+    pub status: LaneStatus,
+}
+
+/// Tolerances and limits of the lane integrator.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LaneOptions {
+    pub rtol: f64,
+    pub atol: f64,
+    pub max_steps: u32,
+}
+
+impl Default for LaneOptions {
+    fn default() -> Self {
+        Self { rtol: 1e-12, atol: 1e-12, max_steps: 200_000 }
+    }
+}
+
+#[inline(always)]
+fn lincomb<const D: usize, const M: usize>(out: &mut [V; D], y: &[V; D], h: V, coef: [f64; M], ks: [&[V; D]; M]) {
+    for i in 0..D {
+        let mut acc = V::ZERO;
+        for m in 0..M {
+            acc = V::splat(coef[m]).mul_add(ks[m][i], acc);
+        }
+        out[i] = h.mul_add(acc, y[i]);
+    }
+}
+
+#[inline(always)]
+fn rhs<const D: usize>(f: &OrbitForcing, t: V, y: &[V; D], kz15: V, dy: &mut [V; D]) {
+    let (s, c) = f.sc4(t);
+    let w = y[1] - V::ONE;
+    dy[0] = w;
+    dy[1] = kz15 * (s * y[2] - c * y[3]);
+    let w2 = w + w;
+    dy[2] = -(w2 * y[3]);
+    dy[3] = w2 * y[2];
+    if D == 8 {
+        let k = -(kz15 + kz15) * (s * y[3] + c * y[2]);
+        dy[4] = y[6];
+        dy[5] = y[7];
+        dy[6] = k * y[4];
+        dy[7] = k * y[5];
+    }
+}
+
+struct Stages<const D: usize> {
+    k: [[V; D]; 13],
+    tmp: [V; D],
+}
+
+macro_rules! stage {
+    ($st:ident, $f:ident, $t:ident, $y:ident, $h:ident, $kz:ident, $s:literal; $($j:literal),+) => {{
+        lincomb(&mut $st.tmp, $y, $h, [$(A[$s][$j]),+], [$(&$st.k[$j]),+]);
+        let ts = V::splat(C[$s]).mul_add($h, $t);
+        rhs($f, ts, &$st.tmp, $kz, &mut $st.k[$s]);
+    }};
+}
+
+impl<const D: usize> Stages<D> {
+    /// One step of size h (per lane) from (t, y): writes the 8th-order solution and returns the
+    /// scaled max-norm error per lane.
+    #[inline(always)]
+    fn step(&mut self, f: &OrbitForcing, t: V, y: &[V; D], h: V, kz15: V, out: &mut [V; D], rtol: V, atol: V) -> V {
+        rhs(f, t, y, kz15, &mut self.k[0]);
+        stage!(self, f, t, y, h, kz15, 1; 0);
+        stage!(self, f, t, y, h, kz15, 2; 0, 1);
+        stage!(self, f, t, y, h, kz15, 3; 0, 2);
+        stage!(self, f, t, y, h, kz15, 4; 0, 2, 3);
+        stage!(self, f, t, y, h, kz15, 5; 0, 3, 4);
+        stage!(self, f, t, y, h, kz15, 6; 0, 3, 4, 5);
+        stage!(self, f, t, y, h, kz15, 7; 0, 4, 5, 6);
+        stage!(self, f, t, y, h, kz15, 8; 0, 3, 4, 5, 6, 7);
+        stage!(self, f, t, y, h, kz15, 9; 0, 3, 4, 5, 6, 7, 8);
+        stage!(self, f, t, y, h, kz15, 10; 0, 3, 4, 5, 6, 7, 8, 9);
+        stage!(self, f, t, y, h, kz15, 11; 0, 5, 6, 7, 8, 9);
+        stage!(self, f, t, y, h, kz15, 12; 0, 3, 4, 5, 6, 7, 8, 9, 11);
+        let k = &self.k;
+        lincomb(out, y, h, [B8[5], B8[6], B8[7], B8[8], B8[9], B8[11], B8[12]], [&k[5], &k[6], &k[7], &k[8], &k[9], &k[11], &k[12]]);
+        let he = h * V::splat(ERR);
+        let mut err = V::ZERO;
+        for i in 0..D {
+            let e = (he * ((k[0][i] + k[10][i]) - (k[11][i] + k[12][i]))).abs();
+            let sc = rtol.mul_add(y[i].abs().max(out[i].abs()), atol);
+            let r = e / sc;
+            // keep NaN: a NaN ratio fails the `<=` test and becomes the lane's error
+            err = r.simd_le(err).select(err, r);
+        }
+        err
+    }
+}
+
+/// Integrate `cases` from t = 0 to `t_final` along the orbit forcing, four at a time. `D` is 4
+/// (no STM) or 8 (with the 2x2 STM).
+pub fn integrate_cases<const D: usize>(f: &OrbitForcing, t_final: f64, cases: &[Case], opts: &LaneOptions) -> Vec<Outcome> {
+    let mut out = vec![
+        Outcome { phi_t: f64::NAN, wz_t: f64::NAN, stm: [f64::NAN; 4], accepted: 0, rejected: 0, status: LaneStatus::Failed };
+        cases.len()
+    ];
+    let mut st = Stages::<D> { k: [[V::ZERO; D]; 13], tmp: [V::ZERO; D] };
+    let (rtol, atol) = (V::splat(opts.rtol), V::splat(opts.atol));
+    let h_init = t_final / 100.0;
+    // Lane bookkeeping (scalar), mirrored into vectors before each step.
+    let mut lane_case: [Option<usize>; 4] = [None; 4];
+    let mut yl = [[0.0f64; D]; 4];
+    let mut tl = [0.0f64; 4];
+    let mut hl = [0.0f64; 4];
+    let mut kzl = [0.0f64; 4];
+    let mut acc = [0u32; 4];
+    let mut rej = [0u32; 4];
+    let mut after_reject = [false; 4];
+    let mut next = 0usize;
+
+    let start = |l: usize, i: usize, yl: &mut [[f64; D]; 4], tl: &mut [f64; 4], hl: &mut [f64; 4], kzl: &mut [f64; 4]| {
+        let c = cases[i];
+        let mut y = [0.0; D];
+        y[0] = c.phi0;
+        y[1] = c.wz0;
+        let (s2, c2) = (2.0 * c.phi0).sin_cos();
+        y[2] = c2;
+        y[3] = s2;
+        if D == 8 {
+            y[4] = 1.0;
+            y[7] = 1.0;
+        }
+        yl[l] = y;
+        tl[l] = 0.0;
+        hl[l] = h_init;
+        kzl[l] = c.kz;
+    };
+    for l in 0..4 {
+        if next < cases.len() {
+            start(l, next, &mut yl, &mut tl, &mut hl, &mut kzl);
+            lane_case[l] = Some(next);
+            next += 1;
+        }
+    }
+    let mut ynew = [V::ZERO; D];
+    while lane_case.iter().any(|c| c.is_some()) {
+        // Pack lanes (idle lanes take h = 0: a harmless null step).
+        let mut y = [V::ZERO; D];
+        for i in 0..D {
+            y[i] = V::new(std::array::from_fn(|l| if lane_case[l].is_some() { yl[l][i] } else if i == 2 { 1.0 } else { 0.0 }));
+        }
+        let mut heff = [0.0; 4];
+        let mut last = [false; 4];
+        for l in 0..4 {
+            if lane_case[l].is_some() {
+                let rem = t_final - tl[l];
+                if hl[l] >= rem {
+                    heff[l] = rem;
+                    last[l] = true;
+                } else {
+                    heff[l] = hl[l];
+                }
+            }
+        }
+        let t = V::new(tl);
+        let h = V::new(heff);
+        let kz15 = V::new(kzl) * V::splat(1.5);
+        let err = st.step(f, t, &y, h, kz15, &mut ynew, rtol, atol).to_array();
+        // err^(-1/8) per lane through three square roots, lane-wise.
+        let e8 = V::new(err).sqrt().sqrt().sqrt().to_array();
+        let ynew_l: [[f64; 4]; D] = std::array::from_fn(|i| ynew[i].to_array());
+        for l in 0..4 {
+            let Some(ci) = lane_case[l] else { continue };
+            let finite = (0..D).all(|i| ynew_l[i][l].is_finite());
+            let ok = err[l] <= 1.0 && finite;
+            let fac_max = if after_reject[l] { 1.0 } else { 5.0 };
+            let fac = if ok {
+                if err[l] == 0.0 { fac_max } else { (0.8 / e8[l]).clamp(0.2, fac_max) }
+            } else if err[l].is_finite() {
+                (0.8 / e8[l]).clamp(0.2, 1.0)
+            } else {
+                0.2
+            };
+            let mut finished = None;
+            if ok {
+                acc[l] += 1;
+                after_reject[l] = false;
+                for i in 0..D {
+                    yl[l][i] = ynew_l[i][l];
+                }
+                tl[l] = if last[l] { t_final } else { tl[l] + heff[l] };
+                hl[l] = heff[l] * fac;
+                if last[l] {
+                    finished = Some(LaneStatus::Ok);
+                }
+            } else {
+                rej[l] += 1;
+                after_reject[l] = true;
+                hl[l] = heff[l] * fac;
+                if hl[l] <= 1e-14 * t_final.max(1.0) {
+                    finished = Some(LaneStatus::Failed);
+                }
+            }
+            if finished.is_none() && acc[l] + rej[l] >= opts.max_steps {
+                finished = Some(LaneStatus::MaxSteps);
+            }
+            if let Some(status) = finished {
+                let y = &yl[l];
+                out[ci] = Outcome {
+                    phi_t: if status == LaneStatus::Ok { y[0] } else { f64::NAN },
+                    wz_t: if status == LaneStatus::Ok { y[1] } else { f64::NAN },
+                    stm: if D == 8 && status == LaneStatus::Ok { [y[4], y[5], y[6], y[7]] } else { [f64::NAN; 4] },
+                    accepted: acc[l],
+                    rejected: rej[l],
+                    status,
+                };
+                acc[l] = 0;
+                rej[l] = 0;
+                after_reject[l] = false;
+                if next < cases.len() {
+                    start(l, next, &mut yl, &mut tl, &mut hl, &mut kzl);
+                    lane_case[l] = Some(next);
+                    next += 1;
+                } else {
+                    lane_case[l] = None;
+                }
+            }
+        }
+    }
+    out
+}

@@ -1,0 +1,60 @@
+//! The periodicity-map engine (thesis sec. 3.3, PHYSICS.md sec. 5): planar attitude
+//! trajectories along one orbit for many (phi0, wz0, Kz), integrated over one period (or K
+//! periods) in SIMD lanes on all cores, with the orbit forcing computed once per orbit.
+
+pub mod forcing;
+pub mod lanes;
+
+pub use forcing::OrbitForcing;
+pub use lanes::{integrate_cases, Case, LaneOptions, LaneStatus, Outcome};
+
+use rayon::prelude::*;
+
+use crate::error::{check_positive, invalid, Result};
+use crate::propagation::with_threads;
+
+/// Residuals of one trajectory: Dwz = wz(T) - wz0, Dphi = phi(T) - phi0 wrapped to (-pi, pi].
+pub fn residuals(case: &Case, o: &Outcome) -> (f64, f64) {
+    let d = o.phi_t - case.phi0;
+    let two_pi = 2.0 * std::f64::consts::PI;
+    let mut w = d - two_pi * (d / two_pi).round();
+    if w <= -std::f64::consts::PI {
+        w += two_pi;
+    }
+    (o.wz_t - case.wz0, w)
+}
+
+/// Integrate every case over `t_final` on `threads` workers (None: all cores), `chunk` cases
+/// per task. Results are in case order and bit-identical for any `chunk` and thread count.
+pub fn sweep(
+    forcing: &OrbitForcing,
+    t_final: f64,
+    cases: &[Case],
+    opts: &LaneOptions,
+    with_stm: bool,
+    chunk: usize,
+    threads: Option<usize>,
+) -> Result<Vec<Outcome>> {
+    check_positive("t_final", t_final)?;
+    check_positive("rtol", opts.rtol)?;
+    check_positive("atol", opts.atol)?;
+    if chunk == 0 {
+        return Err(invalid("chunk", "must be >= 1"));
+    }
+    for (i, c) in cases.iter().enumerate() {
+        if !(c.phi0.is_finite() && c.wz0.is_finite()) {
+            return Err(invalid("wz0", format!("case {i}: phi0 and wz0 must be finite, got ({}, {})", c.phi0, c.wz0)));
+        }
+        if !(c.kz.is_finite() && (-1.0..=1.0).contains(&c.kz)) {
+            return Err(invalid("kz", format!("case {i}: must be in [-1, 1], got {}", c.kz)));
+        }
+    }
+    let run = |part: &[Case]| -> Vec<Outcome> {
+        if with_stm {
+            integrate_cases::<8>(forcing, t_final, part, opts)
+        } else {
+            integrate_cases::<4>(forcing, t_final, part, opts)
+        }
+    };
+    with_threads(threads, || cases.par_chunks(chunk).map(run).collect::<Vec<_>>().concat())
+}
