@@ -57,7 +57,7 @@ class ContinuationResult:
 def _correct(system: System, p, spatial: bool, kind: str, values, family: str, t_max: float) -> PeriodicOrbit:
     r = _core.symmetric_correct(
         system.mu, [float(v) for v in p], spatial=spatial, constraint=kind, values=[float(v) for v in values],
-        tol=1e-11, max_iter=25, t_max=t_max, rtol=SHOOT_RTOL, atol=SHOOT_ATOL,
+        tol=1e-12, max_iter=25, t_max=t_max, rtol=SHOOT_RTOL, atol=SHOOT_ATOL,
     )
     return _orbit_from(system, r, family)
 

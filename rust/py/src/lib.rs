@@ -17,6 +17,7 @@ use pyo3::types::PyDict;
 
 mod attitude;
 mod fourier;
+mod map;
 
 create_exception!(librate, LibrateError, PyException, "Base class of librate's errors.");
 create_exception!(
@@ -404,6 +405,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(multiple_shooting, m)?)?;
     fourier::register(m)?;
     attitude::register(m)?;
+    map::register(m)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

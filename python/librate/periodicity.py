@@ -1,0 +1,474 @@
+"""Periodic orbit-attitude solutions and periodicity maps (thesis sec. 3.3, PHYSICS.md sec. 5).
+
+Along a periodic orbit of period T, a planar attitude motion started at phi(0) = phi0 with
+inertial rate wz(0) = wz0 is periodic when wz(T) = wz0 and phi(T) = phi0 + 2 pi N (N = net body
+turns relative to the synodic frame per orbit). Motions with phi(T) = phi0 + pi (+ 2 pi N) are
+dynamically periodic too (the inertia is symmetric under a half turn); they are reported as
+their own class, "half-turn". Rates: ``wz0`` is inertial; ``phidot0 = wz0 - 1`` is relative to
+the synodic frame (the quantity on the thesis figures' axes).
+
+The grid work runs in the Rust engine (SIMD lanes, all cores, orbit forcing tabulated once per
+orbit); refinement uses the engine's 2x2 attitude STM; every reported solution is re-propagated
+independently (scalar model, orbit integrated alongside, tight tolerance).
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from dataclasses import dataclass, field
+from typing import Callable, Sequence
+
+import numpy as np
+
+from . import _core
+from ._errors import ConvergenceError
+from .families import OrbitFamily
+from .orbits import PeriodicOrbit
+
+__all__ = ["AttitudeSolution", "periodic_attitude", "find_periodic_attitudes", "periodicity_map", "orbit_forcing", "zero_contours"]
+
+MAP_RTOL = 1e-12
+MAP_ATOL = 1e-12
+_FORCINGS: dict = {}
+
+
+def orbit_forcing(orbit: PeriodicOrbit, primaries: tuple[bool, bool] = (True, True)):
+    """The orbit's gravity-gradient forcing table (computed once per orbit and cached)."""
+    key = (orbit.system.mu, tuple(np.asarray(orbit.state0).tolist()), float(orbit.period), tuple(primaries))
+    f = _FORCINGS.get(key)
+    if f is None:
+        if len(_FORCINGS) > 256:
+            _FORCINGS.clear()
+        f = _core.OrbitForcing(orbit.system.mu, [float(v) for v in orbit.state0], float(orbit.period), primaries=list(primaries))
+        _FORCINGS[key] = f
+    return f
+
+
+def _sweep(forcing, t_final, phi0, wz0, kz, *, stm=False, rtol=MAP_RTOL, atol=MAP_ATOL, chunk=64, threads=None):
+    n = np.broadcast(np.asarray(phi0), np.asarray(wz0), np.asarray(kz)).shape
+    p, w, k = (np.ascontiguousarray(np.broadcast_to(np.asarray(a, dtype=np.float64), n)).ravel() for a in (phi0, wz0, kz))
+    return _core.map_sweep(forcing, float(t_final), p, w, k, rtol=float(rtol), atol=float(atol), max_steps=200_000,
+                           stm=bool(stm), chunk=int(chunk), threads=threads)
+
+
+def _check_orbit(orbit) -> PeriodicOrbit:
+    if not isinstance(orbit, PeriodicOrbit):
+        raise ValueError(f"invalid argument `orbit`: must be a librate.PeriodicOrbit, got {type(orbit).__name__}")
+    if orbit.state0[2] != 0.0 or orbit.state0[5] != 0.0:
+        raise ValueError("invalid argument `orbit`: the planar attitude model needs a planar orbit (z = zd = 0)")
+    return orbit
+
+
+def _check_kz(kz) -> float:
+    if not (isinstance(kz, (int, float, np.floating, np.integer)) and math.isfinite(kz) and -1 <= kz <= 1):
+        raise ValueError(f"invalid argument `kz`: must be a number in [-1, 1], got {kz!r}")
+    return float(kz)
+
+
+def _symmetric(orbit: PeriodicOrbit, phi0: float) -> bool:
+    """x-symmetric orbit started on the x axis, and a symmetric initial attitude."""
+    s = orbit.state0
+    on_axis = s[1] == 0.0 and s[3] == 0.0
+    k = phi0 / (0.5 * math.pi)
+    return on_axis and abs(k - round(k)) < 1e-15
+
+
+@dataclass(frozen=True)
+class AttitudeSolution:
+    """A periodic (or half-turn) planar attitude motion along an orbit.
+
+    ``n``: net body turns per orbit relative to the synodic frame (for "half-turn" solutions
+    phi(T) = phi0 + 2 pi n + pi). ``residual``: max(|Dphi|, |Dwz|) after one period from an
+    independent re-propagation. ``monodromy``: the 2x2 d(phi, wz)(T)/d(phi0, wz0); the motion is
+    linearly stable when |trace| < 2 (multipliers on the unit circle).
+    """
+
+    orbit: PeriodicOrbit
+    kz: float
+    n: int
+    kind: str
+    phi0: float
+    wz0: float
+    residual_dphi: float
+    residual_dwz: float
+    monodromy: np.ndarray = field(repr=False)
+    iterations: int = 0
+
+    @property
+    def phidot0(self) -> float:
+        """Initial rate relative to the synodic frame, wz0 - 1."""
+        return self.wz0 - 1.0
+
+    @property
+    def residual(self) -> float:
+        return max(abs(self.residual_dphi), abs(self.residual_dwz))
+
+    @property
+    def trace(self) -> float:
+        return float(np.trace(self.monodromy))
+
+    @property
+    def multipliers(self) -> np.ndarray:
+        return np.linalg.eigvals(self.monodromy)
+
+    @property
+    def stable(self) -> bool:
+        return abs(self.trace) < 2.0
+
+    def propagate(self, n_periods: float = 1.0, **kwargs):
+        """The motion over ``n_periods`` orbits (planar model, orbit integrated alongside)."""
+        from .attitude import RigidBody, propagate_attitude
+
+        kwargs.setdefault("rtol", 1e-13)
+        kwargs.setdefault("atol", 1e-13)
+        return propagate_attitude(self.orbit.system, self.orbit.state0, (self.phi0, self.wz0), RigidBody.from_kz(self.kz),
+                                  n_periods * self.orbit.period, planar=True, **kwargs)
+
+
+def _verify(orbit, kz, phi0, wz0, turns, n_periods):
+    """Independent re-propagation (scalar planar model with the orbit integrated alongside, at
+    rtol = atol = 1e-14): residuals and the 2x2 monodromy."""
+    from .attitude import RigidBody, propagate_attitude
+
+    T = n_periods * orbit.period
+    tr = propagate_attitude(orbit.system, orbit.state0, (phi0, wz0), RigidBody.from_kz(kz), T, planar=True, stm=True,
+                            rtol=1e-14, atol=1e-14, t_eval=[T])
+    dphi = tr.phi[-1] - phi0 - 2 * math.pi * turns
+    dwz = tr.wz[-1] - wz0
+    return dphi, dwz, tr.stm
+
+
+def periodic_attitude(
+    orbit: PeriodicOrbit,
+    *,
+    kz: float,
+    n: int,
+    phi0: float = 0.0,
+    wz0: float | None = None,
+    kind: str = "periodic",
+    method: str = "auto",
+    n_periods: int = 1,
+    tol: float = 1e-12,
+    max_iter: int = 40,
+) -> AttitudeSolution:
+    """The periodic attitude motion with ``n`` net turns per orbit (``kind="half-turn"``: a half
+    turn more) along ``orbit``, for the body with ``kz``.
+
+    ``method``: "half" solves phi(T/2) = phi0 + pi * turns for wz0 (a scalar Newton with the
+    STM; exact for x-symmetric orbits with phi0 a multiple of pi/2), "newton" corrects
+    (phi0, wz0) together with the full-period Newton step [Phi(T) - I] d = -F (PHYSICS.md: the
+    correct form of thesis eq. 53), "auto" picks "half" when it applies. ``wz0``: the guess
+    (default: the torque-free solution 1 + 2 pi turns / T). Raises ConvergenceError.
+    """
+    orbit = _check_orbit(orbit)
+    kz = _check_kz(kz)
+    if not isinstance(n, (int, np.integer)):
+        raise ValueError(f"invalid argument `n`: must be an integer, got {n!r}")
+    if kind not in ("periodic", "half-turn"):
+        raise ValueError(f"invalid argument `kind`: must be 'periodic' or 'half-turn', got {kind!r}")
+    if method not in ("auto", "half", "newton"):
+        raise ValueError(f"invalid argument `method`: must be 'auto', 'half' or 'newton', got {method!r}")
+    if not isinstance(n_periods, (int, np.integer)) or n_periods < 1:
+        raise ValueError(f"invalid argument `n_periods`: must be an integer >= 1, got {n_periods!r}")
+    if not math.isfinite(phi0):
+        raise ValueError(f"invalid argument `phi0`: must be finite, got {phi0!r}")
+    turns = n + (0.5 if kind == "half-turn" else 0.0)
+    T = n_periods * orbit.period
+    w = 1.0 + 2 * math.pi * turns / T if wz0 is None else float(wz0)
+    if not math.isfinite(w):
+        raise ValueError(f"invalid argument `wz0`: must be finite, got {wz0!r}")
+    if method == "auto":
+        method = "half" if (_symmetric(orbit, phi0) and n_periods == 1) else "newton"
+    if method == "half" and not _symmetric(orbit, phi0):
+        raise ValueError("invalid argument `method`: 'half' needs an x-symmetric orbit started on the x axis and phi0 a multiple of pi/2")
+    forcing = orbit_forcing(orbit)
+    p = float(phi0)
+    it = 0
+    res = math.inf
+    for it in range(1, max_iter + 1):
+        if method == "half":
+            r = _sweep(forcing, 0.5 * T, p, w, kz, stm=True, rtol=1e-13, atol=1e-13)
+            g = r["phi_t"][0] - p - math.pi * turns
+            d = r["stm"][0, 0, 1]
+            res = abs(g)
+            if res < tol:
+                break
+            if d == 0 or not math.isfinite(d):
+                raise ConvergenceError(f"periodic attitude (half period): zero derivative at wz0 = {w}")
+            step = -g / d
+            w += float(np.clip(step, -0.5, 0.5))
+        else:
+            r = _sweep(forcing, T, p, w, kz, stm=True, rtol=1e-13, atol=1e-13)
+            F = np.array([r["phi_t"][0] - p - 2 * math.pi * turns, r["wz_t"][0] - w])
+            res = float(np.max(np.abs(F)))
+            if res < tol:
+                break
+            J = r["stm"][0] - np.eye(2)
+            try:
+                dx = np.linalg.solve(J, -F)
+            except np.linalg.LinAlgError:
+                raise ConvergenceError(f"periodic attitude: Phi(T) - I is singular at wz0 = {w} (trace 2: a fold)") from None
+            scale = min(1.0, 0.5 / max(abs(dx[1]), 1e-300))
+            p += float(dx[0]) * scale
+            w += float(dx[1]) * scale
+        if not (math.isfinite(w) and math.isfinite(p)):
+            break
+    else:
+        raise ConvergenceError(f"periodic attitude (N = {n}, {kind}) did not converge after {max_iter} iterations (residual {res:.3e}, tolerance {tol:.1e})")
+    if not math.isfinite(res) or res >= tol:
+        raise ConvergenceError(f"periodic attitude (N = {n}, {kind}) diverged (residual {res:.3e})")
+    dphi, dwz, m = _verify(orbit, kz, p, w, turns, n_periods)
+    return AttitudeSolution(orbit, kz, int(n), kind, p, w, float(dphi), float(dwz), m, it)
+
+
+def _grid_for(T: float, lo: float, hi: float, n_grid: int | None) -> np.ndarray:
+    if n_grid is None:
+        # phi(T) moves by about T per unit wz0: 16 samples per pi of phi(T).
+        n_grid = int(max(200, 16 * (hi - lo) * T / math.pi))
+    return np.linspace(lo, hi, int(n_grid))
+
+
+def _candidates(phi_t, phi0, wz, level):
+    """wz0 brackets where (phi(t) - phi0) / level crosses an integer; returns (k, wz_interp)."""
+    u = (phi_t - phi0) / level
+    out = []
+    ok = np.isfinite(u)
+    for i in range(len(u) - 1):
+        if not (ok[i] and ok[i + 1]):
+            continue
+        a, b = u[i], u[i + 1]
+        lo, hi = (a, b) if a <= b else (b, a)
+        for k in range(math.ceil(lo), math.floor(hi) + 1):
+            if a == b:
+                continue
+            w = wz[i] + (k - a) / (b - a) * (wz[i + 1] - wz[i])
+            out.append((k, w))
+    return out
+
+
+def find_periodic_attitudes(
+    orbit: PeriodicOrbit,
+    *,
+    kz: float,
+    wz0_range: tuple[float, float],
+    phi0: float = 0.0,
+    kinds: Sequence[str] = ("periodic", "half-turn"),
+    n_grid: int | None = None,
+    n_periods: int = 1,
+) -> list[AttitudeSolution]:
+    """Every periodic (and half-turn) attitude motion with inertial wz0 in ``wz0_range``.
+
+    A grid scan by the engine brackets the candidates (crossings of phi(T/2) - phi0 through
+    multiples of pi/2 for symmetric cases, of phi(T) - phi0 through multiples of pi otherwise);
+    each is refined by :func:`periodic_attitude` and kept when it converges inside the window.
+    Sorted by wz0.
+    """
+    orbit = _check_orbit(orbit)
+    kz = _check_kz(kz)
+    try:
+        lo, hi = (float(v) for v in wz0_range)
+    except (TypeError, ValueError):
+        raise ValueError(f"invalid argument `wz0_range`: must be (lo, hi), got {wz0_range!r}") from None
+    if not (math.isfinite(lo) and math.isfinite(hi) and lo < hi):
+        raise ValueError(f"invalid argument `wz0_range`: must be finite with lo < hi, got {wz0_range!r}")
+    for k in kinds:
+        if k not in ("periodic", "half-turn"):
+            raise ValueError(f"invalid argument `kinds`: must be 'periodic' and/or 'half-turn', got {k!r}")
+    T = n_periods * orbit.period
+    wz = _grid_for(T, lo, hi, n_grid)
+    symmetric = _symmetric(orbit, phi0) and n_periods == 1
+    forcing = orbit_forcing(orbit)
+    t_scan, level = (0.5 * T, 0.5 * math.pi) if symmetric else (T, math.pi)
+    r = _sweep(forcing, t_scan, phi0, wz, kz)
+    found: list[AttitudeSolution] = []
+    for k, w in _candidates(r["phi_t"], phi0, wz, level):
+        # symmetric: phi(T/2) - phi0 = k pi/2 -> turns = k/2; else phi(T) - phi0 = k pi -> turns = k/2
+        kind = "periodic" if k % 2 == 0 else "half-turn"
+        if kind not in kinds:
+            continue
+        n = k // 2
+        try:
+            sol = periodic_attitude(orbit, kz=kz, n=n, phi0=phi0, wz0=w, kind=kind, n_periods=n_periods)
+        except ConvergenceError:
+            continue
+        if not (lo <= sol.wz0 <= hi) or sol.residual > 1e-8:
+            continue
+        if any(s.n == sol.n and s.kind == sol.kind and abs(s.wz0 - sol.wz0) < 1e-8 for s in found):
+            continue
+        found.append(sol)
+    return sorted(found, key=lambda s: s.wz0)
+
+
+def _orbits_of(orbits) -> tuple[list[PeriodicOrbit], OrbitFamily | None]:
+    if isinstance(orbits, OrbitFamily):
+        return list(orbits), orbits
+    if isinstance(orbits, PeriodicOrbit):
+        return [orbits], None
+    try:
+        lst = list(orbits)
+    except TypeError:
+        raise ValueError(f"invalid argument `orbits`: must be an OrbitFamily, a PeriodicOrbit or a list of them, got {type(orbits).__name__}") from None
+    if not lst or not all(isinstance(o, PeriodicOrbit) for o in lst):
+        raise ValueError("invalid argument `orbits`: must be a non-empty list of librate.PeriodicOrbit")
+    return lst, None
+
+
+def periodicity_map(
+    orbits,
+    *,
+    kz,
+    wz0,
+    phi0: float = 0.0,
+    n_periods: int = 1,
+    solve: bool = True,
+    progress: Callable[[int, int], None] | None = None,
+    rtol: float = MAP_RTOL,
+    atol: float = MAP_ATOL,
+    chunk: int = 64,
+    threads: int | None = None,
+):
+    """Residual grids over (orbit, Kz, wz0) and the periodic solutions they contain.
+
+    ``orbits``: an :class:`OrbitFamily`, a list of planar :class:`PeriodicOrbit` or one orbit;
+    ``kz``: one value or an array; ``wz0``: array of inertial initial rates. Returns an xarray
+    Dataset with ``dwz`` = wz(T) - wz0, ``dphi`` = phi(T) - phi0 wrapped to (-pi, pi] and the
+    unwrapped ``phi_T`` over dims (orbit, kz, wz0), coordinates with units (x0, period,
+    period_days per orbit; phidot0 = wz0 - 1), and, with ``solve``, the refined solutions along a
+    ``solution`` dimension. Work is done one orbit at a time (``progress(done, total)`` after
+    each); on KeyboardInterrupt the finished orbits are kept and returned, with
+    ``attrs["complete"] = 0``. Results are bit-identical for any ``chunk`` and ``threads``.
+    """
+    import xarray as xr
+
+    from . import __version__
+
+    olist, family = _orbits_of(orbits)
+    for o in olist:
+        _check_orbit(o)
+    kzs = np.atleast_1d(np.asarray(kz, dtype=np.float64))
+    if kzs.ndim != 1 or kzs.size == 0 or not np.all(np.isfinite(kzs)) or np.any(np.abs(kzs) > 1):
+        raise ValueError(f"invalid argument `kz`: values must be finite and in [-1, 1], got {kz!r}")
+    wz = np.asarray(wz0, dtype=np.float64).ravel()
+    if wz.size < 2 or not np.all(np.isfinite(wz)) or np.any(np.diff(wz) <= 0):
+        raise ValueError("invalid argument `wz0`: must be a finite, strictly increasing array of at least 2 rates")
+    if not isinstance(n_periods, (int, np.integer)) or n_periods < 1:
+        raise ValueError(f"invalid argument `n_periods`: must be an integer >= 1, got {n_periods!r}")
+    no, nk, nw = len(olist), kzs.size, wz.size
+    dwz = np.full((no, nk, nw), np.nan)
+    dphi = np.full((no, nk, nw), np.nan)
+    phi_t = np.full((no, nk, nw), np.nan)
+    status = np.full((no, nk, nw), 255, dtype=np.uint8)
+    done = np.zeros(no, dtype=bool)
+    sols: list[tuple[int, AttitudeSolution]] = []
+    kz_grid, wz_grid = np.meshgrid(kzs, wz, indexing="ij")
+    complete = True
+    try:
+        for i, o in enumerate(olist):
+            r = _sweep(orbit_forcing(o), n_periods * o.period, phi0, wz_grid, kz_grid, rtol=rtol, atol=atol, chunk=chunk, threads=threads)
+            dwz[i], dphi[i], phi_t[i] = (r[k].reshape(nk, nw) for k in ("dwz", "dphi", "phi_t"))
+            status[i] = r["status"].reshape(nk, nw)
+            if solve:
+                for j, k in enumerate(kzs):
+                    sols += [(i, s) for s in _solutions_from_row(o, float(k), phi0, wz, phi_t[i, j], n_periods)]
+            done[i] = True
+            if progress is not None:
+                progress(i + 1, no)
+    except KeyboardInterrupt:
+        complete = False
+        warnings.warn(f"periodicity_map interrupted: {int(done.sum())} of {no} orbits finished and kept", stacklevel=2)
+    ds = xr.Dataset(
+        {
+            "dwz": (("orbit", "kz", "wz0"), dwz, {"units": "1/TU", "long_name": "wz(T) - wz(0)"}),
+            "dphi": (("orbit", "kz", "wz0"), dphi, {"units": "rad", "long_name": "phi(T) - phi0 wrapped to (-pi, pi]"}),
+            "phi_T": (("orbit", "kz", "wz0"), phi_t, {"units": "rad", "long_name": "phi(T), unwrapped"}),
+            "status": (("orbit", "kz", "wz0"), status, {"flag_values": "0 ok, 1 max steps, 2 failed, 255 not computed"}),
+            "computed": ("orbit", done),
+        },
+        coords={
+            "orbit": np.arange(no),
+            "x0": ("orbit", np.array([o.x0 for o in olist]), {"units": "LU"}),
+            "period": ("orbit", np.array([o.period for o in olist]), {"units": "TU"}),
+            "period_days": ("orbit", np.array([o.period_days for o in olist]), {"units": "d"}),
+            "kz": ("kz", kzs, {"long_name": "(Iy - Ix) / Iz"}),
+            "wz0": ("wz0", wz, {"units": "1/TU", "long_name": "initial inertial angular rate"}),
+            "phidot0": ("wz0", wz - 1.0, {"units": "1/TU", "long_name": "initial rate relative to the synodic frame"}),
+        },
+        attrs={
+            "title": "librate attitude periodicity map",
+            "phi0": float(phi0),
+            "n_periods": int(n_periods),
+            "rtol": float(rtol),
+            "atol": float(atol),
+            "complete": int(complete),
+            "mu": olist[0].system.mu,
+            "lu_km": olist[0].system.lu_km,
+            "tu_s": olist[0].system.tu_s,
+            "system_name": olist[0].system.name,
+            "family": family.kind if family is not None else "",
+            "librate_version": __version__,
+        },
+    )
+    if solve:
+        ds = ds.merge(_solutions_dataset(sols))
+    return ds
+
+
+def _solutions_from_row(orbit, kz, phi0, wz, phi_t_row, n_periods) -> list[AttitudeSolution]:
+    """Candidates from one full-period row (phi(T) - phi0 through multiples of pi), refined."""
+    out: list[AttitudeSolution] = []
+    for k, w in _candidates(phi_t_row, phi0, wz, math.pi):
+        kind = "periodic" if k % 2 == 0 else "half-turn"
+        n = k // 2
+        try:
+            sol = periodic_attitude(orbit, kz=kz, n=n, phi0=phi0, wz0=w, kind=kind, n_periods=n_periods)
+        except ConvergenceError:
+            continue
+        if not (wz[0] <= sol.wz0 <= wz[-1]) or sol.residual > 1e-8:
+            continue
+        if any(s.n == sol.n and s.kind == sol.kind and abs(s.wz0 - sol.wz0) < 1e-8 for s in out):
+            continue
+        out.append(sol)
+    return out
+
+
+def _solutions_dataset(sols):
+    import xarray as xr
+
+    idx = np.array([i for i, _ in sols], dtype=np.int64)
+    s = [x for _, x in sols]
+    return xr.Dataset(
+        {
+            "sol_orbit": ("solution", idx),
+            "sol_kz": ("solution", np.array([x.kz for x in s], dtype=float)),
+            "sol_wz0": ("solution", np.array([x.wz0 for x in s], dtype=float), {"units": "1/TU"}),
+            "sol_phidot0": ("solution", np.array([x.phidot0 for x in s], dtype=float), {"units": "1/TU"}),
+            "sol_phi0": ("solution", np.array([x.phi0 for x in s], dtype=float), {"units": "rad"}),
+            "sol_n": ("solution", np.array([x.n for x in s], dtype=np.int64)),
+            "sol_kind": ("solution", np.array([x.kind for x in s], dtype="<U9")),
+            "sol_residual": ("solution", np.array([x.residual for x in s], dtype=float)),
+            "sol_trace": ("solution", np.array([x.trace for x in s], dtype=float)),
+            "sol_stable": ("solution", np.array([x.stable for x in s], dtype=bool)),
+        }
+    )
+
+
+def zero_contours(ds, var: str = "dwz", kz_index: int = 0) -> np.ndarray:
+    """Points (orbit x0, wz0) where ``var`` crosses zero along wz0, for each orbit row (linear
+    interpolation; for ``dphi`` the wrap jumps at +-pi are not crossings). (m, 2) array."""
+    if var not in ("dwz", "dphi"):
+        raise ValueError(f"invalid argument `var`: must be 'dwz' or 'dphi', got {var!r}")
+    a = ds[var].values[:, kz_index, :]
+    wz = ds["wz0"].values
+    x0 = ds["x0"].values
+    pts = []
+    for i in range(a.shape[0]):
+        row = a[i]
+        for j in range(len(row) - 1):
+            u, v = row[j], row[j + 1]
+            if not (np.isfinite(u) and np.isfinite(v)) or (u > 0) == (v > 0) or u == v:
+                continue
+            if var == "dphi" and abs(u - v) > math.pi:
+                continue
+            pts.append((x0[i], wz[j] + u / (u - v) * (wz[j + 1] - wz[j])))
+    return np.array(pts).reshape(-1, 2)

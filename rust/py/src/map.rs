@@ -1,0 +1,103 @@
+//! Bindings of the periodicity-map engine.
+
+use librate_core::map::{self, Case, LaneOptions};
+use numpy::{IntoPyArray, PyArrayMethods, PyReadonlyArray1};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+use crate::to_py;
+
+/// Gravity-gradient forcing S(t), C(t) of one planar periodic orbit, tabulated once (piecewise
+/// Chebyshev) and shared by every attitude trajectory on that orbit.
+#[pyclass(frozen, name = "OrbitForcing", module = "librate._core")]
+pub struct PyOrbitForcing {
+    inner: map::OrbitForcing,
+}
+
+#[pymethods]
+impl PyOrbitForcing {
+    #[new]
+    #[pyo3(signature = (mu, state0, period, *, primaries=[true, true], tol=1e-13))]
+    fn new(py: Python<'_>, mu: f64, state0: [f64; 6], period: f64, primaries: [bool; 2], tol: f64) -> PyResult<Self> {
+        let inner = py.detach(|| map::OrbitForcing::new(mu, &state0, period, primaries, tol)).map_err(to_py)?;
+        Ok(Self { inner })
+    }
+    #[getter]
+    fn period(&self) -> f64 {
+        self.inner.period
+    }
+    #[getter]
+    fn segments(&self) -> usize {
+        self.inner.segments()
+    }
+    #[getter]
+    fn max_error(&self) -> f64 {
+        self.inner.max_error
+    }
+    /// (S, C) at the given times.
+    fn sc<'py>(&self, py: Python<'py>, t: PyReadonlyArray1<'py, f64>) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
+        let (s, c): (Vec<f64>, Vec<f64>) = t.as_array().iter().map(|&ti| self.inner.sc(ti)).unzip();
+        Ok((s.into_pyarray(py).into_any(), c.into_pyarray(py).into_any()))
+    }
+}
+
+/// Integrate planar attitude trajectories (phi0, wz0, kz arrays of one length) over t_final.
+#[pyfunction]
+#[pyo3(signature = (forcing, t_final, phi0, wz0, kz, *, rtol, atol, max_steps, stm, chunk, threads))]
+#[allow(clippy::too_many_arguments)]
+fn map_sweep<'py>(
+    py: Python<'py>,
+    forcing: PyRef<'py, PyOrbitForcing>,
+    t_final: f64,
+    phi0: PyReadonlyArray1<'py, f64>,
+    wz0: PyReadonlyArray1<'py, f64>,
+    kz: PyReadonlyArray1<'py, f64>,
+    rtol: f64,
+    atol: f64,
+    max_steps: u32,
+    stm: bool,
+    chunk: usize,
+    threads: Option<usize>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let (p, w, k) = (phi0.as_array(), wz0.as_array(), kz.as_array());
+    if p.len() != w.len() || k.len() != w.len() {
+        return Err(PyValueError::new_err(format!("invalid argument: phi0, wz0 and kz must have one length, got {}, {}, {}", p.len(), w.len(), k.len())));
+    }
+    let cases: Vec<Case> = (0..w.len()).map(|i| Case { phi0: p[i], wz0: w[i], kz: k[i] }).collect();
+    let opts = LaneOptions { rtol, atol, max_steps };
+    let f = &forcing.inner;
+    let out = py.detach(|| map::sweep(f, t_final, &cases, &opts, stm, chunk, threads)).map_err(to_py)?;
+    let n = out.len();
+    let (mut phi_t, mut wz_t, mut dwz, mut dphi) = (Vec::with_capacity(n), Vec::with_capacity(n), Vec::with_capacity(n), Vec::with_capacity(n));
+    let mut m = Vec::with_capacity(if stm { 4 * n } else { 0 });
+    let mut status = Vec::with_capacity(n);
+    let mut steps = Vec::with_capacity(2 * n);
+    for (c, o) in cases.iter().zip(&out) {
+        let (a, b) = map::residuals(c, o);
+        phi_t.push(o.phi_t);
+        wz_t.push(o.wz_t);
+        dwz.push(a);
+        dphi.push(b);
+        if stm {
+            m.extend_from_slice(&o.stm);
+        }
+        status.push(o.status as u8);
+        steps.extend([o.accepted, o.rejected]);
+    }
+    let d = PyDict::new(py);
+    d.set_item("phi_t", phi_t.into_pyarray(py))?;
+    d.set_item("wz_t", wz_t.into_pyarray(py))?;
+    d.set_item("dwz", dwz.into_pyarray(py))?;
+    d.set_item("dphi", dphi.into_pyarray(py))?;
+    d.set_item("stm", if stm { Some(m.into_pyarray(py).reshape([n, 2, 2])?) } else { None })?;
+    d.set_item("status", status.into_pyarray(py))?;
+    d.set_item("steps", steps.into_pyarray(py).reshape([n, 2])?)?;
+    Ok(d)
+}
+
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<PyOrbitForcing>()?;
+    m.add_function(wrap_pyfunction!(map_sweep, m)?)?;
+    Ok(())
+}

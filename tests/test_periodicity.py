@@ -1,0 +1,150 @@
+"""Periodic orbit-attitude solutions and periodicity maps: thesis sec. 3.3 / PHYSICS.md sec. 5."""
+
+import math
+
+import numpy as np
+import pytest
+
+import librate
+
+
+@pytest.fixture(scope="module")
+def dro1266(em):
+    return librate.dro(em, period_days=12.66)
+
+
+def test_thesis_fig23_n_minus_one(dro1266):
+    """Thesis Fig. 23 (PHYSICS.md sec. 5): on the 12.66-day DRO with Kz = 0.8 the N = -1 solution
+    sits at phidot0 = -2.4545 (inertial wz0 = -1.4545; 4 digits), and both residual curves cross
+    zero there with slopes of opposite sign, staying within +-0.15 over [-2.55, -2.35]."""
+    sol = librate.periodic_attitude(dro1266, kz=0.8, n=-1)
+    assert round(sol.phidot0, 4) == -2.4545 and round(sol.wz0, 4) == -1.4545
+    assert sol.residual < 1e-9 and sol.kind == "periodic"
+    ds = librate.periodicity_map(dro1266, kz=0.8, wz0=np.linspace(-1.55, -1.35, 201), solve=False)
+    dwz, dphi = ds.dwz.values[0, 0], ds.dphi.values[0, 0]
+    assert np.max(np.abs(dwz)) < 0.15 and np.max(np.abs(dphi)) < 0.15
+    assert np.sign(dwz[0]) != np.sign(dwz[-1]) and np.sign(dphi[0]) != np.sign(dphi[-1])
+    slope_wz = np.polyfit(ds.wz0.values, dwz, 1)[0]
+    slope_phi = np.polyfit(ds.wz0.values, dphi, 1)[0]
+    assert slope_wz * slope_phi < 0
+
+
+def test_torque_free_solutions_are_exact(dro1266):
+    """Kz = 0: the solutions are exactly wz0 = 1 + 2 pi N / T for every N in the window (and the
+    half-turn ones 1 + 2 pi (N + 1/2) / T), to 1e-12."""
+    T = dro1266.period
+    sols = librate.find_periodic_attitudes(dro1266, kz=0.0, wz0_range=(-4.0, 6.0))
+    per = [s for s in sols if s.kind == "periodic"]
+    half = [s for s in sols if s.kind == "half-turn"]
+    expect = [1 + 2 * math.pi * n / T for n in range(-3, 3) if -4 < 1 + 2 * math.pi * n / T < 6]
+    assert [s.n for s in per] == [n for n in range(-3, 3) if -4 < 1 + 2 * math.pi * n / T < 6]
+    np.testing.assert_allclose([s.wz0 for s in per], expect, atol=1e-12)
+    for s in half:
+        assert s.wz0 == pytest.approx(1 + 2 * math.pi * (s.n + 0.5) / T, abs=1e-12)
+    # free rotation: monodromy [[1, T], [0, 1]], trace 2 (marginal)
+    np.testing.assert_allclose(per[0].monodromy, [[1, T], [0, 1]], atol=1e-10)
+
+
+def test_solutions_repeat_when_repropagated(dro1266, em):
+    """Every reported solution, re-propagated independently (3-D model this time, started
+    planar), repeats after one period to 1e-9 in wz and phi (half-turn: phi + pi)."""
+    sols = librate.find_periodic_attitudes(dro1266, kz=0.8, wz0_range=(-3.0, 2.0))
+    assert {(s.n, s.kind) for s in sols} >= {(-1, "periodic"), (0, "periodic")}
+    body = librate.RigidBody.from_kz(0.8)
+    for s in sols:
+        q0 = librate.quaternion_from_euler([0, 0, s.phi0])
+        tr = librate.propagate_attitude(em, dro1266.state0, (q0, [0, 0, s.wz0]), body, dro1266.period, rtol=1e-13, atol=1e-13)
+        turns = s.n + (0.5 if s.kind == "half-turn" else 0.0)
+        phi_T = 2 * math.atan2(tr.q[-1, 2], tr.q[-1, 3])
+        dphi = math.remainder(phi_T - s.phi0 - 2 * math.pi * turns, 2 * math.pi)
+        assert abs(dphi) < 1e-9 and abs(tr.w[-1, 2] - s.wz0) < 1e-9, (s.n, s.kind)
+
+
+def test_newton_matches_half_period_method(dro1266):
+    """PHYSICS.md: the correct Newton step [Phi(T) - I] d = -F on (phi0, wz0) converges for N = -1
+    and N = -2, where the thesis's eq. 53 fails, and agrees with the half-period method (1e-9);
+    phi0 stays at the symmetric 0."""
+    for n in (-1, -2):
+        a = librate.periodic_attitude(dro1266, kz=0.8, n=n, method="half")
+        b = librate.periodic_attitude(dro1266, kz=0.8, n=n, method="newton")
+        assert b.wz0 == pytest.approx(a.wz0, abs=1e-9) and abs(b.phi0) < 1e-9
+        assert b.residual < 1e-9
+
+
+def test_coarse_map_finds_the_direct_solutions(dro1266):
+    """A coarse map (250 rates) finds the same solutions as the direct solver (1e-9)."""
+    direct = librate.find_periodic_attitudes(dro1266, kz=0.8, wz0_range=(-3.0, 2.0))
+    ds = librate.periodicity_map(dro1266, kz=0.8, wz0=np.linspace(-3.0, 2.0, 250))
+    assert ds.sizes["solution"] == len(direct)
+    got = sorted(zip(ds.sol_wz0.values, ds.sol_n.values, ds.sol_kind.values))
+    for (w, n, k), s in zip(got, direct):
+        assert (n, k) == (s.n, s.kind) and w == pytest.approx(s.wz0, abs=1e-9)
+    assert np.all(ds.sol_residual.values < 1e-9)
+    # zero contours of both residuals pass through each periodic solution
+    for var in ("dwz", "dphi"):
+        pts = librate.periodicity.zero_contours(ds, var)
+        for s in direct:
+            if s.kind == "periodic":
+                assert np.min(np.abs(pts[:, 1] - s.wz0)) < 0.03
+
+
+def test_map_over_the_family_and_kz_is_deterministic(em):
+    """Residual arrays bit-identical with 1 or 2 threads and any chunk size; dims and units."""
+    fam = librate.dro_family(em, x0=[0.9, 0.8, 0.7])
+    wz = np.linspace(-3, 2, 120)
+    a = librate.periodicity_map(fam, kz=[0.3, 0.8], wz0=wz, threads=1, chunk=64, solve=False)
+    b = librate.periodicity_map(fam, kz=[0.3, 0.8], wz0=wz, threads=2, chunk=5, solve=False)
+    for v in ("dwz", "dphi", "phi_T"):
+        np.testing.assert_array_equal(a[v].values, b[v].values)
+    assert a.dwz.dims == ("orbit", "kz", "wz0") and a.wz0.attrs["units"] == "1/TU"
+    np.testing.assert_allclose(a.phidot0.values, wz - 1)
+    assert a.attrs["complete"] == 1 and a.attrs["librate_version"] == librate.__version__
+    # dphi is phi_T - phi0 wrapped to (-pi, pi]
+    np.testing.assert_allclose(np.angle(np.exp(1j * a.phi_T.values)), a.dphi.values, atol=1e-12)
+    assert np.all(a.dphi.values > -math.pi) and np.all(a.dphi.values <= math.pi)
+
+
+def test_interrupted_map_keeps_finished_orbits(em):
+    """Ctrl-C (KeyboardInterrupt) between orbits: the finished rows are kept and flagged."""
+    fam = librate.dro_family(em, x0=[0.9, 0.8, 0.7])
+
+    def stop_after_two(done, total):
+        if done == 2:
+            raise KeyboardInterrupt
+
+    with pytest.warns(UserWarning, match="2 of 3"):
+        ds = librate.periodicity_map(fam, kz=0.8, wz0=np.linspace(-3, 2, 50), progress=stop_after_two)
+    assert ds.attrs["complete"] == 0 and ds.computed.values.tolist() == [True, True, False]
+    full = librate.periodicity_map(fam, kz=0.8, wz0=np.linspace(-3, 2, 50))
+    np.testing.assert_array_equal(ds.dwz.values[:2], full.dwz.values[:2])
+    assert np.isnan(ds.dwz.values[2]).all()
+
+
+def test_half_turn_solutions_are_their_own_class(dro1266):
+    """Half-turn motions (phi(T) = phi0 + pi + 2 pi N) are found and labelled, never as periodic."""
+    sols = librate.find_periodic_attitudes(dro1266, kz=0.8, wz0_range=(-3.0, 2.0))
+    half = [s for s in sols if s.kind == "half-turn"]
+    assert half
+    for s in half:
+        tr = s.propagate()
+        d = tr.phi[-1] - s.phi0
+        assert abs(math.remainder(d - math.pi, 2 * math.pi)) < 1e-9
+        assert abs(math.remainder(d, 2 * math.pi)) > 3.0
+
+
+BAD = [
+    ("kz out of range", lambda o: librate.periodic_attitude(o, kz=1.5, n=0), "kz"),
+    ("n not an integer", lambda o: librate.periodic_attitude(o, kz=0.5, n=0.5), "n"),
+    ("unknown kind", lambda o: librate.periodic_attitude(o, kz=0.5, n=0, kind="quarter"), "kind"),
+    ("bad window", lambda o: librate.find_periodic_attitudes(o, kz=0.5, wz0_range=(2, 1)), "wz0_range"),
+    ("rates not increasing", lambda o: librate.periodicity_map(o, kz=0.5, wz0=[1.0, 0.5]), "wz0"),
+    ("kz array out of range", lambda o: librate.periodicity_map(o, kz=[0.5, 2.0], wz0=[0.0, 1.0]), "kz"),
+    ("not an orbit", lambda o: librate.periodicity_map("dro", kz=0.5, wz0=[0.0, 1.0]), "orbits"),
+]
+
+
+@pytest.mark.parametrize("desc, call, text", BAD, ids=[b[0] for b in BAD])
+def test_bad_requests(dro1266, desc, call, text):
+    with pytest.raises(ValueError) as info:
+        call(dro1266)
+    assert text in str(info.value)
