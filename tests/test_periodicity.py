@@ -148,3 +148,44 @@ def test_bad_requests(dro1266, desc, call, text):
     with pytest.raises(ValueError) as info:
         call(dro1266)
     assert text in str(info.value)
+
+
+def test_attitude_family_across_kz(dro1266):
+    """Continuing the N = -1 solution of the 12.66-day DRO in Kz (pseudo-arclength): every point
+    is a solution (re-solved independently at its Kz, 1e-9), and where the curve crosses Kz = 0
+    its rate is the torque-free 1 - 2 pi / T (1e-6, cubic-spline interpolation between points)."""
+    from librate.periodicity import attitude_family
+
+    fam = attitude_family(dro1266, kz=0.8, n=-1, direction=-1, ds=0.05)
+    assert fam.parameter_name == "kz" and fam.parameter[0] == 0.8 and fam.parameter[-1] < -0.99
+    for i in range(0, len(fam), 9):
+        s = librate.periodic_attitude(dro1266, kz=float(fam.parameter[i]), n=-1, wz0=float(fam.wz0[i]))
+        assert s.wz0 == pytest.approx(fam.wz0[i], abs=1e-9)
+    from scipy.interpolate import CubicSpline
+
+    w_at_0 = float(CubicSpline(fam.parameter[::-1], fam.wz0[::-1])(0.0))
+    assert w_at_0 == pytest.approx(1 - 2 * math.pi / dro1266.period, abs=1e-6)
+
+
+def test_attitude_family_across_the_orbit_family_through_folds(em):
+    """The N = 1 family across the DRO family (thesis Fig. 27) turns back (folds) and is followed
+    past the fold: points on both branches next to the fold are solutions of their orbits
+    (re-solved directly, 1e-8), and on the map of one member the family's rate is a solution."""
+    from librate.periodicity import attitude_family
+
+    dros = librate.dro_family(em)
+    fam = attitude_family(dros, kz=0.8, n=1, start=0.9, direction=-1, max_points=140)
+    assert fam.folds, "expected a fold of the N = 1 family"
+    x_fold = fam.folds[0]["x0"]
+    k = int(np.argmin(np.abs(fam.parameter - x_fold)))
+    for i in (k - 2, k + 2):
+        orbit = dros.member(x0=float(fam.parameter[i]))
+        s = librate.periodic_attitude(orbit, kz=0.8, n=1, wz0=float(fam.wz0[i]))
+        assert s.wz0 == pytest.approx(fam.wz0[i], abs=1e-8)
+    dp = np.diff(fam.parameter)
+    assert np.any(dp > 0) and np.any(dp < 0)  # the curve turns back in x0
+    # the member x0 = 0.85 lies on the first branch: the map of that orbit has the solution
+    i = int(np.argmin(np.abs(fam.parameter[:k] - 0.85)))
+    orbit = dros.member(x0=float(fam.parameter[i]))
+    sols = librate.find_periodic_attitudes(orbit, kz=0.8, wz0_range=(fam.wz0[i] - 0.1, fam.wz0[i] + 0.1))
+    assert any(s.n == 1 and abs(s.wz0 - fam.wz0[i]) < 1e-8 for s in sols)

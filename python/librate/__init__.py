@@ -12,7 +12,7 @@ from .families import OrbitFamily, dro, dro_family, halo, halo_family, lyapunov,
 from .fourier import FourierOrbit, fit_fourier
 from .frames import MeanElements, OsculatingElements, eci_to_synodic, mean_elements, osculating_elements, synodic_to_eci
 from .orbits import PeriodicOrbit, correct_dro, correct_periodic, correct_symmetric
-from .periodicity import AttitudeSolution, find_periodic_attitudes, periodic_attitude, periodicity_map
+from .periodicity import AttitudeFamily, AttitudeSolution, attitude_family, find_periodic_attitudes, periodic_attitude, periodicity_map
 from .propagation import BatchResult, Event, EventHit, Stats, Trajectory, propagate, propagate_many
 from .system import System
 
@@ -41,6 +41,8 @@ __all__ = [
     "periodic_attitude",
     "find_periodic_attitudes",
     "periodicity_map",
+    "AttitudeFamily",
+    "attitude_family",
     "OrbitFamily",
     "dro",
     "dro_family",
