@@ -16,11 +16,21 @@ def test_public_api_is_declared():
     assert files.joinpath("py.typed").is_file() and files.joinpath("_core.pyi").is_file()
 
 
-def test_cli_info_and_demo():
+def test_cli_info_dros_and_demo(tmp_path):
     runner = CliRunner()
     info = runner.invoke(main, ["info"])
     assert info.exit_code == 0 and "earth-moon-jpl" in info.output and "0.836915125772357" in info.output
-    demo = runner.invoke(main, ["demo", "--x0", "0.9", "--x0", "0.85"])
-    assert demo.exit_code == 0, demo.output
-    rows = [line.split() for line in demo.output.splitlines() if line.strip().startswith("0.8")]
+    dros = runner.invoke(main, ["dros", "--x0", "0.9", "--x0", "0.85"])
+    assert dros.exit_code == 0, dros.output
+    rows = [line.split() for line in dros.output.splitlines() if line.strip().startswith("0.8")]
     assert len(rows) == 1 and float(rows[0][6]) < 1e-10  # closure after one period
+    demo = runner.invoke(main, ["demo", "--orbits", "4", "--rates", "200", "--out", str(tmp_path)])
+    assert demo.exit_code == 0, demo.output
+    assert "4 orbits x 200 rates" in demo.output
+    import xarray as xr
+
+    ds = xr.open_dataset(tmp_path / "dro_map_kz0.8.nc", engine="scipy")
+    assert ds.dwz.shape == (4, 1, 200) and ds.sizes["solution"] > 0
+    assert float(ds.sol_residual.max()) < 1e-9
+    bad = runner.invoke(main, ["demo", "--kz", "2"])
+    assert bad.exit_code != 0 and "kz" in bad.output.lower()
