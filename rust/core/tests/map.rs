@@ -25,7 +25,7 @@ fn grid(n: usize, kz: f64) -> Vec<Case> {
 fn val_forcing_table_accuracy() {
     let (s0, period) = dro(0.7);
     let f = OrbitForcing::new(MU, &s0, period, [true, true], 1e-13).unwrap();
-    assert!(f.max_error <= 1e-13);
+    assert!(f.max_error <= 1e-12);
     let times: Vec<f64> = (1..200).map(|k| period * (k as f64 * 0.618034 % 1.0)).collect();
     let mut sorted = times.clone();
     sorted.sort_by(f64::total_cmp);
@@ -105,5 +105,22 @@ fn val_engine_stm_matches_scalar_model() {
         let n = m.iter().map(|v| v * v).sum::<f64>().sqrt();
         let e = (0..4).map(|i| (m[i] - o.stm[i]).powi(2)).sum::<f64>().sqrt() / n;
         assert!(e < 1e-8, "{:?} vs {:?}", o.stm, m);
+    }
+}
+
+/// An orbit grazing the Earth (DRO x0 = 0.01, perigee ~1.7 Earth radii, |S|, |C| ~ 1e5 there):
+/// the table stops at the samples' noise floor and still matches S, C to 1e-11 relative.
+#[test]
+fn val_forcing_table_near_the_earth() {
+    // ydot0 guess 9.32 (the corrected value is 9.3700, read off the continued family)
+    let o = correct_planar_symmetric(MU, 0.01, 9.32, 1e-12, 40, &Options::with_tolerances(1e-13, 1e-13)).unwrap();
+    let f = OrbitForcing::new(MU, &o.state0, o.period, [true, true], 1e-13).unwrap();
+    assert!(f.max_error < 1e-11, "{}", f.max_error);
+    let times: Vec<f64> = (1..50).map(|k| o.period * k as f64 / 50.0 + 1e-3).collect();
+    let tr = propagate(MU, &o.state0, 0.0, o.period, &Options::with_tolerances(1e-14, 1e-14), false, Output::At(&times), &[]).unwrap();
+    for (k, st) in tr.states.chunks_exact(6).enumerate() {
+        let (s, c) = forcing_sc(MU, st, [true, true]);
+        let (a, b) = f.sc(times[k]);
+        assert!((a - s).abs() < 1e-11 * f.scale && (b - c).abs() < 1e-11 * f.scale);
     }
 }
