@@ -61,7 +61,7 @@ fn val_torque_free_body_conserves_momentum_and_norm() {
 #[test]
 fn val_symmetric_body_feels_no_planar_torque() {
     let (orbit, period) = dro(0.8);
-    let tr = propagate_planar(MU, 0.0, [true, true], false, &orbit, 0.3, 0.7, 0.0, period, &tight(), false, Output::Steps).unwrap();
+    let tr = propagate_planar(MU, 0.0, [true, true], false, &orbit, 0.3, 0.7, 0.0, period, &tight(), false, Output::Steps, None).unwrap();
     assert!(tr.wz.iter().all(|&w| w == 0.7));
     let body = RigidBody::new(1.0, 1.0, 1.7).unwrap();
     let gg = GravityGradient::BOTH;
@@ -89,7 +89,7 @@ fn val_three_d_started_planar_matches_reduced_model() {
     s0[12] = wz0;
     let times: Vec<f64> = (1..=20).map(|k| k as f64 * period / 20.0).collect();
     let t3 = propagate_attitude(MU, body, &[&gg as &dyn Torque], OrbitMode::Integrate, &s0, 0.0, period, &tight(), false, Output::At(&times)).unwrap();
-    let tp = propagate_planar(MU, body.kz(), [true, true], false, &orbit, phi0, wz0, 0.0, period, &tight(), false, Output::At(&times)).unwrap();
+    let tp = propagate_planar(MU, body.kz(), [true, true], false, &orbit, phi0, wz0, 0.0, period, &tight(), false, Output::At(&times), None).unwrap();
     for (k, row) in t3.states.chunks_exact(13).enumerate() {
         assert!(row[6].abs() < 1e-15 && row[7].abs() < 1e-15 && row[10].abs() < 1e-15 && row[11].abs() < 1e-15);
         let phi3 = 2.0 * row[8].atan2(row[9]);
@@ -147,7 +147,7 @@ fn val_coupled_stm_matches_finite_differences() {
 #[test]
 fn val_planar_stm_matches_finite_differences() {
     let (orbit, period) = dro(0.7);
-    let run = |phi: f64, wz: f64, stm: bool| propagate_planar(MU, 0.8, [true, true], false, &orbit, phi, wz, 0.0, period, &tight(), stm, Output::Final).unwrap();
+    let run = |phi: f64, wz: f64, stm: bool| propagate_planar(MU, 0.8, [true, true], false, &orbit, phi, wz, 0.0, period, &tight(), stm, Output::Final, None).unwrap();
     let base = run(0.1, -1.4, true);
     let m = base.stm_final.unwrap();
     let d = 1e-6;
@@ -189,8 +189,8 @@ fn val_fourier_forcing_matches_simultaneous_integration() {
     }
     let series = FourierOrbit::new(period, a0, cos, sin).unwrap();
     let forcing = FourierForcing { mu: MU, orbit: &series, primaries: [true, true] };
-    let a = propagate_planar_forced(0.8, &forcing, 0.0, -1.45, 0.0, period, &tight(), false, Output::Final).unwrap();
-    let b = propagate_planar(MU, 0.8, [true, true], false, &orbit, 0.0, -1.45, 0.0, period, &tight(), false, Output::Final).unwrap();
+    let a = propagate_planar_forced(0.8, &forcing, 0.0, -1.45, 0.0, period, &tight(), false, Output::Final, None).unwrap();
+    let b = propagate_planar(MU, 0.8, [true, true], false, &orbit, 0.0, -1.45, 0.0, period, &tight(), false, Output::Final, None).unwrap();
     assert!((a.phi[0] - b.phi[0]).abs() < 1e-6 && (a.wz[0] - b.wz[0]).abs() < 1e-6, "{} {}", a.phi[0] - b.phi[0], a.wz[0] - b.wz[0]);
     let (s, c) = forcing_sc(MU, &orbit, [true, true]);
     assert!(s.abs() < 1e-12 && c > 0.0); // on the x axis: theta_i in {0, pi}

@@ -51,7 +51,7 @@ fn val_engine_matches_scalar_model() {
     let tight = Options::with_tolerances(1e-13, 1e-13);
     for (c, o) in cases.iter().zip(&out) {
         assert_eq!(o.status, LaneStatus::Ok);
-        let r = propagate_planar(MU, c.kz, [true, true], false, &s0, c.phi0, c.wz0, 0.0, period, &tight, false, Output::Final).unwrap();
+        let r = propagate_planar(MU, c.kz, [true, true], false, &s0, c.phi0, c.wz0, 0.0, period, &tight, false, Output::Final, None).unwrap();
         let scale = 1f64.max(r.phi[0].abs()).max(r.wz[0].abs());
         assert!((o.phi_t - r.phi[0]).abs() / scale < 1e-9, "wz0 = {}: phi {} vs {}", c.wz0, o.phi_t, r.phi[0]);
         assert!((o.wz_t - r.wz[0]).abs() / scale < 1e-9, "wz0 = {}: wz {} vs {}", c.wz0, o.wz_t, r.wz[0]);
@@ -100,7 +100,7 @@ fn val_engine_stm_matches_scalar_model() {
     let cases = vec![Case { phi0: 0.1, wz0: -1.4, kz: 0.8 }, Case { phi0: -0.2, wz0: 1.7, kz: 0.5 }];
     let out = sweep(&f, period, &cases, &LaneOptions::default(), true, 4, None).unwrap();
     for (c, o) in cases.iter().zip(&out) {
-        let r = propagate_planar(MU, c.kz, [true, true], false, &s0, c.phi0, c.wz0, 0.0, period, &Options::with_tolerances(1e-13, 1e-13), true, Output::Final).unwrap();
+        let r = propagate_planar(MU, c.kz, [true, true], false, &s0, c.phi0, c.wz0, 0.0, period, &Options::with_tolerances(1e-13, 1e-13), true, Output::Final, None).unwrap();
         let m = r.stm_final.unwrap();
         let n = m.iter().map(|v| v * v).sum::<f64>().sqrt();
         let e = (0..4).map(|i| (m[i] - o.stm[i]).powi(2)).sum::<f64>().sqrt() / n;

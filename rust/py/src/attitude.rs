@@ -81,7 +81,7 @@ fn planar_propagate<'py>(
     let opts = Options::from(options);
     let times = t_eval.map(|a| a.as_array().to_vec());
     let tr = py
-        .detach(|| attitude::propagate_planar(mu, kz, primaries, held, &orbit0, phi0, wz0, t0, tf, &opts, stm, output(&times)))
+        .detach(|| attitude::propagate_planar(mu, kz, primaries, held, &orbit0, phi0, wz0, t0, tf, &opts, stm, output(&times), None))
         .map_err(to_py)?;
     let n = tr.t.len();
     let d = PyDict::new(py);

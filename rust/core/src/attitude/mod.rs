@@ -7,10 +7,12 @@ pub mod dual;
 pub mod dynamics;
 pub mod planar;
 pub mod propagate;
+pub mod srp;
 pub mod torque;
 
 pub use body::RigidBody;
 pub use dynamics::{dcm, Coupled, CoupledStm, OrbitMode};
 pub use planar::{forcing_sc, Forcing, FourierForcing, PlanarAlongOrbit, PlanarForced};
 pub use propagate::{evaluate_torques, propagate_attitude, propagate_planar, propagate_planar_forced, AttitudeTrajectory, PlanarTrajectory};
+pub use srp::{Facet, FacetSrp, FlatPlate, Sun, OMEGA_SUN, P0};
 pub use torque::{gravity_gradient_by_name, GravityGradient, Torque, TorqueInput};

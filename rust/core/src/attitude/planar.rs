@@ -7,6 +7,7 @@
 //! precomputed through the [`Forcing`] trait (e.g. a Fourier series of the orbit).
 //! Optional 2x2 attitude STM: d/dt [dphi, dwz] = [[0, 1], [-3 Kz (S sin 2phi + C cos 2phi), 0]].
 
+use super::srp::FlatPlate;
 use crate::cr3bp::Cr3bp;
 use crate::fourier::FourierOrbit;
 use crate::integrate::System;
@@ -48,11 +49,17 @@ impl Forcing for FourierForcing<'_> {
     }
 }
 
-/// (phidot, wzdot) and the STM coefficient from S, C.
+/// (phidot, wzdot) and the STM coefficient d(wzdot)/d(phi) from S, C (and the flat-plate SRP).
 #[inline(always)]
-fn attitude_rhs(kz: f64, s: f64, c: f64, phi: f64, wz: f64) -> (f64, f64, f64) {
+fn attitude_rhs(kz: f64, s: f64, c: f64, t: f64, phi: f64, wz: f64, srp: &Option<FlatPlate>) -> (f64, f64, f64) {
     let (s2, c2) = (2.0 * phi).sin_cos();
-    (wz - 1.0, 1.5 * kz * (s * c2 - c * s2), -3.0 * kz * (s * s2 + c * c2))
+    let (mut dwz, mut k) = (1.5 * kz * (s * c2 - c * s2), -3.0 * kz * (s * s2 + c * c2));
+    if let Some(p) = srp {
+        let (v, d) = p.wzdot(t, phi);
+        dwz += v;
+        k += d;
+    }
+    (wz - 1.0, dwz, k)
 }
 
 /// Planar attitude with the orbit integrated alongside (or held): state (x, y, z, xd, yd, zd,
@@ -63,6 +70,8 @@ pub struct PlanarAlongOrbit {
     pub kz: f64,
     pub primaries: [bool; 2],
     pub held: bool,
+    /// Optional simplified SRP (one flat plate).
+    pub srp: Option<FlatPlate>,
 }
 
 impl PlanarAlongOrbit {
@@ -77,7 +86,7 @@ impl PlanarAlongOrbit {
             dy[..6].copy_from_slice(&d);
         }
         let (s, c) = forcing_sc(self.mu, &y[..3], self.primaries);
-        let (dphi, dwz, k) = attitude_rhs(self.kz, s, c, y[6], y[7]);
+        let (dphi, dwz, k) = attitude_rhs(self.kz, s, c, t, y[6], y[7], &self.srp);
         dy[6] = dphi;
         dy[7] = dwz;
         k
@@ -112,13 +121,14 @@ fn stm2(k: f64, p: &[f64], d: &mut [f64]) {
 pub struct PlanarForced<'a> {
     pub kz: f64,
     pub forcing: &'a dyn Forcing,
+    pub srp: Option<FlatPlate>,
 }
 
 impl System<[f64; 2]> for PlanarForced<'_> {
     #[inline]
     fn derivative(&self, t: f64, y: &[f64; 2], dy: &mut [f64; 2]) {
         let (s, c) = self.forcing.sc(t);
-        let (a, b, _) = attitude_rhs(self.kz, s, c, y[0], y[1]);
+        let (a, b, _) = attitude_rhs(self.kz, s, c, t, y[0], y[1], &self.srp);
         dy[0] = a;
         dy[1] = b;
     }
@@ -128,7 +138,7 @@ impl System<[f64; 6]> for PlanarForced<'_> {
     #[inline]
     fn derivative(&self, t: f64, y: &[f64; 6], dy: &mut [f64; 6]) {
         let (s, c) = self.forcing.sc(t);
-        let (a, b, k) = attitude_rhs(self.kz, s, c, y[0], y[1]);
+        let (a, b, k) = attitude_rhs(self.kz, s, c, t, y[0], y[1], &self.srp);
         dy[0] = a;
         dy[1] = b;
         stm2(k, &y[2..6], &mut dy[2..6]);

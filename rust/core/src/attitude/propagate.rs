@@ -3,6 +3,7 @@
 use super::body::RigidBody;
 use super::dynamics::{Coupled, CoupledStm, OrbitMode, DIM, STM_DIM};
 use super::planar::{Forcing, PlanarAlongOrbit, PlanarForced};
+use super::srp::FlatPlate;
 use super::torque::Torque;
 use crate::cr3bp::check_mu;
 use crate::error::{check_finite, invalid, Result};
@@ -94,6 +95,7 @@ pub fn propagate_planar(
     opts: &Options,
     with_stm: bool,
     output: Output<'_>,
+    srp: Option<FlatPlate>,
 ) -> Result<PlanarTrajectory> {
     check_mu(mu)?;
     check_kz(kz)?;
@@ -102,7 +104,7 @@ pub fn propagate_planar(
     if orbit0[2] != 0.0 || orbit0[5] != 0.0 {
         return Err(invalid("orbit_state", format!("the planar model needs a planar orbit (z = zd = 0), got z = {}, zd = {}", orbit0[2], orbit0[5])));
     }
-    let sys = PlanarAlongOrbit { mu, kz, primaries, held };
+    let sys = PlanarAlongOrbit { mu, kz, primaries, held, srp };
     let mut y0 = [0.0; 12];
     y0[..6].copy_from_slice(orbit0);
     y0[6] = phi0;
@@ -141,10 +143,11 @@ pub fn propagate_planar_forced(
     opts: &Options,
     with_stm: bool,
     output: Output<'_>,
+    srp: Option<FlatPlate>,
 ) -> Result<PlanarTrajectory> {
     check_kz(kz)?;
     check_finite("attitude", &[phi0, wz0])?;
-    let sys = PlanarForced { kz, forcing };
+    let sys = PlanarForced { kz, forcing, srp };
     let (t, rows, width, stm, stats) = if with_stm {
         let sol = solve(&sys, t0, &[phi0, wz0, 1.0, 0.0, 0.0, 1.0], tf, opts, output, &[])?;
         let f = sol.y_final;
