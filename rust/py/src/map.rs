@@ -64,8 +64,8 @@ fn map_sweep<'py>(
     if p.len() != w.len() || k.len() != w.len() {
         return Err(PyValueError::new_err(format!("invalid argument: phi0, wz0 and kz must have one length, got {}, {}, {}", p.len(), w.len(), k.len())));
     }
-    let cases: Vec<Case> = (0..w.len()).map(|i| Case { phi0: p[i], wz0: w[i], kz: k[i] }).collect();
-    let opts = LaneOptions { rtol, atol, max_steps };
+    let cases: Vec<Case> = (0..w.len()).map(|i| Case::new(p[i], w[i], k[i])).collect();
+    let opts = LaneOptions { rtol, atol, max_steps, ..LaneOptions::default() };
     let f = &forcing.inner;
     let out = py.detach(|| map::sweep(f, t_final, &cases, &opts, stm, chunk, threads)).map_err(to_py)?;
     let n = out.len();

@@ -2,10 +2,12 @@
 //! lanes (`wide::f64x4`), each lane with its own time, step size and Kz, refilled with the next
 //! trajectory as soon as its own finishes.
 //!
-//! State per lane: (phi, wz, cos 2phi, sin 2phi) and, with the STM, the 2x2 d(phi, wz)/d(phi0,
-//! wz0) row-major. Carrying (cos 2phi, sin 2phi) as states (d/dt = -+2 phidot (sin, cos))
-//! removes every trigonometric call from the right-hand side; phi itself is integrated
-//! (phidot = wz - 1) and gives the unwrapped phi(T).
+//! State per lane: (phi, wz, cos phi, sin phi) and, with the STM, the 2x2 d(phi, wz)/d(phi0,
+//! wz0) row-major. Carrying (cos phi, sin phi) as states (d/dt = phidot (-sin, cos)) removes the
+//! trigonometric calls of the gravity gradient (cos 2phi = c^2 - s^2, sin 2phi = 2 c s); phi
+//! itself is integrated (phidot = wz - 1) and gives the unwrapped phi(T). With solar radiation
+//! pressure (the flat plate of PHYSICS.md sec. 6, per-lane eps, Cs, Cd and Sun phase) the Sun
+//! angle needs one sin_cos per evaluation; that path is compiled separately (`SRP`).
 //!
 //! Every operation is lane-wise, so a trajectory's result does not depend on which lane it
 //! ran in or on its neighbours: results are bit-identical for any chunking and thread count.
@@ -24,6 +26,18 @@ pub struct Case {
     /// Inertial initial rate.
     pub wz0: f64,
     pub kz: f64,
+    /// Flat-plate SRP amplitude (0: gravity only), its coefficients and the Sun's initial phase.
+    pub eps: f64,
+    pub cs: f64,
+    pub cd: f64,
+    pub theta_sun0: f64,
+}
+
+impl Case {
+    /// A gravity-gradient-only trajectory.
+    pub fn new(phi0: f64, wz0: f64, kz: f64) -> Self {
+        Self { phi0, wz0, kz, eps: 0.0, cs: 0.0, cd: 0.0, theta_sun0: 0.0 }
+    }
 }
 
 /// How a trajectory ended.
@@ -55,12 +69,25 @@ pub struct LaneOptions {
     pub rtol: f64,
     pub atol: f64,
     pub max_steps: u32,
+    /// Rate of the Sun direction in the synodic frame (1/TU), for SRP cases.
+    pub sun_omega: f64,
 }
 
 impl Default for LaneOptions {
     fn default() -> Self {
-        Self { rtol: 1e-12, atol: 1e-12, max_steps: 200_000 }
+        Self { rtol: 1e-12, atol: 1e-12, max_steps: 200_000, sun_omega: crate::attitude::OMEGA_SUN }
     }
+}
+
+/// Per-lane parameters.
+#[derive(Clone, Copy)]
+struct Params {
+    kz15: V,
+    /// eps (1 + Cs), eps (2/3) Cd, Sun phase at t = 0.
+    a1: V,
+    a2: V,
+    theta0: V,
+    omega: V,
 }
 
 #[inline(always)]
@@ -75,16 +102,33 @@ fn lincomb<const D: usize, const M: usize>(out: &mut [V; D], y: &[V; D], h: V, c
 }
 
 #[inline(always)]
-fn rhs<const D: usize>(f: &OrbitForcing, t: V, y: &[V; D], kz15: V, dy: &mut [V; D]) {
+fn rhs<const D: usize, const SRP: bool>(f: &OrbitForcing, t: V, y: &[V; D], p: &Params, dy: &mut [V; D]) {
     let (s, c) = f.sc4(t);
     let w = y[1] - V::ONE;
+    let (cp, sp) = (y[2], y[3]);
+    let c2 = cp * cp - sp * sp;
+    let s2 = (cp + cp) * sp;
     dy[0] = w;
-    dy[1] = kz15 * (s * y[2] - c * y[3]);
-    let w2 = w + w;
-    dy[2] = -(w2 * y[3]);
-    dy[3] = w2 * y[2];
+    let mut dwz = p.kz15 * (s * c2 - c * s2);
+    dy[2] = -(w * sp);
+    dy[3] = w * cp;
+    let mut k = V::ZERO;
     if D == 8 {
-        let k = -(kz15 + kz15) * (s * y[3] + c * y[2]);
+        k = -(p.kz15 + p.kz15) * (s * s2 + c * c2);
+    }
+    if SRP {
+        // alpha = theta_sun(t) - phi
+        let (st, ct) = p.omega.mul_add(t, p.theta0).sin_cos();
+        let ca = ct.mul_add(cp, st * sp);
+        let aca = ca.abs();
+        dwz = dwz + ca * p.a1.mul_add(aca, p.a2);
+        if D == 8 {
+            let sa = st.mul_add(cp, -(ct * sp));
+            k = k + sa * (p.a1 + p.a1).mul_add(aca, p.a2);
+        }
+    }
+    dy[1] = dwz;
+    if D == 8 {
         dy[4] = y[6];
         dy[5] = y[7];
         dy[6] = k * y[4];
@@ -101,7 +145,7 @@ macro_rules! stage {
     ($st:ident, $f:ident, $t:ident, $y:ident, $h:ident, $kz:ident, $s:literal; $($j:literal),+) => {{
         lincomb(&mut $st.tmp, $y, $h, [$(A[$s][$j]),+], [$(&$st.k[$j]),+]);
         let ts = V::splat(C[$s]).mul_add($h, $t);
-        rhs($f, ts, &$st.tmp, $kz, &mut $st.k[$s]);
+        rhs::<D, SRP>($f, ts, &$st.tmp, $kz, &mut $st.k[$s]);
     }};
 }
 
@@ -109,8 +153,8 @@ impl<const D: usize> Stages<D> {
     /// One step of size h (per lane) from (t, y): writes the 8th-order solution and returns the
     /// scaled max-norm error per lane.
     #[inline(always)]
-    fn step(&mut self, f: &OrbitForcing, t: V, y: &[V; D], h: V, kz15: V, out: &mut [V; D], rtol: V, atol: V) -> V {
-        rhs(f, t, y, kz15, &mut self.k[0]);
+    fn step<const SRP: bool>(&mut self, f: &OrbitForcing, t: V, y: &[V; D], h: V, kz15: &Params, out: &mut [V; D], rtol: V, atol: V) -> V {
+        rhs::<D, SRP>(f, t, y, kz15, &mut self.k[0]);
         stage!(self, f, t, y, h, kz15, 1; 0);
         stage!(self, f, t, y, h, kz15, 2; 0, 1);
         stage!(self, f, t, y, h, kz15, 3; 0, 2);
@@ -139,8 +183,9 @@ impl<const D: usize> Stages<D> {
 }
 
 /// Integrate `cases` from t = 0 to `t_final` along the orbit forcing, four at a time. `D` is 4
-/// (no STM) or 8 (with the 2x2 STM).
-pub fn integrate_cases<const D: usize>(f: &OrbitForcing, t_final: f64, cases: &[Case], opts: &LaneOptions) -> Vec<Outcome> {
+/// (no STM) or 8 (with the 2x2 STM); `SRP` compiles the flat-plate term in (cases with eps = 0
+/// give the same bits on either path: the term adds exact zeros).
+pub fn integrate_cases<const D: usize, const SRP: bool>(f: &OrbitForcing, t_final: f64, cases: &[Case], opts: &LaneOptions) -> Vec<Outcome> {
     let mut out = vec![
         Outcome { phi_t: f64::NAN, wz_t: f64::NAN, stm: [f64::NAN; 4], accepted: 0, rejected: 0, status: LaneStatus::Failed };
         cases.len()
@@ -154,19 +199,26 @@ pub fn integrate_cases<const D: usize>(f: &OrbitForcing, t_final: f64, cases: &[
     let mut tl = [0.0f64; 4];
     let mut hl = [0.0f64; 4];
     let mut kzl = [0.0f64; 4];
+    let mut a1l = [0.0f64; 4];
+    let mut a2l = [0.0f64; 4];
+    let mut th0l = [0.0f64; 4];
     let mut acc = [0u32; 4];
     let mut rej = [0u32; 4];
     let mut after_reject = [false; 4];
     let mut next = 0usize;
 
-    let start = |l: usize, i: usize, yl: &mut [[f64; D]; 4], tl: &mut [f64; 4], hl: &mut [f64; 4], kzl: &mut [f64; 4]| {
+    let start = |l: usize, i: usize, yl: &mut [[f64; D]; 4], tl: &mut [f64; 4], hl: &mut [f64; 4], pl: [&mut [f64; 4]; 4]| {
         let c = cases[i];
         let mut y = [0.0; D];
         y[0] = c.phi0;
         y[1] = c.wz0;
-        let (s2, c2) = (2.0 * c.phi0).sin_cos();
-        y[2] = c2;
-        y[3] = s2;
+        let (s1, c1) = c.phi0.sin_cos();
+        y[2] = c1;
+        y[3] = s1;
+        let [kzl, a1l, a2l, th0l] = pl;
+        a1l[l] = c.eps * (1.0 + c.cs);
+        a2l[l] = c.eps * (2.0 / 3.0) * c.cd;
+        th0l[l] = c.theta_sun0;
         if D == 8 {
             y[4] = 1.0;
             y[7] = 1.0;
@@ -178,7 +230,7 @@ pub fn integrate_cases<const D: usize>(f: &OrbitForcing, t_final: f64, cases: &[
     };
     for l in 0..4 {
         if next < cases.len() {
-            start(l, next, &mut yl, &mut tl, &mut hl, &mut kzl);
+            start(l, next, &mut yl, &mut tl, &mut hl, [&mut kzl, &mut a1l, &mut a2l, &mut th0l]);
             lane_case[l] = Some(next);
             next += 1;
         }
@@ -205,8 +257,8 @@ pub fn integrate_cases<const D: usize>(f: &OrbitForcing, t_final: f64, cases: &[
         }
         let t = V::new(tl);
         let h = V::new(heff);
-        let kz15 = V::new(kzl) * V::splat(1.5);
-        let err = st.step(f, t, &y, h, kz15, &mut ynew, rtol, atol).to_array();
+        let params = Params { kz15: V::new(kzl) * V::splat(1.5), a1: V::new(a1l), a2: V::new(a2l), theta0: V::new(th0l), omega: V::splat(opts.sun_omega) };
+        let err = st.step::<SRP>(f, t, &y, h, &params, &mut ynew, rtol, atol).to_array();
         // err^(-1/8) per lane through three square roots, lane-wise.
         let e8 = V::new(err).sqrt().sqrt().sqrt().to_array();
         let ynew_l: [[f64; 4]; D] = std::array::from_fn(|i| ynew[i].to_array());
@@ -259,7 +311,7 @@ pub fn integrate_cases<const D: usize>(f: &OrbitForcing, t_final: f64, cases: &[
                 rej[l] = 0;
                 after_reject[l] = false;
                 if next < cases.len() {
-                    start(l, next, &mut yl, &mut tl, &mut hl, &mut kzl);
+                    start(l, next, &mut yl, &mut tl, &mut hl, [&mut kzl, &mut a1l, &mut a2l, &mut th0l]);
                     lane_case[l] = Some(next);
                     next += 1;
                 } else {

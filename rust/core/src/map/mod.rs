@@ -49,11 +49,21 @@ pub fn sweep(
             return Err(invalid("kz", format!("case {i}: must be in [-1, 1], got {}", c.kz)));
         }
     }
+    for (i, c) in cases.iter().enumerate() {
+        if !(c.eps.is_finite() && c.theta_sun0.is_finite()) {
+            return Err(invalid("eps", format!("case {i}: eps and the Sun phase must be finite")));
+        }
+        if !(c.cs >= 0.0 && c.cd >= 0.0 && c.cs + c.cd <= 1.0 + 1e-12) {
+            return Err(invalid("cs", format!("case {i}: need cs, cd >= 0 and cs + cd <= 1, got ({}, {})", c.cs, c.cd)));
+        }
+    }
     let run = |part: &[Case]| -> Vec<Outcome> {
-        if with_stm {
-            integrate_cases::<8>(forcing, t_final, part, opts)
-        } else {
-            integrate_cases::<4>(forcing, t_final, part, opts)
+        let srp = part.iter().any(|c| c.eps != 0.0);
+        match (with_stm, srp) {
+            (true, false) => integrate_cases::<8, false>(forcing, t_final, part, opts),
+            (false, false) => integrate_cases::<4, false>(forcing, t_final, part, opts),
+            (true, true) => integrate_cases::<8, true>(forcing, t_final, part, opts),
+            (false, true) => integrate_cases::<4, true>(forcing, t_final, part, opts),
         }
     };
     with_threads(threads, || cases.par_chunks(chunk).map(run).collect::<Vec<_>>().concat())
