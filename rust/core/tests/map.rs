@@ -127,7 +127,7 @@ fn val_forcing_table_near_the_earth() {
 
 /// SRP in the engine (flat plate, PHYSICS.md sec. 6) against the scalar planar model with the
 /// same plate, over K = 2 revolutions of an orbit (t_final = 2 T), for several Sun phases and
-/// coefficient sets: 1e-9 relative in phi and wz (the STM to 1e-4, see below). Cases with eps = 0 give the same bits on the SRP path as on
+/// coefficient sets: 1e-9 relative in phi and wz, 1e-8 in the STM. Cases with eps = 0 give the same bits on the SRP path as on
 /// the gravity-only path.
 #[test]
 fn val_engine_srp_matches_scalar_model() {
@@ -150,16 +150,17 @@ fn val_engine_srp_matches_scalar_model() {
         assert!((o.phi_t - r.phi[0]).abs() / scale < 1e-9 && (o.wz_t - r.wz[0]).abs() / scale < 1e-9, "{c:?}: {} {} vs {} {}", o.phi_t, o.wz_t, r.phi[0], r.wz[0]);
         let m = r.stm_final.unwrap();
         let n = m.iter().map(|v| v * v).sum::<f64>().sqrt();
-        // The plate law has cos(a)|cos(a)|: C1 only, so the STM's coefficient has kinks where a
-        // face turns edge-on; two integrators agree there to ~3e-6 (finite differences too).
+        // The plate law has cos(a)|cos(a)|: C1 only. Both integrators stop at every terminator
+        // crossing, so they keep their order and agree (without that: 3e-6 on the STM, 1e-8 on wz).
         let e = (0..4).map(|i| (m[i] - o.stm[i]).powi(2)).sum::<f64>().sqrt() / n;
-        assert!(e < 1e-4, "{c:?}: STM relative difference {e:e}");
+        assert!(e < 1e-8, "{c:?}: STM relative difference {e:e}");
     }
     // eps = 0 on the SRP path (mixed chunk) vs the gravity-only path (its own chunk)
     let g = Case::new(0.1, -1.4, 0.8);
     let mixed = sweep(&f, tf, &[cases[0], g], &LaneOptions::default(), false, 8, Some(1)).unwrap();
     let alone = sweep(&f, tf, &[g], &LaneOptions::default(), false, 8, Some(1)).unwrap();
-    assert_eq!(mixed[1], alone[0]);
+    let key = |o: &librate_core::map::Outcome| (o.phi_t.to_bits(), o.wz_t.to_bits(), o.accepted, o.rejected);
+    assert_eq!(key(&mixed[1]), key(&alone[0]));
 }
 
 /// The vector sin_cos used for the Sun angle agrees with the scalar one to 2 ulp-level (4e-16

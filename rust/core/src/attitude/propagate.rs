@@ -7,7 +7,7 @@ use super::srp::FlatPlate;
 use super::torque::Torque;
 use crate::cr3bp::check_mu;
 use crate::error::{check_finite, invalid, Result};
-use crate::integrate::{solve, Options, Output, Stats};
+use crate::integrate::{solve, solve_piecewise, EventFn, Options, Output, Stats};
 
 /// Result of [`propagate_attitude`].
 #[derive(Debug, Clone)]
@@ -109,15 +109,24 @@ pub fn propagate_planar(
     y0[..6].copy_from_slice(orbit0);
     y0[6] = phi0;
     y0[7] = wz0;
+    // The plate law is C1 only: integrate piecewise between the terminator crossings.
+    let kink12 = srp.map(|p| move |t: f64, y: &[f64; 12]| (p.sun.omega * t + p.sun.theta0 - y[6]).cos());
+    let kink8 = srp.map(|p| move |t: f64, y: &[f64; 8]| (p.sun.omega * t + p.sun.theta0 - y[6]).cos());
     let (t, rows, width, stm, stats) = if with_stm {
         y0[8] = 1.0;
         y0[11] = 1.0;
-        let sol = solve(&sys, t0, &y0, tf, opts, output, &[])?;
+        let sol = match &kink12 {
+            Some(k) => solve_piecewise(&sys, t0, &y0, tf, opts, output, &[k as &dyn EventFn<[f64; 12]>])?,
+            None => solve(&sys, t0, &y0, tf, opts, output, &[])?,
+        };
         let f = sol.y_final;
         (sol.t, sol.y, 12, Some([f[8], f[9], f[10], f[11]]), sol.stats)
     } else {
         let y8: [f64; 8] = std::array::from_fn(|i| y0[i]);
-        let sol = solve(&sys, t0, &y8, tf, opts, output, &[])?;
+        let sol = match &kink8 {
+            Some(k) => solve_piecewise(&sys, t0, &y8, tf, opts, output, &[k as &dyn EventFn<[f64; 8]>])?,
+            None => solve(&sys, t0, &y8, tf, opts, output, &[])?,
+        };
         (sol.t, sol.y, 8, None, sol.stats)
     };
     let n = t.len();
@@ -148,12 +157,21 @@ pub fn propagate_planar_forced(
     check_kz(kz)?;
     check_finite("attitude", &[phi0, wz0])?;
     let sys = PlanarForced { kz, forcing, srp };
+    let kink6 = srp.map(|p| move |t: f64, y: &[f64; 6]| (p.sun.omega * t + p.sun.theta0 - y[0]).cos());
+    let kink2 = srp.map(|p| move |t: f64, y: &[f64; 2]| (p.sun.omega * t + p.sun.theta0 - y[0]).cos());
     let (t, rows, width, stm, stats) = if with_stm {
-        let sol = solve(&sys, t0, &[phi0, wz0, 1.0, 0.0, 0.0, 1.0], tf, opts, output, &[])?;
+        let y0 = [phi0, wz0, 1.0, 0.0, 0.0, 1.0];
+        let sol = match &kink6 {
+            Some(k) => solve_piecewise(&sys, t0, &y0, tf, opts, output, &[k as &dyn EventFn<[f64; 6]>])?,
+            None => solve(&sys, t0, &y0, tf, opts, output, &[])?,
+        };
         let f = sol.y_final;
         (sol.t, sol.y, 6, Some([f[2], f[3], f[4], f[5]]), sol.stats)
     } else {
-        let sol = solve(&sys, t0, &[phi0, wz0], tf, opts, output, &[])?;
+        let sol = match &kink2 {
+            Some(k) => solve_piecewise(&sys, t0, &[phi0, wz0], tf, opts, output, &[k as &dyn EventFn<[f64; 2]>])?,
+            None => solve(&sys, t0, &[phi0, wz0], tf, opts, output, &[])?,
+        };
         (sol.t, sol.y, 2, None, sol.stats)
     };
     let phi = rows.chunks_exact(width).map(|r| r[0]).collect();

@@ -261,7 +261,97 @@ pub fn integrate_cases<const D: usize, const SRP: bool>(f: &OrbitForcing, t_fina
         let err = st.step::<SRP>(f, t, &y, h, &params, &mut ynew, rtol, atol).to_array();
         // err^(-1/8) per lane through three square roots, lane-wise.
         let e8 = V::new(err).sqrt().sqrt().sqrt().to_array();
-        let ynew_l: [[f64; 4]; D] = std::array::from_fn(|i| ynew[i].to_array());
+        let mut ynew_l: [[f64; 4]; D] = std::array::from_fn(|i| ynew[i].to_array());
+        if SRP {
+            // The plate law is C1 only: a step may not span a terminator crossing
+            // (cos(theta_sun - phi) = 0). Lanes whose accepted step crosses one are cut back to
+            // the crossing, located by Illinois iterations on the step length (each trial one
+            // RK step from the step start; lanes not searching take h = 0).
+            let g = |l: usize, tt: f64, phi: f64| (opts.sun_omega * tt + th0l[l] - phi).cos();
+            let mut search = [false; 4];
+            let (mut ta, mut tb, mut ga, mut gb) = ([0.0f64; 4], [0.0f64; 4], [0.0f64; 4], [0.0f64; 4]);
+            let mut side = [0i8; 4];
+            for l in 0..4 {
+                // lanes without a plate term (eps = 0) have no kink: same steps as gravity only
+                if lane_case[l].is_none() || !(err[l] <= 1.0) || (a1l[l] == 0.0 && a2l[l] == 0.0) {
+                    continue;
+                }
+                let g0 = g(l, tl[l], yl[l][0]);
+                let g1 = g(l, tl[l] + heff[l], ynew_l[0][l]);
+                if (g0 < 0.0 && g1 > 0.0) || (g0 > 0.0 && g1 < 0.0) {
+                    search[l] = true;
+                    (ta[l], tb[l], ga[l], gb[l]) = (0.0, heff[l], g0, g1);
+                }
+            }
+            if search.iter().any(|&b| b) {
+                let mut yc = [V::ZERO; D];
+                let mut tau = [0.0f64; 4];
+                for _ in 0..60 {
+                    let mut active = false;
+                    for l in 0..4 {
+                        tau[l] = 0.0;
+                        if search[l] {
+                            let tol = 1e-15 * (1.0 + tl[l].abs()) + 4.0 * f64::EPSILON * tb[l].abs();
+                            if (tb[l] - ta[l]).abs() <= tol {
+                                continue;
+                            }
+                            active = true;
+                            let c = tb[l] - gb[l] * (tb[l] - ta[l]) / (gb[l] - ga[l]);
+                            tau[l] = c.clamp(ta[l].min(tb[l]), ta[l].max(tb[l]));
+                        }
+                    }
+                    if !active {
+                        break;
+                    }
+                    st.step::<SRP>(f, t, &y, V::new(tau), &params, &mut yc, rtol, atol);
+                    let yc0 = yc[0].to_array();
+                    for l in 0..4 {
+                        if !search[l] || tau[l] == 0.0 {
+                            continue;
+                        }
+                        let gc = g(l, tl[l] + tau[l], yc0[l]);
+                        if (gc > 0.0) == (gb[l] > 0.0) {
+                            tb[l] = tau[l];
+                            gb[l] = gc;
+                            if side[l] == 1 {
+                                ga[l] *= 0.5;
+                            }
+                            side[l] = 1;
+                        } else {
+                            ta[l] = tau[l];
+                            ga[l] = gc;
+                            if side[l] == -1 {
+                                gb[l] *= 0.5;
+                            }
+                            side[l] = -1;
+                        }
+                    }
+                }
+                // Cut each searching lane's step at the far end of its final bracket (just past
+                // the crossing), unless the crossing is at the very start (a restart).
+                let mut cut = [0.0f64; 4];
+                for l in 0..4 {
+                    if search[l] && tb[l].abs() > 1e-12 * (1.0 + tl[l].abs()) {
+                        cut[l] = tb[l];
+                    }
+                }
+                if cut.iter().any(|&c| c != 0.0) {
+                    st.step::<SRP>(f, t, &y, V::new(cut), &params, &mut yc, rtol, atol);
+                    let ycl: [[f64; 4]; D] = std::array::from_fn(|i| yc[i].to_array());
+                    for l in 0..4 {
+                        if cut[l] != 0.0 {
+                            for i in 0..D {
+                                ynew_l[i][l] = ycl[i][l];
+                            }
+                            if cut[l] < heff[l] {
+                                last[l] = false;
+                                heff[l] = cut[l];
+                            }
+                        }
+                    }
+                }
+            }
+        }
         for l in 0..4 {
             let Some(ci) = lane_case[l] else { continue };
             let finite = (0..D).all(|i| ynew_l[i][l].is_finite());
