@@ -1,10 +1,14 @@
-"""librate.plotting: the thesis ch. 2 figures, rendered with Agg and checked against the data.
+"""librate.plotting: the thesis ch. 2 and sec. 3.3 figures, rendered with Agg and checked against
+the data.
 
 Each figure is written to a PNG (non-trivial: over 10 kB, not one colour) and its artists are
 compared with the numbers they show: one line per requested orbit starting at the member's x0,
 the colour scale spanning the family's Jacobi range, resonance lines at 2 pi / K and Ts / K in
 days through the system's TU, stability curves equal to the family's indices, ECI curves
-starting |r0 - r_earth| LU from the Earth and 1:K resonant orbits closing after K periods.
+starting |r0 - r_earth| LU from the Earth and 1:K resonant orbits closing after K periods;
+residual curves equal to the periodicity map's values, solution markers at the solutions' rates,
+map contours through the solutions, family curves holding exactly the solutions of their N and
+Kz, periodic motions ending at phi0 + 2 pi N.
 """
 
 import math
@@ -288,3 +292,285 @@ def test_plot_attitude_response(tmp_path):
     assert path.stat().st_size > 10_000
     with pytest.raises(ValueError, match="traj"):
         lp.plot_attitude("nope")
+
+
+# --- periodic attitude motions (thesis sec. 3.3, Figs. 23-31) ------------------------------------
+# Rates are plotted relative to the synodic frame by default (phidot0 = wz0 - 1, what the thesis
+# figures show under the label wz(0)); every check below compares the drawn data with the
+# Dataset / solutions they come from.
+
+
+@pytest.fixture(scope="module")
+def dro1266(em):
+    return librate.dro(em, period_days=12.66)
+
+
+@pytest.fixture(scope="module")
+def map_rates():
+    return np.linspace(-2.5, 2.5, 300)  # inertial; phidot0 in [-3.5, 1.5]
+
+
+@pytest.fixture(scope="module")
+def small_map(em, map_rates):
+    """6 DRO members x 300 rates, Kz = 0.8, with solutions."""
+    fam6 = librate.dro_family(em, x0=np.linspace(0.9, 0.6, 6))
+    return librate.periodicity_map(fam6, kz=0.8, wz0=map_rates)
+
+
+@pytest.fixture(scope="module")
+def kz_map(em, map_rates):
+    """The same 6 members for Kz = 0.2, 0.5, 0.8."""
+    fam6 = librate.dro_family(em, x0=np.linspace(0.9, 0.6, 6))
+    return librate.periodicity_map(fam6, kz=[0.2, 0.5, 0.8], wz0=map_rates)
+
+
+def marker_points(ax):
+    """(x, y, filled) of every solution marker drawn with gid "solutions", sorted by (x, y)."""
+    pts = []
+    for h in gid(ax, "solutions"):
+        filled = h.get_markerfacecolor() != "none" and matplotlib.colors.to_rgba(h.get_markerfacecolor())[3] > 0
+        pts += [(x, y, filled) for x, y in zip(h.get_xdata(), h.get_ydata())]
+    return sorted(pts)
+
+
+def contour_vertices(ax, name):
+    (cs,) = gid(ax, name)
+    return np.vstack([p.vertices for p in cs.get_paths() if len(p.vertices)])
+
+
+def test_plot_residuals_fig23(dro1266, map_rates, tmp_path):
+    """Thesis Fig. 23 on the 12.66-day DRO, Kz = 0.8, phidot0 in [-3.5, 1.5]: the curves carry
+    the map's Dwz and Dphi against phidot0 = wz0 - 1 (the Dphi line broken by NaNs at the +-pi
+    wrap: no segment jumps by more than pi); the solution markers sit at (phidot0, 0) of the
+    map's solutions, filled exactly for the stable ones, the N = -1 one at -2.4545."""
+    fig = lp.plot_residuals(dro1266, kz=0.8, wz0=map_rates)
+    assert_png(fig, tmp_path / "fig23.png")
+    ax = fig.axes[0]
+    ds = librate.periodicity_map(dro1266, kz=0.8, wz0=map_rates)
+    (hw,) = gid(ax, "residual-dwz")
+    np.testing.assert_array_equal(hw.get_xdata(), ds.phidot0.values)
+    np.testing.assert_array_equal(hw.get_ydata(), ds.dwz.values[0, 0])
+    (hp,) = gid(ax, "residual-dphi")
+    x, y = np.asarray(hp.get_xdata()), np.asarray(hp.get_ydata())
+    ok = np.isfinite(y)
+    np.testing.assert_array_equal(x[ok], ds.phidot0.values)
+    np.testing.assert_array_equal(y[ok], ds.dphi.values[0, 0])
+    assert (~ok).sum() >= 1  # the wrap at -0.7 is broken ...
+    steps = np.diff(y)
+    assert np.all(np.abs(steps[np.isfinite(steps)]) < math.pi)  # ... and no drawn segment spans it
+    assert gid(ax, "zero")[0].get_ydata()[0] == 0.0
+    pts = marker_points(ax)
+    want = sorted(zip(ds.sol_phidot0.values, np.zeros(ds.sizes["solution"]), ds.sol_stable.values))
+    assert len(pts) == len(want) >= 3
+    np.testing.assert_allclose([p[:2] for p in pts], [w[:2] for w in want], atol=1e-12)
+    assert [p[2] for p in pts] == [bool(w[2]) for w in want]
+    n_minus_1 = float(ds.sol_phidot0.values[(ds.sol_n.values == -1) & (ds.sol_kind.values == "periodic")][0])
+    assert round(n_minus_1, 4) == -2.4545 and any(abs(p[0] - n_minus_1) < 1e-12 for p in pts)
+    assert "relative to the synodic frame" in ax.get_xlabel()
+    # the same figure from the Dataset, and on the inertial axis
+    ax2 = lp.plot_residuals(ds, rate="inertial").axes[0]
+    np.testing.assert_array_equal(gid(ax2, "residual-dwz")[0].get_xdata(), map_rates)
+    np.testing.assert_allclose(sorted(p[0] for p in marker_points(ax2)), sorted(ds.sol_wz0.values), atol=1e-12)
+    assert "inertial" in ax2.get_xlabel() and "relative" not in ax2.get_xlabel()
+    ax3 = lp.plot_residuals(ds, kinds=("periodic",)).axes[0]
+    assert len(marker_points(ax3)) == int((ds.sol_kind.values == "periodic").sum())
+
+
+def test_plot_residuals_picks_orbit_and_kz(kz_map):
+    ax = lp.plot_residuals(kz_map, orbit_index=2, kz=0.5).axes[0]
+    np.testing.assert_array_equal(gid(ax, "residual-dwz")[0].get_ydata(), kz_map.dwz.values[2, 1])
+    sel = (kz_map.sol_orbit.values == 2) & (kz_map.sol_kz.values == 0.5)
+    np.testing.assert_allclose(sorted(p[0] for p in marker_points(ax)), sorted(kz_map.sol_phidot0.values[sel]), atol=1e-12)
+
+
+def test_plot_map_fig24(small_map, tmp_path):
+    """Thesis Fig. 24: the Dphi = 0 contour passes through every periodic solution (on the
+    solution's orbit column a contour vertex lies within one grid step, 0.017, of its rate, the
+    error of linear interpolation in a cell), and so does the Dwz = 0 contour wherever the grid resolves it: a miss is allowed only
+    where the Dwz row has no sign change within two cells of the solution (the thin Dwz < 0 dip,
+    ~0.004 wide, beside a stable solution, narrower than the grid); no Dphi contour runs along the
+    +-pi wrap (the unwrapped phi(T) interpolated at each column vertex is a multiple of 2 pi); the
+    markers sit at (period in days, phidot0) of the periodic solutions, filled exactly for the
+    stable ones."""
+    ds = small_map
+    fig = lp.plot_map(ds)
+    assert_png(fig, tmp_path / "fig24.png")
+    ax = fig.axes[0]
+    periodic = ds.sol_kind.values == "periodic"
+    orb, rate = ds.sol_orbit.values[periodic], ds.sol_phidot0.values[periodic]
+    xcol, grid = ds.period_days.values, ds.phidot0.values
+    assert periodic.sum() >= 8
+    for name in ("contour-dwz", "contour-dphi"):
+        v = contour_vertices(ax, name)
+        hits = 0
+        for o, r in zip(orb, rate):
+            on_col = v[np.abs(v[:, 0] - xcol[o]) < 1e-9]
+            if on_col.size and np.min(np.abs(on_col[:, 1] - r)) < grid[1] - grid[0]:
+                hits += 1
+                continue
+            assert name == "contour-dwz", (name, o, r)
+            j = np.searchsorted(grid, r)
+            near = ds.dwz.values[o, 0, max(j - 3, 0):j + 3]
+            assert np.all(near > 0) or np.all(near < 0), (o, r)  # unresolved by the grid, not a missing contour
+        assert hits >= 0.75 * len(orb)
+    v = contour_vertices(ax, "contour-dphi")
+    for o in range(ds.sizes["orbit"]):
+        col = v[np.abs(v[:, 0] - xcol[o]) < 1e-9, 1]
+        phi_t = np.interp(col, ds.phidot0.values, ds.phi_T.values[o, 0])
+        assert np.all(np.cos(phi_t) > 0.999)
+    pts = marker_points(ax)
+    want = sorted(zip(xcol[orb], rate, ds.sol_stable.values[periodic]))
+    np.testing.assert_allclose([p[:2] for p in pts], [w[:2] for w in want], atol=1e-12)
+    assert [p[2] for p in pts] == [bool(w[2]) for w in want]
+    for h in gid(ax, "solutions"):  # one colour per N
+        ns = {int(n) for o, r, n in zip(orb, rate, ds.sol_n.values[periodic]) if abs(r - h.get_ydata()[0]) < 1e-12}
+        assert len(ns) == 1 and h.get_color() == lp._n_color(ns.pop())
+    legend = [t.get_text() for t in ax.get_legend().get_texts()]
+    assert "$N$ = -1" in legend and "$N$ = 0" in legend
+    assert ax.get_xlabel() == "orbit period $T$ (days)" and "relative to the synodic frame" in ax.get_ylabel()
+    assert not gid(ax, "contour-dphi-half")
+
+
+def test_plot_map_inertial_x0_and_half_turns(small_map):
+    ds = small_map
+    ax = lp.plot_map(ds, against="x0", rate="inertial", kinds=("periodic", "half-turn")).axes[0]
+    pts = marker_points(ax)
+    want = sorted(zip(ds.x0.values[ds.sol_orbit.values], ds.sol_wz0.values))
+    np.testing.assert_allclose([p[:2] for p in pts], want, atol=1e-12)
+    assert gid(ax, "contour-dphi-half") and "inertial" in ax.get_ylabel()
+    # half-turn solutions sit on Dphi = pi: phi(T) - phi0 an odd multiple of pi
+    v = contour_vertices(ax, "contour-dphi-half")
+    for o in range(ds.sizes["orbit"]):
+        col = v[np.abs(v[:, 0] - ds.x0.values[o]) < 1e-9, 1]
+        assert np.all(np.cos(np.interp(col, ds.wz0.values, ds.phi_T.values[o, 0])) < -0.999)
+
+
+def test_plot_solution_families(kz_map, tmp_path):
+    """Thesis Figs. 27-29: one panel per N (1, 0, -1); in each, the lines of each Kz hold exactly
+    that (N, Kz)'s solutions at (period in days, phidot0), each line visiting consecutive orbits
+    once (no zigzag); the stable ones are overdrawn; the single-panel variant holds the same."""
+    ds = kz_map
+    fig = lp.plot_solution_families(ds, n=(1, 0, -1))
+    assert_png(fig, tmp_path / "families.png")
+    axes = [a for a in fig.axes]
+    assert len(axes) == 3 and [a.get_title().split(":")[0] for a in axes] == ["$N$ = 1", "$N$ = 0", "$N$ = -1"]
+    xcol = ds.period_days.values
+    total = singles = 0
+    for a, n in zip(axes, (1, 0, -1)):
+        fam_lines = [h for h in a.get_lines() if (h.get_gid() or "").startswith("family-periodic-")]
+        assert all(h.get_gid().startswith(f"family-periodic-N{n:+d}-") for h in fam_lines)
+        for kz in (0.2, 0.5, 0.8):
+            lines = gid(a, f"family-periodic-N{n:+d}-kz{kz:g}")
+            got = sorted((x, y) for h in lines for x, y in zip(h.get_xdata(), h.get_ydata()))
+            sel = (ds.sol_n.values == n) & (ds.sol_kind.values == "periodic") & (ds.sol_kz.values == kz)
+            want = sorted(zip(xcol[ds.sol_orbit.values[sel]], ds.sol_phidot0.values[sel]))
+            assert len(got) == len(want)
+            if want:
+                np.testing.assert_allclose(got, want, atol=1e-12)
+            total += len(want)
+            for h in lines:
+                o = np.searchsorted(xcol, h.get_xdata())
+                assert np.all(np.diff(o) == 1)
+            o = np.sort(ds.sol_orbit.values[sel])
+            if o.size > 1 and np.all(np.diff(o) == 1):  # one solution on each of consecutive orbits: one curve
+                assert len(lines) == 1
+                singles += 1
+        stable = sorted((x, y) for h in gid(a, "family-stable") for x, y in zip(h.get_xdata(), h.get_ydata()))
+        sel = (ds.sol_n.values == n) & (ds.sol_kind.values == "periodic") & ds.sol_stable.values
+        np.testing.assert_allclose(stable, sorted(zip(xcol[ds.sol_orbit.values[sel]], ds.sol_phidot0.values[sel])), atol=1e-12)
+    assert total >= 10 and singles >= 2
+    one = lp.plot_solution_families(ds, n=(1, 0, -1), separate=False, against="x0", rate="inertial").axes
+    assert len(one) == 1
+    lines = gid(one[0], "family-periodic-N-1-kz0.8")
+    sel = (ds.sol_n.values == -1) & (ds.sol_kind.values == "periodic") & (ds.sol_kz.values == 0.8)
+    got = sorted((x, y) for h in lines for x, y in zip(h.get_xdata(), h.get_ydata()))
+    np.testing.assert_allclose(got, sorted(zip(ds.x0.values[ds.sol_orbit.values[sel]], ds.sol_wz0.values[sel])), atol=1e-12)
+    assert {h.get_linestyle() for h in gid(one[0], "family-periodic-N+0-kz0.2")} == {"-"}
+    assert {h.get_linestyle() for h in gid(one[0], "family-periodic-N+0-kz0.5")} == {"--"}
+
+
+def test_solution_branches_follow_the_nearest_rate():
+    """Two solutions per orbit, crossing ranks: each branch keeps one per consecutive orbit and
+    follows the nearest rate; a gap in the orbits ends a branch; ``max_jump`` cuts a long step."""
+    orbit = np.array([0, 0, 1, 1, 2, 2, 4])
+    rate = np.array([0.0, 1.0, 0.1, 0.9, 0.25, 0.8, 0.3])
+    br = sorted(lp._branches(orbit, rate, None))
+    assert br == [[0, 2, 4], [1, 3, 5], [6]]
+    assert sorted(lp._branches(np.array([0, 1]), np.array([0.0, 2.0]), 1.0)) == [[0], [1]]
+
+
+def test_plot_attitude_motion_fig30_31(dro1266, tmp_path):
+    """Thesis Figs. 30-31 for N = 1, 0, -1 on the 12.66-day DRO (Kz = 0.8): each angle curve
+    starts at phi0 and ends at phi0 + 360 N deg after one period (to 1e-6 deg), each rate curve
+    starts and ends at the solution's phidot0 (1e-8); time in orbital periods; two periods end at
+    720 N deg."""
+    sols = [librate.periodic_attitude(dro1266, kz=0.8, n=n) for n in (1, 0, -1)]
+    fig = lp.plot_attitude_motion(sols)
+    assert_png(fig, tmp_path / "motion.png")
+    a_ang, a_rate = fig.axes
+    angles, rates = gid(a_ang, "angle"), gid(a_rate, "rate")
+    assert len(angles) == len(rates) == 3
+    for s, ha, hr in zip(sols, angles, rates):
+        x, y = ha.get_xdata(), ha.get_ydata()
+        assert x[0] == 0.0 and x[-1] == pytest.approx(1.0, abs=1e-12)
+        assert y[0] == pytest.approx(math.degrees(s.phi0), abs=1e-9)
+        assert y[-1] == pytest.approx(math.degrees(s.phi0 + 2 * math.pi * s.n), abs=1e-6)
+        r = hr.get_ydata()
+        assert r[0] == pytest.approx(s.phidot0, abs=1e-12) and r[-1] == pytest.approx(s.phidot0, abs=1e-8)
+        assert ha.get_color() == lp._n_color(s.n) and f"$N$ = {s.n}" in ha.get_label()
+    assert "relative to the synodic frame" in a_rate.get_ylabel() and "orbital periods" in a_ang.get_xlabel()
+    fig2 = lp.plot_attitude_motion(sols[2], n_periods=2, rate="inertial", degrees=False)
+    a2, r2 = fig2.axes
+    (h,) = gid(a2, "angle")
+    assert h.get_xdata()[-1] == pytest.approx(2.0) and h.get_ydata()[-1] == pytest.approx(-4 * math.pi, abs=1e-7)
+    assert gid(r2, "rate")[0].get_ydata()[-1] == pytest.approx(sols[2].wz0, abs=1e-7) and "inertial" in r2.get_ylabel()
+
+
+@pytest.fixture(scope="module")
+def unsolved(small_map, map_rates, em):
+    return librate.periodicity_map(librate.dro_family(em, x0=[0.9, 0.8]), kz=0.8, wz0=map_rates, solve=False)
+
+
+MAP_BAD = [
+    (lambda m, u, o: lp.plot_residuals(o, wz0=[0.0, 1.0]), "`kz`"),
+    (lambda m, u, o: lp.plot_residuals(o, kz=0.8), "`wz0`"),
+    (lambda m, u, o: lp.plot_residuals(o, kz=0.8, wz0=[0.0, 1.0], rate="synodic"), "`rate`"),
+    (lambda m, u, o: lp.plot_residuals(m), "`orbit_index`"),
+    (lambda m, u, o: lp.plot_residuals(m, orbit_index=0, kz=0.3), "`kz`"),
+    (lambda m, u, o: lp.plot_residuals(m, orbit_index=9), "`orbit_index`"),
+    (lambda m, u, o: lp.plot_residuals(m, orbit_index=0, wz0=[0.0, 1.0]), "`wz0`"),
+    (lambda m, u, o: lp.plot_residuals("map"), "`orbit_or_ds`"),
+    (lambda m, u, o: lp.plot_map("map"), "`ds`"),
+    (lambda m, u, o: lp.plot_map(m, kz_index=1), "`kz_index`"),
+    (lambda m, u, o: lp.plot_map(m, against="jacobi"), "`against`"),
+    (lambda m, u, o: lp.plot_map(m, kinds=("quarter",)), "`kinds`"),
+    (lambda m, u, o: lp.plot_map(m.isel(orbit=[0])), "`ds`"),
+    (lambda m, u, o: lp.plot_map(m, plt.subplots(1, 2)[1]), "`ax`"),
+    (lambda m, u, o: lp.plot_solution_families(u), "`ds`"),
+    (lambda m, u, o: lp.plot_solution_families(m, n="one"), "`n`"),
+    (lambda m, u, o: lp.plot_solution_families(m, max_jump=-1), "`max_jump`"),
+    (lambda m, u, o: lp.plot_solution_families(m, n=(0, 1), ax=plt.subplots()[1]), "`ax`"),
+    (lambda m, u, o: lp.plot_attitude_motion([]), "`solutions`"),
+    (lambda m, u, o: lp.plot_attitude_motion(o), "`solutions`"),
+    (lambda m, u, o: lp.plot_attitude_motion(librate.periodic_attitude(o, kz=0.8, n=0), n_periods=0), "`n_periods`"),
+    (lambda m, u, o: lp.plot_attitude_motion(librate.periodic_attitude(o, kz=0.8, n=0), ax=plt.subplots()[1]), "`ax`"),
+]
+
+
+@pytest.mark.parametrize("call, text", MAP_BAD, ids=[f"{i}-{b[1].strip('`')}" for i, b in enumerate(MAP_BAD)])
+def test_bad_arguments_attitude_figures(small_map, unsolved, dro1266, call, text):
+    with pytest.raises(ValueError, match=text):
+        call(small_map, unsolved, dro1266)
+
+
+def test_plot_map_of_a_subset_of_orbits(small_map):
+    """A map cut with ``isel(orbit=...)`` keeps its solutions on the right orbits (sol_orbit
+    holds orbit labels, not positions)."""
+    sub = small_map.isel(orbit=[3, 4, 5])
+    ax = lp.plot_map(sub).axes[0]
+    sel = np.isin(small_map.sol_orbit.values, [3, 4, 5]) & (small_map.sol_kind.values == "periodic")
+    want = sorted(zip(small_map.period_days.values[small_map.sol_orbit.values[sel]], small_map.sol_phidot0.values[sel]))
+    np.testing.assert_allclose([p[:2] for p in marker_points(ax)], want, atol=1e-12)
+    ax = lp.plot_residuals(small_map.isel(orbit=[4])).axes[0]
+    sel = (small_map.sol_orbit.values == 4)
+    np.testing.assert_allclose(sorted(p[0] for p in marker_points(ax)), sorted(small_map.sol_phidot0.values[sel]), atol=1e-12)

@@ -1,23 +1,32 @@
-"""Figures of periodic-orbit families and orbits (thesis ch. 2), drawn with matplotlib.
+"""Figures of periodic-orbit families and orbits (thesis ch. 2) and of periodic attitude motions
+(thesis sec. 3.3), drawn with matplotlib.
 
 This module is the only part of librate that uses matplotlib, and ``import librate`` does not
 import it: import it explicitly, ``import librate.plotting as lp`` (install with
 ``pip install "librate[plot]"``). ``matplotlib.pyplot`` itself is imported only when a function
 has to create a figure.
 
-Every ``plot_*`` function takes the data (an :class:`~librate.OrbitFamily` or
-:class:`~librate.PeriodicOrbit` objects) and an optional ``ax``: with ``ax=None`` it creates a
+Every ``plot_*`` function takes the data (an :class:`~librate.OrbitFamily`,
+:class:`~librate.PeriodicOrbit` objects, a Dataset from :func:`librate.periodicity_map`,
+:class:`~librate.AttitudeSolution` objects) and an optional ``ax``: with ``ax=None`` it creates a
 new figure (through ``pyplot``, so ``plt.show()`` displays it; close it with ``plt.close(fig)``
 when drawing many), otherwise it draws into the given Axes (a sequence of Axes where a
 function draws several panels). **Every function returns the matplotlib Figure** it drew
 into; it never calls ``plt.show()``. Axes are labelled with units: LU (the primaries'
-distance, ``system.lu_km``), TU, days or km. Artists carry a ``gid`` naming what they show
+distance, ``system.lu_km``), TU, days or km. Attitude rates are plotted RELATIVE to the
+synodic frame by default, phidot = wz - 1 (the quantity on the thesis figures' axes, which
+label it wz(0)); ``rate="inertial"`` plots wz, and the axis label says which. Artists carry a ``gid`` naming what they show
 (``"orbit"``, ``"earth"``, ``"resonance-synodic-2"``, ...), so figures can be inspected.
 
 - :func:`plot_family`: a family's orbits in the synodic frame, coloured by Jacobi constant (Fig. 3)
 - :func:`plot_period`: period against x0 with synodic and Sun resonances (Fig. 6)
 - :func:`plot_stability`: stability indices against x0 with bifurcations (Fig. 5)
 - :func:`plot_eci`: orbits in the Earth-centred inertial frame, in km (Figs. 7a, 10, 11)
+- :func:`plot_attitude`: an attitude response, rates and Euler angles (Figs. 16-21)
+- :func:`plot_residuals`: Dwz and Dphi after one period against the initial rate (Fig. 23)
+- :func:`plot_map`: the periodicity map, zero contours and solutions over (orbit, rate) (Fig. 24)
+- :func:`plot_solution_families`: solutions of each N across the orbit family, per Kz (Figs. 27-29)
+- :func:`plot_attitude_motion`: phi(t) and the rate of periodic motions (Figs. 30-31)
 - :func:`save_figure`: write a figure to a file
 """
 
@@ -36,7 +45,7 @@ try:
     from matplotlib.cm import ScalarMappable
     from matplotlib.colors import Normalize
     from matplotlib.lines import Line2D
-    from matplotlib.ticker import FuncFormatter
+    from matplotlib.ticker import FuncFormatter, MultipleLocator
     from matplotlib.transforms import blended_transform_factory
 except ImportError as exc:  # pragma: no cover - depends on the environment
     raise ImportError('librate.plotting needs matplotlib >= 3.6: pip install "librate[plot]"') from exc
@@ -49,7 +58,18 @@ from .orbits import PeriodicOrbit
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
-__all__ = ["plot_family", "plot_period", "plot_stability", "plot_eci", "plot_attitude", "save_figure"]
+__all__ = [
+    "plot_family",
+    "plot_period",
+    "plot_stability",
+    "plot_eci",
+    "plot_attitude",
+    "plot_residuals",
+    "plot_map",
+    "plot_solution_families",
+    "plot_attitude_motion",
+    "save_figure",
+]
 
 _EARTH = dict(marker="o", color="tab:blue", markersize=9, markeredgecolor="k", linestyle="none")
 _MOON = dict(marker="o", color="0.6", markersize=6, markeredgecolor="k", linestyle="none")
@@ -491,7 +511,7 @@ def plot_eci(
     return fig
 
 
-# --- output --------------------------------------------------------------------------------------
+# --- attitude response (Figs. 16-21) ------------------------------------------------------------
 def plot_attitude(traj, ax=None, *, period: float | None = None, relative_to: str | None = None, degrees: bool = True) -> Figure:
     """Attitude response of an :class:`librate.AttitudeTrajectory` against revolutions (thesis
     Fig. 16-21): the angular rates (left) and the 1-2-3 Euler angles (right) for roll, pitch and
@@ -532,6 +552,532 @@ def plot_attitude(traj, ax=None, *, period: float | None = None, relative_to: st
     return fig
 
 
+# --- periodic attitude motions: residuals, maps, families, motions (Figs. 23-31) --------------
+_KINDS = ("periodic", "half-turn")
+_KIND_MARKER = {"periodic": "o", "half-turn": "D"}
+# Solutions are coloured by N (the same N, the same colour in every figure), |N| > 3 in one grey;
+# blue and orange are left to the residuals Dwz and Dphi (curves in Fig. 23, contours in Fig. 24).
+_N_COLORS = {0: "tab:green", 1: "tab:red", -1: "tab:purple", 2: "tab:brown", -2: "tab:pink", 3: "tab:olive", -3: "tab:cyan"}
+_N_OTHER = "0.55"
+_DWZ_COLOR, _DPHI_COLOR = "tab:blue", "tab:orange"
+_KZ_STYLES = ("-", "--", ":", "-.")
+_ORBIT_AXES = {"period": "orbit period $T$ (days)", "x0": "orbit $x_0$ (LU)"}
+
+
+def _n_color(n: int) -> str:
+    """The colour of N (|N| <= 3 each its own, the others one grey)."""
+    return _N_COLORS.get(int(n), _N_OTHER)
+
+
+def _rate_axis(rate: str, *, initial: bool = True) -> tuple[float, str]:
+    """(offset subtracted from inertial rates, axis label) for ``rate="relative"`` (phidot =
+    wz - 1, the quantity on the thesis figures' axes) or ``"inertial"`` (wz)."""
+    t = "(0)" if initial else "(t)"
+    what = "initial rate" if initial else "angular velocity"
+    if rate == "relative":
+        return 1.0, f"{what} $\\dot\\varphi{t} = \\omega_z{t} - 1$, relative to the synodic frame (1/TU)"
+    if rate == "inertial":
+        return 0.0, f"{what} $\\omega_z{t}$, inertial (1/TU)"
+    raise ValueError(f"invalid argument `rate`: must be 'relative' (wz - 1, the thesis figures' axis) or 'inertial', got {rate!r}")
+
+
+def _check_kinds(kinds) -> tuple[str, ...]:
+    ks = (kinds,) if isinstance(kinds, str) else tuple(kinds)
+    if not ks or any(k not in _KINDS for k in ks):
+        raise ValueError(f"invalid argument `kinds`: must be 'periodic' and/or 'half-turn', got {kinds!r}")
+    return ks
+
+
+def _check_map(ds, name: str = "ds"):
+    names = getattr(ds, "variables", None)
+    if not hasattr(ds, "data_vars") or names is None or not all(v in names for v in ("dwz", "dphi", "wz0", "x0", "period_days", "kz")):
+        raise ValueError(f"invalid argument `{name}`: must be an xarray Dataset from librate.periodicity_map, got {type(ds).__name__}")
+    return ds
+
+
+def _index(value, size: int, name: str) -> int:
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or not -size <= value < size:
+        raise ValueError(f"invalid argument `{name}`: must be an integer index below {size}, got {value!r}")
+    return int(value) % size
+
+
+def _orbit_axis(ds, against: str) -> tuple[np.ndarray, str]:
+    if against not in _ORBIT_AXES:
+        raise ValueError(f"invalid argument `against`: must be 'period' (days) or 'x0', got {against!r}")
+    return np.asarray(ds["period_days" if against == "period" else "x0"].values, dtype=float), _ORBIT_AXES[against]
+
+
+def _solution_table(ds) -> dict[str, np.ndarray] | None:
+    """The ``sol_*`` variables of a map as arrays (None when it was computed with solve=False),
+    ``orbit`` turned into the position along the Dataset's orbit dimension (solutions of orbits
+    not in it, after ``ds.isel(orbit=...)``, are dropped)."""
+    if "sol_wz0" not in ds.variables:
+        return None
+    tab = {k: np.asarray(ds[f"sol_{k}"].values) for k in ("orbit", "kz", "wz0", "n", "kind", "stable")}
+    labels = np.asarray(ds["orbit"].values)
+    pos = {int(v): i for i, v in enumerate(labels)}
+    where = np.array([pos.get(int(o), -1) for o in tab["orbit"]], dtype=np.int64)
+    keep = where >= 0
+    tab = {k: v[keep] for k, v in tab.items()}
+    tab["orbit"] = where[keep]
+    return tab
+
+
+def _kz_mask(tab, kz: float) -> np.ndarray:
+    return np.abs(tab["kz"].astype(float) - float(kz)) <= 1e-12 * max(1.0, abs(float(kz)))
+
+
+def _draw_solutions(a, x, y, n, kind, stable, *, markersize: float = 6.5) -> None:
+    """Markers for solutions: colour by N, circle periodic / diamond half-turn, filled when
+    linearly stable, hollow when not; one Line2D per group, all with ``gid="solutions"``."""
+    for k in _KINDS:
+        for nn in sorted(set(n[kind == k].tolist()), reverse=True):
+            for st in (True, False):
+                m = (kind == k) & (n == nn) & (stable == st)
+                if not m.any():
+                    continue
+                c = _n_color(nn)
+                (h,) = a.plot(x[m], y[m], linestyle="none", marker=_KIND_MARKER[k], color=c, markeredgecolor=c,
+                              markerfacecolor=c if st else "none", markeredgewidth=1.4, markersize=markersize, zorder=5,
+                              label="_nolegend_")
+                h.set_gid("solutions")
+
+
+def _solution_legend(n, kind, stable) -> list:
+    """Legend proxies explaining the solution markers."""
+    out = []
+    ns = sorted(set(np.asarray(n).tolist()), reverse=True)
+    others = [nn for nn in ns if nn not in _N_COLORS]
+    for nn in ns:
+        if nn in _N_COLORS or len(others) == 1:
+            out.append(Line2D([], [], linestyle="none", marker="s", color=_n_color(nn), markersize=7, label=f"$N$ = {nn}"))
+    if len(others) > 1:
+        out.append(Line2D([], [], linestyle="none", marker="s", color=_N_OTHER, markersize=7,
+                          label=f"other $N$ ({min(others)} ... {max(others)})"))
+    gray = dict(linestyle="none", color="0.3", markeredgecolor="0.3", markersize=6.5, markeredgewidth=1.4)
+    if "periodic" in kind:
+        out.append(Line2D([], [], marker="o", markerfacecolor="0.8", label="periodic, $\\varphi(T) = \\varphi_0 + 2\\pi N$", **gray))
+    if "half-turn" in kind:
+        out.append(Line2D([], [], marker="D", markerfacecolor="0.8",
+                          label="half-turn, $\\varphi(T) = \\varphi_0 + 2\\pi N + \\pi$", **gray))
+    if np.any(stable):
+        out.append(Line2D([], [], marker="o", label="filled: linearly stable ($|\\mathrm{tr}\\,M| < 2$)", **gray))
+    if not np.all(stable):
+        out.append(Line2D([], [], marker="o", markerfacecolor="none", label="hollow: unstable", **gray))
+    return out
+
+
+def _set_gid(cs, gid: str) -> None:
+    if hasattr(cs, "set_gid"):  # matplotlib >= 3.8: a ContourSet is one Collection
+        cs.set_gid(gid)
+    else:  # pragma: no cover - matplotlib < 3.8
+        for c in cs.collections:
+            c.set_gid(gid)
+
+
+def _break_wraps(x: np.ndarray, y: np.ndarray, jump: float = math.pi) -> tuple[np.ndarray, np.ndarray]:
+    """(x, y) with a NaN point inserted where y jumps by more than ``jump`` (the +-pi wrap of
+    Dphi), so that no vertical line joins the two sides; the finite points are (x, y) unchanged."""
+    cut = np.flatnonzero(np.abs(np.diff(y)) > jump) + 1
+    return np.insert(np.asarray(x, dtype=float), cut, np.nan), np.insert(np.asarray(y, dtype=float), cut, np.nan)
+
+
+def plot_residuals(
+    orbit_or_ds,
+    ax=None,
+    *,
+    kz: float | None = None,
+    wz0=None,
+    orbit_index: int | None = None,
+    phi0: float = 0.0,
+    rate: str = "relative",
+    solutions: bool = True,
+    kinds: Sequence[str] = _KINDS,
+    annotate: bool = True,
+) -> Figure:
+    """The residuals after one orbital period against the initial rate, for one orbit and one
+    Kz (thesis Fig. 23): Dwz = wz(T) - wz(0) (``gid="residual-dwz"``) and Dphi = phi(T) - phi0
+    wrapped to (-pi, pi] (``gid="residual-dphi"``; a NaN breaks the line at each +-pi wrap, its
+    finite points are the Dataset's values), the zero line (``gid="zero"``) and, with
+    ``solutions``, the refined solutions of the listed ``kinds`` at (rate, 0) (``gid="solutions"``;
+    colour by N, circle periodic, diamond half-turn, filled when linearly stable), labelled
+    "N = ..." when ``annotate``.
+
+    ``orbit_or_ds``: a Dataset from :func:`librate.periodicity_map` (``orbit_index`` picks the
+    orbit when it holds several, ``kz`` the Kz value when it holds several), or a planar
+    :class:`~librate.PeriodicOrbit` with ``kz`` (a number) and ``wz0`` (the grid of INERTIAL
+    initial rates, increasing): the map is then computed here (``phi0``: the initial angle).
+    ``rate``: the horizontal axis, ``"relative"`` (default: phidot(0) = wz(0) - 1, relative to
+    the synodic frame, what the thesis figures plot under the label wz(0)) or ``"inertial"``
+    (wz(0)); the axis label says which. Returns the Figure.
+    """
+    offset, xlabel = _rate_axis(rate)
+    kinds = _check_kinds(kinds)
+    if isinstance(orbit_or_ds, PeriodicOrbit):
+        if kz is None:
+            raise ValueError("invalid argument `kz`: a number in [-1, 1] is needed with an orbit")
+        if wz0 is None:
+            raise ValueError("invalid argument `wz0`: the inertial initial rates to scan are needed with an orbit")
+        if orbit_index not in (None, 0):
+            raise ValueError(f"invalid argument `orbit_index`: one orbit was given, got {orbit_index!r}")
+        from .periodicity import periodicity_map
+
+        ds = periodicity_map(orbit_or_ds, kz=kz, wz0=wz0, phi0=phi0, solve=bool(solutions))
+        i = j = 0
+    else:
+        ds = _check_map(orbit_or_ds, "orbit_or_ds")
+        if wz0 is not None:
+            raise ValueError("invalid argument `wz0`: rates are given only with an orbit (a Dataset has its own)")
+        norb = ds.sizes["orbit"]
+        if orbit_index is None and norb != 1:
+            raise ValueError(f"invalid argument `orbit_index`: the Dataset holds {norb} orbits, pick one")
+        i = _index(0 if orbit_index is None else orbit_index, norb, "orbit_index")
+        kzs = np.asarray(ds["kz"].values, dtype=float)
+        if kz is None:
+            if kzs.size != 1:
+                raise ValueError(f"invalid argument `kz`: the Dataset holds {kzs.size} Kz values {kzs.tolist()}, pick one")
+            j = 0
+        else:
+            hit = np.flatnonzero(np.abs(kzs - float(kz)) <= 1e-12)
+            if not hit.size:
+                raise ValueError(f"invalid argument `kz`: {kz!r} is not in the Dataset's Kz values {kzs.tolist()}")
+            j = int(hit[0])
+    kz_value = float(ds["kz"].values[j])
+    x = np.asarray(ds["wz0"].values, dtype=float) - offset
+    dwz = np.asarray(ds["dwz"].values[i, j], dtype=float)
+    dphi = np.asarray(ds["dphi"].values[i, j], dtype=float)
+
+    created = ax is None
+    fig, (a,) = _axes(ax, 1, figsize=(7.4, 4.8))
+    z = a.axhline(0.0, color="0.35", linewidth=0.8, zorder=1)
+    z.set_gid("zero")
+    (h,) = a.plot(x, dwz, color=_DWZ_COLOR, linewidth=1.4, label="$\\Delta\\omega_z = \\omega_z(T) - \\omega_z(0)$ (1/TU)")
+    h.set_gid("residual-dwz")
+    (h,) = a.plot(*_break_wraps(x, dphi), color=_DPHI_COLOR, linewidth=1.4,
+                  label="$\\Delta\\varphi = \\varphi(T) - \\varphi_0$, wrapped to $(-\\pi, \\pi]$ (rad)")
+    h.set_gid("residual-dphi")
+    handles = list(a.get_legend_handles_labels()[0])
+    tab = _solution_table(ds) if solutions else None
+    if tab is not None:
+        m = (tab["orbit"] == i) & _kz_mask(tab, kz_value) & np.isin(tab["kind"], kinds)
+        if m.any():
+            xs = tab["wz0"][m] - offset
+            _draw_solutions(a, xs, np.zeros_like(xs), tab["n"][m], tab["kind"][m], tab["stable"][m])
+            if annotate:
+                for xv, nn, k in zip(xs, tab["n"][m], tab["kind"][m]):
+                    txt = f"$N$ = {nn}" + (", half-turn" if k == "half-turn" else "")
+                    a.annotate(txt, (xv, 0.0), xytext=(0, 9), textcoords="offset points", ha="center", va="bottom",
+                               fontsize=7.5, color=_n_color(nn), rotation=90)
+            handles += _solution_legend(tab["n"][m], tab["kind"][m], tab["stable"][m])
+    a.set_xlabel(xlabel)
+    a.set_ylabel("residual after one period: $\\Delta\\omega_z$ (1/TU), $\\Delta\\varphi$ (rad)")
+    a.set_xlim(x[0], x[-1])
+    a.grid(True, linewidth=0.3, alpha=0.5)
+    a.legend(handles=handles, loc="best", fontsize=7.5)
+    if created:
+        a.set_title(f"residuals after one period: orbit T = {float(ds['period_days'].values[i]):.2f} d "
+                    f"($x_0$ = {float(ds['x0'].values[i]):.4f}), $K_z$ = {kz_value:g}")
+    return fig
+
+
+def plot_map(
+    ds,
+    ax=None,
+    *,
+    kz_index: int = 0,
+    against: str = "period",
+    rate: str = "relative",
+    solutions: bool = True,
+    kinds: Sequence[str] = ("periodic",),
+    half_turn_contours: bool | None = None,
+    legend: bool = True,
+) -> Figure:
+    """The attitude periodicity map of an orbit family for one Kz (thesis Fig. 24): over (orbit,
+    initial rate), the zero contours of Dwz (``gid="contour-dwz"``) and of Dphi
+    (``gid="contour-dphi"``), and the refined solutions where they cross (``gid="solutions"``,
+    colour by N, filled when linearly stable, hollow when not; a legend explains them).
+
+    ``ds``: a Dataset from :func:`librate.periodicity_map` with at least 2 orbits;
+    ``kz_index`` picks the Kz. The Dwz contour is ``matplotlib.contour`` at level 0 of the
+    (orbit, rate) grid. Dphi = 0 is contoured on the unwrapped phi(T) at the levels phi0 + 2 pi k
+    (every k in the data's range; the same zero set as the wrapped Dphi, without a false contour
+    along the +-pi wrap; a Dataset without ``phi_T`` falls back to sin(Dphi) where cos(Dphi) >
+    0). ``kinds``: the solutions marked, ``"periodic"`` (default) and/or ``"half-turn"``
+    (diamonds); ``half_turn_contours`` (default: when half-turn solutions are marked) adds the
+    contours Dphi = pi, the levels phi0 + pi (2 k + 1), dotted (``gid="contour-dphi-half"``),
+    on which those sit. The contours are those of the sampled grid: a feature narrower than the
+    rate step is not drawn (beside a stable solution Dwz can dip below zero over a few 1e-3
+    1/TU, so the Dwz contour may pass a stable solution at some distance on a coarse grid); the
+    markers are the refined solutions, exact whatever the grid. ``against``: the orbit axis, ``"period"`` (days, default)
+    or ``"x0"``. ``rate``: the rate axis, ``"relative"`` (phidot(0) = wz(0) - 1, default, the
+    thesis convention) or ``"inertial"`` (wz(0)). Returns the Figure.
+    """
+    ds = _check_map(ds)
+    j = _index(kz_index, ds.sizes["kz"], "kz_index")
+    xv, xlabel = _orbit_axis(ds, against)
+    offset, ylabel = _rate_axis(rate)
+    kinds = _check_kinds(kinds)
+    if half_turn_contours is None:
+        half_turn_contours = "half-turn" in kinds
+    if xv.size < 2:
+        raise ValueError("invalid argument `ds`: a map needs at least 2 orbits (plot_residuals draws one)")
+    y = np.asarray(ds["wz0"].values, dtype=float) - offset
+    kz_value = float(ds["kz"].values[j])
+    phi0 = float(ds.attrs.get("phi0", 0.0))
+
+    created = ax is None
+    fig, (a,) = _axes(ax, 1, figsize=(8.6, 5.8))
+    dwz = np.asarray(ds["dwz"].values[:, j, :], dtype=float).T  # (rate, orbit)
+    if np.isfinite(dwz).any() and np.nanmin(dwz) < 0 < np.nanmax(dwz):
+        cs = a.contour(xv, y, dwz, levels=[0.0], colors=_DWZ_COLOR, linewidths=1.1)
+        _set_gid(cs, "contour-dwz")
+    if "phi_T" in ds.variables:
+        p = np.asarray(ds["phi_T"].values[:, j, :], dtype=float).T - phi0
+        fin = p[np.isfinite(p)]
+        groups = [("contour-dphi", 0.0, dict(linewidths=1.1, linestyles="solid"))]
+        if half_turn_contours:
+            groups.append(("contour-dphi-half", math.pi, dict(linewidths=0.7, linestyles="dotted")))
+        for gid_, shift, style in groups:
+            if not fin.size:
+                break
+            ks = np.arange(math.ceil((fin.min() - shift) / (2 * math.pi)), math.floor((fin.max() - shift) / (2 * math.pi)) + 1)
+            levels = shift + 2 * math.pi * ks
+            levels = levels[(levels > fin.min()) & (levels < fin.max())]
+            if levels.size:
+                cs = a.contour(xv, y, p, levels=levels, colors=_DPHI_COLOR, **style)
+                _set_gid(cs, gid_)
+    else:
+        d = np.asarray(ds["dphi"].values[:, j, :], dtype=float).T
+        s = np.where(np.cos(d) > 0, np.sin(d), np.nan)
+        if np.isfinite(s).any() and np.nanmin(s) < 0 < np.nanmax(s):
+            cs = a.contour(xv, y, s, levels=[0.0], colors=_DPHI_COLOR, linewidths=1.1)
+            _set_gid(cs, "contour-dphi")
+    handles = [Line2D([], [], color=_DWZ_COLOR, linewidth=1.1, label="$\\Delta\\omega_z = 0$"),
+               Line2D([], [], color=_DPHI_COLOR, linewidth=1.1, label="$\\Delta\\varphi = 0$")]
+    if half_turn_contours:
+        handles.append(Line2D([], [], color=_DPHI_COLOR, linewidth=0.7, linestyle=":", label="$\\Delta\\varphi = \\pi$"))
+    tab = _solution_table(ds) if solutions else None
+    if tab is not None:
+        m = _kz_mask(tab, kz_value) & np.isin(tab["kind"], kinds)
+        if m.any():
+            _draw_solutions(a, xv[tab["orbit"][m]], tab["wz0"][m] - offset, tab["n"][m], tab["kind"][m], tab["stable"][m],
+                            markersize=5.0)
+            handles += _solution_legend(tab["n"][m], tab["kind"][m], tab["stable"][m])
+    a.set_xlim(np.nanmin(xv), np.nanmax(xv))
+    a.set_ylim(y[0], y[-1])
+    a.set_xlabel(xlabel)
+    a.set_ylabel(ylabel)
+    a.grid(True, linewidth=0.3, alpha=0.5)
+    if legend:
+        a.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=7.5, borderaxespad=0.0)
+    if created:
+        fam = ds.attrs.get("family", "") or "orbit"
+        a.set_title(f"attitude periodicity map, {fam.upper() if fam == 'dro' else fam} family, $K_z$ = {kz_value:g}")
+    return fig
+
+
+def _branches(orbit: np.ndarray, rate: np.ndarray, max_jump: float | None) -> list[list[int]]:
+    """Solutions (orbit index, rate) joined into branches across consecutive orbits: each
+    solution continues the branch ending on the previous orbit nearest in rate (greedy, closest
+    pairs first, at most ``max_jump`` apart), else starts a new one."""
+    branches: list[list[int]] = []
+    for o in np.unique(orbit):
+        cur = [int(c) for c in np.flatnonzero(orbit == o)]
+        cur.sort(key=lambda c: rate[c])
+        ends = [b for b in branches if orbit[b[-1]] == o - 1]
+        pairs = sorted((abs(rate[b[-1]] - rate[c]), bi, ci) for bi, b in enumerate(ends) for ci, c in enumerate(cur))
+        used_b: set[int] = set()
+        used_c: set[int] = set()
+        for d, bi, ci in pairs:
+            if bi in used_b or ci in used_c or (max_jump is not None and d > max_jump):
+                continue
+            ends[bi].append(cur[ci])
+            used_b.add(bi)
+            used_c.add(ci)
+        branches += [[c] for ci, c in enumerate(cur) if ci not in used_c]
+    return branches
+
+
+def plot_solution_families(
+    ds,
+    ax=None,
+    *,
+    n: int | Iterable[int] | None = None,
+    kinds: Sequence[str] = ("periodic",),
+    against: str = "period",
+    rate: str = "relative",
+    separate: bool = True,
+    stability: bool = True,
+    max_jump: float | None = None,
+) -> Figure:
+    """Families of periodic attitude solutions across an orbit family (thesis Figs. 27-29): the
+    initial rate of the solutions with N net turns per orbit against the orbit's period (or x0),
+    one curve per Kz of the Dataset.
+
+    ``ds``: a Dataset from :func:`librate.periodicity_map` with solutions (any number of Kz).
+    Solutions of one (kind, N, Kz) are joined across consecutive orbits into branches
+    (nearest rate, at most ``max_jump`` apart; None: no limit), each a line with
+    ``gid="family-{kind}-N{N:+d}-kz{Kz:g}"`` (e.g. ``"family-periodic-N-1-kz0.8"``) whose points
+    are exactly the Dataset's solutions; with ``stability`` the linearly stable ones are
+    overdrawn filled (``gid="family-stable"``). ``n``: the N values to show (default: all in
+    the Dataset), ``kinds``: ``"periodic"`` (default) and/or ``"half-turn"``. ``separate``: one
+    panel per (kind, N), N descending, Kz by colour (``ax``: that many Axes); else a single
+    panel, N by colour and Kz by line style. ``against``: ``"period"`` (days) or ``"x0"``;
+    ``rate``: ``"relative"`` (phidot(0) = wz(0) - 1, default) or ``"inertial"``. Returns the
+    Figure.
+    """
+    ds = _check_map(ds)
+    tab = _solution_table(ds)
+    if tab is None:
+        raise ValueError("invalid argument `ds`: the map holds no solutions (compute it with solve=True)")
+    kinds = _check_kinds(kinds)
+    xv, xlabel = _orbit_axis(ds, against)
+    offset, ylabel = _rate_axis(rate)
+    if max_jump is not None and not (isinstance(max_jump, (int, float, np.integer, np.floating)) and max_jump > 0):
+        raise ValueError(f"invalid argument `max_jump`: must be a number > 0 or None, got {max_jump!r}")
+    if n is None:
+        ns = sorted(set(tab["n"][np.isin(tab["kind"], kinds)].tolist()), reverse=True)
+    else:
+        ns = [n] if isinstance(n, (int, np.integer)) else list(n)
+        if not ns or not all(isinstance(v, (int, np.integer)) and not isinstance(v, bool) for v in ns):
+            raise ValueError(f"invalid argument `n`: must be an integer, a sequence of integers or None, got {n!r}")
+    groups = [(k, int(v)) for v in ns for k in kinds]
+    if n is None:
+        groups = [(k, v) for k, v in groups if np.any((tab["kind"] == k) & (tab["n"] == v))]
+    if not groups:
+        raise ValueError(f"invalid argument `ds`: it holds no solutions of kinds {list(kinds)}")
+    kzs = np.asarray(ds["kz"].values, dtype=float)
+    kz_colors = (["k"] if kzs.size == 1 else
+                 [matplotlib.colormaps["viridis"](v) for v in np.linspace(0.0, 0.85, kzs.size)])
+
+    created = ax is None
+    npanels = len(groups) if separate else 1
+    fig, axs = _axes(ax, npanels, figsize=(7.4, 5.2) if npanels == 1 else None)
+    for g, (kind, nn) in enumerate(groups):
+        a = axs[g] if separate else axs[0]
+        drawn = False
+        for jk, kz in enumerate(kzs):
+            sel = np.flatnonzero((tab["kind"] == kind) & (tab["n"] == nn) & _kz_mask(tab, kz))
+            if not sel.size:
+                continue
+            color = kz_colors[jk] if separate else _n_color(nn)
+            style = "-" if separate else _KZ_STYLES[jk % len(_KZ_STYLES)]
+            name = f"$K_z$ = {kz:g}" if separate else f"$N$ = {nn}{' half-turn' if kind == 'half-turn' else ''}, $K_z$ = {kz:g}"
+            orb, w = tab["orbit"][sel], tab["wz0"][sel]
+            for b_i, br in enumerate(_branches(orb, w, max_jump)):
+                idx = sel[br]
+                (h,) = a.plot(xv[tab["orbit"][idx]], tab["wz0"][idx] - offset, color=color, linestyle=style, linewidth=1.4,
+                              marker=".", markersize=4, label=name if b_i == 0 else "_nolegend_")
+                h.set_gid(f"family-{kind}-N{nn:+d}-kz{kz:g}")
+            st = sel[tab["stable"][sel]]
+            if stability and st.size:
+                (h,) = a.plot(xv[tab["orbit"][st]], tab["wz0"][st] - offset, linestyle="none", marker="o", markersize=5,
+                              color=color, label="_nolegend_")
+                h.set_gid("family-stable")
+            drawn = True
+        if separate or g == len(groups) - 1:
+            handles = list(a.get_legend_handles_labels()[0])
+            if stability and any(h.get_gid() == "family-stable" for h in a.get_lines()):
+                handles.append(Line2D([], [], linestyle="none", marker="o", markersize=5, color="0.3",
+                                      label="linearly stable ($|\\mathrm{tr}\\,M| < 2$)"))
+            if handles and separate:
+                a.legend(handles=handles, fontsize=7.5, loc="best")
+            elif handles:  # one entry per (N, Kz): beside the panel
+                a.legend(handles=handles, fontsize=7.5, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)
+        if separate:
+            turns = {0: "", 1: " + 2\\pi", -1: " - 2\\pi"}.get(nn, f" {'+' if nn > 0 else '-'} {2 * abs(nn)}\\pi")
+            if kind == "half-turn":
+                turns += " + \\pi"
+            a.set_title(f"$N$ = {nn}{' (half-turn)' if kind == 'half-turn' else ''}: $\\varphi(T) = \\varphi_0{turns}$", fontsize=10)
+            if not drawn:
+                a.text(0.5, 0.5, "no solutions in the map", transform=a.transAxes, ha="center", va="center", color="0.4")
+    lo, hi = float(np.nanmin(xv)), float(np.nanmax(xv))
+    pad = 0.02 * (hi - lo)
+    for a in axs:
+        a.set_xlim(lo - pad, hi + pad)  # the whole orbit family on every panel
+        a.set_xlabel(xlabel)
+        a.set_ylabel(ylabel)
+        a.grid(True, linewidth=0.3, alpha=0.5)
+    if created:
+        fam = ds.attrs.get("family", "") or "orbit"
+        fig.suptitle(f"periodic attitude solution families along the {fam.upper() if fam == 'dro' else fam} family")
+    return fig
+
+
+def plot_attitude_motion(
+    solutions,
+    ax=None,
+    *,
+    n_periods: float = 1,
+    rate: str = "relative",
+    degrees: bool = True,
+    samples: int = 400,
+) -> Figure:
+    """Rotation angle phi(t) (left, ``gid="angle"``) and angular velocity (right,
+    ``gid="rate"``) of periodic attitude motions against time in orbital periods t / T (thesis
+    Figs. 30-31), one line per solution in the given order, coloured by N (dashed: half-turn).
+
+    ``solutions``: an :class:`~librate.AttitudeSolution` or a list of them (e.g. from
+    :func:`librate.find_periodic_attitudes`); each is propagated with
+    ``solution.propagate(n_periods)``, ``samples`` points per period. phi is measured from the
+    synodic X axis (unwrapped, in degrees unless ``degrees=False``): a periodic motion reaches
+    phi0 + 360 N deg after each period. ``rate``: ``"relative"`` (phidot = wz - 1, relative to
+    the synodic frame, default) or ``"inertial"`` (wz). ``ax``: two Axes. Returns the Figure.
+    """
+    from .periodicity import AttitudeSolution
+
+    offset, ylabel = _rate_axis(rate, initial=False)
+    sols = [solutions] if isinstance(solutions, AttitudeSolution) else solutions
+    try:
+        sols = list(sols)
+    except TypeError:
+        sols = []
+    if not sols or not all(isinstance(s, AttitudeSolution) for s in sols):
+        raise ValueError("invalid argument `solutions`: must be a librate.AttitudeSolution or a non-empty list of them, "
+                         f"got {type(solutions).__name__}")
+    number = isinstance(n_periods, (int, float, np.integer, np.floating)) and not isinstance(n_periods, bool)
+    if not (number and math.isfinite(n_periods) and n_periods > 0):
+        raise ValueError(f"invalid argument `n_periods`: must be a number > 0, got {n_periods!r}")
+    if isinstance(samples, bool) or not isinstance(samples, (int, np.integer)) or samples < 2:
+        raise ValueError(f"invalid argument `samples`: must be an integer >= 2, got {samples!r}")
+    k = 180.0 / math.pi if degrees else 1.0
+    keys = [(s.n, s.kind) for s in sols]
+    by_n = len(set(keys)) == len(keys)  # colour by N unless two motions share (N, kind)
+    cycle = matplotlib.rcParams["axes.prop_cycle"].by_key().get("color", ["tab:blue"])
+
+    created = ax is None
+    fig, (a_ang, a_rate) = _axes(ax, 2, figsize=(12.0, 4.6))
+    for i, s in enumerate(sols):
+        T = s.orbit.period
+        m = max(2, int(math.ceil(samples * n_periods)) + 1)
+        tr = s.propagate(n_periods, t_eval=np.linspace(0.0, n_periods * T, m))
+        color = _n_color(s.n) if by_n else cycle[i % len(cycle)]
+        ls = "--" if s.kind == "half-turn" else "-"
+        label = (f"$N$ = {s.n}{' half-turn' if s.kind == 'half-turn' else ''}, "
+                 f"$\\dot\\varphi(0)$ = {s.phidot0:.4f} ($\\omega_z(0)$ = {s.wz0:.4f}), {'stable' if s.stable else 'unstable'}")
+        (h,) = a_ang.plot(tr.t / T, k * tr.phi, color=color, linestyle=ls, linewidth=1.4, label=label)
+        h.set_gid("angle")
+        (h,) = a_rate.plot(tr.t / T, tr.wz - offset, color=color, linestyle=ls, linewidth=1.4, label=label)
+        h.set_gid("rate")
+    a_ang.set_ylabel(f"rotation angle $\\varphi$ from the synodic $X$ axis ({'deg' if degrees else 'rad'})")
+    a_rate.set_ylabel(ylabel.replace(", relative", "\nrelative"))
+    for a in (a_ang, a_rate):
+        a.set_xlabel("time $t/T$ (orbital periods)")
+        a.set_xlim(0.0, float(n_periods))
+        a.margins(y=0.22)  # room for the legend
+        a.grid(True, linewidth=0.3, alpha=0.5)
+        a.legend(fontsize=7.5, loc="best")
+    if degrees:
+        a_ang.yaxis.set_major_locator(MultipleLocator(90.0 if np.ptp(a_ang.get_ylim()) <= 1080 else 360.0))
+    if created:
+        orbs = {id(s.orbit) for s in sols}
+        kzs = sorted({s.kz for s in sols})
+        where = f"orbit T = {sols[0].orbit.period_days:.2f} d" if len(orbs) == 1 else f"{len(orbs)} orbits"
+        fig.suptitle(f"periodic attitude motions, {where}, $K_z$ = {', '.join(f'{v:g}' for v in kzs)}")
+    return fig
+
+
+# --- output --------------------------------------------------------------------------------------
 def save_figure(fig, path, *, dpi: int = 150, close: bool = False, **kwargs) -> Path:
     """Write ``fig`` (a Figure, or an Axes: its figure) to ``path`` (format from the suffix:
     .png, .pdf, .svg, ...), creating missing directories; ``bbox_inches="tight"`` unless given
