@@ -12,7 +12,8 @@ from .families import OrbitFamily, dro, dro_family, halo, halo_family, lyapunov,
 from .fourier import FourierOrbit, fit_fourier
 from .frames import MeanElements, OsculatingElements, eci_to_synodic, mean_elements, osculating_elements, synodic_to_eci
 from .orbits import PeriodicOrbit, correct_dro, correct_periodic, correct_symmetric
-from .periodicity import AttitudeFamily, AttitudeSolution, attitude_family, find_periodic_attitudes, periodic_attitude, periodicity_map
+from .periodicity import AttitudeFamily, AttitudeSolution, SrpContinuation, attitude_family, continue_srp, find_periodic_attitudes, periodic_attitude, periodicity_map
+from .srp import Facet, FacetBody, FlatPlateSRP, SunModel
 from .propagation import BatchResult, Event, EventHit, Stats, Trajectory, propagate, propagate_many
 from .system import System
 
@@ -43,6 +44,12 @@ __all__ = [
     "periodicity_map",
     "AttitudeFamily",
     "attitude_family",
+    "SunModel",
+    "Facet",
+    "FacetBody",
+    "FlatPlateSRP",
+    "continue_srp",
+    "SrpContinuation",
     "OrbitFamily",
     "dro",
     "dro_family",

@@ -23,7 +23,7 @@ from .system import System, resolve_system
 __all__ = ["RigidBody", "AttitudeTrajectory", "propagate_attitude", "quaternion_from_euler", "TORQUES"]
 
 #: Torque model names accepted by ``torques=``.
-TORQUES = ("gravity_gradient", "gravity_gradient_earth", "gravity_gradient_moon")
+TORQUES = ("gravity_gradient", "gravity_gradient_earth", "gravity_gradient_moon", "srp")
 _EULER = {"123": "XYZ", "321": "ZYX", "313": "ZXZ"}
 
 
@@ -124,9 +124,10 @@ class AttitudeTrajectory:
         return Rotation.from_matrix(np.transpose(a_bl, (0, 2, 1))).as_euler(_EULER.get(sequence, sequence))
 
     def torques(self) -> np.ndarray:
-        """(n, 3) total torque of the run's torque models in body axes (inertia units / TU^2)."""
+        """(n, 3) gravity-gradient torque of the run in body axes (inertia units / TU^2)."""
         states = np.ascontiguousarray(np.hstack([self.orbit, self.q, self.w]))
-        return _core.attitude_torques(self.system.mu, list(self.body.moments), list(self.torque_models), np.ascontiguousarray(self.t), states)
+        names = [n for n in self.torque_models if n != "srp"]
+        return _core.attitude_torques(self.system.mu, list(self.body.moments), names, np.ascontiguousarray(self.t), states)
 
 
 def propagate_attitude(
@@ -139,6 +140,9 @@ def propagate_attitude(
     torques: Sequence[str] = ("gravity_gradient",),
     planar: bool = False,
     orbit: str = "integrate",
+    srp=None,
+    sun=None,
+    srp_force: bool = False,
     stm: bool = False,
     t_eval=None,
     rtol: float = 1e-12,
@@ -159,16 +163,32 @@ def propagate_attitude(
     "integrate" (point-mass CR3BP), "held" (the body kept at its initial position, as at the
     Lagrange points) or "coupled" (with the second-order extended-body acceleration, thesis
     eq. 37, which needs ``body.mass_kg``; inertia in kg m^2 and the system's LU).
+
+    Solar radiation pressure: planar runs take ``srp=FlatPlateSRP(...)`` (the simplified plate);
+    3-D runs take a :class:`librate.FacetBody` with "srp" among ``torques`` (inertia in kg m^2),
+    the Sun from ``sun`` (a :class:`librate.SunModel`, default phase 0), and ``srp_force=True``
+    adds the SRP force to the orbit (needs ``body.mass_kg``; off by default). Both SRP models
+    are integrated piecewise between the faces' Sun-terminator crossings (the plate law is C1).
     """
     sys_ = resolve_system(system)
     s = as_state(orbit_state, "orbit_state")
     t0, tf = as_time_span(t_span)
     if not isinstance(body, RigidBody):
         raise ValueError(f"invalid argument `body`: must be a librate.RigidBody, got {body!r}")
+    from .srp import FacetBody, FlatPlateSRP, SunModel
+
     names = tuple(torques)
     for n in names:
         if n not in TORQUES:
             raise ValueError(f"invalid argument `torques`: unknown torque {n!r}; known: {', '.join(TORQUES)}")
+    if srp is not None and not (planar and isinstance(srp, FlatPlateSRP)):
+        raise ValueError("invalid argument `srp`: a librate.FlatPlateSRP, for planar runs (3-D runs use a FacetBody with torques including 'srp')")
+    if planar and "srp" in names:
+        raise ValueError("invalid argument `torques`: planar runs take the SRP plate through srp=FlatPlateSRP(...)")
+    if not planar and ("srp" in names or srp_force) and not isinstance(body, FacetBody):
+        raise ValueError("invalid argument `body`: the SRP torque or force needs a librate.FacetBody")
+    if sun is not None and not isinstance(sun, SunModel):
+        raise ValueError(f"invalid argument `sun`: must be a librate.SunModel, got {sun!r}")
     if orbit not in ("integrate", "held", "coupled"):
         raise ValueError(f"invalid argument `orbit`: must be 'integrate', 'held' or 'coupled', got {orbit!r}")
     opts = _options(rtol, atol, h0, h_min, h_max, max_steps, safety, fixed_step)
@@ -181,7 +201,7 @@ def propagate_attitude(
         primaries = [any(n in ("gravity_gradient", "gravity_gradient_earth") for n in names),
                      any(n in ("gravity_gradient", "gravity_gradient_moon") for n in names)]
         r = _core.planar_propagate(sys_.mu, body.kz, primaries, orbit == "held", [float(v) for v in s], phi0, wz0, t0, tf,
-                                   options=opts, stm=bool(stm), t_eval=te)
+                                   options=opts, stm=bool(stm), t_eval=te, plate=None if srp is None else srp._plate())
         phi, wz = r["phi"], r["wz"]
         zero = np.zeros_like(phi)
         q = np.stack([zero, zero, np.sin(0.5 * phi), np.cos(0.5 * phi)], axis=1)
@@ -196,8 +216,16 @@ def propagate_attitude(
         lu_m = sys_.lu_km * 1e3
         inertia_nd = [m / (body.mass_kg * lu_m * lu_m) for m in body.moments]
     state0 = [*map(float, s), *map(float, q0), *map(float, w0)]
+    extra = {}
+    if isinstance(body, FacetBody):
+        sun = sun or SunModel()
+        extra = dict(facets=[f._tuple() for f in body.facets], sun=(float(sun.theta0), float(sun.omega), float(sun.pressure)), tu_s=float(sys_.tu_s))
+        if srp_force:
+            if body.mass_kg is None:
+                raise ValueError("invalid argument `body`: srp_force needs body.mass_kg")
+            extra["srp_force"] = (float(body.mass_kg), sys_.lu_km * 1e3)
     r = _core.attitude_propagate(sys_.mu, list(body.moments), list(names), orbit, state0, t0, tf,
-                                 options=opts, stm=bool(stm), t_eval=te, inertia_nd=inertia_nd)
+                                 options=opts, stm=bool(stm), t_eval=te, inertia_nd=inertia_nd, **extra)
     st = r["states"]
     return AttitudeTrajectory(sys_, body, names, False, r["t"], st[:, :6], st[:, 6:10], st[:, 10:], None, None, r["stm"], Stats(*r["stats"]))
 

@@ -26,7 +26,7 @@ from ._errors import ConvergenceError
 from .families import OrbitFamily
 from .orbits import PeriodicOrbit
 
-__all__ = ["AttitudeSolution", "AttitudeFamily", "attitude_family", "periodic_attitude", "find_periodic_attitudes", "periodicity_map", "orbit_forcing", "zero_contours"]
+__all__ = ["AttitudeSolution", "AttitudeFamily", "attitude_family", "SrpContinuation", "continue_srp", "periodic_attitude", "find_periodic_attitudes", "periodicity_map", "orbit_forcing", "zero_contours"]
 
 MAP_RTOL = 1e-12
 MAP_ATOL = 1e-12
@@ -45,11 +45,17 @@ def orbit_forcing(orbit: PeriodicOrbit, primaries: tuple[bool, bool] = (True, Tr
     return f
 
 
-def _sweep(forcing, t_final, phi0, wz0, kz, *, stm=False, rtol=MAP_RTOL, atol=MAP_ATOL, chunk=64, threads=None):
-    n = np.broadcast(np.asarray(phi0), np.asarray(wz0), np.asarray(kz)).shape
-    p, w, k = (np.ascontiguousarray(np.broadcast_to(np.asarray(a, dtype=np.float64), n)).ravel() for a in (phi0, wz0, kz))
+def _sweep(forcing, t_final, phi0, wz0, kz, *, stm=False, rtol=MAP_RTOL, atol=MAP_ATOL, chunk=64, threads=None, srp=None, eps=None):
+    """The engine over broadcast (phi0, wz0, kz[, eps]) arrays; ``srp`` a FlatPlateSRP (its eps
+    overridden per case by ``eps`` when given)."""
+    n = np.broadcast(np.asarray(phi0), np.asarray(wz0), np.asarray(kz), np.asarray(0.0 if eps is None else eps)).shape
+    flat = lambda a: np.ascontiguousarray(np.broadcast_to(np.asarray(a, dtype=np.float64), n)).ravel()  # noqa: E731
+    p, w, k = flat(phi0), flat(wz0), flat(kz)
+    extra = {}
+    if srp is not None:
+        extra = dict(eps=flat(srp.eps if eps is None else eps), cs=flat(srp.cs), cd=flat(srp.cd), theta_sun0=flat(srp.sun.theta0))
     return _core.map_sweep(forcing, float(t_final), p, w, k, rtol=float(rtol), atol=float(atol), max_steps=200_000,
-                           stm=bool(stm), chunk=int(chunk), threads=threads)
+                           stm=bool(stm), chunk=int(chunk), threads=threads, **extra)
 
 
 def _check_orbit(orbit) -> PeriodicOrbit:
@@ -94,6 +100,8 @@ class AttitudeSolution:
     residual_dwz: float
     monodromy: np.ndarray = field(repr=False)
     iterations: int = 0
+    srp: object = None
+    n_periods: int = 1
 
     @property
     def phidot0(self) -> float:
@@ -123,17 +131,27 @@ class AttitudeSolution:
         kwargs.setdefault("rtol", 1e-13)
         kwargs.setdefault("atol", 1e-13)
         return propagate_attitude(self.orbit.system, self.orbit.state0, (self.phi0, self.wz0), RigidBody.from_kz(self.kz),
-                                  n_periods * self.orbit.period, planar=True, **kwargs)
+                                  n_periods * self.orbit.period, planar=True, srp=self.srp, **kwargs)
 
 
-def _verify(orbit, kz, phi0, wz0, turns, n_periods):
+def _check_srp(srp):
+    if srp is None:
+        return None
+    from .srp import FlatPlateSRP
+
+    if not isinstance(srp, FlatPlateSRP):
+        raise ValueError(f"invalid argument `srp`: must be a librate.FlatPlateSRP or None, got {srp!r}")
+    return srp
+
+
+def _verify(orbit, kz, phi0, wz0, turns, n_periods, srp=None):
     """Independent re-propagation (scalar planar model with the orbit integrated alongside, at
     rtol = atol = 1e-14): residuals and the 2x2 monodromy."""
     from .attitude import RigidBody, propagate_attitude
 
     T = n_periods * orbit.period
     tr = propagate_attitude(orbit.system, orbit.state0, (phi0, wz0), RigidBody.from_kz(kz), T, planar=True, stm=True,
-                            rtol=1e-14, atol=1e-14, t_eval=[T])
+                            rtol=1e-14, atol=1e-14, t_eval=[T], srp=srp)
     dphi = tr.phi[-1] - phi0 - 2 * math.pi * turns
     dwz = tr.wz[-1] - wz0
     return dphi, dwz, tr.stm
@@ -149,14 +167,16 @@ def periodic_attitude(
     kind: str = "periodic",
     method: str = "auto",
     n_periods: int = 1,
+    srp=None,
     tol: float = 1e-12,
     max_iter: int = 40,
 ) -> AttitudeSolution:
     """The periodic attitude motion with ``n`` net turns per orbit (``kind="half-turn"``: a half
     turn more) along ``orbit``, for the body with ``kz``.
 
-    ``method``: "half" solves phi(T/2) = phi0 + pi * turns for wz0 (a scalar Newton with the
-    STM; exact for x-symmetric orbits with phi0 a multiple of pi/2), "newton" corrects
+    ``method``: "half" solves phi(KT/2) = phi0 + pi * turns for wz0 (a scalar Newton with the
+    STM; exact for x-symmetric orbits with phi0 a multiple of pi/2 and no SRP; K = ``n_periods``),
+    "newton" corrects
     (phi0, wz0) together with the full-period Newton step [Phi(T) - I] d = -F (PHYSICS.md: the
     correct form of thesis eq. 53), "auto" picks "half" when it applies. ``wz0``: the guess
     (default: the torque-free solution 1 + 2 pi turns / T). Raises ConvergenceError.
@@ -178,17 +198,19 @@ def periodic_attitude(
     w = 1.0 + 2 * math.pi * turns / T if wz0 is None else float(wz0)
     if not math.isfinite(w):
         raise ValueError(f"invalid argument `wz0`: must be finite, got {wz0!r}")
+    srp = _check_srp(srp)
+    symmetric = _symmetric(orbit, phi0) and (srp is None or srp.eps == 0.0)
     if method == "auto":
-        method = "half" if (_symmetric(orbit, phi0) and n_periods == 1) else "newton"
-    if method == "half" and not _symmetric(orbit, phi0):
-        raise ValueError("invalid argument `method`: 'half' needs an x-symmetric orbit started on the x axis and phi0 a multiple of pi/2")
+        method = "half" if symmetric else "newton"
+    if method == "half" and not symmetric:
+        raise ValueError("invalid argument `method`: 'half' needs an x-symmetric orbit started on the x axis, phi0 a multiple of pi/2 and no SRP")
     forcing = orbit_forcing(orbit)
     p = float(phi0)
     it = 0
     res = math.inf
     for it in range(1, max_iter + 1):
         if method == "half":
-            r = _sweep(forcing, 0.5 * T, p, w, kz, stm=True, rtol=1e-13, atol=1e-13)
+            r = _sweep(forcing, 0.5 * T, p, w, kz, stm=True, rtol=1e-13, atol=1e-13, srp=srp)
             g = r["phi_t"][0] - p - math.pi * turns
             d = r["stm"][0, 0, 1]
             res = abs(g)
@@ -199,7 +221,7 @@ def periodic_attitude(
             step = -g / d
             w += float(np.clip(step, -0.5, 0.5))
         else:
-            r = _sweep(forcing, T, p, w, kz, stm=True, rtol=1e-13, atol=1e-13)
+            r = _sweep(forcing, T, p, w, kz, stm=True, rtol=1e-13, atol=1e-13, srp=srp)
             F = np.array([r["phi_t"][0] - p - 2 * math.pi * turns, r["wz_t"][0] - w])
             res = float(np.max(np.abs(F)))
             if res < tol:
@@ -218,8 +240,8 @@ def periodic_attitude(
         raise ConvergenceError(f"periodic attitude (N = {n}, {kind}) did not converge after {max_iter} iterations (residual {res:.3e}, tolerance {tol:.1e})")
     if not math.isfinite(res) or res >= tol:
         raise ConvergenceError(f"periodic attitude (N = {n}, {kind}) diverged (residual {res:.3e})")
-    dphi, dwz, m = _verify(orbit, kz, p, w, turns, n_periods)
-    return AttitudeSolution(orbit, kz, int(n), kind, p, w, float(dphi), float(dwz), m, it)
+    dphi, dwz, m = _verify(orbit, kz, p, w, turns, n_periods, srp)
+    return AttitudeSolution(orbit, kz, int(n), kind, p, w, float(dphi), float(dwz), m, it, srp, int(n_periods))
 
 
 def _grid_for(T: float, lo: float, hi: float, n_grid: int | None) -> np.ndarray:
@@ -256,6 +278,7 @@ def find_periodic_attitudes(
     kinds: Sequence[str] = ("periodic", "half-turn"),
     n_grid: int | None = None,
     n_periods: int = 1,
+    srp=None,
 ) -> list[AttitudeSolution]:
     """Every periodic (and half-turn) attitude motion with inertial wz0 in ``wz0_range``.
 
@@ -275,12 +298,13 @@ def find_periodic_attitudes(
     for k in kinds:
         if k not in ("periodic", "half-turn"):
             raise ValueError(f"invalid argument `kinds`: must be 'periodic' and/or 'half-turn', got {k!r}")
+    srp = _check_srp(srp)
     T = n_periods * orbit.period
     wz = _grid_for(T, lo, hi, n_grid)
-    symmetric = _symmetric(orbit, phi0) and n_periods == 1
+    symmetric = _symmetric(orbit, phi0) and (srp is None or srp.eps == 0.0)
     forcing = orbit_forcing(orbit)
     t_scan, level = (0.5 * T, 0.5 * math.pi) if symmetric else (T, math.pi)
-    r = _sweep(forcing, t_scan, phi0, wz, kz)
+    r = _sweep(forcing, t_scan, phi0, wz, kz, srp=srp)
     found: list[AttitudeSolution] = []
     for k, w in _candidates(r["phi_t"], phi0, wz, level):
         # symmetric: phi(T/2) - phi0 = k pi/2 -> turns = k/2; else phi(T) - phi0 = k pi -> turns = k/2
@@ -289,7 +313,7 @@ def find_periodic_attitudes(
             continue
         n = k // 2
         try:
-            sol = periodic_attitude(orbit, kz=kz, n=n, phi0=phi0, wz0=w, kind=kind, n_periods=n_periods)
+            sol = periodic_attitude(orbit, kz=kz, n=n, phi0=phi0, wz0=w, kind=kind, n_periods=n_periods, srp=srp)
         except ConvergenceError:
             continue
         if not (lo <= sol.wz0 <= hi) or sol.residual > 1e-8:
@@ -327,6 +351,7 @@ def periodicity_map(
     atol: float = MAP_ATOL,
     chunk: int = 64,
     threads: int | None = None,
+    srp=None,
 ):
     """Residual grids over (orbit, Kz, wz0) and the periodic solutions they contain.
 
@@ -338,6 +363,9 @@ def periodicity_map(
     ``solution`` dimension. Work is done one orbit at a time (``progress(done, total)`` after
     each); on KeyboardInterrupt the finished orbits are kept and returned, with
     ``attrs["complete"] = 0``. Results are bit-identical for any ``chunk`` and ``threads``.
+    ``srp``: a :class:`librate.FlatPlateSRP` (with ``n_periods`` = K for Sun-resonant orbits,
+    T = Ts / K); its parameters are stored as attributes. With SRP the mirror symmetry is broken
+    and solutions are refined in (phi0, wz0) together (PHYSICS.md sec. 6).
     """
     import xarray as xr
 
@@ -346,6 +374,7 @@ def periodicity_map(
     olist, family = _orbits_of(orbits)
     for o in olist:
         _check_orbit(o)
+    srp = _check_srp(srp)
     kzs = np.atleast_1d(np.asarray(kz, dtype=np.float64))
     if kzs.ndim != 1 or kzs.size == 0 or not np.all(np.isfinite(kzs)) or np.any(np.abs(kzs) > 1):
         raise ValueError(f"invalid argument `kz`: values must be finite and in [-1, 1], got {kz!r}")
@@ -365,12 +394,12 @@ def periodicity_map(
     complete = True
     try:
         for i, o in enumerate(olist):
-            r = _sweep(orbit_forcing(o), n_periods * o.period, phi0, wz_grid, kz_grid, rtol=rtol, atol=atol, chunk=chunk, threads=threads)
+            r = _sweep(orbit_forcing(o), n_periods * o.period, phi0, wz_grid, kz_grid, rtol=rtol, atol=atol, chunk=chunk, threads=threads, srp=srp)
             dwz[i], dphi[i], phi_t[i] = (r[k].reshape(nk, nw) for k in ("dwz", "dphi", "phi_t"))
             status[i] = r["status"].reshape(nk, nw)
             if solve:
                 for j, k in enumerate(kzs):
-                    sols += [(i, s) for s in _solutions_from_row(o, float(k), phi0, wz, phi_t[i, j], n_periods)]
+                    sols += [(i, s) for s in _solutions_from_row(o, float(k), phi0, wz, phi_t[i, j], n_periods, srp)]
             done[i] = True
             if progress is not None:
                 progress(i + 1, no)
@@ -407,6 +436,10 @@ def periodicity_map(
             "system_name": olist[0].system.name,
             "family": family.kind if family is not None else "",
             "librate_version": __version__,
+            "srp_eps": float(srp.eps) if srp is not None else 0.0,
+            "srp_cs": float(srp.cs) if srp is not None else 0.0,
+            "srp_cd": float(srp.cd) if srp is not None else 0.0,
+            "sun_theta0": float(srp.sun.theta0) if srp is not None else 0.0,
         },
     )
     if solve:
@@ -414,14 +447,14 @@ def periodicity_map(
     return ds
 
 
-def _solutions_from_row(orbit, kz, phi0, wz, phi_t_row, n_periods) -> list[AttitudeSolution]:
+def _solutions_from_row(orbit, kz, phi0, wz, phi_t_row, n_periods, srp=None) -> list[AttitudeSolution]:
     """Candidates from one full-period row (phi(T) - phi0 through multiples of pi), refined."""
     out: list[AttitudeSolution] = []
     for k, w in _candidates(phi_t_row, phi0, wz, math.pi):
         kind = "periodic" if k % 2 == 0 else "half-turn"
         n = k // 2
         try:
-            sol = periodic_attitude(orbit, kz=kz, n=n, phi0=phi0, wz0=w, kind=kind, n_periods=n_periods)
+            sol = periodic_attitude(orbit, kz=kz, n=n, phi0=phi0, wz0=w, kind=kind, n_periods=n_periods, srp=srp)
         except ConvergenceError:
             continue
         if not (wz[0] <= sol.wz0 <= wz[-1]) or sol.residual > 1e-8:
@@ -659,3 +692,80 @@ def attitude_family(
         traces.append(trace_at(p, w))
         ds = min(ds * 1.3, ds_max)
     return AttitudeFamily(name, np.array(ps), np.array(ws), np.array(traces), int(n), kind, kz if name == "x0" else None, folds, reason)
+
+
+# --- continuation in the SRP amplitude ---------------------------------------------------------
+@dataclass
+class SrpContinuation:
+    """Solutions continued in the flat-plate SRP amplitude ``eps`` from a starting solution.
+    ``reached``: the target eps was reached; otherwise ``fold`` gives where the branch turns
+    back ({"eps", "trace"}: the 2x2 monodromy's trace passes 2 there, where Phi - I is singular)
+    or ``end_reason`` why the continuation stopped. No point of another branch is ever returned."""
+
+    solutions: list[AttitudeSolution]
+    eps: np.ndarray
+    reached: bool
+    fold: dict | None
+    end_reason: str
+
+
+def continue_srp(solution: AttitudeSolution, srp, *, steps: int = 10, min_step: float = 1e-7) -> SrpContinuation:
+    """Continue ``solution`` (gravity-only, or with SRP) to the plate ``srp`` (its eps is the
+    target; cs, cd and the Sun phase are kept along the way) by natural continuation in eps:
+    linear extrapolation of (phi0, wz0), Newton in (phi0, wz0) with [Phi(KT) - I], steps halved on
+    failure or on a jump (a change of (phi0, wz0) five times the trend), and the fold detected
+    where the monodromy's trace crosses 2 (det(Phi - I) = 2 - trace changes sign)."""
+    srp = _check_srp(srp)
+    if srp is None:
+        raise ValueError("invalid argument `srp`: the target plate is required")
+    if not isinstance(solution, AttitudeSolution):
+        raise ValueError("invalid argument `solution`: must be a librate.AttitudeSolution")
+    if not (isinstance(steps, int) and steps >= 1):
+        raise ValueError(f"invalid argument `steps`: must be an integer >= 1, got {steps!r}")
+    e0 = 0.0 if solution.srp is None else float(solution.srp.eps)
+    target = float(srp.eps)
+    sols, eps = [solution], [e0]
+    h_nominal = (target - e0) / steps
+    h = h_nominal / 16.0  # a small first step: there is no trend yet to guard against jumps
+    fold = None
+    reason = "reached the target eps"
+    while eps[-1] != target:
+        e = target if abs(target - eps[-1]) <= abs(h) * (1 + 1e-9) else eps[-1] + h
+        a = sols[-1]
+        if len(sols) >= 2:
+            b = sols[-2]
+            r = (e - eps[-1]) / (eps[-1] - eps[-2])
+            guess = (a.phi0 + r * (a.phi0 - b.phi0), a.wz0 + r * (a.wz0 - b.wz0))
+        else:
+            guess = (a.phi0, a.wz0)
+        ok = True
+        try:
+            s = periodic_attitude(a.orbit, kz=a.kz, n=a.n, kind=a.kind, phi0=guess[0], wz0=guess[1], n_periods=a.n_periods,
+                                  srp=srp.with_eps(e), method="newton")
+        except ConvergenceError:
+            ok = False
+        if ok:
+            jump = max(abs(s.wz0 - guess[1]), abs(s.phi0 - guess[0]))
+            if len(sols) >= 2:
+                trend = max(abs(a.wz0 - sols[-2].wz0), abs(a.phi0 - sols[-2].phi0)) * abs(e - eps[-1]) / abs(eps[-1] - eps[-2])
+                ok = jump <= 5 * trend + 1e-9
+            else:
+                ok = jump <= 1e-2
+            ok = ok and s.residual <= 1e-8
+        crossing = ok and (2.0 - a.trace) * (2.0 - s.trace) < 0
+        if ok and not crossing:
+            sols.append(s)
+            eps.append(e)
+            h = float(np.sign(h_nominal) * min(abs(h) * 1.5, abs(h_nominal)))
+            continue
+        if abs(h) * 0.5 < min_step:
+            if crossing:
+                w = (2.0 - a.trace) / (s.trace - a.trace)
+                fold = {"eps": eps[-1] + w * (e - eps[-1]), "trace": 2.0}
+                reason = f"fold: the monodromy trace crosses 2 at eps = {fold['eps']:.8g} (Phi - I singular)"
+            else:
+                fold = {"eps": eps[-1], "trace": a.trace}
+                reason = f"fold or end of the branch near eps = {eps[-1]:.8g} (trace {a.trace:.6g}; step below {min_step:g})"
+            break
+        h *= 0.5  # failure, jump, or a trace crossing to pin down: shorten the step
+    return SrpContinuation(sols, np.array(eps), eps[-1] == target, fold, reason)

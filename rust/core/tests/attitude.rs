@@ -44,7 +44,7 @@ fn val_torque_free_body_conserves_momentum_and_norm() {
     s0[..6].copy_from_slice(&orbit);
     s0[6..10].copy_from_slice(&q0);
     s0[10..].copy_from_slice(&[0.4, -1.1, 2.0]);
-    let tr = propagate_attitude(MU, body, &[], OrbitMode::Integrate, &s0, 0.0, 20.0, &tight(), false, Output::Steps).unwrap();
+    let tr = propagate_attitude(MU, body, &[], OrbitMode::Integrate, &s0, 0.0, 20.0, &tight(), false, Output::Steps, None, None).unwrap();
     let h0 = inertial_momentum(0.0, &s0, &body);
     let hn = (h0.iter().map(|v| v * v).sum::<f64>()).sqrt();
     for (k, row) in tr.states.chunks_exact(13).enumerate() {
@@ -70,7 +70,7 @@ fn val_symmetric_body_feels_no_planar_torque() {
     s0[8] = 0.15f64.sin();
     s0[9] = 0.15f64.cos();
     s0[12] = 0.7;
-    let t3 = propagate_attitude(MU, body, &[&gg as &dyn Torque], OrbitMode::Integrate, &s0, 0.0, period, &tight(), false, Output::Final).unwrap();
+    let t3 = propagate_attitude(MU, body, &[&gg as &dyn Torque], OrbitMode::Integrate, &s0, 0.0, period, &tight(), false, Output::Final, None, None).unwrap();
     assert!((t3.states[12] - 0.7).abs() < 1e-14);
 }
 
@@ -88,7 +88,7 @@ fn val_three_d_started_planar_matches_reduced_model() {
     s0[9] = (0.5 * phi0).cos();
     s0[12] = wz0;
     let times: Vec<f64> = (1..=20).map(|k| k as f64 * period / 20.0).collect();
-    let t3 = propagate_attitude(MU, body, &[&gg as &dyn Torque], OrbitMode::Integrate, &s0, 0.0, period, &tight(), false, Output::At(&times)).unwrap();
+    let t3 = propagate_attitude(MU, body, &[&gg as &dyn Torque], OrbitMode::Integrate, &s0, 0.0, period, &tight(), false, Output::At(&times), None, None).unwrap();
     let tp = propagate_planar(MU, body.kz(), [true, true], false, &orbit, phi0, wz0, 0.0, period, &tight(), false, Output::At(&times), None).unwrap();
     for (k, row) in t3.states.chunks_exact(13).enumerate() {
         assert!(row[6].abs() < 1e-15 && row[7].abs() < 1e-15 && row[10].abs() < 1e-15 && row[11].abs() < 1e-15);
@@ -119,14 +119,14 @@ fn val_coupled_stm_matches_finite_differences() {
         *v /= qn;
     }
     let tf = 0.5 * period;
-    let tr = propagate_attitude(MU, body, &torques, OrbitMode::Integrate, &s0, 0.0, tf, &tight(), true, Output::Final).unwrap();
+    let tr = propagate_attitude(MU, body, &torques, OrbitMode::Integrate, &s0, 0.0, tf, &tight(), true, Output::Final, None, None).unwrap();
     let stm = tr.stm_final.unwrap();
     let d = 1e-6;
     let mut num = 0.0;
     let mut den = 0.0;
     // Perturb every component (the quaternion directions too: the model uses A(q)/|q|^2, so
     // the flow is defined off the unit sphere).
-    let model = Coupled { mu: MU, body, torques: torques.to_vec(), orbit: OrbitMode::Integrate };
+    let model = Coupled { mu: MU, body, torques: torques.to_vec(), orbit: OrbitMode::Integrate, orbit_srp: None };
     for j in 0..13 {
         let (mut p, mut m) = (s0, s0);
         p[j] += d;
@@ -209,8 +209,8 @@ fn val_extended_body_acceleration_matches_a_dumbbell() {
     let mut s = [0.0; 13];
     s[..3].copy_from_slice(&pos);
     s[6..10].copy_from_slice(&q);
-    let coupled = Coupled { mu: MU, body, torques: vec![], orbit: OrbitMode::Coupled { inertia_nd: [0.0, l * l, l * l] } };
-    let point = Coupled { mu: MU, body, torques: vec![], orbit: OrbitMode::Integrate };
+    let coupled = Coupled { mu: MU, body, torques: vec![], orbit: OrbitMode::Coupled { inertia_nd: [0.0, l * l, l * l] }, orbit_srp: None };
+    let point = Coupled { mu: MU, body, torques: vec![], orbit: OrbitMode::Integrate, orbit_srp: None };
     let (mut d1, mut d0) = ([0.0; 13], [0.0; 13]);
     coupled.derivative(0.0, &s, &mut d1);
     point.derivative(0.0, &s, &mut d0);

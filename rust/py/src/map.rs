@@ -44,7 +44,7 @@ impl PyOrbitForcing {
 
 /// Integrate planar attitude trajectories (phi0, wz0, kz arrays of one length) over t_final.
 #[pyfunction]
-#[pyo3(signature = (forcing, t_final, phi0, wz0, kz, *, rtol, atol, max_steps, stm, chunk, threads))]
+#[pyo3(signature = (forcing, t_final, phi0, wz0, kz, *, rtol, atol, max_steps, stm, chunk, threads, eps=None, cs=None, cd=None, theta_sun0=None))]
 #[allow(clippy::too_many_arguments)]
 fn map_sweep<'py>(
     py: Python<'py>,
@@ -59,12 +59,24 @@ fn map_sweep<'py>(
     stm: bool,
     chunk: usize,
     threads: Option<usize>,
+    eps: Option<PyReadonlyArray1<'py, f64>>,
+    cs: Option<PyReadonlyArray1<'py, f64>>,
+    cd: Option<PyReadonlyArray1<'py, f64>>,
+    theta_sun0: Option<PyReadonlyArray1<'py, f64>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let (p, w, k) = (phi0.as_array(), wz0.as_array(), kz.as_array());
     if p.len() != w.len() || k.len() != w.len() {
         return Err(PyValueError::new_err(format!("invalid argument: phi0, wz0 and kz must have one length, got {}, {}, {}", p.len(), w.len(), k.len())));
     }
-    let cases: Vec<Case> = (0..w.len()).map(|i| Case::new(p[i], w[i], k[i])).collect();
+    let extra = |a: &Option<PyReadonlyArray1<'py, f64>>, name: &str| -> PyResult<Vec<f64>> {
+        match a {
+            None => Ok(vec![0.0; w.len()]),
+            Some(v) if v.as_array().len() == w.len() => Ok(v.as_array().to_vec()),
+            Some(v) => Err(PyValueError::new_err(format!("invalid argument `{name}`: must have the length of wz0 ({}), got {}", w.len(), v.as_array().len()))),
+        }
+    };
+    let (e, s, d, th) = (extra(&eps, "eps")?, extra(&cs, "cs")?, extra(&cd, "cd")?, extra(&theta_sun0, "theta_sun0")?);
+    let cases: Vec<Case> = (0..w.len()).map(|i| Case { eps: e[i], cs: s[i], cd: d[i], theta_sun0: th[i], ..Case::new(p[i], w[i], k[i]) }).collect();
     let opts = LaneOptions { rtol, atol, max_steps, ..LaneOptions::default() };
     let f = &forcing.inner;
     let out = py.detach(|| map::sweep(f, t_final, &cases, &opts, stm, chunk, threads)).map_err(to_py)?;

@@ -37,6 +37,9 @@ pub struct Coupled<'a> {
     pub body: RigidBody,
     pub torques: Vec<&'a dyn Torque>,
     pub orbit: OrbitMode,
+    /// Solar radiation pressure force on the orbit (facets, spacecraft mass in kg, LU in m);
+    /// off (None) by default, as for the maps.
+    pub orbit_srp: Option<(&'a super::srp::FacetSrp, f64, f64)>,
 }
 
 /// Attitude matrix A(q)/|q|^2 (synodic -> body), scalar-last quaternion.
@@ -76,6 +79,12 @@ impl Coupled<'_> {
                 let mut acc = cr3bp_acc(mu, &pos, &vel);
                 if let OrbitMode::Coupled { inertia_nd } = self.orbit {
                     let extra = extended_body_acc(mu, &pos, &a, inertia_nd);
+                    for i in 0..3 {
+                        acc[i] = acc[i] + extra[i];
+                    }
+                }
+                if let Some((srp, mass, lu_m)) = self.orbit_srp {
+                    let extra = srp.acceleration(t, &a, mass, lu_m);
                     for i in 0..3 {
                         acc[i] = acc[i] + extra[i];
                     }

@@ -1,7 +1,7 @@
 //! Propagation drivers of the attitude models.
 
 use super::body::RigidBody;
-use super::dynamics::{Coupled, CoupledStm, OrbitMode, DIM, STM_DIM};
+use super::dynamics::{dcm, Coupled, CoupledStm, OrbitMode, DIM, STM_DIM};
 use super::planar::{Forcing, PlanarAlongOrbit, PlanarForced};
 use super::srp::FlatPlate;
 use super::torque::Torque;
@@ -33,6 +33,8 @@ pub fn propagate_attitude(
     opts: &Options,
     with_stm: bool,
     output: Output<'_>,
+    orbit_srp: Option<(&super::srp::FacetSrp, f64, f64)>,
+    terminators: Option<&super::srp::FacetSrp>,
 ) -> Result<AttitudeTrajectory> {
     check_mu(mu)?;
     RigidBody::new(body.ix, body.iy, body.iz)?;
@@ -44,17 +46,35 @@ pub fn propagate_attitude(
     if let OrbitMode::Coupled { inertia_nd } = orbit {
         check_finite("inertia_nd", &inertia_nd)?;
     }
-    let model = Coupled { mu, body, torques: torques.to_vec(), orbit };
+    let model = Coupled { mu, body, torques: torques.to_vec(), orbit, orbit_srp };
+    // Facet SRP is C1 in the attitude: integrate piecewise between the facets' terminator
+    // crossings n_k . s_body = 0 (one switching function per facet).
+    let facets = terminators.map(|m| m.facets.clone()).unwrap_or_default();
+    let sun = terminators.map(|m| m.sun).unwrap_or_default();
+    let switch = |k: usize, t: f64, y: &[f64]| -> f64 {
+        let a = dcm(&[y[6], y[7], y[8], y[9]]);
+        let s = sun.direction(t);
+        let n = facets[k].normal;
+        (0..3).map(|i| n[i] * (a[i][0] * s[0] + a[i][1] * s[1] + a[i][2] * s[2])).sum()
+    };
     if with_stm {
         let sys = CoupledStm(model);
-        let sol = solve(&sys, t0, &CoupledStm::initial(state0), tf, opts, output, &[])?;
+        let fns: Vec<Box<dyn Fn(f64, &[f64; STM_DIM]) -> f64 + Sync + '_>> = (0..facets.len()).map(|k| Box::new(move |t: f64, y: &[f64; STM_DIM]| switch(k, t, y)) as Box<dyn Fn(f64, &[f64; STM_DIM]) -> f64 + Sync>).collect();
+        let kinks: Vec<&dyn EventFn<[f64; STM_DIM]>> = fns.iter().map(|f| f as &dyn EventFn<[f64; STM_DIM]>).collect();
+        let sol = if kinks.is_empty() {
+            solve(&sys, t0, &CoupledStm::initial(state0), tf, opts, output, &[])?
+        } else {
+            solve_piecewise(&sys, t0, &CoupledStm::initial(state0), tf, opts, output, &kinks)?
+        };
         let mut states = Vec::with_capacity(sol.t.len() * DIM);
         for row in sol.y.chunks_exact(STM_DIM) {
             states.extend_from_slice(&row[..DIM]);
         }
         Ok(AttitudeTrajectory { t: sol.t, states, stm_final: Some(sol.y_final[DIM..].to_vec()), stats: sol.stats })
     } else {
-        let sol = solve(&model, t0, state0, tf, opts, output, &[])?;
+        let fns: Vec<Box<dyn Fn(f64, &[f64; DIM]) -> f64 + Sync + '_>> = (0..facets.len()).map(|k| Box::new(move |t: f64, y: &[f64; DIM]| switch(k, t, y)) as Box<dyn Fn(f64, &[f64; DIM]) -> f64 + Sync>).collect();
+        let kinks: Vec<&dyn EventFn<[f64; DIM]>> = fns.iter().map(|f| f as &dyn EventFn<[f64; DIM]>).collect();
+        let sol = if kinks.is_empty() { solve(&model, t0, state0, tf, opts, output, &[])? } else { solve_piecewise(&model, t0, state0, tf, opts, output, &kinks)? };
         Ok(AttitudeTrajectory { t: sol.t, states: sol.y, stm_final: None, stats: sol.stats })
     }
 }

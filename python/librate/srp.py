@@ -1,0 +1,179 @@
+"""Solar radiation pressure (thesis ch. 4; the models of PHYSICS.md sec. 6).
+
+Two models: the general one (any list of :class:`Facet`, force and torque, lit only when facing
+the Sun; no self-shadowing) attached to a body as a :class:`FacetBody`, used by the 3-D model;
+and the simplified planar one, a two-sided flat plate with a single amplitude, :class:`FlatPlateSRP`,
+used by the planar model, periodic solutions and periodicity maps. The Sun direction turns
+clockwise in the synodic frame at omega_sun = -(1 - n_sun); ``SunModel.theta0`` is its phase at
+t = 0.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from . import _core
+from .attitude import RigidBody
+from .constants import OMEGA_SUN, SOLAR_PRESSURE_1AU
+
+__all__ = ["SunModel", "Facet", "FacetBody", "FlatPlateSRP"]
+
+
+@dataclass(frozen=True)
+class SunModel:
+    """The apparent Sun: phase ``theta0`` (rad, from the synodic X axis at t = 0) and pressure
+    (N/m^2, 4.56e-6 at 1 AU)."""
+
+    theta0: float = 0.0
+    pressure: float = SOLAR_PRESSURE_1AU
+
+    def __post_init__(self):
+        if not math.isfinite(self.theta0):
+            raise ValueError(f"invalid argument `theta0`: must be finite, got {self.theta0!r}")
+        if not (math.isfinite(self.pressure) and self.pressure >= 0):
+            raise ValueError(f"invalid argument `pressure`: must be finite and >= 0 N/m^2, got {self.pressure!r}")
+
+    @property
+    def omega(self) -> float:
+        """Rate of the Sun direction in the synodic frame, 1/TU (clockwise)."""
+        return OMEGA_SUN
+
+    def direction(self, t) -> np.ndarray:
+        """Unit vector(s) from the spacecraft to the Sun in synodic components, (3,) or (n, 3)."""
+        a = self.omega * np.asarray(t, dtype=float) + self.theta0
+        return np.stack([np.cos(a), np.sin(a), np.zeros_like(a)], axis=-1)
+
+
+@dataclass(frozen=True)
+class Facet:
+    """A flat surface element: ``area`` (m^2), outward ``normal`` and centre of pressure
+    ``center`` (m, from the centre of mass) in body axes, and the fractions of light absorbed
+    (``ca``), reflected specularly (``cs``) and diffusely (``cd``), summing to one."""
+
+    area: float
+    normal: tuple[float, float, float]
+    center: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    ca: float = 1.0
+    cs: float = 0.0
+    cd: float = 0.0
+
+    def __post_init__(self):
+        n = np.asarray(self.normal, dtype=float).ravel()
+        c = np.asarray(self.center, dtype=float).ravel()
+        if n.shape != (3,) or c.shape != (3,):
+            raise ValueError("invalid argument `normal`/`center`: each must have 3 components")
+        # validated by the core: area > 0, non-zero normal, coefficients in [0, 1] summing to one
+        _core.facets_force_torque([self._tuple(n, c)], [1.0, 0.0, 0.0])
+        object.__setattr__(self, "normal", tuple(float(v) for v in n / np.linalg.norm(n)))
+        object.__setattr__(self, "center", tuple(float(v) for v in c))
+
+    def _tuple(self, n=None, c=None):
+        n = self.normal if n is None else n
+        c = self.center if c is None else c
+        return (float(self.area), [float(v) for v in n], [float(v) for v in c], float(self.ca), float(self.cs), float(self.cd))
+
+
+def force_torque(facets, sun_body) -> tuple[np.ndarray, np.ndarray]:
+    """SRP force (N) and torque (N m) in body axes on ``facets`` for the Sun direction ``sun_body``
+    (unit vector in body axes), at 1 AU."""
+    f, t = _core.facets_force_torque([fa._tuple() for fa in facets], [float(v) for v in sun_body])
+    return np.array(f), np.array(t)
+
+
+@dataclass(frozen=True)
+class FacetBody(RigidBody):
+    """A rigid body (principal moments ix, iy, iz in kg m^2, ``mass_kg``) with a surface made of
+    :class:`Facet` elements for solar radiation pressure."""
+
+    facets: tuple = field(default=())
+
+    def __post_init__(self):
+        super().__post_init__()
+        if not self.facets or not all(isinstance(f, Facet) for f in self.facets):
+            raise ValueError("invalid argument `facets`: must be a non-empty sequence of librate.Facet")
+        object.__setattr__(self, "facets", tuple(self.facets))
+
+    def force_torque(self, sun_body):
+        """Force (N) and torque (N m) in body axes for a Sun direction in body axes."""
+        return force_torque(self.facets, sun_body)
+
+    @classmethod
+    def flat_plate(cls, area, *, normal=(1.0, 0.0, 0.0), center=(0.0, 0.0, 0.0), ca=1.0, cs=0.0, cd=0.0, inertia, mass_kg=None):
+        """One one-sided plate."""
+        return cls(*inertia, mass_kg=mass_kg, facets=(Facet(area, normal, center, ca, cs, cd),))
+
+    @classmethod
+    def two_sided_panel(cls, area, *, normal=(1.0, 0.0, 0.0), center=(0.0, 0.0, 0.0), ca=1.0, cs=0.0, cd=0.0, inertia, mass_kg=None):
+        """A two-sided panel: two facets with opposite normals at the same centre of pressure."""
+        n = np.asarray(normal, dtype=float)
+        return cls(*inertia, mass_kg=mass_kg, facets=(Facet(area, tuple(n), center, ca, cs, cd), Facet(area, tuple(-n), center, ca, cs, cd)))
+
+    @classmethod
+    def box_with_arrays(cls, bus_size=(4.0, 4.0, 6.0), *, array_area=50.0, array_offset=8.0, bus_coefficients=(0.6, 0.2, 0.2),
+                        array_coefficients=(0.8, 0.15, 0.05), inertia, mass_kg=None):
+        """A box bus (side lengths along x, y, z in m, six facets) with two solar arrays: two-sided
+        panels of ``array_area`` each, normal x_B, centres at +-``array_offset`` along y_B."""
+        a, b, c = (0.5 * float(v) for v in bus_size)
+        facets = []
+        for axis, half, area in ((0, a, 4 * b * c), (1, b, 4 * a * c), (2, c, 4 * a * b)):
+            for sg in (1.0, -1.0):
+                n = [0.0, 0.0, 0.0]
+                n[axis] = sg
+                ctr = [0.0, 0.0, 0.0]
+                ctr[axis] = sg * half
+                facets.append(Facet(area, tuple(n), tuple(ctr), *bus_coefficients))
+        for sy in (1.0, -1.0):
+            for sx in (1.0, -1.0):
+                facets.append(Facet(array_area, (sx, 0.0, 0.0), (0.0, sy * array_offset, 0.0), *array_coefficients))
+        return cls(*inertia, mass_kg=mass_kg, facets=tuple(facets))
+
+
+@dataclass(frozen=True)
+class FlatPlateSRP:
+    """The simplified planar SRP model (PHYSICS.md sec. 6): one two-sided flat plate with normal
+    x_B and centre of pressure offset d along y_B; with alpha the Sun's angle in body axes,
+    wzdot_srp = eps [(1 + Cs) cos(alpha)|cos(alpha)| + (2/3) Cd cos(alpha)],
+    eps = P A d TU^2 / Iz (nondimensional; about 10 d/k^2 per metre for A/m = 0.016 m^2/kg)."""
+
+    eps: float
+    cs: float = 0.0
+    cd: float = 0.0
+    sun: SunModel = field(default_factory=SunModel)
+
+    def __post_init__(self):
+        if not math.isfinite(self.eps):
+            raise ValueError(f"invalid argument `eps`: must be finite, got {self.eps!r}")
+        for name, v in (("cs", self.cs), ("cd", self.cd)):
+            if not (math.isfinite(v) and 0 <= v <= 1):
+                raise ValueError(f"invalid argument `{name}`: must be in [0, 1], got {v!r}")
+        if self.cs + self.cd > 1 + 1e-12:
+            raise ValueError(f"invalid argument `cs`: cs + cd must not exceed one (ca = 1 - cs - cd), got {self.cs + self.cd}")
+        if not isinstance(self.sun, SunModel):
+            raise ValueError("invalid argument `sun`: must be a librate.SunModel")
+
+    @property
+    def ca(self) -> float:
+        return 1.0 - self.cs - self.cd
+
+    @classmethod
+    def from_geometry(cls, system, *, area_m2: float, offset_m: float, iz_kgm2: float, cs: float = 0.0, cd: float = 0.0, sun: SunModel | None = None):
+        """eps = P A d TU^2 / Iz from the plate's area, offset and the body's Iz (SI units)."""
+        sun = sun or SunModel()
+        if not (area_m2 > 0 and iz_kgm2 > 0 and math.isfinite(offset_m)):
+            raise ValueError("invalid argument: need area_m2 > 0, iz_kgm2 > 0 and a finite offset_m")
+        return cls(sun.pressure * area_m2 * offset_m * system.tu_s**2 / iz_kgm2, cs, cd, sun)
+
+    def with_eps(self, eps: float) -> FlatPlateSRP:
+        return FlatPlateSRP(float(eps), self.cs, self.cd, self.sun)
+
+    def wzdot(self, t, phi) -> np.ndarray:
+        """The SRP angular acceleration (1/TU^2) at times t and attitudes phi."""
+        a = self.sun.omega * np.asarray(t, dtype=float) + self.sun.theta0 - np.asarray(phi, dtype=float)
+        c = np.cos(a)
+        return self.eps * ((1 + self.cs) * c * np.abs(c) + (2.0 / 3.0) * self.cd * c)
+
+    def _plate(self):
+        return (float(self.eps), float(self.cs), float(self.cd), float(self.sun.theta0), float(self.sun.omega))

@@ -1,0 +1,136 @@
+"""Solar radiation pressure: the facet and flat-plate models (PHYSICS.md sec. 6), Sun-resonant
+periodic solutions, continuation in the SRP amplitude with folds."""
+
+import math
+
+import numpy as np
+import pytest
+
+import librate
+from librate.constants import SUN_SYNODIC_PERIOD
+
+
+@pytest.fixture(scope="module")
+def sun12(em):
+    """The 1:2 Sun-resonant DRO: T = Ts / 2 (14.75 d), periodicity checked after K = 2 orbits."""
+    o = librate.dro_family(em).resonant(2, "sun")
+    assert o.period == pytest.approx(SUN_SYNODIC_PERIOD / 2, abs=1e-10)
+    return o
+
+
+@pytest.fixture(scope="module")
+def gravity_solution(sun12):
+    return librate.periodic_attitude(sun12, kz=0.8, n=-2, n_periods=2)
+
+
+def test_plate_model_equals_the_facet_model_in_3d(em, sun12):
+    """The simplified plate (planar model) and a two-sided facet panel (3-D model, inertia in
+    kg m^2, the same geometry) give the same attitude over two orbits of the Sun-resonant DRO,
+    to 1e-9: two independent models and integration paths (both stop at the terminators)."""
+    area, d, iz = 100.0, 3.0, 2.0e8  # eps = 0.96
+    ix, iy = 0.5 * (1 - 0.6) * iz, 0.5 * (1 + 0.6) * iz  # Kz = 0.6, triangle inequality with equality
+    body = librate.FacetBody.two_sided_panel(area, normal=(1, 0, 0), center=(0, d, 0), ca=0.5, cs=0.4, cd=0.1, inertia=(ix, iy, iz))
+    sun = librate.SunModel(theta0=0.7)
+    plate = librate.FlatPlateSRP.from_geometry(em, area_m2=area, offset_m=d, iz_kgm2=iz, cs=0.4, cd=0.1, sun=sun)
+    assert 0.01 < plate.eps < 10
+    T = 2 * sun12.period
+    t = np.linspace(0, T, 9)
+    p = librate.propagate_attitude(em, sun12.state0, (0.3, -0.9), librate.RigidBody(ix, iy, iz), T, planar=True, srp=plate,
+                                   t_eval=t, rtol=1e-13, atol=1e-13)
+    q0 = librate.quaternion_from_euler([0, 0, 0.3])
+    s = librate.propagate_attitude(em, sun12.state0, (q0, [0, 0, -0.9]), body, T, torques=("gravity_gradient", "srp"), sun=sun,
+                                   t_eval=t, rtol=1e-13, atol=1e-13)
+    np.testing.assert_allclose(s.w[:, 2], p.wz, atol=1e-9)
+    np.testing.assert_allclose(np.unwrap(s.euler_angles()[:, 2]), np.unwrap(p.phi), atol=1e-9)
+
+
+def test_srp_solutions_tend_to_the_gravity_solution(sun12, gravity_solution):
+    """Continuity (issue 7): as eps -> 0 the SRP solutions converge to the gravity-only one,
+    linearly: the distance halves when eps halves (ratio 2 within 2 %)."""
+    g = gravity_solution
+    dist = []
+    for eps in (4e-3, 2e-3, 1e-3):
+        s = librate.periodic_attitude(sun12, kz=0.8, n=-2, n_periods=2, srp=librate.FlatPlateSRP(eps, cs=0.4, cd=0.1),
+                                      phi0=g.phi0, wz0=g.wz0, method="newton")
+        dist.append(math.hypot(s.wz0 - g.wz0, s.phi0 - g.phi0))
+    assert dist[0] / dist[1] == pytest.approx(2, rel=0.02) and dist[1] / dist[2] == pytest.approx(2, rel=0.02)
+
+
+def test_srp_solution_repeats_over_k_revolutions_in_the_facet_model(em, sun12, gravity_solution):
+    """Every periodic SRP solution re-propagated over K revolutions repeats to 1e-9: here the
+    plate solution re-propagated with the 3-D facet model of the same panel (independent)."""
+    area, d, iz = 20.0, 2.0, 1.5e8  # eps = P A d TU^2 / Iz = 0.17, below the branch's fold at 0.52
+    ix, iy = 0.1 * iz, 0.9 * iz  # Kz = 0.8
+    sun = librate.SunModel()
+    plate = librate.FlatPlateSRP.from_geometry(em, area_m2=area, offset_m=d, iz_kgm2=iz, cs=0.4, cd=0.1, sun=sun)
+    g = gravity_solution
+    s = librate.continue_srp(g, plate).solutions[-1]
+    assert s.srp.eps == plate.eps and s.residual < 1e-9
+    body = librate.FacetBody.two_sided_panel(area, center=(0, d, 0), ca=0.5, cs=0.4, cd=0.1, inertia=(ix, iy, iz))
+    q0 = librate.quaternion_from_euler([0, 0, s.phi0])
+    tr = librate.propagate_attitude(em, sun12.state0, (q0, [0, 0, s.wz0]), body, 2 * sun12.period,
+                                    torques=("gravity_gradient", "srp"), sun=sun, rtol=1e-13, atol=1e-13)
+    phi_T = 2 * math.atan2(tr.q[-1, 2], tr.q[-1, 3])
+    assert abs(math.remainder(phi_T - s.phi0, 2 * math.pi)) < 1e-9
+    assert abs(tr.w[-1, 2] - s.wz0) < 1e-9
+
+
+def test_continuation_reports_the_fold(gravity_solution):
+    """Continuing to a large eps, the branch folds: the fold is reported with the trace at 2
+    (Phi - I singular), and no solution past it (from another branch) is returned."""
+    c = librate.continue_srp(gravity_solution, librate.FlatPlateSRP(1.0, cs=0.4, cd=0.1))
+    assert not c.reached and c.fold is not None
+    assert 0 < c.fold["eps"] < 1.0 and c.fold["trace"] == 2.0
+    assert np.all(np.diff(c.eps) > 0) and c.eps[-1] <= c.fold["eps"]
+    assert abs(c.solutions[-1].trace - 2.0) < 1e-3  # the last point sits next to the fold
+    traces = np.array([s.trace for s in c.solutions])
+    assert np.all(traces > 2.0)  # all on the starting side: never a point of the other branch
+    ok = librate.continue_srp(gravity_solution, librate.FlatPlateSRP(0.05, cs=0.4, cd=0.1))
+    assert ok.reached and ok.eps[-1] == 0.05 and all(s.residual < 1e-9 for s in ok.solutions)
+
+
+def test_srp_map_on_the_sun_resonant_orbit(sun12):
+    """A periodicity map with SRP over K = 2 revolutions: its refined solutions repeat (1e-9) and
+    the parameters are stored."""
+    plate = librate.FlatPlateSRP(0.02, cs=0.4, cd=0.1, sun=librate.SunModel(theta0=0.3))
+    ds = librate.periodicity_map(sun12, kz=0.8, wz0=np.linspace(-1.6, 1.2, 400), n_periods=2, srp=plate)
+    assert ds.sizes["solution"] > 0 and np.all(ds.sol_residual.values < 1e-9)
+    assert ds.attrs["srp_eps"] == 0.02 and ds.attrs["sun_theta0"] == 0.3 and ds.attrs["n_periods"] == 2
+    # the symmetry is broken: the solutions' phi0 are free (not all zero)
+    assert np.max(np.abs(ds.sol_phi0.values)) > 1e-6
+
+
+def test_srp_force_on_the_orbit(em, sun12):
+    """The SRP force (switchable, off by default) moves the orbit by a small but non-zero amount:
+    A/m = 0.016 m^2/kg gives ~2.7e-5 nondimensional acceleration (Table 2: ~1e-5), a drift of
+    order a t^2 / 2 over one orbit (between 1e-7 and 1e-3 LU)."""
+    mass = 1.0e5
+    body = librate.FacetBody.flat_plate(0.016 * mass, normal=(1, 0, 0), inertia=(1e8, 1.5e8, 2e8), mass_kg=mass)
+    args = (em, sun12.state0, ([0, 0, 0, 1], [0, 0, 1.0]), body, sun12.period)
+    off = librate.propagate_attitude(*args, torques=("gravity_gradient", "srp"))
+    on = librate.propagate_attitude(*args, torques=("gravity_gradient", "srp"), srp_force=True)
+    dev = np.max(np.abs(on.orbit[-1, :3] - off.orbit[-1, :3]))
+    assert 1e-7 < dev < 1e-3
+
+
+BAD = [
+    ("coefficients not summing to one", lambda: librate.Facet(1.0, (1, 0, 0), ca=0.5, cs=0.5, cd=0.5), "sum"),
+    ("negative area", lambda: librate.Facet(-1.0, (1, 0, 0)), "area"),
+    ("zero normal", lambda: librate.Facet(1.0, (0, 0, 0)), "normal"),
+    ("plate cs + cd > 1", lambda: librate.FlatPlateSRP(0.1, cs=0.8, cd=0.5), "cs"),
+    ("plate eps not finite", lambda: librate.FlatPlateSRP(math.inf), "eps"),
+    ("facet body without facets", lambda: librate.FacetBody(1.0, 2.0, 2.5), "facets"),
+    ("negative pressure", lambda: librate.SunModel(pressure=-1.0), "pressure"),
+]
+
+
+@pytest.mark.parametrize("desc, call, text", BAD, ids=[b[0] for b in BAD])
+def test_bad_srp_parameters(desc, call, text):
+    with pytest.raises(ValueError) as info:
+        call()
+    assert text in str(info.value)
+
+
+def test_srp_needs_a_facet_body(em):
+    with pytest.raises(ValueError, match="FacetBody"):
+        librate.propagate_attitude(em, [0.8, 0, 0, 0, 0.5, 0], ([0, 0, 0, 1], [0, 0, 1]), librate.RigidBody(1, 2, 2.5), 1.0, torques=("srp",))
