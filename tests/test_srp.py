@@ -134,3 +134,26 @@ def test_bad_srp_parameters(desc, call, text):
 def test_srp_needs_a_facet_body(em):
     with pytest.raises(ValueError, match="FacetBody"):
         librate.propagate_attitude(em, [0.8, 0, 0, 0, 0.5, 0], ([0, 0, 0, 1], [0, 0, 1]), librate.RigidBody(1, 2, 2.5), 1.0, torques=("srp",))
+
+
+def test_free_sun_phase_finds_the_symmetric_phases(sun12, gravity_solution):
+    """PHYSICS.md sec. 6: with phi0 = 0 kept, solutions survive only for special Sun phases (a
+    multiple of pi/K for this plate). Freeing the Sun phase from 0.3 converges to such a phase
+    (K = 2: a multiple of pi/2, to 1e-9), and the solution repeats (1e-9)."""
+    plate = librate.FlatPlateSRP(0.05, cs=0.4, cd=0.1, sun=librate.SunModel(theta0=0.3))
+    s = librate.periodic_attitude(sun12, kz=0.8, n=-2, n_periods=2, srp=plate, wz0=gravity_solution.wz0, free="sun_phase")
+    assert s.phi0 == 0.0 and s.residual < 1e-9
+    k = s.srp.sun.theta0 / (math.pi / 2)
+    assert abs(k - round(k)) < 1e-9
+
+
+def test_map_over_several_plates(sun12):
+    """A list of plates adds an srp dimension; the eps = 0 slice equals the gravity-only map bit
+    for bit; solutions carry their plate index."""
+    wz = np.linspace(-1.6, 1.2, 150)
+    plates = [librate.FlatPlateSRP(e, cs=0.4, cd=0.1) for e in (0.0, 0.03)]
+    ds = librate.periodicity_map(sun12, kz=0.8, wz0=wz, n_periods=2, srp=plates)
+    assert ds.dwz.dims == ("orbit", "srp", "kz", "wz0") and ds.srp_eps.values.tolist() == [0.0, 0.03]
+    grav = librate.periodicity_map(sun12, kz=0.8, wz0=wz, n_periods=2, solve=False)
+    np.testing.assert_array_equal(ds.dwz.values[:, 0], grav.dwz.values)
+    assert set(ds.sol_srp.values.tolist()) == {0, 1} and np.all(ds.sol_residual.values < 1e-9)

@@ -134,6 +134,45 @@ class AttitudeSolution:
                                   n_periods * self.orbit.period, planar=True, srp=self.srp, **kwargs)
 
 
+def _solve_sun_phase(orbit, kz, n, kind, phi0, w, srp, n_periods, turns, tol, max_iter):
+    """Newton on (Sun phase, wz0) with phi0 fixed."""
+    from .srp import FlatPlateSRP, SunModel
+
+    forcing = orbit_forcing(orbit)
+    T = n_periods * orbit.period
+    th = float(srp.sun.theta0)
+
+    def plate(theta):
+        return FlatPlateSRP(srp.eps, srp.cs, srp.cd, SunModel(theta0=theta, pressure=srp.sun.pressure))
+
+    def F(theta, wz, stm=False):
+        r = _sweep(forcing, T, phi0, wz, kz, stm=stm, rtol=1e-13, atol=1e-13, srp=plate(theta))
+        return np.array([r["phi_t"][0] - phi0 - 2 * math.pi * turns, r["wz_t"][0] - wz]), r
+
+    res = math.inf
+    for it in range(1, max_iter + 1):
+        f, r = F(th, w, stm=True)
+        res = float(np.max(np.abs(f)))
+        if res < tol:
+            break
+        h = 1e-6
+        dth = (F(th + h, w)[0] - F(th - h, w)[0]) / (2 * h)
+        m = r["stm"][0]
+        jac = np.array([[dth[0], m[0, 1]], [dth[1], m[1, 1] - 1.0]])
+        try:
+            d = np.linalg.solve(jac, -f)
+        except np.linalg.LinAlgError:
+            raise ConvergenceError(f"periodic attitude (Sun phase free): singular Jacobian at wz0 = {w}") from None
+        scale = min(1.0, 0.5 / max(abs(d[0]), abs(d[1]), 1e-300))
+        th += float(d[0]) * scale
+        w += float(d[1]) * scale
+    else:
+        raise ConvergenceError(f"periodic attitude (Sun phase free, N = {n}) did not converge after {max_iter} iterations (residual {res:.3e})")
+    found = plate(math.remainder(th, 2 * math.pi))
+    dphi, dwz, mono = _verify(orbit, kz, phi0, w, turns, n_periods, found)
+    return AttitudeSolution(orbit, kz, int(n), kind, phi0, w, float(dphi), float(dwz), mono, it, found, int(n_periods))
+
+
 def _check_srp(srp):
     if srp is None:
         return None
@@ -168,6 +207,7 @@ def periodic_attitude(
     method: str = "auto",
     n_periods: int = 1,
     srp=None,
+    free: str = "phi0",
     tol: float = 1e-12,
     max_iter: int = 40,
 ) -> AttitudeSolution:
@@ -178,7 +218,10 @@ def periodic_attitude(
     STM; exact for x-symmetric orbits with phi0 a multiple of pi/2 and no SRP; K = ``n_periods``),
     "newton" corrects
     (phi0, wz0) together with the full-period Newton step [Phi(T) - I] d = -F (PHYSICS.md: the
-    correct form of thesis eq. 53), "auto" picks "half" when it applies. ``wz0``: the guess
+    correct form of thesis eq. 53), "auto" picks "half" when it applies. With SRP the mirror
+    symmetry is broken (PHYSICS.md sec. 6): ``free="phi0"`` (default) corrects (phi0, wz0);
+    ``free="sun_phase"`` keeps phi0 and corrects (Sun phase, wz0) instead (the returned
+    solution's ``srp.sun.theta0`` is the phase found; d/d(phase) by central differences). ``wz0``: the guess
     (default: the torque-free solution 1 + 2 pi turns / T). Raises ConvergenceError.
     """
     orbit = _check_orbit(orbit)
@@ -199,6 +242,12 @@ def periodic_attitude(
     if not math.isfinite(w):
         raise ValueError(f"invalid argument `wz0`: must be finite, got {wz0!r}")
     srp = _check_srp(srp)
+    if free not in ("phi0", "sun_phase"):
+        raise ValueError(f"invalid argument `free`: must be 'phi0' or 'sun_phase', got {free!r}")
+    if free == "sun_phase":
+        if srp is None:
+            raise ValueError("invalid argument `free`: 'sun_phase' needs srp")
+        return _solve_sun_phase(orbit, kz, n, kind, float(phi0), w, srp, n_periods, turns, tol, max_iter)
     symmetric = _symmetric(orbit, phi0) and (srp is None or srp.eps == 0.0)
     if method == "auto":
         method = "half" if symmetric else "newton"
@@ -364,7 +413,8 @@ def periodicity_map(
     each); on KeyboardInterrupt the finished orbits are kept and returned, with
     ``attrs["complete"] = 0``. Results are bit-identical for any ``chunk`` and ``threads``.
     ``srp``: a :class:`librate.FlatPlateSRP` (with ``n_periods`` = K for Sun-resonant orbits,
-    T = Ts / K); its parameters are stored as attributes. With SRP the mirror symmetry is broken
+    T = Ts / K); its parameters are stored as attributes. A list of plates (e.g. several eps or
+    Cs) adds an ``srp`` dimension (orbit, srp, kz, wz0) with their parameters as coordinates. With SRP the mirror symmetry is broken
     and solutions are refined in (phi0, wz0) together (PHYSICS.md sec. 6).
     """
     import xarray as xr
@@ -374,6 +424,13 @@ def periodicity_map(
     olist, family = _orbits_of(orbits)
     for o in olist:
         _check_orbit(o)
+    if isinstance(srp, (list, tuple)):
+        if not srp:
+            raise ValueError("invalid argument `srp`: an empty list of plates")
+        plates = [_check_srp(p) for p in srp]
+        maps = [periodicity_map(olist if family is None else family, kz=kz, wz0=wz0, phi0=phi0, n_periods=n_periods, solve=solve,
+                                progress=progress, rtol=rtol, atol=atol, chunk=chunk, threads=threads, srp=p) for p in plates]
+        return _stack_srp(maps, plates)
     srp = _check_srp(srp)
     kzs = np.atleast_1d(np.asarray(kz, dtype=np.float64))
     if kzs.ndim != 1 or kzs.size == 0 or not np.all(np.isfinite(kzs)) or np.any(np.abs(kzs) > 1):
@@ -445,6 +502,35 @@ def periodicity_map(
     if solve:
         ds = ds.merge(_solutions_dataset(sols))
     return ds
+
+
+def _stack_srp(maps, plates):
+    """Maps for several plates stacked along an ``srp`` dimension (coordinates eps, cs, cd and
+    the Sun phase); solutions gain ``sol_srp``."""
+    import xarray as xr
+
+    grid_vars = ["dwz", "dphi", "phi_T", "status"]
+    out = xr.concat([m[grid_vars + ["computed"]] for m in maps], dim="srp")
+    out = out.transpose("orbit", "srp", "kz", "wz0")
+    out = out.assign_coords(
+        srp=np.arange(len(plates)),
+        srp_eps=("srp", np.array([p.eps for p in plates])),
+        srp_cs=("srp", np.array([p.cs for p in plates])),
+        srp_cd=("srp", np.array([p.cd for p in plates])),
+        srp_theta0=("srp", np.array([p.sun.theta0 for p in plates])),
+    )
+    out["computed"] = out["computed"].all("srp")
+    out.attrs = {k: v for k, v in maps[0].attrs.items() if not k.startswith("srp_") and k != "sun_theta0"}
+    out.attrs["complete"] = int(all(m.attrs["complete"] for m in maps))
+    if "solution" in maps[0].dims:
+        sols = []
+        for i, m in enumerate(maps):
+            if m.sizes.get("solution", 0):
+                part = m[[v for v in m.data_vars if v.startswith("sol_")]]
+                sols.append(part.assign(sol_srp=("solution", np.full(m.sizes["solution"], i))))
+        if sols:
+            out = out.merge(xr.concat(sols, dim="solution"))
+    return out
 
 
 def _solutions_from_row(orbit, kz, phi0, wz, phi_t_row, n_periods, srp=None) -> list[AttitudeSolution]:
