@@ -1,6 +1,7 @@
-//! The attitude periodicity engine's integrator: RKF7(8) on four trajectories at once in SIMD
-//! lanes (`wide::f64x4`), in lock step: the four share the time and the step size (the
-//! smallest any of them needs), each with its own state, Kz and SRP parameters.
+//! The attitude periodicity engine's integrator: RKF7(8) on eight trajectories at once in SIMD
+//! lanes (`wide::f64x8`, AVX-512 where the CPU has it), in lock step: the eight share the time
+//! and the step size (the smallest any of them needs), each with its own state, Kz and SRP
+//! parameters.
 //!
 //! Why lock step: the planar model's only orbit input is the forcing S(t), C(t), tabulated once
 //! per orbit. With a time per lane, every stage had to gather four lanes' table coefficients,
@@ -8,8 +9,8 @@
 //! with the lookup removed). With a shared time the forcing is one scalar Chebyshev sum per
 //! stage, broadcast to the lanes, and so is the Sun's direction for SRP
 //! (cos(w t + theta0_l) from one scalar sin_cos and each lane's (cos theta0_l, sin theta0_l)).
-//! Trajectories are grouped four by four in case order from the start of the slice (the caller
-//! aligns slices to multiples of four), so a trajectory's result depends only on its group, never
+//! Trajectories are grouped eight by eight in case order from the start of the slice (the caller
+//! aligns slices to multiples of eight), so a trajectory's result depends only on its group, never
 //! on chunking or thread count: results are bit-identical for any of them.
 //!
 //! State per lane: (phi, wz, cos phi, sin phi) and, with the STM, the 2x2 d(phi, wz)/d(phi0,
@@ -19,12 +20,14 @@
 //! law (PHYSICS.md sec. 6) is C1 only: a step never spans a lane's Sun-terminator crossing
 //! (cos(theta_sun - phi) = 0); the step is cut there (Illinois iterations on its length).
 
-use wide::f64x4;
+use wide::f64x8;
 
 use super::forcing::OrbitForcing;
 use crate::integrate::tableau::{A, B8, C, ERR};
 
-type V = f64x4;
+type V = f64x8;
+/// Trajectories per lock-step group (SIMD width).
+pub const LANES: usize = 8;
 
 /// One attitude trajectory of a sweep.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -198,8 +201,8 @@ fn lane(v: &V, l: usize) -> f64 {
     v.to_array()[l]
 }
 
-/// Integrate one group of up to four trajectories in lock step; missing lanes repeat the last.
-fn integrate_group<const D: usize, const SRP: bool>(f: &OrbitForcing, t_final: f64, group: &[Case], opts: &LaneOptions, st: &mut Stages<D>) -> [Outcome; 4] {
+/// Integrate one group of up to LANES trajectories in lock step; missing lanes repeat the last.
+fn integrate_group<const D: usize, const SRP: bool>(f: &OrbitForcing, t_final: f64, group: &[Case], opts: &LaneOptions, st: &mut Stages<D>) -> [Outcome; LANES] {
     let n = group.len();
     let pick = |l: usize| group[l.min(n - 1)];
     let mut y = [V::ZERO; D];
@@ -219,7 +222,7 @@ fn integrate_group<const D: usize, const SRP: bool>(f: &OrbitForcing, t_final: f
         s0: V::new(std::array::from_fn(|l| pick(l).theta_sun0.sin())),
         omega: opts.sun_omega,
     };
-    let plate: [bool; 4] = std::array::from_fn(|l| pick(l).eps != 0.0);
+    let plate: [bool; LANES] = std::array::from_fn(|l| pick(l).eps != 0.0);
     let (rtol, atol) = (V::splat(opts.rtol), V::splat(opts.atol));
     let mut ynew = [V::ZERO; D];
     let mut yc = [V::ZERO; D];
@@ -252,7 +255,7 @@ fn integrate_group<const D: usize, const SRP: bool>(f: &OrbitForcing, t_final: f
         if SRP {
             // Cut the step at the earliest terminator crossing of any lane with a plate.
             let mut cut = f64::INFINITY;
-            for l in 0..4 {
+            for l in 0..LANES {
                 if !plate[l] {
                     continue;
                 }
@@ -319,13 +322,13 @@ fn integrate_group<const D: usize, const SRP: bool>(f: &OrbitForcing, t_final: f
     })
 }
 
-/// Integrate `cases` from t = 0 to `t_final` along the orbit forcing, in lock-step groups of four
+/// Integrate `cases` from t = 0 to `t_final` along the orbit forcing, in lock-step groups of LANES
 /// taken in order from the start of the slice. `D` is 4 (no STM) or 8 (with the 2x2 STM); `SRP`
 /// compiles the flat-plate term in (lanes with eps = 0 add exact zeros and never cut steps).
 pub fn integrate_cases<const D: usize, const SRP: bool>(f: &OrbitForcing, t_final: f64, cases: &[Case], opts: &LaneOptions) -> Vec<Outcome> {
     let mut st = Stages::<D> { k: [[V::ZERO; D]; 13], tmp: [V::ZERO; D] };
     let mut out = Vec::with_capacity(cases.len());
-    for group in cases.chunks(4) {
+    for group in cases.chunks(LANES) {
         let r = integrate_group::<D, SRP>(f, t_final, group, opts, &mut st);
         out.extend_from_slice(&r[..group.len()]);
     }

@@ -57,11 +57,11 @@ pub fn sweep(
             return Err(invalid("cs", format!("case {i}: need cs, cd >= 0 and cs + cd <= 1, got ({}, {})", c.cs, c.cd)));
         }
     }
-    // Lock-step groups of four are taken from the start of each chunk: chunks are multiples of
-    // four so that the groups, and so the results, are the same for any chunk size.
-    let chunk = chunk.div_ceil(4) * 4;
+    // Lock-step groups are taken from the start of each chunk: chunks are multiples of the group
+    // size so that the groups, and so the results, are the same for any chunk size.
+    let chunk = chunk.div_ceil(lanes::LANES) * lanes::LANES;
     let run = |part: &[Case]| -> Vec<Outcome> {
-        let srp = part.chunks(4).any(|g| g.iter().any(|c| c.eps != 0.0));
+        let srp = part.chunks(lanes::LANES).any(|g| g.iter().any(|c| c.eps != 0.0));
         match (with_stm, srp) {
             (true, false) => integrate_cases::<8, false>(forcing, t_final, part, opts),
             (false, false) => integrate_cases::<4, false>(forcing, t_final, part, opts),
