@@ -14,6 +14,7 @@ from .frames import MeanElements, OsculatingElements, eci_to_synodic, mean_eleme
 from .orbits import PeriodicOrbit, correct_dro, correct_periodic, correct_symmetric
 from .periodicity import AttitudeFamily, AttitudeSolution, SrpContinuation, attitude_family, continue_srp, find_periodic_attitudes, periodic_attitude, periodicity_map
 from .srp import Facet, FacetBody, FlatPlateSRP, SunModel
+from .runner import run_map
 from .propagation import BatchResult, Event, EventHit, Stats, Trajectory, propagate, propagate_many
 from .system import System
 
@@ -49,6 +50,7 @@ __all__ = [
     "FacetBody",
     "FlatPlateSRP",
     "continue_srp",
+    "run_map",
     "SrpContinuation",
     "OrbitFamily",
     "dro",
