@@ -6,6 +6,10 @@
 //! - [`periodic`]: symmetric periodic orbits by half-period shooting.
 //! - [`fourier`]: periodic orbits as truncated Fourier series, with analytic derivatives.
 
+// Intentional patterns: `!(x <= tol)` is the NaN-safe test (a NaN must fail it); numerical
+// kernels take many scalar arguments; dual-number products contain sums by definition.
+#![allow(clippy::neg_cmp_op_on_partial_ord, clippy::too_many_arguments, clippy::suspicious_arithmetic_impl, clippy::type_complexity)]
+
 pub mod attitude;
 pub mod cr3bp;
 pub mod error;

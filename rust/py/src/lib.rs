@@ -2,6 +2,8 @@
 //! calls the core with the GIL released, and converts the result; no numerics live here.
 //! The public, documented API is the `librate` Python package, which wraps these.
 
+#![allow(clippy::too_many_arguments, clippy::type_complexity)]
+
 use librate_core::cr3bp::{self, SystemConstants, PRESETS};
 use librate_core::error::Error;
 use librate_core::integrate::{Options, Output, Status};

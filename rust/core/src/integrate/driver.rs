@@ -243,8 +243,8 @@ pub fn solve<S: State, Sys: System<S>>(
         }
         // Last step lands exactly on tf.
         let mut last = false;
-        if fixed.is_some() {
-            if stats.accepted + 1 == fixed.unwrap().0 {
+        if let Some((n_fixed, _)) = fixed {
+            if stats.accepted + 1 == n_fixed {
                 h = tf - t;
                 last = true;
             }

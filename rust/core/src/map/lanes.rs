@@ -136,10 +136,10 @@ fn rhs<const D: usize, const SRP: bool>(f: &OrbitForcing, t: f64, y: &[V; D], p:
         let st = swt * p.c0 + cwt * p.s0;
         let ca = ct.mul_add(cp, st * sp);
         let aca = ca.abs();
-        dwz = dwz + ca * p.a1.mul_add(aca, p.a2);
+        dwz += ca * p.a1.mul_add(aca, p.a2);
         if D == 8 {
             let sa = st.mul_add(cp, -(ct * sp));
-            k = k + sa * (p.a1 + p.a1).mul_add(aca, p.a2);
+            k += sa * (p.a1 + p.a1).mul_add(aca, p.a2);
         }
     }
     dy[1] = dwz;
@@ -255,8 +255,8 @@ fn integrate_group<const D: usize, const SRP: bool>(f: &OrbitForcing, t_final: f
         if SRP {
             // Cut the step at the earliest terminator crossing of any lane with a plate.
             let mut cut = f64::INFINITY;
-            for l in 0..LANES {
-                if !plate[l] {
+            for (l, &has_plate) in plate.iter().enumerate() {
+                if !has_plate {
                     continue;
                 }
                 let g0 = g(l, t, lane(&y[0], l));
