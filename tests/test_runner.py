@@ -71,6 +71,12 @@ def test_sigkill_and_resume_is_bit_identical(tmp_path, fam, reference):
     resumed = run_map(fam, kz=KZ, wz0=WZ, out=out, progress=False)
     assert resumed.attrs["complete"] == 1
     _same(resumed, reference)
+    # the store reopens as the same Dataset, coordinates included
+    import xarray as xr
+
+    back = xr.open_zarr(out)
+    np.testing.assert_array_equal(back.dwz.values, reference.dwz.values)
+    assert "x0" in back.coords and "phidot0" in back.coords and back.attrs["complete"] == 1
 
 
 def test_interrupt_keeps_finished_rows(tmp_path, fam, reference, monkeypatch):

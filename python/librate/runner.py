@@ -77,11 +77,12 @@ def _open_store(out: Path, fingerprint: str, shape, resume: bool, coords: dict):
     g.attrs.update({"librate_store": "periodicity_map", "fingerprint": fingerprint})
     no, nk, nw = shape
     dims3 = ["orbit", "kz", "wz0"]
+    extra_coords = "x0 period period_days phidot0"
     for name in _GRID:
         a = g.create_array(name, shape=shape, chunks=(1, nk, nw), dtype="f8", fill_value=np.nan)
-        a.attrs["_ARRAY_DIMENSIONS"] = dims3
+        a.attrs.update({"_ARRAY_DIMENSIONS": dims3, "coordinates": extra_coords})
     a = g.create_array("status", shape=shape, chunks=(1, nk, nw), dtype="u1", fill_value=255)
-    a.attrs["_ARRAY_DIMENSIONS"] = dims3
+    a.attrs.update({"_ARRAY_DIMENSIONS": dims3, "coordinates": extra_coords})
     a = g.create_array("done", shape=(no,), chunks=(1,), dtype="bool", fill_value=False)
     a.attrs["_ARRAY_DIMENSIONS"] = ["orbit"]
     for name, (dim, values, attrs) in coords.items():
