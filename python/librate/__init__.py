@@ -15,6 +15,7 @@ from .orbits import PeriodicOrbit, correct_dro, correct_periodic, correct_symmet
 from .periodicity import AttitudeFamily, AttitudeSolution, attitude_family, find_periodic_attitudes, periodic_attitude, periodicity_map
 from .propagation import BatchResult, Event, EventHit, Stats, Trajectory, propagate, propagate_many
 from .system import System
+from .flexible import Appendage, FlexibleBody, flexible_periodic, frequency_scan, quasi_static
 
 __all__ = [
     "__version__",
@@ -58,4 +59,9 @@ __all__ = [
     "osculating_elements",
     "MeanElements",
     "mean_elements",
+    "Appendage",
+    "FlexibleBody",
+    "quasi_static",
+    "flexible_periodic",
+    "frequency_scan",
 ]
