@@ -567,7 +567,7 @@ def _common(system, orbit_state, body, t_span, torques, orbit):
 class QuasiStaticResponse:
     """Result of :func:`quasi_static`. ``phi``, ``wz`` (n_t,): the rigid composite solution (phi of
     the body x axis); ``q``, ``qdot``, ``qddot`` (n_t, n): the closed-form deflections q_j = L_j / k_j
-    along it and their derivatives (m, m/TU, m/TU^2); ``dtau`` (n_t,): the first-order torque
+    along it (with the damper's lag) and their derivatives (m, m/TU, m/TU^2); ``dtau`` (n_t,): the first-order torque
     perturbation (N m); ``dphi``, ``dwz``: the first-order attitude perturbation (rad, rad/TU),
     so the flexible model's attitude is ``phi + dphi``, ``wz + dwz`` to O((rate / Omega)^4)."""
 
@@ -611,7 +611,8 @@ def quasi_static(
     ``attitude = (phi0, wz0)`` (phi of the body x axis, wz inertial). Along it, the transverse load
     on m_j is L_j = m_j [t_j . T_B b_j - wzdot (b_j x t_j)] (tidal + Euler; the centrifugal part
     vanishes because t_j is normal to b_j), and the deflection is q_j = L_j / k_j
-    = L_j / (m_j Omega_j^2), with its derivatives in closed form from the orbit's velocity and
+    = L_j / (m_j Omega_j^2), less the damper's lag c_j L_j' / k_j^2 (a relative
+    2 zeta_j rate / Omega_j), with its derivatives in closed form from the orbit's velocity and
     acceleration. Fed back into the attitude equation, it gives the torque perturbation
     dtau = sum_j [dtau/dq_j q_j - m_j (b_j x t_j) qddot_j] and the attitude perturbation
     (dphi, dwz) from the rigid variational equation forced by dtau / I0 (Duhamel's integral along

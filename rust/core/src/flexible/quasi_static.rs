@@ -5,7 +5,11 @@
 //!   L_j = m_j [ t_j . T_B b_j - wzdot_r (b_j x t_j) ]   (tidal + Euler; the centrifugal
 //!         load m_j wz^2 t_j . b_j vanishes because t_j is normal to b_j)
 //!       = m_j [ (3/2) Re(conj(w) t_j b_j) - wzdot_r a_j ]   (complex products, w = Cb + i Sb),
-//! and the closed form is q_j = L_j / k_j = L_j / (m_j Omega_j^2). Its derivatives follow from
+//! and the closed form is q_j = L_j / k_j = L_j / (m_j Omega_j^2), corrected for the viscous lag
+//! of a damped appendage: q_j = (L_j - (c_j / k_j) L_j') / k_j (the damper's c_j q_j' is a
+//! relative 2 zeta_j rate / Omega_j of the spring force, first order in 1/Omega unlike the
+//! inertial terms; with it the closed form is exact to O((rate / Omega)^2) for any damping
+//! ratio; q_j' carries the lag with L_j'', q_j'' = L_j'' / k_j without it). Its derivatives follow from
 //! those of w = W e^{-2 i phi} (W', W'' from the orbit's velocity and acceleration):
 //!   w'  = (W' - 2i phi' W) e^{-2i phi},
 //!   w'' = (W'' - 4i phi' W' - 2i phi'' W - 4 phi'^2 W) e^{-2i phi},
@@ -68,7 +72,8 @@ fn dtau(body: &FlexibleBody, w: &[Complex<f64>; 3], wzk: &[f64; 3]) -> f64 {
     for a in body.appendages() {
         let bt = Complex::new(a.position[0], a.position[1]) * Complex::new(a.direction[0], a.direction[1]);
         let lever = a.lever();
-        let q = a.mass * (1.5 * (w[0].conj() * bt).re - wzk[0] * lever) / a.stiffness;
+        let l1 = a.mass * (1.5 * (w[1].conj() * bt).re - wzk[1] * lever);
+        let q = (a.mass * (1.5 * (w[0].conj() * bt).re - wzk[0] * lever) - a.damping / a.stiffness * l1) / a.stiffness;
         let qdd = a.mass * (1.5 * (w[2].conj() * bt).re - wzk[2] * lever) / a.stiffness;
         d += 3.0 * a.mass * (bt.conj() * w[0]).im * q - a.mass * lever * qdd;
     }
@@ -87,10 +92,11 @@ impl FlexibleBody {
         for a in self.appendages() {
             let bt = Complex::new(a.position[0], a.position[1]) * Complex::new(a.direction[0], a.direction[1]);
             let lever = a.lever();
-            let c = a.mass / a.stiffness;
-            q.push(c * (1.5 * (w[0].conj() * bt).re - wzk[0] * lever));
-            qdot.push(c * (1.5 * (w[1].conj() * bt).re - wzk[1] * lever));
-            qddot.push(c * (1.5 * (w[2].conj() * bt).re - wzk[2] * lever));
+            let l: [f64; 3] = std::array::from_fn(|k| a.mass * (1.5 * (w[k].conj() * bt).re - wzk[k] * lever));
+            let lag = a.damping / a.stiffness;
+            q.push((l[0] - lag * l[1]) / a.stiffness);
+            qdot.push((l[1] - lag * l[2]) / a.stiffness);
+            qddot.push(l[2] / a.stiffness);
         }
         QuasiStaticPoint { q, qdot, qddot, wzdot: wzk[0], dtau: dtau(self, &w, &wzk) }
     }
