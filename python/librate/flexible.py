@@ -31,6 +31,14 @@ hub's centre sits where it balances them, h = -sum_j m_j b_j / m0.
 - :func:`flexible_periodic`: what flexibility does to a periodic orbit-attitude solution (drift
   and first-order shift in closed form; re-solved with the full model at low frequencies);
 - :func:`frequency_scan`: the coupled response against the structural frequency (resonances).
+
+Two precisions on PHYSICS.md sec. 7. Omega_j = sqrt(k_j / m_j) is the *clamped-hub* frequency:
+with the hub free to rotate and the centre of mass free to shift, the structural modes are
+stiffer (:meth:`FlexibleBody.modes`, sqrt(k / m_eff) with m_eff < m), and the damping ratio that
+sets the decay of the structural energy is the mode's, c / (2 sqrt(k m_eff)), not
+c / (2 sqrt(k m)). And with dampers, q_j = L_j / k_j alone is off by a relative 2 zeta_j
+rate / Omega_j (the damper's force, first order); the closed form here subtracts that viscous
+lag, c_j L_j' / k_j^2, which restores the O((rate / Omega)^2) error for any damping ratio.
 """
 
 from __future__ import annotations
@@ -339,7 +347,7 @@ class FlexibleBody:
         orbital and attitude rates: the quasi-static regime (:func:`quasi_static`).
 
         ``low_frequency=True``: the same structure with every frequency lowered by the factor
-        34560, which puts the arrays' first mode at a 4-day period (2.89e-6 rad/s, 6.8 rad/TU)
+        34560, which puts the arrays' first mode at a 4-day period (1.82e-5 rad/s, 6.82 rad/TU)
         and the modules' at 0.8 days, within a decade of the orbital and attitude rates (thesis
         Figs. 45-46: "lowered frequencies"); the damping ratios are kept.
         """
