@@ -191,7 +191,7 @@ impl FlexibleBody {
         [w[0][0] * s[0] + w[0][1] * s[1], w[1][0] * s[0] + w[1][1] * s[1]]
     }
 
-    /// The constant mass matrix of the deflections, M_qq[j][k] = m_j d_jk - m_j m_k t_j.t_k / M,
+    /// The constant mass matrix of the deflections, M_qq(j, k) = m_j d_jk - m_j m_k t_j.t_k / M,
     /// row-major (for linear analyses).
     pub fn mass_matrix(&self) -> Vec<f64> {
         let n = self.n();

@@ -36,7 +36,7 @@
 //!
 //!   I(q) = J0 + sum_k m_k |rho_k|^2 = I0 + q^T M_qq q     (I0 the composite inertia, q = 0),
 //!   gamma_j(q) = m_j rho_j x t_j = m_j a_j + (m_j / M) sum_l m_l (t_j x t_l) q_l,
-//!   M_qq[j][l] = m_j delta_jl - m_j m_l (t_j . t_l) / M     (constant, positive definite).
+//!   M_qq(j, l) = m_j delta_jl - m_j m_l (t_j . t_l) / M     (constant, positive definite).
 //!
 //! **Tidal potential** (second-order gravity of both primaries about the centre of mass; the
 //! first-order term vanishes because sum m_k rho_k = 0). Per unit mass at rho it is
@@ -60,9 +60,11 @@
 //!   d/dt (I wz + gamma . qdot) = tau,
 //!   d/dt (wz gamma + M_qq qdot) - dT_rel/dq + dV_tidal/dq + K q + C qdot = 0,
 //!
-//! with tau = -dV_tidal/dphi = sum_k m_k rho_k x (T_B rho_k) + (3/2)(Iy0 - Ix0) Sb
-//!          = (3/2) Im(conj(Z(q)) w),   Z(q) = (Iy0 - Ix0) + sum_k m_k rho_k^2 (complex squares),
-//! the tidal torque on the deformed body. Expanding (gamma-dot . qdot = 0, G antisymmetric):
+//! (K = diag(k_j), C = diag(c_j); the second line from dD/dqdot = C qdot),
+//! where tau = -dV_tidal/dphi = sum_k m_k rho_k x (T_B rho_k) + (3/2)(Iy0 - Ix0) Sb
+//!          = (3/2) Im(conj(Z(q)) w),   Z(q) = (Iy0 - Ix0) + sum_k m_k rho_k^2 (rho_k as complex
+//!            numbers x + i y; Z0 = Z(0), |Z0| = Iy - Ix of the composite principal axes) is
+//! the tidal torque on the deformed body. Expanding (gammadot . qdot = 0 because t_j x t_l is antisymmetric):
 //!
 //!   I(q) wzdot + gamma(q) . qddot = tau - Idot wz,           Idot = 2 sum_j m_j qdot_j (t_j . rho_j),
 //!   gamma_j wzdot + (M_qq qddot)_j = F_j,
@@ -75,7 +77,7 @@
 //! Coriolis, Euler = -gamma_j wzdot): the Lagrangian derivation and the force balance agree.
 //! The (n + 1) x (n + 1) symmetric positive-definite system is solved in O(n) at every
 //! right-hand-side call with the Schur complement on wzdot and the Woodbury form
-//! M_qq^{-1} x = x / m + T^T (M I_2 - sum_j m_j t_j t_j^T)^{-1} T x (T = [t_1 .. t_n], 2 x n):
+//! (M_qq^{-1} x)_j = x_j / m_j + t_j . [(M I_2 - sum_l m_l t_l t_l^T)^{-1} sum_l t_l x_l]:
 //!
 //!   wzdot = (tau - Idot wz - gamma . M_qq^{-1} F) / (I - gamma . M_qq^{-1} gamma),
 //!   qddot = M_qq^{-1} (F - gamma wzdot),   phidot = wz - 1.
