@@ -17,6 +17,7 @@ from .srp import Facet, FacetBody, FlatPlateSRP, SunModel
 from .runner import run_map
 from .propagation import BatchResult, Event, EventHit, Stats, Trajectory, propagate, propagate_many
 from .system import System
+from .flexible import Appendage, FlexibleBody, flexible_periodic, frequency_scan, quasi_static
 
 __all__ = [
     "__version__",
@@ -67,4 +68,9 @@ __all__ = [
     "osculating_elements",
     "MeanElements",
     "mean_elements",
+    "Appendage",
+    "FlexibleBody",
+    "quasi_static",
+    "flexible_periodic",
+    "frequency_scan",
 ]

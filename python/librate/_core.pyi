@@ -93,3 +93,24 @@ def map_sweep(
     forcing: OrbitForcing, t_final: float, phi0: _F64, wz0: _F64, kz: _F64, *,
     rtol: float, atol: float, max_steps: int, stm: bool, chunk: int, threads: int | None
 ) -> dict[str, Any]: ...
+
+_FlexBody = tuple[float, list[float], list[tuple[float, list[float], list[float], float, float]]]
+
+def flexible_body_check(body_arg: _FlexBody) -> dict[str, Any]: ...
+def flexible_propagate(
+    mu: float, body_arg: _FlexBody, primaries: list[bool], held: bool, orbit0: list[float], phi0: float, wz0: float,
+    q0: list[float], qdot0: list[float], t0: float, tf: float, *, options: _Options, t_eval: _F64 | None
+) -> dict[str, Any]: ...
+def flexible_quasi_static(
+    mu: float, body_arg: _FlexBody, primaries: list[bool], held: bool, orbit0: list[float], phi0: float, wz0: float,
+    t0: float, tf: float, *, options: _Options, t_eval: _F64 | None
+) -> dict[str, Any]: ...
+def flexible_quasi_static_point(
+    mu: float, body_arg: _FlexBody, primaries: list[bool], held: bool, orbit: list[float], phi: float, wz: float
+) -> tuple[list[float], list[float], list[float], float, float]: ...
+def flexible_energies(
+    mu: float, body_arg: _FlexBody, primaries: list[bool], orbit: _F64, phi: _F64, wz: _F64, q: _F64, qdot: _F64
+) -> dict[str, _F64]: ...
+def flexible_rates(
+    mu: float, body_arg: _FlexBody, primaries: list[bool], orbit: list[float], phi: float, wz: float, q: list[float], qdot: list[float]
+) -> tuple[float, list[float]]: ...

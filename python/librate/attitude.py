@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Sequence
+from typing import TYPE_CHECKING, Sequence
 
 import numpy as np
 
@@ -19,6 +19,9 @@ from . import _core
 from ._checks import as_state, as_time_span
 from .propagation import Stats, _options
 from .system import System, resolve_system
+
+if TYPE_CHECKING:
+    from .flexible import FlexibleResponse
 
 __all__ = ["RigidBody", "AttitudeTrajectory", "propagate_attitude", "quaternion_from_euler", "TORQUES"]
 
@@ -73,7 +76,9 @@ def quaternion_from_euler(angles: Sequence[float], sequence: str = "123") -> np.
 class AttitudeTrajectory:
     """Result of :func:`propagate_attitude`: ``t`` (n,), ``orbit`` (n, 6), ``q`` (n, 4, scalar
     last), ``w`` (n, 3, inertial rate in body axes); planar runs also ``phi`` and ``wz`` (n,).
-    ``stm``: 13x13 (3-D) or 2x2 (planar, d(phi, wz)) at the final time, when asked."""
+    ``stm``: 13x13 (3-D) or 2x2 (planar, d(phi, wz)) at the final time, when asked.
+    ``flex``: for a :class:`~librate.FlexibleBody`, the deflections ``flex.q`` (n, appendages; m)
+    and their rates ``flex.qdot`` (m/TU) (:class:`~librate.flexible.FlexibleResponse`); else None."""
 
     system: System
     body: RigidBody
@@ -87,6 +92,7 @@ class AttitudeTrajectory:
     wz: np.ndarray | None
     stm: np.ndarray | None
     stats: Stats
+    flex: FlexibleResponse | None = None
 
     def dcm(self) -> np.ndarray:
         """(n, 3, 3) attitude matrices A (synodic -> body components)."""
@@ -125,6 +131,8 @@ class AttitudeTrajectory:
 
     def torques(self) -> np.ndarray:
         """(n, 3) gravity-gradient torque of the run in body axes (inertia units / TU^2)."""
+        if self.flex is not None:  # flexible runs: the tidal torque on the deformed body, kg m^2 / TU^2
+            return np.stack([np.zeros_like(self.t), np.zeros_like(self.t), self.flex.energies()["torque"] * self.system.tu_s**2], axis=1)
         states = np.ascontiguousarray(np.hstack([self.orbit, self.q, self.w]))
         names = [n for n in self.torque_models if n != "srp"]
         return _core.attitude_torques(self.system.mu, list(self.body.moments), names, np.ascontiguousarray(self.t), states)
@@ -153,6 +161,7 @@ def propagate_attitude(
     max_steps: int = 1_000_000,
     safety: float = 0.8,
     fixed_step: float | None = None,
+    deflection=None,
 ) -> AttitudeTrajectory:
     """Propagate the attitude of a rigid body along its CR3BP orbit.
 
@@ -169,12 +178,18 @@ def propagate_attitude(
     the Sun from ``sun`` (a :class:`librate.SunModel`, default phase 0), and ``srp_force=True``
     adds the SRP force to the orbit (needs ``body.mass_kg``; off by default). Both SRP models
     are integrated piecewise between the faces' Sun-terminator crossings (the plate law is C1).
+
+    A :class:`~librate.FlexibleBody` runs the planar flexible model (whatever ``planar``):
+    ``attitude = (phi0, wz0)``, ``deflection`` None (undeformed, at rest), "quasi-static" (on the
+    closed-form deflection) or (q0 in m, qdot0 in m/TU); the deflections are in ``traj.flex``.
     """
     sys_ = resolve_system(system)
     s = as_state(orbit_state, "orbit_state")
     t0, tf = as_time_span(t_span)
-    if not isinstance(body, RigidBody):
-        raise ValueError(f"invalid argument `body`: must be a librate.RigidBody, got {body!r}")
+    from .flexible import FlexibleBody, _propagate_flexible
+
+    if not isinstance(body, (RigidBody, FlexibleBody)):
+        raise ValueError(f"invalid argument `body`: must be a librate.RigidBody or librate.FlexibleBody, got {body!r}")
     from .srp import FacetBody, FlatPlateSRP, SunModel
 
     names = tuple(torques)
@@ -193,6 +208,12 @@ def propagate_attitude(
         raise ValueError(f"invalid argument `orbit`: must be 'integrate', 'held' or 'coupled', got {orbit!r}")
     opts = _options(rtol, atol, h0, h_min, h_max, max_steps, safety, fixed_step)
     te = None if t_eval is None else np.ascontiguousarray(t_eval, dtype=np.float64).ravel()
+    if isinstance(body, FlexibleBody):
+        if srp is not None or "srp" in names or srp_force:
+            raise ValueError("invalid argument `srp`: the flexible model has no solar radiation pressure yet; use a RigidBody or FacetBody")
+        return _propagate_flexible(sys_, s, attitude, body, t0, tf, names, orbit, opts, te, deflection, stm)
+    if deflection is not None:
+        raise ValueError("invalid argument `deflection`: only a librate.FlexibleBody has deflections")
 
     if planar:
         if orbit == "coupled":

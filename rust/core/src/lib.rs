@@ -13,6 +13,7 @@
 pub mod attitude;
 pub mod cr3bp;
 pub mod error;
+pub mod flexible;
 pub mod fourier;
 pub mod integrate;
 pub mod map;

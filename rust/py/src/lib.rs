@@ -18,6 +18,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 mod attitude;
+mod flexible;
 mod fourier;
 mod map;
 
@@ -408,6 +409,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     fourier::register(m)?;
     attitude::register(m)?;
     map::register(m)?;
+    flexible::register(m)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

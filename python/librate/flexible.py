@@ -1,0 +1,864 @@
+"""Flexible spacecraft (thesis ch. 5, PHYSICS.md sec. 7): a planar lumped-parameter model.
+
+A rigid hub (mass m0, principal moments (Ix0, Iy0, Iz0) about its centre, axes along the body
+axes) carries appendage masses m_j at body positions b_j, each deflecting by q_j along a unit
+vector t_j normal to b_j against a spring k_j and a damper c_j >= 0 (clamped natural frequency
+Omega_j = sqrt(k_j / m_j), damping ratio zeta_j = c_j / (2 sqrt(k_j m_j))). Every mass feels the
+tidal (second-order) field of both primaries about the system's instantaneous centre of mass,
+which follows the orbit. The equations, derived with Lagrange's method, are written out in the
+Rust core's documentation (``rust/core/src/flexible/mod.rs``): with rho_k the positions relative
+to the instantaneous centre of mass,
+
+    I(q) wzdot + gamma(q) . qddot = tau - Idot wz,          phidot = wz - 1,
+    gamma_j wzdot + (M_qq qddot)_j = m_j t_j . (T_B rho_j) + m_j wz^2 t_j . rho_j
+                                     + 2 wz m_j (cdot x t_j) - k_j q_j - c_j qdot_j,
+
+I(q) the instantaneous moment of inertia, gamma_j = m_j rho_j x t_j, M_qq the (constant) mass
+matrix of the deflections including the centre-of-mass shift, T_B the tidal tensor in body axes
+and tau the tidal torque on the deformed body.
+
+Units: the API takes SI (kg, m, kg m^2, N/m, N s/m) and converts with the system's time unit;
+time and rates stay in TU and 1/TU as everywhere in librate, so deflections are in m and their
+rates in m/TU. Positions b_j are measured from the **undeformed system's centre of mass**; the
+hub's centre sits where it balances them, h = -sum_j m_j b_j / m0.
+
+- :class:`Appendage`, :class:`FlexibleBody` (presets :meth:`FlexibleBody.sample_station`, TOML
+  input and output, free-free modes, the rigid composite body);
+- :func:`librate.propagate_attitude` accepts a FlexibleBody (planar model, the deflections in
+  ``traj.flex``);
+- :func:`quasi_static`: high structural frequencies, the closed form q_j = L_j / k_j along the
+  rigid solution (L_j the transverse load) and the first-order attitude perturbation;
+- :func:`flexible_periodic`: what flexibility does to a periodic orbit-attitude solution (drift
+  and first-order shift in closed form; re-solved with the full model at low frequencies);
+- :func:`frequency_scan`: the coupled response against the structural frequency (resonances).
+
+Two precisions on PHYSICS.md sec. 7. Omega_j = sqrt(k_j / m_j) is the *clamped-hub* frequency:
+with the hub free to rotate and the centre of mass free to shift, the structural modes are
+stiffer (:meth:`FlexibleBody.modes`, sqrt(k / m_eff) with m_eff < m), and the damping ratio that
+sets the decay of the structural energy is the mode's, c / (2 sqrt(k m_eff)), not
+c / (2 sqrt(k m)). And with dampers, q_j = L_j / k_j alone is off by a relative 2 zeta_j
+rate / Omega_j (the damper's force, first order); the closed form here subtracts that viscous
+lag, c_j L_j' / k_j^2, which restores the O((rate / Omega)^2) error for any damping ratio.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+from typing import Sequence
+
+import numpy as np
+
+from . import _core
+from ._checks import as_state, as_time_span
+from .attitude import AttitudeTrajectory, RigidBody, TORQUES
+from .propagation import Stats, _options
+from .system import System, resolve_system
+
+__all__ = [
+    "Appendage",
+    "FlexibleBody",
+    "FlexibleModes",
+    "FlexibleResponse",
+    "QuasiStaticResponse",
+    "FlexiblePeriodic",
+    "FrequencyScan",
+    "quasi_static",
+    "flexible_periodic",
+    "frequency_scan",
+]
+
+#: Relative tolerance of the geometric checks (direction normal to the arm, mass off the CM).
+GEOMETRY_TOL = 1e-9
+
+
+def _positive(name: str, value, *, allow_zero: bool = False) -> float:
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise ValueError(f"invalid argument `{name}`: must be a number, got {value!r}") from None
+    ok = math.isfinite(v) and (v >= 0 if allow_zero else v > 0)
+    if not ok:
+        raise ValueError(f"invalid argument `{name}`: must be finite and {'>= 0' if allow_zero else '> 0'}, got {value!r}")
+    return v
+
+
+def _vector2(name: str, value) -> tuple[float, float]:
+    try:
+        arr = np.asarray(value, dtype=np.float64).ravel()
+    except (TypeError, ValueError):
+        raise ValueError(f"invalid argument `{name}`: must be a 2-vector (x, y) in body axes, got {value!r}") from None
+    if arr.shape == (3,):
+        if arr[2] != 0.0:
+            raise ValueError(f"invalid argument `{name}`: the flexible model is planar, the z component must be 0, got {value!r}")
+        arr = arr[:2]
+    if arr.shape != (2,) or not np.all(np.isfinite(arr)):
+        raise ValueError(f"invalid argument `{name}`: must be a finite 2-vector (x, y) in body axes, got {value!r}")
+    return float(arr[0]), float(arr[1])
+
+
+@dataclass(frozen=True)
+class Appendage:
+    """An appendage mass on a spring: ``mass`` (kg) at ``position`` (m, body axes (x, y), from the
+    undeformed system's centre of mass), deflecting along ``direction`` (normal to the position;
+    normalised) against ``stiffness`` (N/m) and ``damping`` (N s/m, >= 0). ``name`` labels it in
+    figures and files.
+
+    Raises ValueError for a non-positive mass or stiffness, negative damping, a mass at the centre
+    of mass (zero position), a zero direction or one not normal to the arm.
+    """
+
+    mass: float
+    position: tuple[float, float]
+    direction: tuple[float, float]
+    stiffness: float
+    damping: float = 0.0
+    name: str = ""
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "mass", _positive("mass", self.mass))
+        object.__setattr__(self, "stiffness", _positive("stiffness", self.stiffness))
+        object.__setattr__(self, "damping", _positive("damping", self.damping, allow_zero=True))
+        b = _vector2("position", self.position)
+        t = _vector2("direction", self.direction)
+        nb, nt = math.hypot(*b), math.hypot(*t)
+        if nb == 0.0:
+            raise ValueError("invalid argument `position`: the appendage sits at the centre of mass (position (0, 0)); "
+                             "positions are measured from the undeformed system's centre of mass")
+        if nt == 0.0:
+            raise ValueError(f"invalid argument `direction`: must be a nonzero vector, got {self.direction!r}")
+        t = (t[0] / nt, t[1] / nt)
+        cosine = (t[0] * b[0] + t[1] * b[1]) / nb
+        if abs(cosine) > GEOMETRY_TOL:
+            raise ValueError(f"invalid argument `direction`: must be normal to the arm (position {b}); "
+                             f"the angle between them is {math.degrees(math.acos(max(-1.0, min(1.0, cosine)))):.6g} deg")
+        object.__setattr__(self, "position", b)
+        object.__setattr__(self, "direction", t)
+        object.__setattr__(self, "name", str(self.name))
+
+    @classmethod
+    def from_frequency(cls, mass: float, position, direction, frequency_hz: float, damping_ratio: float = 0.0, name: str = "") -> Appendage:
+        """An appendage with the clamped natural frequency ``frequency_hz`` (Hz) and damping ratio
+        (k = m (2 pi f)^2, c = 2 zeta sqrt(k m))."""
+        m = _positive("mass", mass)
+        f = _positive("frequency_hz", frequency_hz)
+        z = _positive("damping_ratio", damping_ratio, allow_zero=True)
+        k = m * (2 * math.pi * f) ** 2
+        return cls(m, position, direction, k, 2 * z * math.sqrt(k * m), name)
+
+    @property
+    def frequency(self) -> float:
+        """Clamped natural frequency Omega = sqrt(k / m), rad/s."""
+        return math.sqrt(self.stiffness / self.mass)
+
+    @property
+    def frequency_hz(self) -> float:
+        return self.frequency / (2 * math.pi)
+
+    @property
+    def damping_ratio(self) -> float:
+        """zeta = c / (2 sqrt(k m))."""
+        return self.damping / (2 * math.sqrt(self.stiffness * self.mass))
+
+    @property
+    def lever(self) -> float:
+        """Signed lever arm b x t (m): +|b| when a positive deflection turns counterclockwise."""
+        return self.position[0] * self.direction[1] - self.position[1] * self.direction[0]
+
+    def to_dict(self) -> dict:
+        return {"name": self.name, "mass": self.mass, "position": list(self.position), "direction": list(self.direction),
+                "stiffness": self.stiffness, "damping": self.damping}
+
+
+@dataclass(frozen=True)
+class FlexibleModes:
+    """Free-free modes of a flexible body (hub free to rotate, no external field), from the
+    linearisation about the undeformed body: ``frequency`` (rad/s), ``frequency_hz``,
+    ``damping_ratio`` (from the damped eigenvalues, zeta = -Re(lambda) / |lambda|), ``shapes``
+    (n, n) mass-normalised undamped mode shapes (columns, deflections q), and ``mass`` (n, n), the
+    effective mass matrix M_qq - gamma0 gamma0^T / I0 of the deflections."""
+
+    frequency: np.ndarray
+    damping_ratio: np.ndarray
+    shapes: np.ndarray
+    mass: np.ndarray
+
+    @property
+    def frequency_hz(self) -> np.ndarray:
+        return self.frequency / (2 * math.pi)
+
+
+def _hub(hub) -> RigidBody:
+    if isinstance(hub, RigidBody):
+        if hub.mass_kg is None:
+            raise ValueError("invalid argument `hub`: the hub needs its mass: RigidBody(ix, iy, iz, mass_kg=...)")
+        return hub
+    try:
+        m, j0 = hub
+    except (TypeError, ValueError):
+        raise ValueError(f"invalid argument `hub`: must be a librate.RigidBody with mass_kg, or a pair (mass_kg, J0), got {hub!r}") from None
+    j0 = _positive("hub", j0)
+    return RigidBody(0.5 * j0, 0.5 * j0, j0, mass_kg=_positive("hub", m))
+
+
+@dataclass(frozen=True)
+class FlexibleBody:
+    """A planar flexible spacecraft: a rigid ``hub`` (a :class:`RigidBody` with ``mass_kg``: its
+    principal moments about its own centre, kg m^2, axes along the body axes; or a pair
+    ``(mass_kg, J0)`` for a hub with inertia J0 about z only) and ``appendages`` (a sequence of
+    :class:`Appendage`, positions from the undeformed system's centre of mass).
+
+    Derived: ``total_mass``, ``hub_position`` (the hub centre), ``inertia`` (composite moment about
+    z, kg m^2), ``kz`` and ``principal_angle`` of the rigid composite body (:meth:`rigid_body`).
+    """
+
+    hub: RigidBody
+    appendages: tuple[Appendage, ...]
+    name: str = "custom"
+    _derived: dict = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "hub", _hub(self.hub))
+        try:
+            apps = tuple(self.appendages)
+        except TypeError:
+            raise ValueError(f"invalid argument `appendages`: must be a sequence of librate.Appendage, got {self.appendages!r}") from None
+        for j, a in enumerate(apps):
+            if not isinstance(a, Appendage):
+                raise ValueError(f"invalid argument `appendages`: item {j} must be a librate.Appendage, got {a!r}")
+        object.__setattr__(self, "appendages", apps)
+        object.__setattr__(self, "name", str(self.name))
+        object.__setattr__(self, "_derived", dict(_core.flexible_body_check(self._core_arg(1.0))))
+
+    # --- conversion ---------------------------------------------------------------------------
+    def _core_arg(self, tu_s: float):
+        """(hub_mass, [ix, iy, iz], [(m, b, t, k TU^2, c TU), ...]) for the Rust core."""
+        apps = [(a.mass, list(a.position), list(a.direction), a.stiffness * tu_s * tu_s, a.damping * tu_s) for a in self.appendages]
+        return (float(self.hub.mass_kg), list(self.hub.moments), apps)
+
+    # --- derived quantities ------------------------------------------------------------------
+    @property
+    def n(self) -> int:
+        """Number of appendages (flexible coordinates)."""
+        return len(self.appendages)
+
+    @property
+    def total_mass(self) -> float:
+        return float(self._derived["total_mass"])
+
+    @property
+    def hub_position(self) -> tuple[float, float]:
+        """Hub centre relative to the undeformed system's centre of mass (m)."""
+        return tuple(self._derived["hub_position"])
+
+    @property
+    def inertia(self) -> float:
+        """I0: the composite moment of inertia about z of the undeformed body (kg m^2)."""
+        return float(self._derived["inertia"])
+
+    @property
+    def kz(self) -> float:
+        """Kz = (Iy - Ix) / Iz of the rigid composite body (principal axes)."""
+        return float(self._derived["kz"])
+
+    @property
+    def principal_angle(self) -> float:
+        """Angle (rad) of the composite principal x axis from the body x axis: the rigid
+        composite model's phi is the flexible model's phi plus this angle."""
+        return float(self._derived["principal_angle"])
+
+    @property
+    def mass_matrix(self) -> np.ndarray:
+        """(n, n) mass matrix of the deflections, M_qq = diag(m) - m_j m_k t_j . t_k / M (kg)."""
+        return np.array(self._derived["mass_matrix"], dtype=float).reshape(self.n, self.n)
+
+    @property
+    def frequencies(self) -> np.ndarray:
+        """(n,) clamped natural frequencies Omega_j = sqrt(k_j / m_j), rad/s."""
+        return np.array([a.frequency for a in self.appendages])
+
+    def frequencies_nd(self, system: System | str) -> np.ndarray:
+        """(n,) clamped natural frequencies in rad/TU of ``system``."""
+        return self.frequencies * resolve_system(system).tu_s
+
+    def rigid_body(self) -> RigidBody:
+        """The rigid composite body (undeformed): principal moments (kg m^2) and mass; its x axis
+        is at :attr:`principal_angle` from the body x axis."""
+        re, im = self._derived["asymmetry"]
+        delta = math.hypot(re, im)
+        s = self.hub.ix + self.hub.iy + (self.inertia - self.hub.iz)
+        return RigidBody(0.5 * (s - delta), 0.5 * (s + delta), self.inertia, mass_kg=self.total_mass)
+
+    def modes(self) -> FlexibleModes:
+        """Free-free modes (hub free to rotate, no external field): frequencies (rad/s) and damping
+        ratios from the linearised equations [M_qq - gamma0 gamma0^T / I0] qdd + C qd + K q = 0
+        (the rotation eliminated through the angular momentum), gamma0_j = m_j (b_j x t_j). They
+        are stiffer than the clamped Omega_j: the hub recoils."""
+        from scipy.linalg import eigh
+
+        g = np.array([a.mass * a.lever for a in self.appendages])
+        meff = self.mass_matrix - np.outer(g, g) / self.inertia
+        k = np.diag([a.stiffness for a in self.appendages])
+        c = np.diag([a.damping for a in self.appendages])
+        w2, shapes = eigh(k, meff)
+        n = self.n
+        minv = np.linalg.inv(meff)
+        a = np.block([[np.zeros((n, n)), np.eye(n)], [-minv @ k, -minv @ c]])
+        lam = np.linalg.eigvals(a)
+        osc = sorted((z for z in lam if z.imag > 0), key=abs)
+        real = sorted(z.real for z in lam if z.imag == 0)
+        freq, zeta = [abs(z) for z in osc], [-z.real / abs(z) for z in osc]
+        for i in range(0, len(real) - 1, 2):  # overdamped pairs
+            w = math.sqrt(real[i] * real[i + 1])
+            freq.append(w)
+            zeta.append(-(real[i] + real[i + 1]) / (2 * w))
+        order = np.argsort(freq)
+        return FlexibleModes(np.sqrt(w2), np.asarray(zeta)[order], shapes, meff)
+
+    def scaled(self, frequency_factor: float, name: str | None = None) -> FlexibleBody:
+        """The same body with every clamped frequency multiplied by ``frequency_factor`` (stiffness
+        by its square, damping by it: the damping ratios are kept)."""
+        f = _positive("frequency_factor", frequency_factor)
+        apps = [replace(a, stiffness=a.stiffness * f * f, damping=a.damping * f) for a in self.appendages]
+        return FlexibleBody(self.hub, apps, name if name is not None else f"{self.name} x{f:g}")
+
+    # --- presets -------------------------------------------------------------------------------
+    @classmethod
+    def sample_station(cls, low_frequency: bool = False) -> FlexibleBody:
+        """A real-scale station (ISS-like numbers), thesis Table 5's role; planar, the 109 m truss
+        along the body x axis, the pressurised modules along y, in the orbit plane.
+
+        - total mass 420 t (ISS: about 420 t);
+        - hub 371.28 t: the integrated truss (about 90 t over 109 m, (1/12) m L^2 = 7.5e7 kg m^2)
+          and the pressurised core; principal moments (6.36e6, 75.09471e6, 76.60471e6) kg m^2 about its
+          centre;
+        - four solar-array assemblies of 2180 kg (two 35 m x 12 m wings of about 1090 kg each, as
+          on the ISS photovoltaic modules) at x = +-33 m and +-47.5 m along the truss, bending in
+          the plane normal to it (along +-y), first bending mode 0.10 Hz (the ISS wings' first modes
+          are 0.05-0.1 Hz), damping ratio 0.5 %;
+        - two module clusters of 20 t (a laboratory and a habitation stack, each about one and a
+          half ISS modules) at y = +-12 m, bending along x, first mode 0.50 Hz, damping ratio 0.5 %.
+
+        The rigid composite body is the thesis's canonical case (Table 3): Ix = 12.12e6,
+        Iy = 89.68e6, Iz = 96.95e6 kg m^2, Kz = 0.800. With the Earth-Moon TU (375190 s) the
+        structural frequencies are 2.4e5 and 1.2e6 rad/TU, five orders of magnitude above the
+        orbital and attitude rates: the quasi-static regime (:func:`quasi_static`).
+
+        ``low_frequency=True``: the same structure with every frequency lowered by the factor
+        34560, which puts the arrays' first mode at a 4-day period (1.82e-5 rad/s, 6.82 rad/TU)
+        and the modules' at 0.8 days, within a decade of the orbital and attitude rates (thesis
+        Figs. 45-46: "lowered frequencies"); the damping ratios are kept.
+        """
+        zeta = 0.005
+        arrays = [
+            ("array P4 (inboard port)", (-33.0, 0.0), (0.0, -1.0)),
+            ("array S4 (inboard starboard)", (33.0, 0.0), (0.0, 1.0)),
+            ("array P6 (outboard port)", (-47.5, 0.0), (0.0, -1.0)),
+            ("array S6 (outboard starboard)", (47.5, 0.0), (0.0, 1.0)),
+        ]
+        apps = [Appendage.from_frequency(2180.0, b, t, 0.10, zeta, name) for name, b, t in arrays]
+        apps += [
+            Appendage.from_frequency(20000.0, (0.0, 12.0), (-1.0, 0.0), 0.50, zeta, "laboratory modules"),
+            Appendage.from_frequency(20000.0, (0.0, -12.0), (1.0, 0.0), 0.50, zeta, "habitation modules"),
+        ]
+        body = cls(RigidBody(6.36e6, 75.09471e6, 76.60471e6, mass_kg=371280.0), apps, "sample-station")
+        if low_frequency:
+            return body.scaled(1.0 / LOW_FREQUENCY_FACTOR, "sample-station-low-frequency")
+        return body
+
+    @classmethod
+    def preset(cls, name: str) -> FlexibleBody:
+        """A named preset: ``"sample-station"`` or ``"sample-station-low-frequency"``."""
+        if name == "sample-station":
+            return cls.sample_station()
+        if name == "sample-station-low-frequency":
+            return cls.sample_station(low_frequency=True)
+        raise ValueError(f"invalid argument `name`: unknown flexible-body preset {name!r}; known: {', '.join(FLEXIBLE_PRESETS)}")
+
+    # --- files ---------------------------------------------------------------------------------
+    def to_dict(self) -> dict:
+        """Plain data (SI units): name, hub (mass, inertia), appendages."""
+        return {"name": self.name, "hub": {"mass": float(self.hub.mass_kg), "inertia": list(self.hub.moments)},
+                "appendages": [a.to_dict() for a in self.appendages]}
+
+    @classmethod
+    def from_dict(cls, data: dict) -> FlexibleBody:
+        """From :meth:`to_dict`'s layout, or ``{"preset": name}`` (optionally with
+        ``low_frequency``). Appendages may give ``frequency_hz`` (and ``damping_ratio``) instead of
+        ``stiffness`` (and ``damping``)."""
+        if not isinstance(data, dict):
+            raise ValueError(f"invalid argument `data`: must be a dict, got {type(data).__name__}")
+        if "preset" in data:
+            name = str(data["preset"]).replace("_", "-")
+            if data.get("low_frequency", False) and not name.endswith("low-frequency"):
+                name += "-low-frequency"
+            return cls.preset(name)
+        try:
+            hub = data["hub"]
+            inertia = hub["inertia"]
+            hub_body = RigidBody(*map(float, inertia), mass_kg=float(hub["mass"])) if np.ndim(inertia) else (hub["mass"], inertia)
+            apps = []
+            for j, a in enumerate(data.get("appendages", [])):
+                kw = {"name": a.get("name", "")}
+                if "stiffness" in a:
+                    apps.append(Appendage(a["mass"], a["position"], a["direction"], a["stiffness"], a.get("damping", 0.0), **kw))
+                elif "frequency_hz" in a:
+                    apps.append(Appendage.from_frequency(a["mass"], a["position"], a["direction"], a["frequency_hz"], a.get("damping_ratio", 0.0), **kw))
+                else:
+                    raise ValueError(f"invalid argument `appendages`: appendage {j} needs `stiffness` (N/m) or `frequency_hz`")
+        except (KeyError, TypeError) as exc:
+            raise ValueError(f"invalid argument `data`: a flexible body needs hub.mass, hub.inertia and appendages with mass, position, direction ({exc!r})") from None
+        return cls(hub_body, apps, data.get("name", "custom"))
+
+    def to_toml(self, path=None) -> str:
+        """The body as TOML (SI units); written to ``path`` when given. Read back with
+        :meth:`from_toml`."""
+        def num(v):
+            return repr(float(v))
+
+        lines = [f"name = {json.dumps(self.name)}", "", "[hub]", f"mass = {num(self.hub.mass_kg)}  # kg",
+                 f"inertia = [{', '.join(num(v) for v in self.hub.moments)}]  # kg m^2, principal, about the hub centre"]
+        for a in self.appendages:
+            lines += ["", "[[appendages]]", f"name = {json.dumps(a.name)}", f"mass = {num(a.mass)}  # kg",
+                      f"position = [{num(a.position[0])}, {num(a.position[1])}]  # m, from the undeformed centre of mass",
+                      f"direction = [{num(a.direction[0])}, {num(a.direction[1])}]",
+                      f"stiffness = {num(a.stiffness)}  # N/m ({a.frequency_hz:.6g} Hz)",
+                      f"damping = {num(a.damping)}  # N s/m (damping ratio {a.damping_ratio:.6g})"]
+        text = "\n".join(lines) + "\n"
+        if path is not None:
+            Path(path).write_text(text)
+        return text
+
+    @classmethod
+    def from_toml(cls, source) -> FlexibleBody:
+        """From a TOML file path or TOML text: :meth:`to_toml`'s layout, or ``preset =
+        "sample-station"`` (with ``low_frequency = true`` for the low-frequency variant)."""
+        try:
+            import tomllib
+        except ImportError:  # Python 3.10
+            try:
+                import tomli as tomllib  # type: ignore[no-redef]
+            except ImportError:
+                raise ImportError("reading TOML on Python 3.10 needs tomli: pip install tomli") from None
+        text = source
+        if isinstance(source, Path) or (isinstance(source, str) and "\n" not in source and "=" not in source):
+            text = Path(source).read_text()
+        try:
+            data = tomllib.loads(text)
+        except tomllib.TOMLDecodeError as exc:
+            raise ValueError(f"invalid argument `source`: not valid TOML ({exc})") from None
+        return cls.from_dict(data)
+
+
+#: Factor by which :meth:`FlexibleBody.sample_station` (``low_frequency=True``) lowers every frequency.
+LOW_FREQUENCY_FACTOR = 34560.0
+#: Names accepted by :meth:`FlexibleBody.preset`.
+FLEXIBLE_PRESETS = ("sample-station", "sample-station-low-frequency")
+
+
+# --- propagation -------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class FlexibleResponse:
+    """The flexible coordinates of a :func:`librate.propagate_attitude` run with a
+    :class:`FlexibleBody` (``traj.flex``): ``q`` (n_t, n) deflections (m) and ``qdot`` (n_t, n)
+    their rates (m/TU), with the run's system, body, enabled primaries and the trajectory's t,
+    orbit, phi, wz."""
+
+    system: System
+    body: FlexibleBody
+    primaries: tuple[bool, bool]
+    t: np.ndarray
+    orbit: np.ndarray
+    phi: np.ndarray
+    wz: np.ndarray
+    q: np.ndarray
+    qdot: np.ndarray
+
+    def energies(self) -> dict[str, np.ndarray]:
+        """Per output time, in SI: ``kinetic`` (J, motion about the centre of mass, inertial
+        rates), ``elastic`` (J), ``tidal`` (J, the second-order gravity potential of the enabled
+        primaries), ``momentum`` (kg m^2/s, inertial, about the centre of mass), ``structural``
+        (J: kinetic + elastic - momentum^2 / (2 I), the energy above rigid rotation with the same
+        momentum), ``torque`` (N m, tidal torque on the deformed body), ``inertia`` (kg m^2,
+        I(q))."""
+        e = _core.flexible_energies(self.system.mu, self.body._core_arg(self.system.tu_s), list(self.primaries),
+                                    np.ascontiguousarray(self.orbit), np.ascontiguousarray(self.phi), np.ascontiguousarray(self.wz),
+                                    np.ascontiguousarray(self.q), np.ascontiguousarray(self.qdot))
+        tu = self.system.tu_s
+        out = {k: np.asarray(v) for k, v in e.items()}
+        for k in ("kinetic", "elastic", "tidal", "structural", "torque"):
+            out[k] = out[k] / tu**2
+        out["momentum"] = out["momentum"] / tu
+        return out
+
+    def jacobi_energy(self, mean_motion: float) -> np.ndarray:
+        """E_J = T + V_el + V_tidal - n h_z (J) for a circular orbit of inertial mean motion
+        ``mean_motion`` (rad/TU) about one primary (the other off): constant without damping."""
+        e = self.energies()
+        return e["kinetic"] + e["elastic"] + e["tidal"] - mean_motion / self.system.tu_s * e["momentum"]
+
+
+def _primaries(names: Sequence[str]) -> list[bool]:
+    return [any(n in ("gravity_gradient", "gravity_gradient_earth") for n in names),
+            any(n in ("gravity_gradient", "gravity_gradient_moon") for n in names)]
+
+
+def _pair(attitude) -> tuple[float, float]:
+    try:
+        phi0, wz0 = (float(v) for v in attitude)
+    except (TypeError, ValueError):
+        raise ValueError(f"invalid argument `attitude`: flexible runs are planar and take (phi0, wz0), got {attitude!r}") from None
+    if not (math.isfinite(phi0) and math.isfinite(wz0)):
+        raise ValueError(f"invalid argument `attitude`: (phi0, wz0) must be finite, got {attitude!r}")
+    return phi0, wz0
+
+
+def _deflection(deflection, sys_, body, primaries, held, s, phi0, wz0):
+    n = body.n
+    if deflection is None or (isinstance(deflection, str) and deflection == "rest"):
+        return [0.0] * n, [0.0] * n
+    if isinstance(deflection, str):
+        if deflection != "quasi-static":
+            raise ValueError(f"invalid argument `deflection`: must be None/'rest', 'quasi-static' or (q0, qdot0), got {deflection!r}")
+        q, qd, *_ = _core.flexible_quasi_static_point(sys_.mu, body._core_arg(sys_.tu_s), primaries, held, [float(v) for v in s], phi0, wz0)
+        return list(q), list(qd)
+    try:
+        q0, qd0 = deflection
+        q0 = np.asarray(q0, dtype=np.float64).ravel()
+        qd0 = np.asarray(qd0, dtype=np.float64).ravel()
+    except (TypeError, ValueError):
+        raise ValueError(f"invalid argument `deflection`: must be None/'rest', 'quasi-static' or (q0, qdot0), got {deflection!r}") from None
+    if q0.shape != (n,) or qd0.shape != (n,) or not (np.all(np.isfinite(q0)) and np.all(np.isfinite(qd0))):
+        raise ValueError(f"invalid argument `deflection`: q0 (m) and qdot0 (m/TU) need {n} finite values each, got shapes {q0.shape}, {qd0.shape}")
+    return q0.tolist(), qd0.tolist()
+
+
+def _propagate_flexible(sys_, s, attitude, body, t0, tf, names, orbit, opts, te, deflection, stm) -> AttitudeTrajectory:
+    """The branch of :func:`librate.propagate_attitude` for a :class:`FlexibleBody`."""
+    if stm:
+        raise ValueError("invalid argument `stm`: the flexible model has no STM; use stm=False")
+    if orbit not in ("integrate", "held"):
+        raise ValueError(f"invalid argument `orbit`: the flexible model takes 'integrate' or 'held', got {orbit!r}")
+    phi0, wz0 = _pair(attitude)
+    primaries = _primaries(names)
+    held = orbit == "held"
+    q0, qd0 = _deflection(deflection, sys_, body, primaries, held, s, phi0, wz0)
+    r = _core.flexible_propagate(sys_.mu, body._core_arg(sys_.tu_s), primaries, held, [float(v) for v in s], phi0, wz0, q0, qd0,
+                                 t0, tf, options=opts, t_eval=te)
+    phi, wz = r["phi"], r["wz"]
+    zero = np.zeros_like(phi)
+    quat = np.stack([zero, zero, np.sin(0.5 * phi), np.cos(0.5 * phi)], axis=1)
+    w = np.stack([zero, zero, wz], axis=1)
+    flex = FlexibleResponse(sys_, body, tuple(primaries), r["t"], r["orbit"], phi, wz, r["q"], r["qdot"])
+    return AttitudeTrajectory(sys_, body, tuple(names), True, r["t"], r["orbit"], quat, w, phi, wz, None, Stats(*r["stats"]), flex=flex)
+
+
+def _common(system, orbit_state, body, t_span, torques, orbit):
+    sys_ = resolve_system(system)
+    s = as_state(orbit_state, "orbit_state")
+    t0, tf = as_time_span(t_span)
+    if not isinstance(body, FlexibleBody):
+        raise ValueError(f"invalid argument `body`: must be a librate.FlexibleBody, got {type(body).__name__}")
+    names = tuple(torques)
+    for n in names:
+        if n not in TORQUES:
+            raise ValueError(f"invalid argument `torques`: unknown torque {n!r}; known: {', '.join(TORQUES)}")
+    if orbit not in ("integrate", "held"):
+        raise ValueError(f"invalid argument `orbit`: must be 'integrate' or 'held', got {orbit!r}")
+    return sys_, s, t0, tf, names
+
+
+# --- high frequencies: the closed form ---------------------------------------------------------
+@dataclass(frozen=True)
+class QuasiStaticResponse:
+    """Result of :func:`quasi_static`. ``phi``, ``wz`` (n_t,): the rigid composite solution (phi of
+    the body x axis); ``q``, ``qdot``, ``qddot`` (n_t, n): the closed-form deflections q_j = L_j / k_j
+    along it (with the damper's lag) and their derivatives (m, m/TU, m/TU^2); ``dtau`` (n_t,): the first-order torque
+    perturbation (N m); ``dphi``, ``dwz``: the first-order attitude perturbation (rad, rad/TU),
+    so the flexible model's attitude is ``phi + dphi``, ``wz + dwz`` to O((rate / Omega)^4)."""
+
+    system: System
+    body: FlexibleBody
+    t: np.ndarray
+    orbit: np.ndarray
+    phi: np.ndarray
+    wz: np.ndarray
+    dphi: np.ndarray
+    dwz: np.ndarray
+    q: np.ndarray
+    qdot: np.ndarray
+    qddot: np.ndarray
+    dtau: np.ndarray
+    stats: Stats
+
+    @property
+    def load(self) -> np.ndarray:
+        """(n_t, n) transverse loads L_j = k_j q_j on the appendages (N)."""
+        return self.q * np.array([a.stiffness for a in self.body.appendages])
+
+
+def quasi_static(
+    system: System | str,
+    orbit_state,
+    attitude,
+    body: FlexibleBody,
+    t_span,
+    *,
+    torques: Sequence[str] = ("gravity_gradient",),
+    orbit: str = "integrate",
+    t_eval=None,
+    rtol: float = 1e-12,
+    atol: float = 1e-12,
+    max_steps: int = 1_000_000,
+) -> QuasiStaticResponse:
+    """High structural frequencies: the quasi-static closed form along the rigid solution.
+
+    The rigid composite body (the flexible body frozen undeformed) is propagated from
+    ``attitude = (phi0, wz0)`` (phi of the body x axis, wz inertial). Along it, the transverse load
+    on m_j is L_j = m_j [t_j . T_B b_j - wzdot (b_j x t_j)] (tidal + Euler; the centrifugal part
+    vanishes because t_j is normal to b_j), and the deflection is q_j = L_j / k_j
+    = L_j / (m_j Omega_j^2), less the damper's lag c_j L_j' / k_j^2 (a relative
+    2 zeta_j rate / Omega_j), with its derivatives in closed form from the orbit's velocity and
+    acceleration. Fed back into the attitude equation, it gives the torque perturbation
+    dtau = sum_j [dtau/dq_j q_j - m_j (b_j x t_j) qddot_j] and the attitude perturbation
+    (dphi, dwz) from the rigid variational equation forced by dtau / I0 (Duhamel's integral along
+    the rigid solution). Valid when Omega_j >> the orbital and attitude rates: the full model
+    differs from q by a relative O((rate / Omega)^2).
+    """
+    sys_, s, t0, tf, names = _common(system, orbit_state, body, t_span, torques, orbit)
+    phi0, wz0 = _pair(attitude)
+    opts = _options(rtol, atol, None, 0.0, math.inf, max_steps, 0.8, None)
+    te = None if t_eval is None else np.ascontiguousarray(t_eval, dtype=np.float64).ravel()
+    r = _core.flexible_quasi_static(sys_.mu, body._core_arg(sys_.tu_s), _primaries(names), orbit == "held", [float(v) for v in s],
+                                    phi0, wz0, t0, tf, options=opts, t_eval=te)
+    tu2 = sys_.tu_s**2
+    return QuasiStaticResponse(sys_, body, r["t"], r["orbit"], r["phi"], r["wz"], r["dphi"], r["dwz"], r["q"], r["qdot"], r["qddot"],
+                               r["dtau"] / tu2, Stats(*r["stats"]))
+
+
+# --- periodic orbit-attitude solutions ----------------------------------------------------------
+@dataclass(frozen=True)
+class FlexiblePeriodic:
+    """Result of :func:`flexible_periodic`: what flexibility does to a rigid periodic solution.
+
+    First order (closed form, always computed): ``drift`` = (dphi(T), dwz(T)), the flexible
+    motion's departure from the rigid one after one period when started from the rigid initial
+    state on the quasi-static manifold; ``max_dphi``, ``max_dwz`` over the period; ``shift`` =
+    (dphi0, dwz0) = -(M - I)^{-1} drift, the first-order move of the periodic solution (M the
+    rigid monodromy).
+
+    Full model (``method="full"``): ``full_drift`` from a re-propagation of the coupled model over
+    one period, ``full_max_dphi``, ``full_max_dwz``; when re-solved, the periodic solution of the
+    coupled model (``phi0``, ``wz0``, ``q0`` (m), ``qdot0`` (m/TU)) by Newton on all 2 + 2n initial
+    values with a finite-difference Jacobian, its ``residual`` (scaled: rad, rad/TU and q relative
+    to the quasi-static amplitude), ``iterations``, ``multipliers`` (eigenvalues of the coupled
+    monodromy) and ``full_shift`` = (phi0 - phi0_rigid, wz0 - wz0_rigid).
+    """
+
+    solution: object
+    body: FlexibleBody
+    method: str
+    drift: np.ndarray
+    max_dphi: float
+    max_dwz: float
+    shift: np.ndarray
+    full_drift: np.ndarray | None = None
+    full_max_dphi: float | None = None
+    full_max_dwz: float | None = None
+    phi0: float | None = None
+    wz0: float | None = None
+    q0: np.ndarray | None = None
+    qdot0: np.ndarray | None = None
+    residual: float | None = None
+    iterations: int | None = None
+    multipliers: np.ndarray | None = None
+
+    @property
+    def full_shift(self) -> np.ndarray | None:
+        if self.phi0 is None:
+            return None
+        r = self.solution
+        return np.array([self.phi0 - (r.phi0 - self.body.principal_angle), self.wz0 - r.wz0])
+
+    @property
+    def stable(self) -> bool | None:
+        """Coupled solution linearly stable (all multipliers within 1e-6 of the unit circle or inside)."""
+        if self.multipliers is None:
+            return None
+        return bool(np.max(np.abs(self.multipliers)) <= 1 + 1e-6)
+
+
+def flexible_periodic(
+    solution,
+    body: FlexibleBody,
+    *,
+    method: str = "auto",
+    resolve: bool = True,
+    tol: float = 1e-10,
+    max_iter: int = 20,
+    rtol: float = 1e-12,
+    atol: float = 1e-12,
+    max_steps: int = 2_000_000,
+) -> FlexiblePeriodic:
+    """The effect of flexibility on a rigid periodic orbit-attitude solution (an
+    :class:`~librate.AttitudeSolution` of :func:`~librate.periodic_attitude` computed with
+    ``kz=body.kz``, one orbit period).
+
+    ``method``: "quasi-static" (first order in (rate / Omega)^2, closed form: cheap at any
+    stiffness), "full" (the coupled model re-propagated and, with ``resolve``, the periodic
+    solution re-solved), or "auto": "full" when the stiffest mode makes fewer than 2e4 radians per
+    orbit period (the re-propagation is then cheap), else "quasi-static".
+    """
+    from .periodicity import AttitudeSolution
+
+    if not isinstance(solution, AttitudeSolution):
+        raise ValueError(f"invalid argument `solution`: must be a librate.AttitudeSolution, got {type(solution).__name__}")
+    if not isinstance(body, FlexibleBody):
+        raise ValueError(f"invalid argument `body`: must be a librate.FlexibleBody, got {type(body).__name__}")
+    if abs(solution.kz - body.kz) > 1e-9 * max(1.0, abs(body.kz)):
+        raise ValueError(f"invalid argument `solution`: it was computed for Kz = {solution.kz!r}, the body's composite Kz is {body.kz!r}; "
+                         "solve the rigid problem with kz=body.kz")
+    if method not in ("auto", "quasi-static", "full"):
+        raise ValueError(f"invalid argument `method`: must be 'auto', 'quasi-static' or 'full', got {method!r}")
+    orbit = solution.orbit
+    sys_ = orbit.system
+    T = orbit.period
+    if method == "auto":
+        method = "full" if float(np.max(body.frequencies_nd(sys_))) * T <= 2e4 else "quasi-static"
+    phi0 = solution.phi0 - body.principal_angle
+    wz0 = solution.wz0
+    turns = solution.n + (0.5 if solution.kind == "half-turn" else 0.0)
+    te = np.linspace(0.0, T, 401)
+    qs = quasi_static(sys_, orbit.state0, (phi0, wz0), body, T, t_eval=te, rtol=rtol, atol=atol, max_steps=max_steps)
+    drift = np.array([qs.dphi[-1], qs.dwz[-1]])
+    try:
+        shift = -np.linalg.solve(np.asarray(solution.monodromy) - np.eye(2), drift)
+    except np.linalg.LinAlgError:
+        shift = np.full(2, np.nan)
+    out = dict(solution=solution, body=body, method=method, drift=drift, max_dphi=float(np.max(np.abs(qs.dphi))),
+               max_dwz=float(np.max(np.abs(qs.dwz))), shift=shift)
+    if method == "quasi-static":
+        return FlexiblePeriodic(**out)
+
+    opts = _options(rtol, atol, None, 0.0, math.inf, max_steps, 0.8, None)
+    arg = body._core_arg(sys_.tu_s)
+    s0 = [float(v) for v in orbit.state0]
+    n = body.n
+
+    def flow(x, t_eval=None):
+        return _core.flexible_propagate(sys_.mu, arg, [True, True], False, s0, float(x[0]), float(x[1]), list(x[2:2 + n]), list(x[2 + n:]),
+                                        0.0, T, options=opts, t_eval=t_eval)
+
+    x = np.concatenate([[phi0, wz0], qs.q[0], qs.qdot[0]])
+    r = flow(x, te)
+    out.update(full_drift=np.array([r["phi"][-1] - phi0 - 2 * math.pi * turns, r["wz"][-1] - wz0]),
+               full_max_dphi=float(np.max(np.abs(r["phi"] - qs.phi))), full_max_dwz=float(np.max(np.abs(r["wz"] - qs.wz))))
+    if not resolve:
+        return FlexiblePeriodic(**out)
+
+    # Newton on all 2 + 2n initial values, residuals scaled by the quasi-static amplitudes.
+    omega = body.frequencies_nd(sys_)
+    qscale = np.maximum(np.max(np.abs(qs.q), axis=0), 1e-12)
+    scale = np.concatenate([[1.0, 1.0], qscale, qscale * omega])
+    target = np.zeros(2 + 2 * n)
+    target[0] = 2 * math.pi * turns
+
+    def residual(x):
+        y = flow(x)
+        yf = np.concatenate([[y["phi"][-1], y["wz"][-1]], y["q"][-1], y["qdot"][-1]])
+        return (yf - x - target) / scale, yf
+
+    res, _ = residual(x)
+    it = 0
+    jac = None
+    for it in range(1, max_iter + 1):
+        jac = np.empty((2 + 2 * n, 2 + 2 * n))
+        for i in range(2 + 2 * n):
+            h = 1e-6 * scale[i]
+            xp, xm = x.copy(), x.copy()
+            xp[i] += h
+            xm[i] -= h
+            jac[:, i] = (residual(xp)[0] - residual(xm)[0]) / (2 * h) * scale[i]
+        dx = np.linalg.lstsq(jac, -res, rcond=None)[0] * scale
+        step = 1.0
+        for _ in range(8):
+            trial = x + step * dx
+            r_trial, _ = residual(trial)
+            if np.max(np.abs(r_trial)) < np.max(np.abs(res)):
+                break
+            step *= 0.5
+        x, res = trial, r_trial
+        if np.max(np.abs(res)) < tol:
+            break
+    # monodromy of the coupled model: d y(T) / d x = jacobian of the residual + identity (unscaled)
+    mono = (jac * scale[:, None] / scale[None, :]) + np.eye(2 + 2 * n) if jac is not None else None
+    out.update(phi0=float(x[0]), wz0=float(x[1]), q0=x[2:2 + n].copy(), qdot0=x[2 + n:].copy(), residual=float(np.max(np.abs(res))),
+               iterations=it, multipliers=np.linalg.eigvals(mono) if mono is not None else None)
+    return FlexiblePeriodic(**out)
+
+
+# --- low frequencies: the coupled response against the structural frequency --------------------
+@dataclass(frozen=True)
+class FrequencyScan:
+    """Result of :func:`frequency_scan`, one row per frequency factor: ``factors``; ``frequency``
+    (n_f, n) the clamped frequencies (rad/TU); ``max_q`` (n_f, n) the largest deflection of the
+    coupled model (m) and ``max_q_quasi_static`` that of the closed form (m), their ratio
+    ``amplification`` (1 in the quasi-static regime, large near resonances); ``max_dphi``,
+    ``max_dwz``: the largest departure of the attitude from the rigid composite solution (rad,
+    rad/TU); ``max_structural`` (J): the largest structural energy."""
+
+    factors: np.ndarray
+    frequency: np.ndarray
+    max_q: np.ndarray
+    max_q_quasi_static: np.ndarray
+    max_dphi: np.ndarray
+    max_dwz: np.ndarray
+    max_structural: np.ndarray
+
+    @property
+    def amplification(self) -> np.ndarray:
+        return self.max_q / self.max_q_quasi_static
+
+
+def frequency_scan(
+    system: System | str,
+    orbit_state,
+    attitude,
+    body: FlexibleBody,
+    t_span,
+    factors,
+    *,
+    torques: Sequence[str] = ("gravity_gradient",),
+    orbit: str = "integrate",
+    deflection: str = "quasi-static",
+    samples: int = 1001,
+    rtol: float = 1e-11,
+    atol: float = 1e-11,
+    max_steps: int = 2_000_000,
+) -> FrequencyScan:
+    """The coupled response of ``body.scaled(f)`` for each frequency factor ``f`` in ``factors``:
+    the coupled model and the rigid composite model from the same ``attitude`` (and the
+    ``deflection`` start, default the quasi-static one), compared on ``samples`` times. Where a
+    structural frequency meets the orbital and attitude forcing, the deflections exceed the
+    quasi-static ones (amplification) and the attitude departs from the rigid motion: the exchange
+    between structural and attitude motion."""
+    from .attitude import propagate_attitude
+
+    sys_, s, t0, tf, names = _common(system, orbit_state, body, t_span, torques, orbit)
+    fs = np.asarray(factors, dtype=float).ravel()
+    if fs.size == 0 or not np.all(np.isfinite(fs)) or np.any(fs <= 0):
+        raise ValueError(f"invalid argument `factors`: must be positive numbers, got {factors!r}")
+    te = np.linspace(t0, tf, int(samples))
+    rows = []
+    for f in fs:
+        b = body.scaled(float(f))
+        qs = quasi_static(sys_, s, attitude, b, (t0, tf), torques=names, orbit=orbit, t_eval=te, rtol=rtol, atol=atol, max_steps=max_steps)
+        tr = propagate_attitude(sys_, s, attitude, b, (t0, tf), torques=names, orbit=orbit, t_eval=te, deflection=deflection,
+                                rtol=rtol, atol=atol, max_steps=max_steps)
+        e = tr.flex.energies()
+        rows.append((b.frequencies_nd(sys_), np.max(np.abs(tr.flex.q), axis=0), np.max(np.abs(qs.q), axis=0),
+                     float(np.max(np.abs(tr.phi - qs.phi))), float(np.max(np.abs(tr.wz - qs.wz))), float(np.max(e["structural"]))))
+    cols = list(zip(*rows))
+    return FrequencyScan(fs, np.array(cols[0]), np.array(cols[1]), np.array(cols[2]), np.array(cols[3]), np.array(cols[4]), np.array(cols[5]))
