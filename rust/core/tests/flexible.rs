@@ -136,7 +136,7 @@ fn val_rigid_limit_with_composite_inertia() {
     for s in [1e2f64, 1e3, 1e4] {
         let body = station(10.0 * s.sqrt(), 20.0 * s.sqrt(), 0.0);
         assert_eq!(body.principal_angle(), 0.0);
-        let rigid = propagate_planar(MU, body.kz(), [true, true], false, &orbit, phi0, wz0, 0.0, period, &tight(), false, Output::At(&times)).unwrap();
+        let rigid = propagate_planar(MU, body.kz(), [true, true], false, &orbit, phi0, wz0, 0.0, period, &tight(), false, Output::At(&times), None).unwrap();
         let qs0 = quasi_static_point(MU, &body, [true, true], false, &orbit, phi0, wz0).unwrap();
         let flex = propagate_flexible(MU, &body, [true, true], false, &orbit, phi0, wz0, &qs0.q, &qs0.qdot, 0.0, period, &tight(), Output::At(&times)).unwrap();
         let cf = propagate_quasi_static(MU, &body, [true, true], false, &orbit, phi0, wz0, 0.0, period, &tight(), Output::At(&times)).unwrap();
