@@ -16,6 +16,8 @@ from .periodicity import AttitudeFamily, AttitudeSolution, SrpContinuation, atti
 from .srp import Facet, FacetBody, FlatPlateSRP, SunModel
 from .propagation import BatchResult, Event, EventHit, Stats, Trajectory, propagate, propagate_many
 from .system import System
+from .results import open_result
+from .study import Study, StudyError
 
 __all__ = [
     "__version__",
@@ -65,4 +67,7 @@ __all__ = [
     "osculating_elements",
     "MeanElements",
     "mean_elements",
+    "Study",
+    "StudyError",
+    "open_result",
 ]
