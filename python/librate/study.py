@@ -349,9 +349,10 @@ def _grid_raw(g) -> Any:
 def _check_increasing(key: str, g, problems: list[str]) -> None:
     if isinstance(g, Range):
         if g.num < 2:
-            problems.append(_problem(f"{key}.num", g.num, "a rate grid needs at least 2 values"))
+            problems.append(_problem(f"{key}.num", g.num, "a rate grid needs at least 2 values", "an integer in [2, 1000000]"))
         if not g.start < g.stop:
-            problems.append(_problem(f"{key}.stop", g.stop, f"must be greater than {key}.start = {_show(g.start)} (rates increase)"))
+            problems.append(_problem(f"{key}.stop", g.stop, f"must be greater than {key}.start = {_show(g.start)} (rates increase)",
+                                     f"a number > {key}.start"))
     else:
         v = np.asarray(g, dtype=float)
         if v.size < 2:
@@ -479,21 +480,23 @@ def _check_sections(s: dict[str, _Table], given: dict, purpose: str | None) -> l
 
     # what the command needs
     if purpose in ("solve", "map"):
-        what = "periodic solutions" if purpose == "solve" else "a periodicity map"
+        what, need = ("periodic solutions", "need") if purpose == "solve" else ("a periodicity map", "needs")
         if "body" not in given:
-            problems.append(_missing("body", f"missing section [body]: {what} need the body (body.kz, or body.ix/iy/iz)"))
+            problems.append(_missing("body", f"missing section [body]: {what} {need} the body (body.kz, or body.ix/iy/iz)"))
         if "rates" not in given:
-            problems.append(_missing("rates", f"missing section [rates]: {what} need the initial rates (rates.wz0 or rates.phidot0)"))
+            problems.append(_missing("rates", f"missing section [rates]: {what} {need} the initial rates (rates.wz0 or rates.phidot0)"))
         if orb is not None and orb.kind == "halo":
-            problems.append(_problem("orbits.kind", orb.kind, f"{what} use the planar attitude model, which needs a planar family", "'dro' or 'lyapunov'"))
+            problems.append(_problem("orbits.kind", orb.kind, f"{what} use{'s' if need == 'needs' else ''} the planar attitude model, which needs a planar family",
+                                     "'dro' or 'lyapunov'"))
         if tq is not None and sorted(tq.gravity_gradient) != ["earth", "moon"]:
             problems.append(_problem("torques.gravity_gradient", tq.gravity_gradient,
                                      f"the planar engine behind {what} models the gravity gradient of both primaries", "[\"earth\", \"moon\"]"))
         if tq is not None and tq.srp is not None and orb is not None:
-            if orb.sun_resonance is None or len(orb.sun_resonance) != 1:
-                problems.append(_problem("orbits.sun_resonance", orb.sun_resonance if orb.sun_resonance is not None else "(not set)",
-                                         "with torques.srp the forcing is periodic only on a Sun-resonant orbit (T = Ts / k): select exactly one",
-                                         "a list of one integer k >= 1, e.g. [2]"))
+            why = "with torques.srp the forcing is periodic only on a Sun-resonant orbit (T = Ts / k): select exactly one"
+            if orb.sun_resonance is None:
+                problems.append(_missing("orbits.sun_resonance", f"missing: {why}, e.g. orbits.sun_resonance = [2]"))
+            elif len(orb.sun_resonance) != 1:
+                problems.append(_problem("orbits.sun_resonance", orb.sun_resonance, why, "a list of one integer k >= 1, e.g. [2]"))
             else:
                 k = orb.sun_resonance[0]
                 sol = s.get("solver")
