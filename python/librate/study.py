@@ -23,6 +23,7 @@ import copy
 import difflib
 import json
 import math
+import re
 import sys
 from collections.abc import Callable
 from pathlib import Path
@@ -242,7 +243,7 @@ _RANGE_ALLOWED = {
 
 
 def _allowed(key: str) -> str | None:
-    base = "".join(ch for ch in key if not ch.isdigit() and ch not in "[]")
+    base = re.sub(r"\[\d+\]", "", key)
     if key in ALLOWED or base in ALLOWED:
         text = ALLOWED.get(key) or ALLOWED[base]
     else:
@@ -291,7 +292,7 @@ def _dotted(prefix: str, loc: tuple) -> str:
 
 
 def _keys_of(parent: str) -> list[str] | None:
-    base = "".join(ch for ch in parent if not ch.isdigit() and ch not in "[]")
+    base = re.sub(r"\[\d+\]", "", parent)
     if base == "":
         return list(_TOP_KEYS)
     if base in _TABLES:
@@ -463,7 +464,7 @@ def _check_sections(s: dict[str, _Table], given: dict, purpose: str | None) -> l
                 problems.append(_problem("torques.srp.cd", srp.cd, f"cs + cd = {srp.cs + srp.cd:g} exceeds 1 (the absorbed fraction is 1 - cs - cd)"))
             if srp.pressure is not None and srp.eps is not None:
                 problems.append(_problem("torques.srp.pressure", srp.pressure, "only used with the geometry (area_m2, offset_m); eps already includes it"))
-            if geo and body is not None and body.iz is None and body.kz is not None:
+            if srp.eps is None and len(geo) == 2 and body is not None and body.iz is None and body.kz is not None:
                 problems.append(_problem("torques.srp.area_m2", srp.area_m2, "the plate's geometry needs the body's Iz in kg m^2 (body.ix, body.iy, body.iz); with body.kz alone give torques.srp.eps",
                                          "torques.srp.eps with body.kz, or the geometry with body.ix/iy/iz"))
 
