@@ -63,10 +63,13 @@ def _resolve(path: str | Path) -> Path:
 def _open_dataset(p: Path):
     import xarray as xr
 
-    if p.is_file() and p.suffix == ".nc":
-        return xr.open_dataset(p, engine="scipy")
-    if _is_zarr(p):
-        return xr.open_dataset(p, engine="zarr", chunks=None)
+    try:
+        if p.is_file() and p.suffix == ".nc":
+            return xr.open_dataset(p, engine="scipy")
+        if _is_zarr(p):
+            return xr.open_dataset(p, engine="zarr", chunks=None)
+    except (OSError, TypeError, ValueError, KeyError) as err:
+        raise ValueError(f"{str(p)!r} cannot be read as a librate result: {type(err).__name__}: {str(err).splitlines()[0]}") from None
     raise ValueError(f"{str(p)!r} is neither a netCDF file (.nc) nor a Zarr store (.zarr folder)")
 
 

@@ -711,10 +711,12 @@ class Study(BaseModel):
         return 1
 
     def output_dir(self, out: str | Path | None = None) -> Path:
-        """The output folder: ``out`` if given, else ``output.folder`` (relative to
-        ``base_dir``)."""
-        p = Path(out) if out is not None else Path(self.output.folder)
-        return p if p.is_absolute() or out is not None else Path(self.base_dir) / p
+        """The output folder, absolute: ``out`` if given (relative to the working directory),
+        else ``output.folder`` (relative to ``base_dir``, the study file's folder)."""
+        if out is not None:
+            return Path(out).resolve()
+        p = Path(self.output.folder)
+        return (p if p.is_absolute() else Path(self.base_dir) / p).resolve()
 
     def figures(self, available: tuple[str, ...]) -> list[str]:
         """The figures to draw among ``available`` (all of them unless ``output.figures``)."""
@@ -905,5 +907,5 @@ phi0 = 0.0                     # initial attitude angle (rad)
 [output]
 folder = "librate-out"         # relative to this file's folder
 format = "zarr"                # "zarr" (chunked, resumable maps) or "netcdf" (also writes .nc)
-figures = ["family", "period", "stability", "map", "residuals"]
+figures = ["family", "period", "stability", "map", "residuals", "solutions"]
 '''
