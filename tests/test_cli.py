@@ -239,3 +239,36 @@ def test_demo_dros_and_info_still_work(run, tmp_path):
     assert "closure" in run("dros", "--x0", "0.9").output
     out = run("info").output
     assert f"librate {librate.__version__}" in out and "earth-moon-jpl" in out and "matplotlib" in out
+
+
+def test_srp_study_solve_and_map(run, tmp_path, no_runner):
+    (tmp_path / "srp.toml").write_text(
+        '[orbits]\nsun_resonance = [2]\n[body]\nkz = 0.8\n[torques.srp]\neps = 0.02\ncs = 0.4\n'
+        '[rates]\nwz0 = { start = -1.4, stop = -1.1, num = 40 }\n[output]\nfigures = []\n'
+    )
+    res = run("solve", "srp.toml")
+    ds = librate.open_result(tmp_path / "librate-out" / "solutions.zarr")
+    assert ds.sizes["solution"] >= 1 and set(ds["sol_n_periods"].values.tolist()) == {2}
+    # the gravity-gradient N = -2 motion continued to eps = 0.02 (examples/03) is among them
+    orbit = librate.dro_family("earth-moon").resonant(2, "sun")
+    ref = librate.continue_srp(librate.periodic_attitude(orbit, kz=0.8, n=-2, n_periods=2), librate.FlatPlateSRP(0.02, cs=0.4)).solutions[-1]
+    assert np.min(np.abs(ds["sol_wz0"].values - ref.wz0)) < 1e-9
+    assert f"{ref.wz0:>13.8f}" in res.output
+    run("map", "srp.toml", "--quiet")
+    mp = librate.open_result(tmp_path / "librate-out" / "map.zarr")
+    assert (mp.attrs["srp_eps"], mp.attrs["srp_cs"], mp.attrs["n_periods"]) == (0.02, 0.4, 2)
+    assert not list((tmp_path / "librate-out").glob("*.png"))  # output.figures = []
+
+
+def test_progress_only_in_a_terminal(monkeypatch, capsys):
+    from librate import cli
+
+    monkeypatch.setattr(sys.stderr, "isatty", lambda: False, raising=False)
+    assert cli._progress(False) is None
+    monkeypatch.setattr(sys.stderr, "isatty", lambda: True, raising=False)
+    assert cli._progress(True) is None  # --quiet
+    report = cli._progress(False)
+    report(1, 4)
+    report(4, 4)
+    err = capsys.readouterr().err
+    assert "1/4 ( 25%)" in err and "4/4 (100%)" in err and "ETA" in err and "/s" in err
