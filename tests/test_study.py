@@ -304,3 +304,19 @@ def test_results_refuse_foreign_paths_and_non_results(tmp_path):
     p = save_family(fam, tmp_path / "f.nc")
     save_family(fam, p)
     assert sorted(x.name for x in tmp_path.iterdir()) == ["f.nc", "family.zarr", "other.nc"]
+
+
+def test_members_outside_the_family_name_the_key_and_the_range():
+    st = Study.from_dict({"orbits": {"kind": "dro", "period_days": [12.66, 100.0]}})
+    with pytest.raises(StudyError) as info:
+        st.build_orbits()
+    (msg,) = info.value.problems
+    assert msg.startswith("orbits.period_days = [12.66, 100.0]: no member at 100 on the dro family")
+    assert "allowed: periods (days) from 0.03" in msg and "to 27.3" in msg
+
+
+def test_the_stored_study_writes_the_defaults_out():
+    d = Study.from_dict({"orbits": {"kind": "halo"}}).to_dict()
+    assert d["system"] == {"preset": "earth-moon"}
+    assert (d["orbits"]["point"], d["orbits"]["branch"], d["solver"]["n_periods"]) == (2, "south", 1)
+    assert d["output"] == {"folder": "librate-out", "format": "zarr"} and d["torques"] == {"gravity_gradient": ["earth", "moon"]}

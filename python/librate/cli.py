@@ -16,6 +16,7 @@ import click
 import numpy as np
 
 from . import __version__
+from ._errors import LibrateError
 from .orbits import correct_dro
 from .propagation import propagate
 from .system import System
@@ -153,6 +154,19 @@ class StudyInvalid(click.ClickException):
     exit_code = 2
 
 
+_FAILURES = (FileExistsError, RuntimeError, ValueError, LibrateError)
+
+
+def _failure(err: Exception) -> click.ClickException:
+    """A clean message for what went wrong after validation (a member outside the family, a
+    refused output folder, a computation that failed)."""
+    from .study import StudyError
+
+    if isinstance(err, StudyError):
+        return StudyInvalid(str(err))
+    return click.ClickException(f"{type(err).__name__}: {err}" if isinstance(err, LibrateError) else str(err))
+
+
 def _overrides(sets: tuple[str, ...]) -> dict:
     out = {}
     for item in sets:
@@ -278,8 +292,8 @@ def family(study, kind, point, branch, x0, members, system_name, fmt, sets, out_
     t0 = time.perf_counter()
     try:
         fam, path = st.run_family(out_dir)
-    except FileExistsError as err:
-        raise click.ClickException(str(err)) from None
+    except _FAILURES as err:
+        raise _failure(err) from None
     el = time.perf_counter() - t0
     _echo(quiet, f"{fam.kind} family: {len(fam)} members, x0 {fam.x0[0]:.6g} -> {fam.x0[-1]:.6g} LU, period {fam.period_days.min():.4g} to "
                  f"{fam.period_days.max():.4g} d, Jacobi {fam.jacobi.min():.6g} to {fam.jacobi.max():.6g} ({el:.2f} s)")
@@ -325,8 +339,8 @@ def solve(study, sets, out_dir, quiet) -> None:
     t0 = time.perf_counter()
     try:
         ds, path = st.run_solve(out_dir, progress=_progress(quiet))
-    except FileExistsError as err:
-        raise click.ClickException(str(err)) from None
+    except _FAILURES as err:
+        raise _failure(err) from None
     el = time.perf_counter() - t0
     n = ds.sizes["solution"]
     _echo(quiet, f"{n} periodic solution(s) over {ds.sizes['orbit']} orbit(s) x {ds.sizes['kz']} Kz ({el:.2f} s)")
@@ -373,8 +387,8 @@ def map_(study, out_dir, quiet, scheduler, resume, sets) -> None:
     t0 = time.perf_counter()
     try:
         ds, path = st.run_map(out_dir, scheduler=scheduler, progress=_progress(quiet), resume=resume)
-    except (FileExistsError, RuntimeError) as err:
-        raise click.ClickException(str(err)) from None
+    except _FAILURES as err:
+        raise _failure(err) from None
     el = time.perf_counter() - t0
     if not quiet:
         no, nk, nw = ds.sizes["orbit"], ds.sizes["kz"], ds.sizes["wz0"]

@@ -595,8 +595,17 @@ class Study(BaseModel):
 
     # --- serialisation -------------------------------------------------------------------------
     def to_dict(self) -> dict:
-        """The full study (with defaults) as plain data, TOML/JSON compatible."""
-        return self.model_dump(mode="json", exclude_none=True, exclude={"base_dir"})
+        """The full study as plain data (TOML/JSON compatible), with the defaults written out:
+        the system preset, the Lagrange point and halo branch, the periods per solution."""
+        d = self.model_dump(mode="json", exclude_none=True, exclude={"base_dir"})
+        if self.system.mu is None:
+            d["system"]["preset"] = self.system.preset or "earth-moon"
+        if self.orbits.kind != "dro":
+            d["orbits"].setdefault("point", 1 if self.orbits.kind == "lyapunov" else 2)
+        if self.orbits.kind == "halo":
+            d["orbits"].setdefault("branch", "south")
+        d["solver"]["n_periods"] = self.n_periods()
+        return d
 
     def to_json(self) -> str:
         """The full study as a JSON string (stored as the ``study`` attribute of every result)."""
@@ -645,16 +654,25 @@ class Study(BaseModel):
             return _subset(fam, idx)
         if o.kind == "dro" and o.x0 is not None:
             return fam  # dro_family(x0=...) computed exactly these members
-        if o.x0 is not None:
-            return [fam.member(x0=float(v)) for v in _grid_values(o.x0)]
-        if o.z0 is not None:
-            return [fam.member(z0=float(v)) for v in _grid_values(o.z0)]
-        if o.period_days is not None:
-            return [fam.member(period_days=float(v)) for v in _grid_values(o.period_days)]
-        if o.resonance is not None:
-            return [fam.resonant(int(k), "synodic") for k in o.resonance]
-        if o.sun_resonance is not None:
-            return [fam.resonant(int(k), "sun") for k in o.sun_resonance]
+        for key, find in (("x0", lambda v: fam.member(x0=float(v))), ("z0", lambda v: fam.member(z0=float(v))),
+                          ("period_days", lambda v: fam.member(period_days=float(v))),
+                          ("resonance", lambda k: fam.resonant(int(k), "synodic")), ("sun_resonance", lambda k: fam.resonant(int(k), "sun"))):
+            sel = getattr(o, key)
+            if sel is None:
+                continue
+            values = _grid_values(sel) if key in ("x0", "z0", "period_days") else sel
+            out = []
+            for v in values:
+                try:
+                    out.append(find(v))
+                except ValueError:  # outside the family's range: name the key and the range
+                    span = {"x0": fam.x0, "z0": np.concatenate([fam.state0[:, 2], fam.state_half[:, 2]]), "period_days": fam.period_days,
+                            "resonance": 2 * math.pi / fam.period, "sun_resonance": _sun_period() / fam.period}[key]
+                    what = {"x0": "x0 (LU)", "z0": "z0 (LU)", "period_days": "periods (days)", "resonance": "k = 2 pi / T",
+                            "sun_resonance": "k = Ts / T"}[key]
+                    raise StudyError([_problem(f"orbits.{key}", _grid_raw(sel), f"no member at {float(v):g} on the {fam.kind} family ({len(fam)} members)",
+                                               f"{what} from {np.min(span):.6g} to {np.max(span):.6g}")]) from None
+            return out
         return fam
 
     def kz_values(self) -> np.ndarray:
@@ -796,6 +814,12 @@ class Study(BaseModel):
 
             save_dataset(ds, folder / "map.nc")
         return ds, path
+
+
+def _sun_period() -> float:
+    from .constants import SUN_SYNODIC_PERIOD
+
+    return SUN_SYNODIC_PERIOD
 
 
 def _subset(fam, idx):
