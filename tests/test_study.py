@@ -320,3 +320,18 @@ def test_the_stored_study_writes_the_defaults_out():
     assert d["system"] == {"preset": "earth-moon"}
     assert (d["orbits"]["point"], d["orbits"]["branch"], d["solver"]["n_periods"]) == (2, "south", 1)
     assert d["output"] == {"folder": "librate-out", "format": "zarr"} and d["torques"] == {"gravity_gradient": ["earth", "moon"]}
+
+
+def test_a_map_is_exported_to_netcdf_too(tmp_path, base, monkeypatch):
+    import sys
+
+    monkeypatch.setitem(sys.modules, "librate.runner", None)
+    st = Study.from_dict(edit(edit(base, "output.format", "netcdf"), "body.kz", [0.5, 0.8]), purpose="map")
+    ds, path = st.run_map(tmp_path)
+    nc = librate.open_result(tmp_path / "map.nc")
+    zr = librate.open_result(path)
+    assert nc.attrs["study"] == zr.attrs["study"] == st.to_json()
+    assert nc["kz"].values.tolist() == [0.5, 0.8]
+    for v in ("dwz", "dphi", "phi_T", "sol_wz0", "sol_kz"):
+        assert np.array_equal(nc[v].values, zr[v].values, equal_nan=True), v
+    assert nc["sol_stable"].values.astype(bool).tolist() == zr["sol_stable"].values.tolist()
