@@ -18,6 +18,8 @@ from .runner import run_map
 from .propagation import BatchResult, Event, EventHit, Stats, Trajectory, propagate, propagate_many
 from .system import System
 from .flexible import Appendage, FlexibleBody, flexible_periodic, frequency_scan, quasi_static
+from .results import open_result
+from .study import Study, StudyError
 
 __all__ = [
     "__version__",
@@ -73,4 +75,7 @@ __all__ = [
     "quasi_static",
     "flexible_periodic",
     "frequency_scan",
+    "Study",
+    "StudyError",
+    "open_result",
 ]

@@ -1,35 +1,74 @@
-"""The ``librate`` command line."""
+"""The ``librate`` command line.
+
+Study commands (``family``, ``solve``, ``map``) read a TOML study file (``librate init`` writes a
+commented one), validate all of it before any work, and write results with the study and the
+package version as attributes; ``plot`` re-draws figures from a saved result. ``demo``, ``dros``
+and ``info`` need no study.
+"""
 
 from __future__ import annotations
 
+import sys
 import time
+from pathlib import Path
 
 import click
 import numpy as np
 
 from . import __version__
+from ._errors import LibrateError
 from .orbits import correct_dro
 from .propagation import propagate
 from .system import System
 
+_CONTEXT = {"help_option_names": ["-h", "--help"], "max_content_width": 100}
 
-@click.group(context_settings={"help_option_names": ["-h", "--help"]})
+
+@click.group(context_settings=_CONTEXT)
 @click.version_option(__version__, prog_name="librate")
 def main() -> None:
-    """librate: coupled orbit-attitude dynamics of large spacecraft in the Earth-Moon CR3BP."""
+    """librate: coupled orbit-attitude dynamics of large spacecraft in the Earth-Moon CR3BP.
+
+    \b
+    Start here:
+      librate init study.toml          write a commented example study
+      librate family study.toml        the orbit family (continuation), saved + figures
+      librate solve study.toml         periodic attitude motions of each orbit, as a table
+      librate map study.toml           the attitude periodicity map (thesis Fig. 24)
+      librate plot librate-out/map.zarr   re-draw figures from a saved result
+      librate demo                     the DRO map at Kz = 0.8 with no study file
+
+    Units: nondimensional CR3BP units (LU = distance between the primaries, TU = 1 / mean
+    motion; rates in 1/TU, the synodic frame turns at rate 1), angles in rad, periods in days.
+    Run `librate COMMAND --help` for what each command computes, reads and writes.
+    """
 
 
-@main.command()
+@main.command(context_settings=_CONTEXT)
 def info() -> None:
-    """Show the version and the system presets with their constants."""
+    """Show the version, the system presets with their constants, and the optional parts.
+
+    For each preset: the mass ratio mu, the length unit LU (km), the time unit TU (s and
+    days) and the x coordinate of L1 (LU). Optional parts: matplotlib (figures), the chunked
+    map runner (resumable and distributed maps) and Dask.
+    """
+    import importlib.util
+
     click.echo(f"librate {__version__}")
     for name in System.presets():
         s = System.preset(name)
         l1 = s.lagrange_points()[0, 0]
         click.echo(f"  {name:16s} mu = {s.mu:.15g}  LU = {s.lu_km} km  TU = {s.tu_s} s ({s.tu_days:.6f} d)  L1 x = {l1:.15f}")
+    parts = {
+        "figures (matplotlib)": importlib.util.find_spec("matplotlib") is not None,
+        "chunked, resumable map runner (librate.runner)": importlib.util.find_spec("librate.runner") is not None,
+        "distributed runs (dask.distributed)": importlib.util.find_spec("dask") is not None,
+    }
+    for what, ok in parts.items():
+        click.echo(f"  {what}: {'available' if ok else 'not installed'}")
 
 
-@main.command()
+@main.command(context_settings=_CONTEXT)
 @click.option("--system", "system_name", default="earth-moon", show_default=True, help="System preset.")
 @click.option("--kz", default=0.8, show_default=True, type=click.FloatRange(-1, 1), help="Inertia parameter Kz = (Iy - Ix)/Iz.")
 @click.option("--orbits", "n_orbits", default=60, show_default=True, type=click.IntRange(2, 2000), help="DRO family members, x0 from 0.95 to 0.15.")
@@ -80,7 +119,7 @@ def demo(system_name: str, kz: float, n_orbits: int, n_rates: int, out_dir: str)
     click.echo(f"written: {path} (xarray Dataset: dwz, dphi, phi_T over (orbit, kz, wz0), solutions, units and parameters)")
 
 
-@main.command(name="dros")
+@main.command(name="dros", context_settings=_CONTEXT)
 @click.option("--system", "system_name", default="earth-moon", show_default=True, help="System preset.")
 @click.option("--x0", "x0_values", multiple=True, type=float, help="DRO start(s) on the x axis (default: 0.96 0.93 0.90 0.87 0.84 0.81).")
 def dros(system_name: str, x0_values: tuple[float, ...]) -> None:
@@ -106,3 +145,378 @@ def dros(system_name: str, x0_values: tuple[float, ...]) -> None:
         )
         guess = orbit.state0[4]
     click.echo("closure = max |state(T) - state(0)| after one full period at rtol = atol = 1e-13.")
+
+
+# --- studies ------------------------------------------------------------------------------------
+class StudyInvalid(click.ClickException):
+    """An invalid study file: every problem listed, exit status 2, nothing computed."""
+
+    exit_code = 2
+
+
+_FAILURES = (FileExistsError, RuntimeError, ValueError, LibrateError)
+
+
+def _failure(err: Exception) -> click.ClickException:
+    """A clean message for what went wrong after validation (a member outside the family, a
+    refused output folder, a computation that failed)."""
+    from .study import StudyError
+
+    if isinstance(err, StudyError):
+        return StudyInvalid(str(err))
+    return click.ClickException(f"{type(err).__name__}: {err}" if isinstance(err, LibrateError) else str(err))
+
+
+def _overrides(sets: tuple[str, ...]) -> dict:
+    out = {}
+    for item in sets:
+        key, sep, value = item.partition("=")
+        if not sep or not key.strip():
+            raise click.BadParameter(f"{item!r}: expected KEY=VALUE, e.g. rates.wz0.num=200", param_hint="--set")
+        out[key.strip()] = value.strip()
+    return out
+
+
+def _load_study(path: str | None, purpose: str, overrides: dict):
+    """The validated study, or a StudyInvalid listing every problem."""
+    from .study import Study, StudyError, apply_overrides
+
+    try:
+        if path is None:
+            return Study.from_dict(apply_overrides({}, overrides), purpose=purpose, base_dir=Path.cwd(), source="(command-line options)")
+        return Study.from_toml(path, purpose=purpose, overrides=overrides)
+    except StudyError as err:
+        raise StudyInvalid(str(err)) from None
+
+
+def _progress(quiet: bool):
+    """A progress line on stderr (done/total, rate, ETA), only in a terminal and without --quiet."""
+    if quiet or not sys.stderr.isatty():
+        return None
+    t0 = time.perf_counter()
+
+    def report(done: int, total: int) -> None:
+        el = max(time.perf_counter() - t0, 1e-9)
+        rate = done / el
+        eta = (total - done) / rate if rate > 0 else float("nan")
+        click.echo(f"\r  {done}/{total} ({100 * done / max(total, 1):3.0f}%)  {rate:.2f}/s  ETA {eta:5.0f} s ", err=True, nl=done >= total)
+
+    return report
+
+
+def _echo(quiet: bool, text: str) -> None:
+    if not quiet:
+        click.echo(text)
+
+
+_SET_HELP = "Override a study key, KEY=VALUE with a TOML value (repeatable): --set body.kz=0.5 --set rates.wz0.num=200."
+
+
+@main.command(context_settings=_CONTEXT)
+@click.argument("path", default="study.toml", type=click.Path(dir_okay=False))
+@click.option("--force", is_flag=True, help="Overwrite PATH if it exists.")
+def init(path: str, force: bool) -> None:
+    """Write a commented example study to PATH (default study.toml) to start from.
+
+    The example is the DRO attitude periodicity map at Kz = 0.8: 12 DROs (x0 from 0.9 to 0.3 LU),
+    300 inertial initial rates wz0 in [-3, 2] 1/TU, results and figures in librate-out/ next to
+    the file. Every key is explained in the file; edit it, then run `librate map PATH`.
+    """
+    from .study import EXAMPLE_STUDY
+
+    p = Path(path)
+    if p.exists() and not force:
+        raise click.ClickException(f"{p} exists: not overwritten (use --force to replace it)")
+    p.parent.mkdir(parents=True, exist_ok=True)
+    p.write_text(EXAMPLE_STUDY, encoding="utf-8")
+    click.echo(f"written: {p}\nnext: librate map {p}   (or: librate family {p}, librate solve {p})")
+
+
+def _x0_option(text: str):
+    """'START:STOP:NUM' -> a range table, 'a,b,c' -> a list (left as text when unparsable, for
+    the study's own error message)."""
+    from .study import _parse_value
+
+    if ":" in text:
+        parts = [_parse_value(v) for v in text.split(":")]
+        if len(parts) == 3:
+            return {"start": parts[0], "stop": parts[1], "num": parts[2]}
+        return text
+    vals = [_parse_value(v) for v in text.split(",")]
+    return vals
+
+
+@main.command(context_settings=_CONTEXT)
+@click.argument("study", required=False, type=click.Path(exists=True, dir_okay=False))
+@click.option("--kind", help="Family: dro, lyapunov or halo (orbits.kind).")
+@click.option("--point", type=int, help="Lagrange point 1 or 2, for lyapunov and halo (orbits.point).")
+@click.option("--branch", help="north or south, for halo (orbits.branch).")
+@click.option("--x0", "x0", help="Members by x0 in LU: START:STOP:NUM or a comma list 0.9,0.8 (orbits.x0).")
+@click.option("--members", type=int, help="That many members evenly spread along the family (orbits.members).")
+@click.option("--system", "system_name", help="System preset, e.g. earth-moon or earth-moon-jpl (system.preset).")
+@click.option("--format", "fmt", help="zarr or netcdf (output.format).")
+@click.option("--set", "sets", multiple=True, metavar="KEY=VALUE", help=_SET_HELP)
+@click.option("--out", "out_dir", type=click.Path(file_okay=False), help="Output folder (default: output.folder of the study, else librate-out).")
+@click.option("--quiet", "-q", is_flag=True, help="Print only the written paths.")
+def family(study, kind, point, branch, x0, members, system_name, fmt, sets, out_dir, quiet) -> None:
+    """Compute an orbit family by continuation and save it, from STUDY and/or options.
+
+    \b
+    Reads [system] and [orbits] of the study (or the options alone, e.g.
+      librate family --kind lyapunov --point 1
+      librate family --kind dro --x0 0.9:0.3:25
+    ); the options override the study. DROs: natural-parameter continuation in x0 (the listed
+    members, or the whole family 0.985 -> 0.005 LU); Lyapunov and halo families (L1/L2, halo
+    branch north/south, into the NRHOs): pseudo-arclength continuation. A selection by
+    period_days, resonance or sun_resonance keeps the corrected members found on the family.
+
+    \b
+    Writes to the output folder:
+      family.zarr (or family.nc)  the members: state0 (LU, LU/TU), period (TU, and days), Jacobi
+                                  constant, monodromy eigenvalues and stability indices, with
+                                  the study (JSON) and the version as attributes;
+                                  reload with librate.open_result(path)
+      family.png, period.png, stability.png   orbits coloured by Jacobi constant, period
+                                  against x0 with the resonances, stability indices
+    """
+    ov = {}
+    for key, value in (("orbits.kind", kind), ("orbits.point", point), ("orbits.branch", branch), ("orbits.members", members),
+                       ("system.preset", system_name), ("output.format", fmt)):
+        if value is not None:
+            ov[key] = value
+    if x0 is not None:
+        ov["orbits.x0"] = _x0_option(x0)
+    ov = {k: _quote(v) for k, v in ov.items()}  # option words stay strings
+    ov.update(_overrides(sets))
+    st = _load_study(study, "family", ov)
+    t0 = time.perf_counter()
+    try:
+        fam, path = st.run_family(out_dir)
+    except _FAILURES as err:
+        raise _failure(err) from None
+    el = time.perf_counter() - t0
+    _echo(quiet, f"{fam.kind} family: {len(fam)} members, x0 {fam.x0[0]:.6g} -> {fam.x0[-1]:.6g} LU, period {fam.period_days.min():.4g} to "
+                 f"{fam.period_days.max():.4g} d, Jacobi {fam.jacobi.min():.6g} to {fam.jacobi.max():.6g} ({el:.2f} s)")
+    _echo(quiet, f"  continuation end: {fam.end_reason}")
+    for b in fam.bifurcations:
+        _echo(quiet, f"  bifurcation: {b['index']} index, {b['type']}, near x0 = {b['x0']:.6g}")
+    click.echo(f"written: {path}")
+    _figures(fam, path.parent, st.figures(("family", "period", "stability")), quiet)
+
+
+def _quote(v):
+    """Options given as plain words (kind, branch, preset, format) are strings, not TOML."""
+    import json
+
+    return json.dumps(v) if isinstance(v, str) else v
+
+
+@main.command(context_settings=_CONTEXT)
+@click.argument("study", type=click.Path(exists=True, dir_okay=False))
+@click.option("--set", "sets", multiple=True, metavar="KEY=VALUE", help=_SET_HELP)
+@click.option("--out", "out_dir", type=click.Path(file_okay=False), help="Output folder (default: output.folder of the study).")
+@click.option("--quiet", "-q", is_flag=True, help="No progress and no table; print only the written path.")
+def solve(study, sets, out_dir, quiet) -> None:
+    """Find the periodic attitude motions of each orbit and Kz of STUDY in its rate window.
+
+    For every selected orbit (period T) and every Kz of [body], scans the study's grid of
+    initial rates ([rates]: inertial wz0, or phidot0 = wz0 - 1 relative to the synodic frame,
+    1/TU) and refines by Newton every planar attitude motion with wz(T) = wz0 and
+    phi(T) = phi0 + 2 pi N (N net turns per orbit; "half-turn" motions, phi(T) = phi0 + pi +
+    2 pi N, are reported as their own kind). Gravity gradient of both primaries, plus the flat
+    plate SRP of [torques.srp] on a Sun-resonant orbit (solver.n_periods orbits per period).
+    Each solution is re-propagated independently: the residual is max(|Dphi| rad, |Dwz| 1/TU);
+    it is linearly stable when |trace| of its 2x2 monodromy < 2.
+
+    \b
+    Prints one line per solution and writes to the output folder:
+      solutions.zarr (or solutions.nc)  over `solution`: orbit index, x0 (LU), period (d), Kz,
+                      N, kind, wz0 and phidot0 (1/TU), phi0 (rad), trace, stable, residual,
+                      with the study (JSON) and the version as attributes
+      solutions.png   the solutions' rates against x0
+    """
+    st = _load_study(study, "solve", _overrides(sets))
+    t0 = time.perf_counter()
+    try:
+        ds, path = st.run_solve(out_dir, progress=_progress(quiet))
+    except _FAILURES as err:
+        raise _failure(err) from None
+    el = time.perf_counter() - t0
+    n = ds.sizes["solution"]
+    _echo(quiet, f"{n} periodic solution(s) over {ds.sizes['orbit']} orbit(s) x {ds.sizes['kz']} Kz ({el:.2f} s)")
+    if n and not quiet:
+        click.echo(f"{'orbit':>5} {'x0 [LU]':>9} {'T [d]':>8} {'Kz':>6} {'N':>4} {'kind':>9} {'wz0 [1/TU]':>13} {'phidot0':>13} {'phi0':>9} {'trace':>10} {'stable':>6} {'residual':>9}")
+        for j in range(n):
+            r = {k: ds[f"sol_{k}"].values[j] for k in ("orbit", "x0", "period_days", "kz", "n", "kind", "wz0", "phidot0", "phi0", "trace", "stable", "residual")}
+            click.echo(f"{r['orbit']:>5d} {r['x0']:>9.5f} {r['period_days']:>8.4f} {r['kz']:>6.3g} {r['n']:>4d} {r['kind']:>9} {r['wz0']:>13.8f} "
+                       f"{r['phidot0']:>13.8f} {r['phi0']:>9.5f} {r['trace']:>10.4g} {'yes' if r['stable'] else 'no':>6} {r['residual']:>9.1e}")
+    click.echo(f"written: {path}")
+    _figures(ds, path.parent, st.figures(("solutions",)), quiet)
+
+
+@main.command(name="map", context_settings=_CONTEXT)
+@click.argument("study", type=click.Path(exists=True, dir_okay=False))
+@click.option("--out", "out_dir", type=click.Path(file_okay=False), help="Output folder (default: output.folder of the study); the map goes to OUT/map.zarr.")
+@click.option("--quiet", "-q", is_flag=True, help="No progress bar and no summary; print only the written paths.")
+@click.option("--scheduler", metavar="tcp://HOST:PORT", help="Run the map's chunks on this Dask scheduler (needs librate.runner and dask.distributed).")
+@click.option("--resume/--no-resume", default=True, show_default=True, help="Continue an interrupted map in OUT/map.zarr from its finished chunks; --no-resume recomputes it.")
+@click.option("--set", "sets", multiple=True, metavar="KEY=VALUE", help=_SET_HELP)
+def map_(study, out_dir, quiet, scheduler, resume, sets) -> None:
+    """Compute the attitude periodicity map of STUDY (thesis Fig. 24) and its solutions.
+
+    For every selected orbit (period T), every Kz and every initial rate wz0 of the grid
+    ([rates], 1/TU), integrates the planar attitude from phi0 over solver.n_periods periods
+    (Rust engine, all cores) and records the residuals dwz = wz(T) - wz0 (1/TU) and
+    dphi = phi(T) - phi0 wrapped to (-pi, pi] (rad) and the unwrapped phi(T); periodic motions
+    lie where both vanish and are refined by Newton (N net turns, kind, stability, residual).
+    A map is written chunk by chunk and resumable: re-running the same command after an
+    interruption continues from the finished chunks.
+
+    \b
+    Writes to the output folder:
+      map.zarr     dims (orbit, kz, wz0): dwz, dphi, phi_T, status; coordinates x0 (LU),
+                   period (TU), period_days, kz, wz0 and phidot0 = wz0 - 1 (1/TU); the
+                   solutions sol_* along `solution`; the study (JSON) and the version as
+                   attributes (map.nc too with output.format = "netcdf")
+      map.png      zero contours of dwz and dphi over (orbit period, phidot0) with the
+                   solutions by N (one file per Kz: map_kz<Kz>.png when several)
+      residuals.png  dwz and dphi against phidot0 for the first orbit (thesis Fig. 23)
+      solutions.png  the solution families across the orbits (thesis Figs. 27-29)
+    """
+    st = _load_study(study, "map", _overrides(sets))
+    t0 = time.perf_counter()
+    try:
+        ds, path = st.run_map(out_dir, scheduler=scheduler, progress=_progress(quiet), resume=resume)
+    except _FAILURES as err:
+        raise _failure(err) from None
+    el = time.perf_counter() - t0
+    if not quiet:
+        no, nk, nw = ds.sizes["orbit"], ds.sizes["kz"], ds.sizes["wz0"]
+        click.echo(f"periodicity map: {no} orbits x {nk} Kz x {nw} rates = {no * nk * nw} attitude trajectories ({el:.2f} s)"
+                   + ("" if int(ds.attrs.get("complete", 1)) else "  [INCOMPLETE: interrupted; re-run to resume]"))
+        _solution_summary(ds)
+    click.echo(f"written: {path}")
+    _figures(ds, path.parent, st.figures(("map", "residuals", "solutions")), quiet)
+
+
+def _solution_summary(ds) -> None:
+    if "solution" not in ds.sizes or ds.sizes["solution"] == 0:
+        click.echo("solutions: none in the rate window")
+        return
+    n_, kind_ = ds["sol_n"].values, ds["sol_kind"].values.astype(str)
+    stable, res, pd = ds["sol_stable"].values, ds["sol_residual"].values, ds["sol_phidot0"].values
+    click.echo(f"solutions (wz(T) = wz0, phi(T) = phi0 + 2 pi N, refined by Newton): {ds.sizes['solution']}")
+    click.echo(f"{'N':>4} {'kind':>10} {'count':>6} {'stable':>7} {'phidot0 range [1/TU]':>24} {'max residual':>13}")
+    for n, kind in sorted(set(zip(n_.tolist(), kind_.tolist())), key=lambda x: (x[1], -x[0])):
+        sel = (n_ == n) & (kind_ == kind)
+        click.echo(f"{n:>4} {kind:>10} {int(sel.sum()):>6} {int(stable[sel].sum()):>7} {pd[sel].min():>11.4f} .. {pd[sel].max():<10.4f} {res[sel].max():>13.1e}")
+
+
+@main.command(context_settings=_CONTEXT)
+@click.argument("result_path", type=click.Path(exists=True))
+@click.option("--quiet", "-q", is_flag=True, help="Print only the written paths.")
+def plot(result_path, quiet) -> None:
+    """Re-draw the figures of a saved result, without recomputing.
+
+    RESULT_PATH: a family, map or solutions result written by `librate family`, `map` or
+    `solve` (a .zarr folder or a .nc file; or an output folder holding one of them). The PNGs
+    are written next to it:
+
+    \b
+      family     family.png (orbits coloured by Jacobi constant), period.png (period in days
+                 against x0, with the 1:k resonances), stability.png (stability indices)
+      map        map.png (zero contours and solutions; map_kz<Kz>.png per Kz when several),
+                 residuals.png (dwz, dphi against phidot0 for the first orbit),
+                 solutions.png (solution families across the orbits)
+      solutions  solutions.png (initial rates phidot0 of the solutions against x0)
+    """
+    from .results import _resolve, open_result
+
+    try:
+        p = _resolve(result_path)
+        res = open_result(p)
+    except (ValueError, FileNotFoundError) as err:
+        raise click.ClickException(str(err)) from None
+    from .families import OrbitFamily
+
+    if isinstance(res, OrbitFamily):
+        _echo(quiet, f"{res.kind} family: {len(res)} members")
+        names = ("family", "period", "stability")
+    else:
+        kind = res.attrs.get("librate_result") or ("map" if "dwz" in res.variables else "solutions")
+        _echo(quiet, f"{kind}: {', '.join(f'{k} {v}' for k, v in res.sizes.items())}")
+        names = ("map", "residuals", "solutions") if "dwz" in res.variables else ("solutions",)
+    written = _figures(res, p.parent, names, quiet)
+    if not written:
+        raise click.ClickException("no figure could be drawn (see the messages above)")
+
+
+def _figures(result, folder: Path, names, quiet: bool) -> list[Path]:
+    """Draw the named figures of a result into ``folder``; a figure that does not apply or
+    fails is skipped with a note (matplotlib missing: all skipped)."""
+    if not names:
+        return []
+    try:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+
+        from . import plotting as lp
+    except ImportError:
+        click.echo("figures skipped: matplotlib is not installed (pip install 'librate[plot]')", err=True)
+        return []
+    from .families import OrbitFamily
+
+    jobs = []
+    if isinstance(result, OrbitFamily):
+        table = {"family": lambda: lp.plot_family(result, n_orbits=30), "period": lambda: lp.plot_period(result),
+                 "stability": lambda: lp.plot_stability(result)}
+        jobs = [(f"{n}.png", table[n]) for n in names if n in table]
+    elif "dwz" in result.variables:
+        kzs = np.atleast_1d(result["kz"].values)
+        for name in names:
+            if name == "map":
+                if result.sizes["orbit"] < 2:
+                    click.echo("map.png skipped: a periodicity map figure needs at least 2 orbits", err=True)
+                    continue
+                for j, kz in enumerate(kzs):
+                    fname = "map.png" if kzs.size == 1 else f"map_kz{kz:g}.png"
+                    jobs.append((fname, lambda j=j: lp.plot_map(result, kz_index=j)))
+            elif name == "residuals":
+                jobs.append(("residuals.png", lambda: lp.plot_residuals(result, orbit_index=0, kz=float(kzs[0]))))
+            elif name == "solutions" and "sol_wz0" in result.variables:
+                if result.sizes["orbit"] < 2 or result.sizes.get("solution", 0) == 0:
+                    continue
+                jobs.append(("solutions.png", lambda: lp.plot_solution_families(result)))
+    elif "sol_wz0" in result.variables and "solutions" in names and result.sizes.get("solution", 0):
+        jobs.append(("solutions.png", lambda: _solutions_scatter(result)))
+    written = []
+    for fname, make in jobs:
+        try:
+            fig = make()
+        except Exception as err:  # a figure must not lose the computed result
+            click.echo(f"{fname} skipped: {type(err).__name__}: {err}", err=True)
+            continue
+        written.append(lp.save_figure(fig, folder / fname))
+        plt.close(fig)
+        click.echo(f"written: {folder / fname}")
+    return written
+
+
+def _solutions_scatter(ds):
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(6.4, 4.8), layout="constrained")
+    n = ds["sol_n"].values
+    stable = ds["sol_stable"].values.astype(bool)
+    x, y = ds["sol_x0"].values, ds["sol_phidot0"].values
+    for k in sorted(set(n.tolist())):
+        sel = n == k
+        sc = ax.scatter(x[sel & stable], y[sel & stable], s=18, label=f"N = {k}")
+        ax.scatter(x[sel & ~stable], y[sel & ~stable], s=18, facecolors="none", edgecolors=sc.get_facecolor())
+    ax.set_xlabel("$x_0$ (LU)")
+    ax.set_ylabel(r"$\dot\phi(0)$ (1/TU)")
+    ax.set_title("periodic attitude solutions (filled: stable)")
+    ax.legend(fontsize="small")
+    return fig

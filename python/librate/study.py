@@ -1,0 +1,935 @@
+"""Studies: one TOML file describes a whole librate job, validated before any work starts.
+
+A study names the CR3BP system, the orbit family and the members wanted, the body (Kz or its
+principal moments of inertia), the torques and their parameters, the grid of initial rates, the
+solver settings and the outputs. :meth:`Study.from_toml` (or :meth:`Study.from_dict`) checks
+everything first: unknown keys, wrong types, out-of-range values and inconsistent combinations
+are collected and raised together as one :class:`StudyError`, one line per problem, each naming
+the key (dotted, e.g. ``body.kz``), the value given and what is allowed. Nothing is computed or
+written before the study is valid.
+
+The ``build_*`` helpers turn a valid study into librate objects (:class:`~librate.System`, the
+:class:`~librate.OrbitFamily` or a list of :class:`~librate.PeriodicOrbit`, the Kz values, the
+:class:`~librate.FlatPlateSRP` plate, the array of inertial initial rates); the ``run_*``
+methods do what the ``librate family``, ``librate solve`` and ``librate map`` commands do.
+
+Units: rates in 1/TU (nondimensional: the synodic frame turns at rate 1), angles in rad, the
+inertia in kg m^2, areas in m^2, lengths in m, the solar pressure in N/m^2, periods in days.
+"""
+
+from __future__ import annotations
+
+import copy
+import difflib
+import json
+import math
+import re
+import sys
+from collections.abc import Callable
+from pathlib import Path
+from typing import Annotated, Any, Literal
+
+import numpy as np
+from pydantic import BaseModel, ConfigDict, Discriminator, Field, Tag, ValidationError
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover - Python 3.10
+    import tomli as tomllib
+
+__all__ = ["EXAMPLE_STUDY", "FIGURES", "PURPOSES", "Study", "StudyError"]
+
+#: What a study can be checked for (the commands that run it).
+PURPOSES = ("family", "solve", "map")
+#: Figure names accepted in ``output.figures``.
+FIGURES = ("family", "period", "stability", "map", "residuals", "solutions")
+
+
+class StudyError(ValueError):
+    """An invalid study: ``problems`` lists one message per problem, each naming the key (dotted
+    path), the value given and what is allowed. ``str(err)`` shows them all."""
+
+    def __init__(self, problems: list[str], source: str | None = None):
+        self.problems = list(problems)
+        self.source = source
+        where = f" {source}" if source else ""
+        n = len(self.problems)
+        head = f"invalid study{where}: {n} problem{'s' if n != 1 else ''}"
+        super().__init__(head + "".join(f"\n  - {p}" for p in self.problems))
+
+
+# --- schema ------------------------------------------------------------------------------------
+class _Table(BaseModel):
+    model_config = ConfigDict(extra="forbid", strict=True, frozen=True, allow_inf_nan=False)
+
+
+class Range(_Table):
+    """``num`` evenly spaced values from ``start`` to ``stop`` (both included)."""
+
+    start: float
+    stop: float
+    num: int = Field(ge=1, le=1_000_000)
+
+    def values(self) -> np.ndarray:
+        return np.linspace(self.start, self.stop, self.num)
+
+
+def _grid_tag(v: Any) -> str | None:
+    if isinstance(v, (dict, Range)):
+        return "range"
+    if isinstance(v, (list, tuple)):
+        return "list"
+    return None
+
+
+def _number_grid_tag(v: Any) -> str | None:
+    if isinstance(v, (int, float)) and not isinstance(v, bool):
+        return "number"
+    return _grid_tag(v)
+
+
+_GRID_MSG = "must be a list of numbers or a table {start, stop, num}"
+Grid = Annotated[
+    Annotated[list[float], Field(min_length=1), Tag("list")] | Annotated[Range, Tag("range")],
+    Discriminator(_grid_tag, custom_error_type="grid", custom_error_message=_GRID_MSG),
+]
+KzValue = Annotated[float, Field(ge=-1, le=1)]
+KzGrid = Annotated[
+    Annotated[KzValue, Tag("number")] | Annotated[list[KzValue], Field(min_length=1), Tag("list")] | Annotated[Range, Tag("range")],
+    Discriminator(_number_grid_tag, custom_error_type="grid", custom_error_message="must be a number, a list of numbers or a table {start, stop, num}"),
+]
+_TAGS = {"list", "range", "number"}
+
+
+class SystemSection(_Table):
+    """[system]: a preset, or a custom system from mu, lu_km, tu_s (and radii_km)."""
+
+    preset: str | None = None
+    mu: float | None = Field(None, gt=0, le=0.5)
+    lu_km: float | None = Field(None, gt=0)
+    tu_s: float | None = Field(None, gt=0)
+    radii_km: list[Annotated[float, Field(ge=0)]] | None = Field(None, min_length=2, max_length=2)
+    name: str | None = None
+
+
+class OrbitsSection(_Table):
+    """[orbits]: the family and the members wanted."""
+
+    kind: Literal["dro", "lyapunov", "halo"] = "dro"
+    point: Literal[1, 2] | None = None
+    branch: Literal["north", "south"] | None = None
+    x0: Grid | None = None
+    z0: Grid | None = None
+    period_days: Grid | None = None
+    resonance: list[Annotated[int, Field(ge=1, le=100)]] | None = Field(None, min_length=1)
+    sun_resonance: list[Annotated[int, Field(ge=1, le=100)]] | None = Field(None, min_length=1)
+    members: int | None = Field(None, ge=1, le=10_000)
+    max_members: int | None = Field(None, ge=2, le=5_000)
+
+
+class BodySection(_Table):
+    """[body]: Kz, or the principal moments of inertia in kg m^2."""
+
+    kz: KzGrid | None = None
+    ix: float | None = Field(None, gt=0)
+    iy: float | None = Field(None, gt=0)
+    iz: float | None = Field(None, gt=0)
+    mass_kg: float | None = Field(None, gt=0)
+
+
+class SrpSection(_Table):
+    """[torques.srp]: the flat plate, by its amplitude eps or by its geometry."""
+
+    eps: float | None = None
+    area_m2: float | None = Field(None, gt=0)
+    offset_m: float | None = None
+    cs: float = Field(0.0, ge=0, le=1)
+    cd: float = Field(0.0, ge=0, le=1)
+    theta0: float = 0.0
+    pressure: float | None = Field(None, ge=0)
+
+
+class TorquesSection(_Table):
+    """[torques]: gravity gradient of the primaries, and solar radiation pressure."""
+
+    gravity_gradient: list[Literal["earth", "moon"]] = Field(default_factory=lambda: ["earth", "moon"])
+    srp: SrpSection | None = None
+
+
+class RatesSection(_Table):
+    """[rates]: the initial rates, inertial wz0 or relative phidot0 = wz0 - 1 (1/TU)."""
+
+    wz0: Grid | None = None
+    phidot0: Grid | None = None
+
+
+class SolverSection(_Table):
+    """[solver]: tolerances, periods per solution, initial angle."""
+
+    rtol: float = Field(1e-12, ge=1e-15, le=1e-3)
+    atol: float = Field(1e-12, ge=1e-15, le=1e-3)
+    n_periods: int | None = Field(None, ge=1, le=1000)
+    phi0: float = Field(0.0, ge=-2 * math.pi, le=2 * math.pi)
+
+
+class OutputSection(_Table):
+    """[output]: where and how results are written."""
+
+    folder: str = Field("librate-out", min_length=1)
+    format: Literal["zarr", "netcdf"] = "zarr"
+    figures: list[Literal["family", "period", "stability", "map", "residuals", "solutions"]] | None = None
+
+
+_SECTIONS: dict[str, type[_Table]] = {
+    "system": SystemSection,
+    "orbits": OrbitsSection,
+    "body": BodySection,
+    "torques": TorquesSection,
+    "rates": RatesSection,
+    "solver": SolverSection,
+    "output": OutputSection,
+}
+_TABLES: dict[str, type[_Table]] = {**_SECTIONS, "torques.srp": SrpSection}
+_TOP_KEYS = ("title", "description", *_SECTIONS)
+
+#: What each key accepts (used in the error messages).
+ALLOWED: dict[str, str] = {
+    "title": "a string",
+    "description": "a string",
+    "system.preset": "one of the presets ({presets})",
+    "system.mu": "a number in (0, 0.5], the mass ratio m2 / (m1 + m2)",
+    "system.lu_km": "a number > 0, the length unit (distance between the primaries) in km",
+    "system.tu_s": "a number > 0, the time unit (1 / mean motion) in s",
+    "system.radii_km": "two numbers >= 0, the primaries' radii in km",
+    "system.name": "a string",
+    "orbits.kind": "'dro', 'lyapunov' or 'halo'",
+    "orbits.point": "1 (L1) or 2 (L2), for lyapunov and halo families",
+    "orbits.branch": "'north' or 'south', for halo families",
+    "orbits.x0": "a list of x0 values (LU) or a table {start, stop, num}",
+    "orbits.z0": "a list of z0 values (LU) or a table {start, stop, num}, for halo families",
+    "orbits.period_days": "a list of periods (days) or a table {start, stop, num}",
+    "orbits.resonance": "a list of integers k >= 1 (synodic 1:k members, T = 2 pi / k)",
+    "orbits.sun_resonance": "a list of integers k >= 1 (Sun-resonant members, T = Ts / k)",
+    "orbits.members": "an integer >= 1: that many members evenly spread along the family",
+    "orbits.max_members": "an integer in [2, 5000], the continuation's length (lyapunov and halo)",
+    "body.kz": "a number in [-1, 1] (Kz = (Iy - Ix) / Iz), a list of them or a table {start, stop, num}",
+    "body.ix": "a number > 0, principal moment of inertia about x in kg m^2",
+    "body.iy": "a number > 0, principal moment of inertia about y in kg m^2",
+    "body.iz": "a number > 0, principal moment of inertia about z in kg m^2",
+    "body.mass_kg": "a number > 0, the mass in kg",
+    "torques.gravity_gradient": "a list of primaries among 'earth' and 'moon'",
+    "torques.srp.eps": "a finite number, the nondimensional plate amplitude P A d TU^2 / Iz",
+    "torques.srp.area_m2": "a number > 0, the plate's area in m^2",
+    "torques.srp.offset_m": "a finite number, the centre-of-pressure offset along y_B in m",
+    "torques.srp.cs": "a number in [0, 1], the specular reflection fraction (cs + cd <= 1)",
+    "torques.srp.cd": "a number in [0, 1], the diffuse reflection fraction (cs + cd <= 1)",
+    "torques.srp.theta0": "a finite number, the Sun's phase at t = 0 in rad",
+    "torques.srp.pressure": "a number >= 0, the solar pressure in N/m^2 (default 4.56e-6)",
+    "rates.wz0": "a list of inertial initial rates (1/TU), strictly increasing, or a table {start, stop, num} with start < stop, num >= 2",
+    "rates.phidot0": "a list of initial rates relative to the synodic frame (1/TU), strictly increasing, or a table {start, stop, num} with start < stop, num >= 2",
+    "solver.rtol": "a number in [1e-15, 1e-3]",
+    "solver.atol": "a number in [1e-15, 1e-3]",
+    "solver.n_periods": "an integer in [1, 1000], orbit periods per attitude period",
+    "solver.phi0": "a number in [-2 pi, 2 pi], the initial attitude angle in rad",
+    "output.folder": "a non-empty path (relative paths are taken from the study file's folder)",
+    "output.format": "'zarr' or 'netcdf'",
+    "output.figures": "a list of figure names among " + ", ".join(repr(f) for f in FIGURES),
+}
+_RANGE_ALLOWED = {
+    "start": "a finite number, the first value",
+    "stop": "a finite number, the last value",
+    "num": "an integer in [1, 1000000], the number of values (both ends included)",
+}
+
+
+def _allowed(key: str) -> str | None:
+    base = re.sub(r"\[\d+\]", "", key)
+    if key in ALLOWED or base in ALLOWED:
+        text = ALLOWED.get(key) or ALLOWED[base]
+    else:
+        last = key.rsplit(".", 1)[-1]
+        text = _RANGE_ALLOWED.get(last)
+    if text and "{presets}" in text:
+        from .system import System
+
+        text = text.format(presets=", ".join(repr(p) for p in System.presets()))
+    return text
+
+
+def _show(value: Any) -> str:
+    if isinstance(value, dict):
+        return "{" + ", ".join(f"{k} = {_show(v)}" for k, v in value.items()) + "}"
+    if isinstance(value, list):
+        return "[" + ", ".join(_show(v) for v in value) + "]"
+    if isinstance(value, str):
+        return json.dumps(value)
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    return repr(value)
+
+
+def _problem(key: str, value: Any, message: str, allowed: str | None = None) -> str:
+    allowed = _allowed(key) if allowed is None else allowed
+    text = f"{key} = {_show(value)}: {message}"
+    return text + (f"; allowed: {allowed}" if allowed else "")
+
+
+def _missing(key: str, message: str) -> str:
+    allowed = _allowed(key)
+    return f"{key}: {message}" + (f"; allowed: {allowed}" if allowed else "")
+
+
+def _dotted(prefix: str, loc: tuple) -> str:
+    key = prefix
+    for part in loc:
+        if isinstance(part, int):
+            key += f"[{part}]"
+        elif part in _TAGS:
+            continue
+        else:
+            key = f"{key}.{part}" if key else str(part)
+    return key
+
+
+def _keys_of(parent: str) -> list[str] | None:
+    base = re.sub(r"\[\d+\]", "", parent)
+    if base == "":
+        return list(_TOP_KEYS)
+    if base in _TABLES:
+        return list(_TABLES[base].model_fields)
+    last = base.rsplit(".", 1)[-1]
+    if last in ("x0", "z0", "period_days", "wz0", "phidot0", "kz"):
+        return list(Range.model_fields)
+    return None
+
+
+def _unknown(key: str, value: Any) -> str:
+    parent, _, name = key.rpartition(".")
+    keys = _keys_of(parent) or []
+    where = f"[{parent}]" if parent else "the top level"
+    hint = difflib.get_close_matches(name, keys, n=1)
+    text = f"{key} = {_show(value)}: unknown key; allowed keys in {where}: {', '.join(keys)}"
+    return text + (f" (did you mean `{(parent + '.') if parent else ''}{hint[0]}`?)" if hint else "")
+
+
+def _pydantic_problems(prefix: str, err: ValidationError) -> list[str]:
+    out = []
+    for e in err.errors():
+        key = _dotted(prefix, e["loc"])
+        if e["type"] == "extra_forbidden":
+            out.append(_unknown(key, e["input"]))
+        elif e["type"] == "missing":
+            out.append(_missing(key, "missing (required)"))
+        else:
+            msg = e["msg"]
+            msg = msg[0].lower() + msg[1:]
+            msg = msg.removeprefix("value error, ")
+            if e["type"] == "model_type":
+                msg = "must be a table"
+            out.append(_problem(key, e["input"], msg))
+    return out
+
+
+# --- checks beyond the types -------------------------------------------------------------------
+def _grid_values(g) -> np.ndarray | None:
+    if g is None:
+        return None
+    if isinstance(g, Range):
+        return g.values()
+    if isinstance(g, (int, float)):
+        return np.array([float(g)])
+    return np.asarray(g, dtype=float)
+
+
+def _grid_raw(g) -> Any:
+    if isinstance(g, Range):
+        return g.model_dump()
+    return g
+
+
+def _check_increasing(key: str, g, problems: list[str]) -> None:
+    if isinstance(g, Range):
+        if g.num < 2:
+            problems.append(_problem(f"{key}.num", g.num, "a rate grid needs at least 2 values", "an integer in [2, 1000000]"))
+        if not g.start < g.stop:
+            problems.append(_problem(f"{key}.stop", g.stop, f"must be greater than {key}.start = {_show(g.start)} (rates increase)",
+                                     f"a number > {key}.start"))
+    else:
+        v = np.asarray(g, dtype=float)
+        if v.size < 2:
+            problems.append(_problem(key, g, "a rate grid needs at least 2 values"))
+        elif np.any(np.diff(v) <= 0):
+            problems.append(_problem(key, g, "must be strictly increasing"))
+
+
+def _check_sections(s: dict[str, _Table], given: dict, purpose: str | None) -> list[str]:
+    """Consistency checks on the sections that passed type validation (``s``); ``given`` is the
+    raw study as written (to tell a missing section from a defaulted one)."""
+    from .system import System
+
+    problems: list[str] = []
+    # [system]
+    mu = None
+    sysc = s.get("system")
+    if sysc is not None:
+        custom = [k for k in ("mu", "lu_km", "tu_s", "radii_km") if getattr(sysc, k) is not None]
+        if sysc.preset is not None:
+            if sysc.preset not in System.presets():
+                problems.append(_problem("system.preset", sysc.preset, "unknown preset"))
+            else:
+                mu = System.preset(sysc.preset).mu
+            for k in custom:
+                problems.append(_problem(f"system.{k}", getattr(sysc, k), "cannot be combined with system.preset (a preset fixes the constants)",
+                                         "either system.preset alone, or system.mu, system.lu_km and system.tu_s (and optionally system.radii_km)"))
+        elif custom:
+            for k in ("mu", "lu_km", "tu_s"):
+                if getattr(sysc, k) is None:
+                    problems.append(_missing(f"system.{k}", f"missing: a custom system (given {', '.join('system.' + c for c in custom)}) needs system.mu, system.lu_km and system.tu_s"))
+            if sysc.mu is not None:
+                mu = sysc.mu
+        else:
+            mu = System.preset("earth-moon").mu
+
+    # [orbits]
+    orb = s.get("orbits")
+    if orb is not None:
+        if orb.kind == "dro":
+            for k in ("point", "branch", "max_members"):
+                if getattr(orb, k) is not None:
+                    problems.append(_problem(f"orbits.{k}", getattr(orb, k), "does not apply to orbits.kind = \"dro\"",
+                                             "orbits.point and orbits.max_members for 'lyapunov' and 'halo', orbits.branch for 'halo'"))
+        if orb.kind == "lyapunov" and orb.branch is not None:
+            problems.append(_problem("orbits.branch", orb.branch, "does not apply to orbits.kind = \"lyapunov\" (planar)", "orbits.branch only with orbits.kind = 'halo'"))
+        if orb.kind != "halo" and orb.z0 is not None:
+            problems.append(_problem("orbits.z0", _grid_raw(orb.z0), f"does not apply to orbits.kind = \"{orb.kind}\" (planar: z0 = 0)", "orbits.z0 only with orbits.kind = 'halo'"))
+        sel = [k for k in ("x0", "z0", "period_days", "resonance", "sun_resonance", "members") if getattr(orb, k) is not None]
+        if len(sel) > 1:
+            for k in sel[1:]:
+                problems.append(_problem(f"orbits.{k}", _grid_raw(getattr(orb, k)), f"cannot be combined with orbits.{sel[0]}: choose the members one way",
+                                         "at most one of orbits.x0, z0, period_days, resonance, sun_resonance, members"))
+        for k in ("x0", "z0", "period_days"):
+            v = _grid_values(getattr(orb, k))
+            if v is None:
+                continue
+            if k == "x0" and mu is not None and orb.kind == "dro" and (np.any(v <= -mu) or np.any(v >= 1 - mu)):
+                problems.append(_problem("orbits.x0", _grid_raw(orb.x0), f"DROs start between the primaries, -mu < x0 < 1 - mu = ({-mu:.6g}, {1 - mu:.6g})",
+                                         "values in (-mu, 1 - mu)"))
+            if k == "period_days" and np.any(v <= 0):
+                problems.append(_problem("orbits.period_days", _grid_raw(orb.period_days), "periods must be > 0 days"))
+
+    # [body]
+    body = s.get("body")
+    if body is not None:
+        moments = {k: getattr(body, k) for k in ("ix", "iy", "iz") if getattr(body, k) is not None}
+        if body.kz is not None and moments:
+            for k, v in moments.items():
+                problems.append(_problem(f"body.{k}", v, "cannot be combined with body.kz (Kz follows from the moments)",
+                                         "either body.kz, or body.ix, body.iy and body.iz"))
+        elif body.kz is None and not moments:
+            problems.append(_missing("body.kz", "missing: give body.kz, or body.ix, body.iy and body.iz in kg m^2"))
+        elif moments and len(moments) < 3:
+            for k in ("ix", "iy", "iz"):
+                if k not in moments:
+                    problems.append(_missing(f"body.{k}", f"missing: the inertia needs all three of body.ix, body.iy, body.iz (given: {', '.join('body.' + m for m in moments)})"))
+        elif len(moments) == 3:
+            ix, iy, iz = moments["ix"], moments["iy"], moments["iz"]
+            for k, a, b, c in (("ix", ix, iy, iz), ("iy", iy, ix, iz), ("iz", iz, ix, iy)):
+                if a > b + c:
+                    problems.append(_problem(f"body.{k}", a, f"violates the triangle inequality: {k} must not exceed the sum of the other two moments ({b + c:g} kg m^2)",
+                                             "principal moments with each <= the sum of the other two"))
+                    break
+        if isinstance(body.kz, Range):
+            for k in ("start", "stop"):
+                v = getattr(body.kz, k)
+                if not -1 <= v <= 1:
+                    problems.append(_problem(f"body.kz.{k}", v, "Kz must be in [-1, 1]", "a number in [-1, 1]"))
+
+    # [torques]
+    tq = s.get("torques")
+    if tq is not None:
+        if len(set(tq.gravity_gradient)) != len(tq.gravity_gradient):
+            problems.append(_problem("torques.gravity_gradient", tq.gravity_gradient, "a primary is listed twice"))
+        srp = tq.srp
+        if srp is not None:
+            geo = [k for k in ("area_m2", "offset_m") if getattr(srp, k) is not None]
+            if srp.eps is not None and geo:
+                for k in geo:
+                    problems.append(_problem(f"torques.srp.{k}", getattr(srp, k), "cannot be combined with torques.srp.eps (eps follows from the geometry)",
+                                             "either torques.srp.eps, or torques.srp.area_m2 and torques.srp.offset_m"))
+            elif srp.eps is None and len(geo) < 2:
+                missing = [k for k in ("area_m2", "offset_m") if k not in geo] if geo else ["eps"]
+                for k in missing:
+                    problems.append(_missing(f"torques.srp.{k}", "missing: the plate needs torques.srp.eps, or torques.srp.area_m2 and torques.srp.offset_m"))
+            if srp.cs + srp.cd > 1 + 1e-12:
+                problems.append(_problem("torques.srp.cd", srp.cd, f"cs + cd = {srp.cs + srp.cd:g} exceeds 1 (the absorbed fraction is 1 - cs - cd)"))
+            if srp.pressure is not None and srp.eps is not None:
+                problems.append(_problem("torques.srp.pressure", srp.pressure, "only used with the geometry (area_m2, offset_m); eps already includes it"))
+            if srp.eps is None and len(geo) == 2 and body is not None and body.iz is None and body.kz is not None:
+                problems.append(_problem("torques.srp.area_m2", srp.area_m2, "the plate's geometry needs the body's Iz in kg m^2 (body.ix, body.iy, body.iz); with body.kz alone give torques.srp.eps",
+                                         "torques.srp.eps with body.kz, or the geometry with body.ix/iy/iz"))
+
+    # [rates]
+    rates = s.get("rates")
+    if rates is not None:
+        if rates.wz0 is not None and rates.phidot0 is not None:
+            problems.append(_problem("rates.phidot0", _grid_raw(rates.phidot0), "cannot be combined with rates.wz0 (phidot0 = wz0 - 1)", "either rates.wz0 or rates.phidot0"))
+        elif rates.wz0 is None and rates.phidot0 is None:
+            problems.append(_missing("rates.wz0", "missing: give rates.wz0 (inertial) or rates.phidot0 (relative to the synodic frame)"))
+        for k in ("wz0", "phidot0"):
+            if getattr(rates, k) is not None:
+                _check_increasing(f"rates.{k}", getattr(rates, k), problems)
+
+    # what the command needs
+    if purpose in ("solve", "map"):
+        what, need = ("periodic solutions", "need") if purpose == "solve" else ("a periodicity map", "needs")
+        if "body" not in given:
+            problems.append(_missing("body", f"missing section [body]: {what} {need} the body (body.kz, or body.ix/iy/iz)"))
+        if "rates" not in given:
+            problems.append(_missing("rates", f"missing section [rates]: {what} {need} the initial rates (rates.wz0 or rates.phidot0)"))
+        if orb is not None and orb.kind == "halo":
+            problems.append(_problem("orbits.kind", orb.kind, f"{what} use{'s' if need == 'needs' else ''} the planar attitude model, which needs a planar family",
+                                     "'dro' or 'lyapunov'"))
+        if tq is not None and sorted(tq.gravity_gradient) != ["earth", "moon"]:
+            problems.append(_problem("torques.gravity_gradient", tq.gravity_gradient,
+                                     f"the planar engine behind {what} models the gravity gradient of both primaries", "[\"earth\", \"moon\"]"))
+        if tq is not None and tq.srp is not None and orb is not None:
+            why = "with torques.srp the forcing is periodic only on a Sun-resonant orbit (T = Ts / k): select exactly one"
+            if orb.sun_resonance is None:
+                problems.append(_missing("orbits.sun_resonance", f"missing: {why}, e.g. orbits.sun_resonance = [2]"))
+            elif len(orb.sun_resonance) != 1:
+                problems.append(_problem("orbits.sun_resonance", orb.sun_resonance, why, "a list of one integer k >= 1, e.g. [2]"))
+            else:
+                k = orb.sun_resonance[0]
+                sol = s.get("solver")
+                if sol is not None and sol.n_periods is not None and sol.n_periods % k:
+                    problems.append(_problem("solver.n_periods", sol.n_periods, f"with torques.srp on the 1:{k} Sun-resonant orbit the attitude period must cover whole Sun periods",
+                                             f"a multiple of {k}"))
+    return problems
+
+
+# --- the study -----------------------------------------------------------------------------------
+class Study(BaseModel):
+    """A validated study (see the module docstring). Build it with :meth:`from_toml` or
+    :meth:`from_dict`; it is immutable. ``base_dir`` is the folder relative output paths are
+    taken from (the study file's folder, or the working directory)."""
+
+    model_config = ConfigDict(extra="forbid", strict=True, frozen=True, allow_inf_nan=False)
+
+    title: str | None = None
+    description: str | None = None
+    system: SystemSection = Field(default_factory=SystemSection)
+    orbits: OrbitsSection = Field(default_factory=OrbitsSection)
+    body: BodySection | None = None
+    torques: TorquesSection = Field(default_factory=TorquesSection)
+    rates: RatesSection | None = None
+    solver: SolverSection = Field(default_factory=SolverSection)
+    output: OutputSection = Field(default_factory=OutputSection)
+    base_dir: str = Field(".", exclude=True)
+
+    # --- construction --------------------------------------------------------------------------
+    @classmethod
+    def from_dict(cls, data: Any, *, purpose: str | None = None, base_dir: str | Path | None = None, source: str | None = None) -> Study:
+        """Validate ``data`` (the parsed TOML: a dict of tables) and return the study.
+
+        ``purpose``: also check what a command needs ("family", "solve" or "map"; e.g. a map needs
+        [body] and [rates] and a planar family). Raises :class:`StudyError` listing every problem.
+        """
+        if purpose is not None and purpose not in PURPOSES:
+            raise ValueError(f"invalid argument `purpose`: must be one of {', '.join(PURPOSES)} or None, got {purpose!r}")
+        if not isinstance(data, dict):
+            raise StudyError([f"the study must be a table of sections, got {type(data).__name__}"], source)
+        problems: list[str] = []
+        sections: dict[str, _Table] = {}
+        for key, value in data.items():
+            if key in ("title", "description"):
+                if not isinstance(value, str):
+                    problems.append(_problem(key, value, "must be a string"))
+            elif key in _SECTIONS:
+                if not isinstance(value, dict):
+                    problems.append(_problem(key, value, f"must be a table [{key}]", f"a table [{key}] with keys {', '.join(_SECTIONS[key].model_fields)}"))
+                    continue
+                try:
+                    sections[key] = _SECTIONS[key].model_validate(value)
+                except ValidationError as err:
+                    problems += _pydantic_problems(key, err)
+            else:
+                problems.append(_unknown(key, value))
+        # Sections left out take their defaults ([body] and [rates] have none); a section that
+        # failed type validation is left out of the checks that involve it.
+        valid: dict[str, _Table] = {}
+        for k, model in _SECTIONS.items():
+            if k in sections:
+                valid[k] = sections[k]
+            elif k not in data and k not in ("body", "rates"):
+                valid[k] = model()
+        problems += _check_sections(valid, data, purpose)
+        if problems:
+            raise StudyError(problems, source)
+        kwargs = {k: v for k, v in data.items() if k in ("title", "description")}
+        return cls.model_construct(**kwargs, **valid, base_dir=str(base_dir if base_dir is not None else "."))
+
+    @classmethod
+    def from_toml(cls, path: str | Path, *, purpose: str | None = None, overrides: dict | None = None) -> Study:
+        """Read and validate a TOML study file (relative output folders are taken from its
+        folder). ``overrides``: a dict of dotted keys to values applied on top (e.g.
+        ``{"rates.wz0.num": 50}``), as the command line's ``--set``. Raises :class:`StudyError`."""
+        p = Path(path)
+        try:
+            text = p.read_text(encoding="utf-8")
+        except FileNotFoundError:
+            raise StudyError([f"study file {str(p)!r} not found"], str(p)) from None
+        except (OSError, UnicodeDecodeError) as err:
+            raise StudyError([f"study file {str(p)!r} cannot be read: {err}"], str(p)) from None
+        try:
+            data = tomllib.loads(text)
+        except tomllib.TOMLDecodeError as err:
+            raise StudyError([f"not valid TOML: {err}"], str(p)) from None
+        if overrides:
+            data = apply_overrides(data, overrides)
+        return cls.from_dict(data, purpose=purpose, base_dir=p.resolve().parent, source=str(p))
+
+    def check(self, purpose: str) -> Study:
+        """Check that the study has what a command needs ("family", "solve", "map"); returns
+        itself, or raises :class:`StudyError`."""
+        return Study.from_dict(self.to_dict(), purpose=purpose, base_dir=self.base_dir)
+
+    # --- serialisation -------------------------------------------------------------------------
+    def to_dict(self) -> dict:
+        """The full study as plain data (TOML/JSON compatible), with the defaults written out:
+        the system preset, the Lagrange point and halo branch, the periods per solution."""
+        d = self.model_dump(mode="json", exclude_none=True, exclude={"base_dir"})
+        if self.system.mu is None:
+            d["system"]["preset"] = self.system.preset or "earth-moon"
+        if self.orbits.kind != "dro":
+            d["orbits"].setdefault("point", 1 if self.orbits.kind == "lyapunov" else 2)
+        if self.orbits.kind == "halo":
+            d["orbits"].setdefault("branch", "south")
+        d["solver"]["n_periods"] = self.n_periods()
+        return d
+
+    def to_json(self) -> str:
+        """The full study as a JSON string (stored as the ``study`` attribute of every result)."""
+        return json.dumps(self.to_dict(), sort_keys=True)
+
+    @classmethod
+    def from_json(cls, text: str, **kwargs) -> Study:
+        """The study stored in a result's ``study`` attribute."""
+        return cls.from_dict(json.loads(text), **kwargs)
+
+    # --- librate objects -----------------------------------------------------------------------
+    def build_system(self):
+        """The :class:`~librate.System`."""
+        from .system import System
+
+        s = self.system
+        if s.mu is None:
+            return System.preset(s.preset or "earth-moon")
+        r1, r2 = s.radii_km or (0.0, 0.0)
+        return System(mu=s.mu, lu_km=s.lu_km, tu_s=s.tu_s, r1_km=r1, r2_km=r2, name=s.name or "custom")
+
+    def build_family(self, system=None):
+        """The orbit family this study works on (computed by continuation, takes 0.1 s to a few
+        s): for DROs with ``orbits.x0``, exactly those members; otherwise the whole family (DRO
+        0.985 -> 0.005; Lyapunov or halo at ``orbits.point`` up to ``orbits.max_members``)."""
+        from .families import dro_family, halo_family, lyapunov_family
+
+        system = system or self.build_system()
+        o = self.orbits
+        if o.kind == "dro":
+            return dro_family(system, x0=_grid_values(o.x0)) if o.x0 is not None else dro_family(system)
+        kw = {} if o.max_members is None else {"max_members": o.max_members}
+        if o.kind == "lyapunov":
+            return lyapunov_family(system, o.point or 1, **kw)
+        return halo_family(system, o.point or 2, o.branch or "south", **kw)
+
+    def build_orbits(self, family=None):
+        """The orbits selected by [orbits]: an :class:`~librate.OrbitFamily` (DROs by x0, all
+        members, or ``orbits.members`` of them evenly spread) or a list of corrected
+        :class:`~librate.PeriodicOrbit` (by x0 or z0 for Lyapunov/halo, period_days, resonance,
+        sun_resonance)."""
+        o = self.orbits
+        fam = family if family is not None else self.build_family()
+        if o.members is not None:
+            idx = np.unique(np.round(np.linspace(0, len(fam) - 1, min(o.members, len(fam)))).astype(int))
+            return _subset(fam, idx)
+        if o.kind == "dro" and o.x0 is not None:
+            return fam  # dro_family(x0=...) computed exactly these members
+        for key, find in (("x0", lambda v: fam.member(x0=float(v))), ("z0", lambda v: fam.member(z0=float(v))),
+                          ("period_days", lambda v: fam.member(period_days=float(v))),
+                          ("resonance", lambda k: fam.resonant(int(k), "synodic")), ("sun_resonance", lambda k: fam.resonant(int(k), "sun"))):
+            sel = getattr(o, key)
+            if sel is None:
+                continue
+            values = _grid_values(sel) if key in ("x0", "z0", "period_days") else sel
+            out = []
+            for v in values:
+                try:
+                    out.append(find(v))
+                except ValueError:  # outside the family's range: name the key and the range
+                    span = {"x0": fam.x0, "z0": np.concatenate([fam.state0[:, 2], fam.state_half[:, 2]]), "period_days": fam.period_days,
+                            "resonance": 2 * math.pi / fam.period, "sun_resonance": _sun_period() / fam.period}[key]
+                    what = {"x0": "x0 (LU)", "z0": "z0 (LU)", "period_days": "periods (days)", "resonance": "k = 2 pi / T",
+                            "sun_resonance": "k = Ts / T"}[key]
+                    raise StudyError([_problem(f"orbits.{key}", _grid_raw(sel), f"no member at {float(v):g} on the {fam.kind} family ({len(fam)} members)",
+                                               f"{what} from {np.min(span):.6g} to {np.max(span):.6g}")]) from None
+            return out
+        return fam
+
+    def kz_values(self) -> np.ndarray:
+        """The Kz value(s) of the body, (n,) array: ``body.kz`` or (Iy - Ix) / Iz."""
+        b = self.body
+        if b is None:
+            raise ValueError("the study has no [body]")
+        if b.kz is not None:
+            return _grid_values(b.kz)
+        return np.array([(b.iy - b.ix) / b.iz])
+
+    def build_body(self):
+        """The :class:`~librate.RigidBody` (moments in kg m^2 when given; else normalised from
+        the single Kz), or None without [body] or with several Kz values."""
+        from .attitude import RigidBody
+
+        b = self.body
+        if b is None:
+            return None
+        if b.ix is not None:
+            return RigidBody(b.ix, b.iy, b.iz, mass_kg=b.mass_kg)
+        kz = self.kz_values()
+        return RigidBody.from_kz(float(kz[0])) if kz.size == 1 else None
+
+    def build_srp(self, system=None):
+        """The :class:`~librate.FlatPlateSRP` plate of [torques.srp], or None."""
+        from .srp import FlatPlateSRP, SunModel
+
+        p = self.torques.srp
+        if p is None:
+            return None
+        sun = SunModel(theta0=p.theta0) if p.pressure is None else SunModel(theta0=p.theta0, pressure=p.pressure)
+        if p.eps is not None:
+            return FlatPlateSRP(p.eps, p.cs, p.cd, sun)
+        return FlatPlateSRP.from_geometry(system or self.build_system(), area_m2=p.area_m2, offset_m=p.offset_m, iz_kgm2=self.body.iz,
+                                          cs=p.cs, cd=p.cd, sun=sun)
+
+    def wz0_values(self) -> np.ndarray:
+        """The inertial initial rates wz0 (1/TU), strictly increasing (``rates.phidot0`` + 1)."""
+        r = self.rates
+        if r is None:
+            raise ValueError("the study has no [rates]")
+        if r.wz0 is not None:
+            return _grid_values(r.wz0)
+        return _grid_values(r.phidot0) + 1.0
+
+    def n_periods(self) -> int:
+        """Orbit periods per attitude period: ``solver.n_periods``, else k for an SRP study on
+        the 1:k Sun-resonant orbit, else 1."""
+        if self.solver.n_periods is not None:
+            return self.solver.n_periods
+        if self.torques.srp is not None and self.orbits.sun_resonance:
+            return int(self.orbits.sun_resonance[0])
+        return 1
+
+    def output_dir(self, out: str | Path | None = None) -> Path:
+        """The output folder, absolute: ``out`` if given (relative to the working directory),
+        else ``output.folder`` (relative to ``base_dir``, the study file's folder)."""
+        if out is not None:
+            return Path(out).resolve()
+        p = Path(self.output.folder)
+        return (p if p.is_absolute() else Path(self.base_dir) / p).resolve()
+
+    def figures(self, available: tuple[str, ...]) -> list[str]:
+        """The figures to draw among ``available`` (all of them unless ``output.figures``)."""
+        want = self.output.figures
+        return [f for f in available if want is None or f in want]
+
+    def result_attrs(self, kind: str) -> dict:
+        """Attributes every result carries: the result kind, the full study (JSON) and the
+        package version."""
+        from . import __version__
+
+        return {"librate_result": kind, "study": self.to_json(), "librate_version": __version__}
+
+    # --- jobs ----------------------------------------------------------------------------------
+    def run_family(self, out: str | Path | None = None):
+        """Compute the orbit family (and the selected members, when the selection is a
+        subset) and save it as ``family.zarr`` (or ``family.nc``) in the output folder with the
+        study and version as attributes. Returns ``(family, path)``."""
+        from .results import save_family
+
+        fam = self.build_family()
+        sel = self.build_orbits(fam)
+        if isinstance(sel, list):
+            sel = _family_of(fam, sel)
+        folder = self.output_dir(out)
+        path = save_family(sel, folder / ("family.zarr" if self.output.format == "zarr" else "family.nc"), self.result_attrs("family"))
+        return sel, path
+
+    def run_solve(self, out: str | Path | None = None, progress: Callable[[int, int], None] | None = None):
+        """The periodic attitude solutions of every selected orbit and Kz with wz0 in the rate
+        window (:func:`librate.find_periodic_attitudes`, scanning on the study's rate grid),
+        saved as ``solutions.zarr`` (or ``.nc``). Returns ``(dataset, path)``; the Dataset has a
+        ``solution`` dimension (orbit index, x0, period, Kz, N, kind, wz0, phidot0, phi0,
+        stability, residual)."""
+        from .periodicity import find_periodic_attitudes
+        from .results import save_dataset, solutions_dataset
+
+        orbits = self.build_orbits()
+        olist = list(orbits)
+        wz = self.wz0_values()
+        srp = self.build_srp(olist[0].system if olist else None)
+        rows = []
+        total = len(olist) * len(self.kz_values())
+        done = 0
+        for i, o in enumerate(olist):
+            for kz in self.kz_values():
+                sols = find_periodic_attitudes(o, kz=float(kz), wz0_range=(float(wz[0]), float(wz[-1])), phi0=self.solver.phi0,
+                                               n_grid=int(wz.size), n_periods=self.n_periods(), srp=srp)
+                rows += [(i, s) for s in sols]
+                done += 1
+                if progress is not None:
+                    progress(done, total)
+        ds = solutions_dataset(rows, olist, self.kz_values(), self.result_attrs("solutions"))
+        folder = self.output_dir(out)
+        path = save_dataset(ds, folder / ("solutions.zarr" if self.output.format == "zarr" else "solutions.nc"))
+        return ds, path
+
+    def run_map(self, out: str | Path | None = None, *, scheduler=None, progress=None, resume: bool = True):
+        """The attitude periodicity map (grids of wz(T) - wz0 and phi(T) - phi0 over orbit x Kz
+        x wz0, and the refined solutions) through ``librate.runner.run_map`` into
+        ``map.zarr`` in the output folder (resumable), or, when the runner is not installed,
+        through :func:`librate.periodicity_map` written with ``to_zarr``. With
+        ``output.format = "netcdf"`` a ``map.nc`` copy is exported too. Returns
+        ``(dataset, path)``."""
+        from .results import run_map_to
+
+        folder = self.output_dir(out)
+        orbits = self.build_orbits()
+        srp = self.build_srp()
+        ds, path = run_map_to(
+            orbits, folder / "map.zarr", kz=self.kz_values(), wz0=self.wz0_values(), phi0=self.solver.phi0, n_periods=self.n_periods(),
+            srp=srp, rtol=self.solver.rtol, atol=self.solver.atol, resume=resume, scheduler=scheduler, progress=progress,
+            attrs=self.result_attrs("map"),
+        )
+        if self.output.format == "netcdf":
+            from .results import save_dataset
+
+            save_dataset(ds, folder / "map.nc")
+        return ds, path
+
+
+def _sun_period() -> float:
+    from .constants import SUN_SYNODIC_PERIOD
+
+    return SUN_SYNODIC_PERIOD
+
+
+def _subset(fam, idx):
+    import dataclasses
+
+    return dataclasses.replace(
+        fam, state0=fam.state0[idx], state_half=fam.state_half[idx], period=fam.period[idx], jacobi=fam.jacobi[idx],
+        eigenvalues=fam.eigenvalues[idx], stability_indices=fam.stability_indices[idx], bifurcations=[],
+        parameters={**fam.parameters, "members": [int(i) for i in idx]},
+    )
+
+
+def _family_of(fam, orbits):
+    """An OrbitFamily holding the corrected members ``orbits`` of ``fam`` (for saving)."""
+    from .families import OrbitFamily
+
+    return OrbitFamily.from_members(fam.system, fam.kind, fam.spatial, [_with_crossing(o) for o in orbits], fam.end_reason,
+                                    {**fam.parameters, "selected": True})
+
+
+def _with_crossing(o):
+    """A PeriodicOrbit with its half-period crossing state (needed by OrbitFamily)."""
+    if o._evaluation is not None and "crossing" in o._evaluation:
+        return o
+    import dataclasses
+
+    from .propagation import propagate
+
+    half = propagate(o.system, o.state0, 0.5 * o.period, rtol=1e-13, atol=1e-13).y[-1]
+    return dataclasses.replace(o, _evaluation={"crossing": half})
+
+
+def _parse_value(text: str) -> Any:
+    try:
+        return tomllib.loads(f"v = {text}")["v"]
+    except tomllib.TOMLDecodeError:
+        return text
+
+
+def apply_overrides(data: dict, overrides: dict) -> dict:
+    """A copy of ``data`` with dotted ``overrides`` applied (``{"rates.wz0.num": 50}``; string
+    values are parsed as TOML values when they can be: ``"0.5"`` -> 0.5, ``"[1, 2]"`` -> a list,
+    ``"{start = 0, stop = 1, num = 5}"`` -> a table; otherwise kept as strings)."""
+    out = copy.deepcopy(data)
+    for key, value in overrides.items():
+        if isinstance(value, str):
+            value = _parse_value(value)
+        parts = key.split(".")
+        d = out
+        for p in parts[:-1]:
+            nxt = d.get(p)
+            if not isinstance(nxt, dict):
+                nxt = {}
+                d[p] = nxt
+            d = nxt
+        d[parts[-1]] = value
+    return out
+
+
+# --- the example written by `librate init` ------------------------------------------------------
+EXAMPLE_STUDY = '''\
+# A librate study: everything one job needs, in one file.
+#   librate family study.toml   the orbit family (continuation), saved with figures
+#   librate solve  study.toml   the periodic attitude motions of each orbit in the rate window
+#   librate map    study.toml   the attitude periodicity map (thesis Fig. 24) and its solutions
+#   librate plot   librate-out/map.zarr   re-draw the figures from the saved result
+# Units: nondimensional CR3BP units (LU, TU; rates in 1/TU, the synodic frame turns at 1),
+# angles in rad, inertia in kg m^2, lengths in m, periods in days.
+# Any key can be overridden on the command line: --set rates.wz0.num=200
+
+title = "DRO attitude periodicity map at Kz = 0.8"
+
+[system]
+preset = "earth-moon"          # or: mu = 0.01215, lu_km = 384400, tu_s = 375190, radii_km = [6378, 1737]
+
+[orbits]
+kind = "dro"                   # "dro", "lyapunov" (point = 1|2) or "halo" (point, branch = "north"|"south")
+x0 = { start = 0.9, stop = 0.3, num = 12 }    # members by x0 (LU); or a list [0.9, 0.8]
+# period_days = [12.66]        # or by period (days)
+# resonance = [1, 2]           # or synodic 1:k members (T = 2 pi / k)
+# sun_resonance = [2]          # or Sun-resonant members (T = Ts / k), for SRP
+# members = 20                 # or that many members evenly spread along the whole family
+
+[body]
+kz = 0.8                       # Kz = (Iy - Ix) / Iz in [-1, 1]; a list [0.2, 0.5, 0.8] maps several
+# ix = 12.12e6                 # or the principal moments (kg m^2) instead of kz
+# iy = 89.68e6
+# iz = 96.95e6
+# mass_kg = 4.0e5
+
+[torques]
+gravity_gradient = ["earth", "moon"]   # the planar engine models both primaries
+# [torques.srp]                # solar radiation pressure, a two-sided flat plate
+# eps = 0.02                   # amplitude P A d TU^2 / Iz; or area_m2 = 100 and offset_m = 2 (needs ix/iy/iz)
+# cs = 0.4                     # specular fraction; cd: diffuse fraction (cs + cd <= 1)
+# theta0 = 0.0                 # Sun phase at t = 0 (rad)
+# (SRP needs one Sun-resonant orbit: [orbits] sun_resonance = [2], and solver.n_periods = 2)
+
+[rates]
+wz0 = { start = -3.0, stop = 2.0, num = 300 }   # inertial initial rates (1/TU), increasing
+# phidot0 = { start = -4.0, stop = 1.0, num = 300 }   # or relative to the synodic frame (wz0 - 1)
+
+[solver]
+rtol = 1e-12
+atol = 1e-12
+n_periods = 1                  # orbit periods per attitude period
+phi0 = 0.0                     # initial attitude angle (rad)
+
+[output]
+folder = "librate-out"         # relative to this file's folder
+format = "zarr"                # "zarr" (chunked, resumable maps) or "netcdf" (also writes .nc)
+figures = ["family", "period", "stability", "map", "residuals", "solutions"]
+'''
