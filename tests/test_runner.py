@@ -77,6 +77,8 @@ def test_sigkill_and_resume_is_bit_identical(tmp_path, fam, reference):
     back = xr.open_zarr(out)
     np.testing.assert_array_equal(back.dwz.values, reference.dwz.values)
     assert "x0" in back.coords and "phidot0" in back.coords and back.attrs["complete"] == 1
+    np.testing.assert_array_equal(back.orbit.values, np.arange(len(X0)))  # orbit 0 is not "missing"
+    np.testing.assert_array_equal(back.kz.values, KZ)
 
 
 def test_interrupt_keeps_finished_rows(tmp_path, fam, reference, monkeypatch):

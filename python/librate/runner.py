@@ -86,7 +86,8 @@ def _open_store(out: Path, fingerprint: str, shape, resume: bool, coords: dict):
     a = g.create_array("done", shape=(no,), chunks=(1,), dtype="bool", fill_value=False)
     a.attrs["_ARRAY_DIMENSIONS"] = ["orbit"]
     for name, (dim, values, attrs) in coords.items():
-        a = g.create_array(name, shape=values.shape, chunks=values.shape, dtype=values.dtype)
+        # no fill value: xarray would read a fill value of 0 as "missing" (orbit 0, Kz = 0)
+        a = g.create_array(name, shape=values.shape, chunks=values.shape, dtype=values.dtype, fill_value=None)
         a[:] = values
         a.attrs.update({"_ARRAY_DIMENSIONS": [dim], **attrs})
     return g
