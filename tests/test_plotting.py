@@ -1,4 +1,4 @@
-"""librate.plotting: the thesis ch. 2 and sec. 3.3 figures, rendered with Agg and checked against
+"""librate.plotting: the thesis ch. 2, sec. 3.3 and ch. 4 figures, rendered with Agg and checked against
 the data.
 
 Each figure is written to a PNG (non-trivial: over 10 kB, not one colour) and its artists are
@@ -8,7 +8,12 @@ days through the system's TU, stability curves equal to the family's indices, EC
 starting |r0 - r_earth| LU from the Earth and 1:K resonant orbits closing after K periods;
 residual curves equal to the periodicity map's values, solution markers at the solutions' rates,
 map contours through the solutions, family curves holding exactly the solutions of their N and
-Kz, periodic motions ending at phi0 + 2 pi N.
+Kz, periodic motions ending at phi0 + 2 pi N. Chapter 4 (SRP): Sun directions at omega_sun t + theta0
+(omega_sun from the sidereal month and year), Sun-resonant DROs of period Ts / K found
+independently, SRP map markers at the map's solutions (which repeat after K revolutions when
+re-propagated), fold crosses where the branches' monodromy trace is 2 and scaling as 1 / (1 + Cs),
+comparison curves ending at an independent propagation's phi(KT) and wz(KT), Sun-pointing
+accelerations equal to the written-out formulas and to the engine's wzdot.
 """
 
 import math
@@ -26,6 +31,7 @@ import pytest  # noqa: E402
 
 import librate  # noqa: E402
 import librate.plotting as lp  # noqa: E402
+from helpers import dro_with_period  # noqa: E402
 from librate.constants import SUN_SYNODIC_PERIOD  # noqa: E402
 
 
@@ -574,3 +580,287 @@ def test_plot_map_of_a_subset_of_orbits(small_map):
     ax = lp.plot_residuals(small_map.isel(orbit=[4])).axes[0]
     sel = (small_map.sol_orbit.values == 4)
     np.testing.assert_allclose(sorted(p[0] for p in marker_points(ax)), sorted(small_map.sol_phidot0.values[sel]), atol=1e-12)
+
+
+# --- solar radiation pressure (thesis ch. 4, Figs. 33-41) ----------------------------------------
+# The apparent solar period from the sidereal month and year (independent of librate.constants):
+# the Sun direction turns clockwise in the synodic frame at -(1 - n_sun).
+_N_SUN = 27.321661 / 365.25636
+_OMEGA_SUN = -(1.0 - _N_SUN)
+_TS = 2 * math.pi / (1.0 - _N_SUN)
+
+
+@pytest.fixture(scope="module")
+def fam_sun(em):
+    """16 DROs, x0 = 0.90 ... 0.75: the 1:2, 1:3 and 1:4 Sun-resonant members inside."""
+    return librate.dro_family(em, x0=np.arange(0.90, 0.745, -0.01))
+
+
+@pytest.fixture(scope="module")
+def sun12_orbit(fam_sun):
+    return fam_sun.resonant(2, "sun")
+
+
+@pytest.fixture(scope="module")
+def eps_map(sun12_orbit):
+    """1:2 Sun-resonant DRO, Kz = 0.6, Cs = 0.4, Cd = 0.1: 6 eps x 120 rates, with branches."""
+    return lp.srp_map(sun12_orbit, kz=0.6, wz0=np.linspace(-1.25, 0.05, 120), eps=np.linspace(0.0, 0.5, 6), cs=0.4, cd=0.1)
+
+
+def test_plot_sun_motion_fig33(em, tmp_path):
+    """Thesis Fig. 33: each Sun-direction ray k points at omega_sun t_k + theta0 (t_k = k Ts / 8,
+    omega_sun from the sidereal month and year), clockwise, the first at theta0; the angle curve
+    equals omega_sun t + theta0 (deg) against t in days and falls by 360 deg per Ts = 29.49 d; a
+    line at each multiple of Ts; the Earth-Moon line joins the primaries."""
+    theta0 = 0.7
+    fig = lp.plot_sun_motion(em, theta0=theta0, n_periods=2)
+    assert_png(fig, tmp_path / "fig33.png")
+    a_geo, a_ang = fig.axes
+    rays = gid(a_geo, "sun-direction")
+    assert len(rays) == 8
+    for k, h in enumerate(rays):
+        (x0, x1), (y0, y1) = h.get_xdata(), h.get_ydata()
+        assert x0 == y0 == 0.0
+        want = _OMEGA_SUN * k * _TS / 8 + theta0
+        assert abs(math.remainder(math.atan2(y1, x1) - want, 2 * math.pi)) < 1e-9
+    ang = [math.atan2(h.get_ydata()[1], h.get_xdata()[1]) for h in rays]
+    assert all(math.remainder(b - a, 2 * math.pi) < 0 for a, b in zip(ang, ang[1:]))  # clockwise
+    suns = gid(a_geo, "sun")
+    assert len(suns) == 8 and all(s.get_xdata()[0] == r.get_xdata()[1] for s, r in zip(suns, rays))
+    (em_line,) = gid(a_geo, "earth-moon-line")
+    np.testing.assert_allclose(em_line.get_xdata(), [-em.mu, 1 - em.mu], atol=1e-15)
+    np.testing.assert_allclose(em_line.get_ydata(), [0.0, 0.0], atol=1e-15)
+    (curve,) = gid(a_ang, "sun-angle")
+    t_days, deg = np.asarray(curve.get_xdata()), np.asarray(curve.get_ydata())
+    np.testing.assert_allclose(deg, np.degrees(_OMEGA_SUN * t_days / em.tu_days + theta0), rtol=0, atol=1e-9)
+    ts_days = _TS * em.tu_days
+    assert round(ts_days, 2) == 29.49 and t_days[-1] == pytest.approx(2 * ts_days, rel=1e-12)
+    assert np.interp(ts_days, t_days, deg) == pytest.approx(math.degrees(theta0) - 360.0, abs=1e-6)
+    np.testing.assert_allclose([v.get_xdata()[0] for v in gid(a_ang, "solar-period")], [ts_days, 2 * ts_days], rtol=1e-12)
+    assert {h.get_ydata()[0] for h in gid(a_ang, "sun-beyond-moon")} == {0.0, -360.0}
+    assert {h.get_ydata()[0] for h in gid(a_ang, "sun-behind-earth")} == {-180.0, -540.0}
+
+
+def test_plot_sun_resonant_fig34(em, fam_sun, tmp_path):
+    """Thesis Fig. 34: the 1:2, 1:3, 1:4 Sun-resonant DROs; each curve starts at (x0, 0), closes
+    after its propagation time and crosses y = 0 once in between, and x0 is that of the DRO of
+    period Ts / K found independently (continuation and a secant on the period, 1e-8); the 1:1
+    member (29.49 d) is longer than any DRO and is named in the note."""
+    fig = lp.plot_sun_resonant(fam_sun)
+    assert_png(fig, tmp_path / "fig34.png")
+    ax = fig.axes[0]
+    assert not gid(ax, "sun-resonant-1")
+    for k in (2, 3, 4):
+        (h,) = gid(ax, f"sun-resonant-{k}")
+        x, y = np.asarray(h.get_xdata()), np.asarray(h.get_ydata())
+        assert y[0] == 0.0 and abs(x[-1] - x[0]) < 1e-8 and abs(y[-1]) < 1e-8
+        assert np.count_nonzero(np.diff(np.sign(y[1:-1])) != 0) == 1
+        o = dro_with_period(em, _TS / k, np.arange(0.90, 0.77, -0.01))  # secant on T(x0), continued independently
+        assert x[0] == pytest.approx(o.x0, abs=1e-8)
+        assert f"1:{k} Sun" in h.get_label() and f"{o.period_days:.2f} d" in h.get_label()
+    (note,) = gid(ax, "missing-resonances")
+    assert "1:1" in note.get_text() and "29.49" in note.get_text()
+    with pytest.raises(ValueError, match="`ks`"):
+        lp.plot_sun_resonant(fam_sun, ks=(1,))
+
+
+def test_srp_map_solutions_and_plot_fig35(eps_map, sun12_orbit, tmp_path):
+    """Thesis Figs. 35-36: over (eps, phidot0) on the 1:2 Sun-resonant DRO. The markers sit at
+    (eps, phidot0) of the map's solutions, filled exactly for the stable ones; at eps = 0 they
+    are the gravity-only solutions (phi0 = 0) and the Dphi = 0 contour passes through them (a
+    vertex on the eps = 0 column within one rate step); solutions re-propagated independently
+    with their plate over K = 2 revolutions repeat (1e-9); the branch lines hold the continuation
+    points; each fold cross sits at its branch's end, where the monodromy trace is 2 (0.05)."""
+    ds = eps_map
+    assert ds.attrs["n_periods"] == 2 and ds.sizes["solution"] >= 10
+    fig = lp.plot_srp_map(ds, reference=(0.25, "plate of A/m = 0.016"))
+    assert_png(fig, tmp_path / "fig35.png")
+    ax = fig.axes[0]
+    pts = marker_points(ax)
+    want = sorted(zip(ds.sol_eps.values, ds.sol_phidot0.values, ds.sol_stable.values))
+    np.testing.assert_allclose([p[:2] for p in pts], [w[:2] for w in want], atol=1e-12)
+    assert [p[2] for p in pts] == [bool(w[2]) for w in want]
+    gravity = librate.find_periodic_attitudes(sun12_orbit, kz=0.6, wz0_range=(-1.25, 0.05), n_periods=2, kinds=("periodic",))
+    at0 = (ds.sol_eps.values == 0.0) & np.isin(ds.sol_branch.values, np.flatnonzero(ds.branch_origin.values == "gravity"))
+    np.testing.assert_allclose(np.sort(ds.sol_wz0.values[at0]), [s.wz0 for s in gravity], atol=1e-12)
+    v = contour_vertices(ax, "contour-dphi")
+    col = v[np.abs(v[:, 0]) < 1e-12, 1]
+    step = ds.phidot0.values[1] - ds.phidot0.values[0]
+    for s in gravity:
+        assert np.min(np.abs(col - s.phidot0)) < step
+    rng = np.random.default_rng(3)
+    for i in rng.choice(ds.sizes["solution"], 4, replace=False):
+        plate = librate.FlatPlateSRP(float(ds.sol_eps.values[i]), cs=0.4, cd=0.1)
+        phi0, wz0, n = float(ds.sol_phi0.values[i]), float(ds.sol_wz0.values[i]), int(ds.sol_n.values[i])
+        T = 2 * sun12_orbit.period
+        tr = librate.propagate_attitude(sun12_orbit.system, sun12_orbit.state0, (phi0, wz0), librate.RigidBody.from_kz(0.6), T,
+                                        planar=True, srp=plate, rtol=1e-13, atol=1e-13, t_eval=[T])
+        assert abs(tr.phi[-1] - phi0 - 2 * math.pi * n) < 1e-9 and abs(tr.wz[-1] - wz0) < 1e-9
+    for b in range(ds.sizes["branch"]):
+        sel = ds.path_branch.values == b
+        lines = gid(ax, f"branch-{ds.branch_kind.values[b]}-N{int(ds.branch_n.values[b]):+d}")
+        assert any(len(h.get_xdata()) == sel.sum() and np.array_equal(h.get_xdata(), ds.path_eps.values[sel])
+                   and np.array_equal(h.get_ydata(), ds.path_wz0.values[sel] - 1.0) for h in lines)
+    folds = gid(ax, "fold")
+    assert len(folds) == int(ds.branch_fold.values.sum()) >= 2
+    for b in np.flatnonzero(ds.branch_fold.values):
+        sel = ds.path_branch.values == b
+        e = ds.path_eps.values[sel]
+        end = e[np.argmax(np.abs(e - ds.branch_start_eps.values[b]))]  # the point farthest from the branch's start
+        assert abs(end - ds.branch_end_eps.values[b]) < 1e-6
+        assert abs(ds.path_trace.values[sel][np.argmax(np.abs(e - ds.branch_start_eps.values[b]))] - 2.0) < 0.05
+        assert any(abs(f.get_xdata()[0] - ds.branch_end_eps.values[b]) < 1e-12 for f in folds)
+    (ref,) = gid(ax, "eps-reference")
+    assert ref.get_xdata()[0] == 0.25
+    assert "plate of A/m = 0.016" in [t.get_text() for t in ax.get_legend().get_texts()]
+    assert ax.get_xlim() == (0.0, 0.5) and "relative to the synodic frame" in ax.get_ylabel()
+
+
+def test_srp_map_without_solutions(sun12_orbit):
+    ds = lp.srp_map(sun12_orbit, kz=0.6, wz0=np.linspace(-1.0, 0.0, 30), eps=[-0.1, 0.0, 0.1], solve=False)
+    assert ds.dwz.shape == (3, 30) and "sol_wz0" not in ds.variables and ds.attrs["n_periods"] == 2
+    ax = lp.plot_srp_map(ds, rate="inertial").axes[0]
+    assert not gid(ax, "solutions") and "inertial" in ax.get_ylabel() and ax.get_xlim() == (-0.1, 0.1)
+
+
+@pytest.fixture(scope="module")
+def srp_pair(sun12_orbit):
+    g = librate.periodic_attitude(sun12_orbit, kz=0.6, n=0, n_periods=2, wz0=1 - 0.066)
+    s = librate.continue_srp(g, librate.FlatPlateSRP(0.1, cs=0.4, cd=0.1)).solutions[-1]
+    return g, s
+
+
+def test_plot_srp_comparison_fig37_38(srp_pair, tmp_path):
+    """Thesis Figs. 37-38: the curves span K = 2 revolutions and end at phi(KT), wz(KT) of an
+    independent propagation of each solution (1e-8), which are phi0 + 2 pi N and wz0 (periodic)."""
+    g, s = srp_pair
+    assert s.srp.eps == 0.1 and g.srp is None and s.n_periods == 2
+    fig = lp.plot_srp_comparison(g, s)
+    assert_png(fig, tmp_path / "fig37.png")
+    a_ang, a_rate = fig.axes
+    for key, sol in (("gravity", g), ("srp", s)):
+        T = 2 * sol.orbit.period
+        tr = librate.propagate_attitude(sol.orbit.system, sol.orbit.state0, (sol.phi0, sol.wz0), librate.RigidBody.from_kz(sol.kz),
+                                        T, planar=True, srp=sol.srp, rtol=1e-13, atol=1e-13, t_eval=[T])
+        (ha,) = gid(a_ang, f"{key}-angle")
+        (hr,) = gid(a_rate, f"{key}-rate")
+        assert ha.get_xdata()[-1] == pytest.approx(2.0, abs=1e-12)
+        assert ha.get_ydata()[-1] == pytest.approx(math.degrees(tr.phi[-1]), abs=1e-7)
+        assert hr.get_ydata()[-1] == pytest.approx(tr.wz[-1] - 1.0, abs=1e-9)
+        assert ha.get_ydata()[-1] == pytest.approx(math.degrees(sol.phi0 + 2 * math.pi * sol.n), abs=1e-6)
+        assert hr.get_ydata()[0] == pytest.approx(sol.phidot0, abs=1e-12)
+    assert "0.1" in gid(a_ang, "srp-angle")[0].get_label() and "gravity only" in gid(a_ang, "gravity-angle")[0].get_label()
+    fig2 = lp.plot_srp_comparison(g, s, n_periods=4, rate="inertial", degrees=False)
+    (h,) = gid(fig2.axes[1], "srp-rate")
+    assert h.get_xdata()[-1] == pytest.approx(4.0) and h.get_ydata()[-1] == pytest.approx(s.wz0, abs=1e-8)
+    assert len(gid(fig2.axes[0], "repeat")) == 2
+
+
+def test_plot_sun_pointing_fig39(em, sun12_orbit, tmp_path):
+    """Thesis Fig. 39, phi(t) = theta_s(t) + offset: at sample times the curves equal the gravity
+    gradient 1.5 Kz (S cos 2phi - C sin 2phi) (S, C of the orbit's forcing) and the plate's SRP
+    eps [(1 + Cs) cos a |cos a| + 2/3 Cd cos a], a = -offset, written out here; their sum is the
+    engine's angular acceleration (finite difference of a short propagation from the pointing
+    state); a two-sided facet panel of the same geometry gives the same SRP curve."""
+    from librate.periodicity import orbit_forcing
+
+    sun = librate.SunModel(theta0=0.4)
+    plate = librate.FlatPlateSRP(0.3, cs=0.4, cd=0.1, sun=sun)
+    offset, kz = 0.2, 0.6
+    fig = lp.plot_sun_pointing(em, plate, orbit=sun12_orbit, kz=kz, offset=offset)
+    assert_png(fig, tmp_path / "fig39.png")
+    ax = fig.axes[0]
+    (hg,) = gid(ax, "gravity-gradient")
+    (hs,) = gid(ax, "srp")
+    (ht,) = gid(ax, "total")
+    t = np.asarray(hg.get_xdata()) / em.tu_days
+    assert t[-1] == pytest.approx(2 * sun12_orbit.period, rel=1e-12)  # default: ceil(Ts / T) = 2 periods
+    idx = np.array([0, 137, 911, len(t) - 1])
+    S, C = orbit_forcing(sun12_orbit).sc(t[idx])
+    phi = _OMEGA_SUN * t[idx] + 0.4 + offset
+    np.testing.assert_allclose(np.asarray(hg.get_ydata())[idx], 1.5 * kz * (S * np.cos(2 * phi) - C * np.sin(2 * phi)), atol=1e-12)
+    ca = math.cos(-offset)
+    srp = 0.3 * ((1 + 0.4) * ca * abs(ca) + 2 / 3 * 0.1 * ca)
+    np.testing.assert_allclose(np.asarray(hs.get_ydata())[idx], srp, atol=1e-12)
+    np.testing.assert_allclose(ht.get_ydata(), np.asarray(hg.get_ydata()) + np.asarray(hs.get_ydata()), atol=1e-15)
+    h = 1e-4
+    tr = librate.propagate_attitude(em, sun12_orbit.state0, (0.4 + offset, 1.0 + _OMEGA_SUN), librate.RigidBody.from_kz(kz), h,
+                                    planar=True, srp=plate, rtol=1e-13, atol=1e-13, t_eval=[0.0, h])
+    assert (tr.wz[-1] - tr.wz[0]) / h == pytest.approx(ht.get_ydata()[0], abs=1e-3)
+    # the facet model of the same plate: the same SRP acceleration
+    area, d, iz = 100.0, 0.02, 1.0e7
+    ix, iy = 0.5 * (1 - kz) * iz, 0.5 * (1 + kz) * iz
+    body = librate.FacetBody.two_sided_panel(area, center=(0, d, 0), ca=0.5, cs=0.4, cd=0.1, inertia=(ix, iy, iz))
+    plate2 = librate.FlatPlateSRP.from_geometry(em, area_m2=area, offset_m=d, iz_kgm2=iz, cs=0.4, cd=0.1, sun=sun)
+    gg_p, srp_p = lp.sun_pointing_accelerations(em, plate2, t[idx], orbit=sun12_orbit, offset=offset, kz=kz)
+    gg_b, srp_b = lp.sun_pointing_accelerations(em, body, t[idx], orbit=sun12_orbit, offset=offset, sun=sun)
+    np.testing.assert_allclose(srp_b, srp_p, rtol=1e-12)
+    np.testing.assert_allclose(gg_b, gg_p, rtol=1e-12, atol=1e-15)
+    ax2 = lp.plot_sun_pointing(em, body, orbit=sun12_orbit, offset=offset, sun=sun, n_periods=1, units="TU").axes[0]
+    assert gid(ax2, "srp")[0].get_xdata()[-1] == pytest.approx(sun12_orbit.period)
+
+
+def test_plot_srp_maps_fig40_41(eps_map, sun12_orbit, kz_map, tmp_path):
+    """Thesis Figs. 40-41: one panel per map, titled with the value that differs (Cs, or Kz), each
+    holding its own map's solutions, the legend beside the last panel only; periodicity_map
+    Datasets are drawn by plot_map. With Cd = 0 the plate's torque is eps (1 + Cs) cos|cos|: the
+    fold of the stable N = 0 branch on the Cs = 0 panel lies at 1.5 times its eps on the Cs = 0.5
+    panel (1e-5)."""
+    maps = [lp.srp_map(sun12_orbit, kz=0.6, wz0=np.linspace(0.8, 1.1, 40), eps=[0.0, 0.5, 1.0], cs=c, cd=0.0) for c in (0.0, 0.5)]
+    fig = lp.plot_srp_maps(maps, reference=0.7)
+    assert_png(fig, tmp_path / "fig40.png")
+    a1, a2 = fig.axes
+    assert a1.get_title() == "$C_s$ = 0" and a2.get_title() == "$C_s$ = 0.5"
+    assert a1.get_legend() is None and a2.get_legend() is not None
+    for a, m in zip((a1, a2), maps):
+        assert len(marker_points(a)) == m.sizes["solution"] > 0 and gid(a, "eps-reference")
+    (f1,), (f2,) = gid(a1, "fold"), gid(a2, "fold")
+    assert f1.get_xdata()[0] / f2.get_xdata()[0] == pytest.approx(1.5, rel=1e-5)
+    assert "$K_z$ = 0.6" in fig._suptitle.get_text() and "$C_d$ = 0" in fig._suptitle.get_text()
+    fig = lp.plot_srp_maps([kz_map.isel(kz=[0]), kz_map.isel(kz=[2])], reference=0.1, against="x0")  # reference: SRP maps only
+    b1, b2 = fig.axes
+    assert b1.get_title() == "$K_z$ = 0.2" and b2.get_title() == "$K_z$ = 0.8"
+    sel = (kz_map.sol_kz.values == 0.8) & (kz_map.sol_kind.values == "periodic")
+    assert len(marker_points(b2)) == int(sel.sum())
+    fig = lp.plot_srp_maps([eps_map], titles=["one"])
+    assert fig.axes[0].get_title() == "one" and len(marker_points(fig.axes[0])) == eps_map.sizes["solution"]
+
+
+SRP_BAD = [
+    (lambda m, o: lp.plot_sun_motion("earth-moon"), "`system`"),
+    (lambda m, o: lp.plot_sun_motion(o.system, theta0=math.nan), "`theta0`"),
+    (lambda m, o: lp.plot_sun_motion(o.system, n_periods=0), "`n_periods`"),
+    (lambda m, o: lp.plot_sun_motion(o.system, n_directions=0), "`n_directions`"),
+    (lambda m, o: lp.plot_sun_motion(o.system, ax=plt.subplots()[1]), "`ax`"),
+    (lambda m, o: lp.plot_sun_resonant(o), "`family`"),
+    (lambda m, o: lp.plot_sun_resonant(librate.dro_family(o.system, x0=[0.9, 0.8]), ks=(0,)), "`ks`"),
+    (lambda m, o: lp.srp_map(o, kz=0.6, wz0=[0.0, 1.0], eps=[0.1, 0.0]), "`eps`"),
+    (lambda m, o: lp.srp_map(o, kz=0.6, wz0=[1.0, 0.0], eps=[0.0, 0.1]), "`wz0`"),
+    (lambda m, o: lp.srp_map(o, kz=2.0, wz0=[0.0, 1.0], eps=[0.0, 0.1]), "`kz`"),
+    (lambda m, o: lp.srp_map(o, kz=0.6, wz0=[0.0, 1.0], eps=[0.0, 0.1], cs=0.8, cd=0.5), "`cs`"),
+    (lambda m, o: lp.srp_map(librate.correct_dro(o.system, 0.85), kz=0.6, wz0=[0.0, 1.0], eps=[0.0, 0.1]), "`n_periods`"),
+    (lambda m, o: lp.plot_srp_map("map"), "`ds`"),
+    (lambda m, o: lp.plot_srp_map(m, rate="synodic"), "`rate`"),
+    (lambda m, o: lp.plot_srp_map(m, reference="x"), "`reference`"),
+    (lambda m, o: lp.plot_srp_maps([]), "`maps`"),
+    (lambda m, o: lp.plot_srp_maps([m, "map"]), "`maps`"),
+    (lambda m, o: lp.plot_srp_maps([m, m], titles=["a"]), "`titles`"),
+    (lambda m, o: lp.plot_srp_maps([m, m], ax=plt.subplots()[1]), "`ax`"),
+    (lambda m, o: lp.plot_srp_maps([m, m], colour="red"), "`colour`"),
+    (lambda m, o: lp.plot_srp_comparison("g", "s"), "`gravity_solution`"),
+    (lambda m, o: lp.plot_srp_comparison(librate.periodic_attitude(o, kz=0.6, n=0, n_periods=2),
+                                         librate.periodic_attitude(librate.dro(o.system, period_days=12.66), kz=0.8, n=0)),
+     "`srp_solution`"),
+    (lambda m, o: lp.plot_sun_pointing(o.system, librate.FlatPlateSRP(0.1), orbit=o), "`kz`"),
+    (lambda m, o: lp.plot_sun_pointing(o.system, librate.RigidBody(1, 2, 2.5), orbit=o), "`body_or_plate`"),
+    (lambda m, o: lp.plot_sun_pointing(o.system, librate.FlatPlateSRP(0.1), orbit=o, kz=0.5, sun=librate.SunModel()), "`sun`"),
+    (lambda m, o: lp.plot_sun_pointing(o.system, librate.FlatPlateSRP(0.1), orbit="dro", kz=0.5), "`orbit`"),
+    (lambda m, o: lp.plot_sun_pointing(o.system, librate.FlatPlateSRP(0.1), orbit=o, kz=0.5, n_periods=-1), "`n_periods`"),
+    (lambda m, o: lp.plot_sun_pointing(o.system, librate.FacetBody.flat_plate(1.0, inertia=(1, 2, 2.5)), orbit=o, kz=0.5), "`kz`"),
+]
+
+
+@pytest.mark.parametrize("call, text", SRP_BAD, ids=[f"{i}-{b[1].strip('`')}" for i, b in enumerate(SRP_BAD)])
+def test_bad_arguments_srp_figures(eps_map, sun12_orbit, call, text):
+    with pytest.raises(ValueError, match=text):
+        call(eps_map, sun12_orbit)

@@ -1,5 +1,5 @@
-"""Figures of periodic-orbit families and orbits (thesis ch. 2) and of periodic attitude motions
-(thesis sec. 3.3), drawn with matplotlib.
+"""Figures of periodic-orbit families and orbits (thesis ch. 2), of periodic attitude motions
+(thesis sec. 3.3) and of solar radiation pressure (thesis ch. 4), drawn with matplotlib.
 
 This module is the only part of librate that uses matplotlib, and ``import librate`` does not
 import it: import it explicitly, ``import librate.plotting as lp`` (install with
@@ -27,7 +27,23 @@ label it wz(0)); ``rate="inertial"`` plots wz, and the axis label says which. Ar
 - :func:`plot_map`: the periodicity map, zero contours and solutions over (orbit, rate) (Fig. 24)
 - :func:`plot_solution_families`: solutions of each N across the orbit family, per Kz (Figs. 27-29)
 - :func:`plot_attitude_motion`: phi(t) and the rate of periodic motions (Figs. 30-31)
+- :func:`plot_sun_motion`: the apparent Sun motion in the synodic frame (Fig. 33)
+- :func:`plot_sun_resonant`: the Sun-resonant members T = Ts / K of a family (Fig. 34)
+- :func:`srp_map` (data) and :func:`plot_srp_map`: flat-plate SRP periodicity maps of one orbit
+  over (eps, rate), zero contours and solution branches with folds (Figs. 35-36)
+- :func:`plot_srp_maps`: several maps side by side, one per Cs, Kz, ... (Figs. 40-41)
+- :func:`plot_srp_comparison`: a gravity-only periodic motion and its SRP counterpart (Figs. 37-38)
+- :func:`sun_pointing_accelerations` (data) and :func:`plot_sun_pointing`: gravity-gradient and
+  SRP angular accelerations on a Sun-pointing spacecraft (Fig. 39)
 - :func:`save_figure`: write a figure to a file
+
+The SRP amplitude of the flat plate is eps = P A d TU^2 / Iz = P (A/m) d TU^2 / k^2 (k the radius
+of gyration, Iz = m k^2): with the Earth-Moon TU (375190 s), P = 4.56e-6 N/m^2 and A/m = 0.016
+m^2/kg, eps = 1.03e4 d / k^2 (d, k in m). The samples and examples take k = 10 m and a centre of
+pressure d = 1 cm from the centre of mass: eps = 1.03. Far from the primaries the gravity gradient
+is weak: on the 1:2 Sun-resonant DRO its angular acceleration is below 1 1/TU^2 (7e-12 1/s^2) for
+Kz = 0.6, so a CoP offset of 1 m (eps ~ 100) makes SRP dominate by two orders of magnitude, and the
+gravity-only solution branches there fold at eps ~ 0.3 - 0.7 (d ~ 3 - 7 mm for k = 10 m).
 """
 
 from __future__ import annotations
@@ -50,7 +66,7 @@ try:
 except ImportError as exc:  # pragma: no cover - depends on the environment
     raise ImportError('librate.plotting needs matplotlib >= 3.6: pip install "librate[plot]"') from exc
 
-from .constants import SUN_SYNODIC_PERIOD
+from .constants import OMEGA_SUN, SUN_SYNODIC_PERIOD
 from .families import OrbitFamily
 from .frames import synodic_to_eci
 from .orbits import PeriodicOrbit
@@ -68,6 +84,14 @@ __all__ = [
     "plot_map",
     "plot_solution_families",
     "plot_attitude_motion",
+    "plot_sun_motion",
+    "plot_sun_resonant",
+    "srp_map",
+    "plot_srp_map",
+    "plot_srp_maps",
+    "plot_srp_comparison",
+    "sun_pointing_accelerations",
+    "plot_sun_pointing",
     "save_figure",
 ]
 
@@ -780,6 +804,41 @@ def plot_residuals(
     return fig
 
 
+def _map_contours(a, x, y, dwz, phi_t, dphi, phi0: float, half_turn_contours: bool) -> list:
+    """The zero contours of a map on the grid (x columns, y rows): Dwz = 0 (``gid="contour-dwz"``)
+    and Dphi = 0 on the unwrapped phi(t) at the levels phi0 + 2 pi k (``gid="contour-dphi"``; with
+    ``phi_t`` None, on sin(Dphi) where cos(Dphi) > 0), with ``half_turn_contours`` also Dphi = pi
+    (``gid="contour-dphi-half"``, dotted). Arrays are (rate, x). Returns legend proxies."""
+    if np.isfinite(dwz).any() and np.nanmin(dwz) < 0 < np.nanmax(dwz):
+        cs = a.contour(x, y, dwz, levels=[0.0], colors=_DWZ_COLOR, linewidths=1.1)
+        _set_gid(cs, "contour-dwz")
+    if phi_t is not None:
+        p = phi_t - phi0
+        fin = p[np.isfinite(p)]
+        groups = [("contour-dphi", 0.0, dict(linewidths=1.1, linestyles="solid"))]
+        if half_turn_contours:
+            groups.append(("contour-dphi-half", math.pi, dict(linewidths=0.7, linestyles="dotted")))
+        for gid_, shift, style in groups:
+            if not fin.size:
+                break
+            ks = np.arange(math.ceil((fin.min() - shift) / (2 * math.pi)), math.floor((fin.max() - shift) / (2 * math.pi)) + 1)
+            levels = shift + 2 * math.pi * ks
+            levels = levels[(levels > fin.min()) & (levels < fin.max())]
+            if levels.size:
+                cs = a.contour(x, y, p, levels=levels, colors=_DPHI_COLOR, **style)
+                _set_gid(cs, gid_)
+    else:
+        s = np.where(np.cos(dphi) > 0, np.sin(dphi), np.nan)
+        if np.isfinite(s).any() and np.nanmin(s) < 0 < np.nanmax(s):
+            cs = a.contour(x, y, s, levels=[0.0], colors=_DPHI_COLOR, linewidths=1.1)
+            _set_gid(cs, "contour-dphi")
+    handles = [Line2D([], [], color=_DWZ_COLOR, linewidth=1.1, label="$\\Delta\\omega_z = 0$"),
+               Line2D([], [], color=_DPHI_COLOR, linewidth=1.1, label="$\\Delta\\varphi = 0$")]
+    if half_turn_contours:
+        handles.append(Line2D([], [], color=_DPHI_COLOR, linewidth=0.7, linestyle=":", label="$\\Delta\\varphi = \\pi$"))
+    return handles
+
+
 def plot_map(
     ds,
     ax=None,
@@ -828,34 +887,9 @@ def plot_map(
     created = ax is None
     fig, (a,) = _axes(ax, 1, figsize=(8.6, 5.8))
     dwz = np.asarray(ds["dwz"].values[:, j, :], dtype=float).T  # (rate, orbit)
-    if np.isfinite(dwz).any() and np.nanmin(dwz) < 0 < np.nanmax(dwz):
-        cs = a.contour(xv, y, dwz, levels=[0.0], colors=_DWZ_COLOR, linewidths=1.1)
-        _set_gid(cs, "contour-dwz")
-    if "phi_T" in ds.variables:
-        p = np.asarray(ds["phi_T"].values[:, j, :], dtype=float).T - phi0
-        fin = p[np.isfinite(p)]
-        groups = [("contour-dphi", 0.0, dict(linewidths=1.1, linestyles="solid"))]
-        if half_turn_contours:
-            groups.append(("contour-dphi-half", math.pi, dict(linewidths=0.7, linestyles="dotted")))
-        for gid_, shift, style in groups:
-            if not fin.size:
-                break
-            ks = np.arange(math.ceil((fin.min() - shift) / (2 * math.pi)), math.floor((fin.max() - shift) / (2 * math.pi)) + 1)
-            levels = shift + 2 * math.pi * ks
-            levels = levels[(levels > fin.min()) & (levels < fin.max())]
-            if levels.size:
-                cs = a.contour(xv, y, p, levels=levels, colors=_DPHI_COLOR, **style)
-                _set_gid(cs, gid_)
-    else:
-        d = np.asarray(ds["dphi"].values[:, j, :], dtype=float).T
-        s = np.where(np.cos(d) > 0, np.sin(d), np.nan)
-        if np.isfinite(s).any() and np.nanmin(s) < 0 < np.nanmax(s):
-            cs = a.contour(xv, y, s, levels=[0.0], colors=_DPHI_COLOR, linewidths=1.1)
-            _set_gid(cs, "contour-dphi")
-    handles = [Line2D([], [], color=_DWZ_COLOR, linewidth=1.1, label="$\\Delta\\omega_z = 0$"),
-               Line2D([], [], color=_DPHI_COLOR, linewidth=1.1, label="$\\Delta\\varphi = 0$")]
-    if half_turn_contours:
-        handles.append(Line2D([], [], color=_DPHI_COLOR, linewidth=0.7, linestyle=":", label="$\\Delta\\varphi = \\pi$"))
+    phi_t = np.asarray(ds["phi_T"].values[:, j, :], dtype=float).T if "phi_T" in ds.variables else None
+    dphi = np.asarray(ds["dphi"].values[:, j, :], dtype=float).T
+    handles = _map_contours(a, xv, y, dwz, phi_t, dphi, phi0, half_turn_contours)
     tab = _solution_table(ds) if solutions else None
     if tab is not None:
         m = _kz_mask(tab, kz_value) & np.isin(tab["kind"], kinds)
@@ -1074,6 +1108,832 @@ def plot_attitude_motion(
         kzs = sorted({s.kz for s in sols})
         where = f"orbit T = {sols[0].orbit.period_days:.2f} d" if len(orbs) == 1 else f"{len(orbs)} orbits"
         fig.suptitle(f"periodic attitude motions, {where}, $K_z$ = {', '.join(f'{v:g}' for v in kzs)}")
+    return fig
+
+
+# --- solar radiation pressure (thesis ch. 4, Figs. 33-41) ---------------------------------------
+_SUN_COLOR = "#f2a900"
+_SRP_COLOR, _GRAVITY_COLOR = "tab:red", "0.15"
+# A continuation that stops with the monodromy trace this close to 2 stopped at a fold.
+_FOLD_TRACE_TOL = 0.05
+
+
+def _number(value, name: str, *, positive: bool = False) -> float:
+    ok = isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, bool) and math.isfinite(value)
+    if not ok or (positive and value <= 0):
+        raise ValueError(f"invalid argument `{name}`: must be a finite number{' > 0' if positive else ''}, got {value!r}")
+    return float(value)
+
+
+def _count(value, name: str, minimum: int) -> int:
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < minimum:
+        raise ValueError(f"invalid argument `{name}`: must be an integer >= {minimum}, got {value!r}")
+    return int(value)
+
+
+def _check_system(system):
+    from .system import System
+
+    if not isinstance(system, System):
+        raise ValueError(f"invalid argument `system`: must be a librate.System, got {type(system).__name__}")
+    return system
+
+
+def _sun_resonance(orbit: PeriodicOrbit, tol: float = 1e-6) -> int | None:
+    """K when the orbit is Sun-resonant, K T = Ts (relative tolerance ``tol``), else None."""
+    k = SUN_SYNODIC_PERIOD / orbit.period
+    return int(round(k)) if round(k) >= 1 and abs(k - round(k)) < tol * k else None
+
+
+def _sun_angle(theta0: float, t) -> np.ndarray:
+    """The Sun's angle from the synodic X axis at times t (TU), unwrapped (rad)."""
+    return OMEGA_SUN * np.asarray(t, dtype=float) + theta0
+
+
+def _primaries(a, system, scale: float = 1.0) -> None:
+    e, m = system.primary_positions() * scale
+    for pos, name, style, gid in ((e, "Earth", _EARTH, "earth"), (m, "Moon", _MOON, "moon")):
+        (h,) = a.plot([pos[0]], [pos[1]], zorder=4, **style)
+        h.set_gid(gid)
+        dx, dy, ha = _LABEL_OFFSETS[name]
+        a.annotate(name, (pos[0], pos[1]), xytext=(dx, dy), textcoords="offset points", fontsize=8, ha=ha)
+
+
+def plot_sun_motion(
+    system,
+    ax=None,
+    *,
+    theta0: float = 0.0,
+    n_periods: float = 1,
+    n_directions: int = 8,
+    units: str = "days",
+) -> Figure:
+    """The apparent motion of the Sun in the synodic frame (thesis Fig. 33).
+
+    The Sun direction s(t) = (cos theta_s, sin theta_s, 0), theta_s(t) = omega_sun t + theta0
+    (PHYSICS.md sec. 6; parallax neglected, so it is the same everywhere in the system), turns
+    CLOCKWISE at omega_sun = -(1 - n_sun) = :data:`librate.constants.OMEGA_SUN` (1/TU): one
+    apparent solar period Ts = 2 pi / (1 - n_sun) (29.49 d with the Earth-Moon TU).
+
+    Left panel: the synodic frame with the Earth-Moon line (``gid="earth-moon-line"``, the X axis
+    from the Earth to the Moon), the Sun directions at t_k = k Ts / ``n_directions``, k = 0 ...
+    n_directions - 1 (rays from the barycentre, ``gid="sun-direction"``, in that order, angle
+    theta_s(t_k), each ending at a Sun marker ``gid="sun"`` labelled with t_k), and the circle they
+    sweep with arrows showing the clockwise sense (``gid="sun-path"``). Right panel: theta_s(t),
+    unwrapped, in degrees against time over ``n_periods`` apparent solar periods
+    (``gid="sun-angle"``), a vertical line at each multiple of Ts (``gid="solar-period"``) and the
+    angles at which the Sun lies on the Earth-Moon line: beyond the Moon (theta_s = 0 mod 360 deg,
+    new Moon, ``gid="sun-beyond-moon"``) and behind the Earth (180 deg mod 360, full Moon,
+    ``gid="sun-behind-earth"``). ``theta0``: the Sun's phase at t = 0 (rad, as
+    :class:`librate.SunModel`); ``units``: ``"days"`` or ``"TU"``; ``ax``: two Axes. Returns the
+    Figure.
+    """
+    sys_ = _check_system(system)
+    theta0 = _number(theta0, "theta0")
+    n_periods = _number(n_periods, "n_periods", positive=True)
+    n_directions = _count(n_directions, "n_directions", 1)
+    tscale, tunit = _time_scale(sys_, units)
+    tname = "d" if tunit == "days" else "TU"
+    ts = SUN_SYNODIC_PERIOD
+    created = ax is None
+    fig, (a_geo, a_ang) = _axes(ax, 2, figsize=(12.4, 5.4))
+
+    # --- geometry in the synodic frame
+    radius = 1.45
+    e, m = sys_.primary_positions()
+    a_geo.axhline(0.0, color="0.7", linewidth=0.6, linestyle=":", zorder=0)
+    (h,) = a_geo.plot([e[0], m[0]], [e[1], m[1]], color="0.25", linewidth=1.8, zorder=3, label="Earth-Moon line (synodic $X$ axis)")
+    h.set_gid("earth-moon-line")
+    t_path = np.linspace(0.0, ts, 361)
+    th = _sun_angle(theta0, t_path)
+    (h,) = a_geo.plot(radius * np.cos(th), radius * np.sin(th), color=_SUN_COLOR, linewidth=1.0, linestyle="--", zorder=1,
+                      label=f"Sun direction over one apparent solar period $T_s$ = {ts * tscale:.2f} {tname}")
+    h.set_gid("sun-path")
+    for f in (0.06, 0.31, 0.56, 0.81):  # arrow heads: the clockwise sense
+        t1, t2 = f * ts, (f + 0.02) * ts
+        p1, p2 = [radius * np.array([math.cos(v), math.sin(v)]) for v in _sun_angle(theta0, [t1, t2])]
+        arr = a_geo.annotate("", xy=p2, xytext=p1, arrowprops=dict(arrowstyle="-|>", color=_SUN_COLOR, linewidth=1.2,
+                                                                  mutation_scale=14))
+        arr.set_gid("sun-path-arrow")
+    cm = matplotlib.colormaps["plasma"]
+    for k in range(n_directions):
+        tk = k * ts / n_directions
+        ang = float(_sun_angle(theta0, tk))
+        c, s = math.cos(ang), math.sin(ang)
+        color = cm(0.85 * k / n_directions)
+        (h,) = a_geo.plot([0.0, radius * c], [0.0, radius * s], color=color, linewidth=2.0 if k == 0 else 1.0, zorder=2,
+                          label=f"Sun direction at $t$ = 0 ($\\theta_{{s0}}$ = {math.degrees(theta0):.4g} deg)" if k == 0 else "_nolegend_")
+        h.set_gid("sun-direction")
+        (h,) = a_geo.plot([radius * c], [radius * s], marker="o", markersize=11 if k == 0 else 8, color=_SUN_COLOR,
+                          markeredgecolor=color, markeredgewidth=1.5, linestyle="none", zorder=4)
+        h.set_gid("sun")
+        a_geo.annotate(f"{tk * tscale:.1f} {tname}", (radius * c, radius * s), xytext=(14 * c, 14 * s), textcoords="offset points",
+                       ha="center", va="center", fontsize=7.5, color="0.2")
+    _primaries(a_geo, sys_)
+    (b,) = a_geo.plot([0.0], [0.0], marker="+", color="k", markersize=7, linestyle="none")
+    b.set_gid("barycentre")
+    lim = radius * 1.3
+    a_geo.set_xlim(-lim, lim)
+    a_geo.set_ylim(-lim, lim)
+    a_geo.set_aspect("equal")
+    a_geo.set_xlabel("$X$ (LU), synodic frame")
+    a_geo.set_ylabel("$Y$ (LU)")
+    a_geo.grid(True, linewidth=0.3, alpha=0.5)
+    a_geo.legend(loc="upper center", bbox_to_anchor=(0.5, -0.11), fontsize=7.5, ncols=1)
+    a_geo.text(0.98, 0.98, f"clockwise: $\\omega_s$ = {OMEGA_SUN:.4f} 1/TU", transform=a_geo.transAxes, ha="right", va="top",
+               fontsize=8, color="0.2")
+
+    # --- the Sun's angle against time
+    t = np.linspace(0.0, n_periods * ts, max(2, int(math.ceil(360 * n_periods)) + 1))
+    deg = np.degrees(_sun_angle(theta0, t))
+    (h,) = a_ang.plot(t * tscale, deg, color=_SUN_COLOR, linewidth=1.8,
+                      label=f"$\\theta_s(t) = \\omega_s t + \\theta_{{s0}}$, $\\omega_s$ = {OMEGA_SUN:.4f} 1/TU = "
+                            f"{math.degrees(OMEGA_SUN) / sys_.tu_days:.2f} deg/d")
+    h.set_gid("sun-angle")
+    for k in range(1, int(math.floor(n_periods + 1e-9)) + 1):
+        v = a_ang.axvline(k * ts * tscale, color="0.35", linestyle="--", linewidth=0.9,
+                          label=f"$t = k T_s$, $T_s$ = {ts * tscale:.2f} {tname}" if k == 1 else "_nolegend_")
+        v.set_gid("solar-period")
+    lo, hi = float(deg.min()), float(deg.max())
+    for shift, gid_, name, style in ((0.0, "sun-beyond-moon", "Sun beyond the Moon on the Earth-Moon line (new Moon)", "-."),
+                                     (180.0, "sun-behind-earth", "Sun behind the Earth on the Earth-Moon line (full Moon)", ":")):
+        levels = shift + 360.0 * np.arange(math.ceil((lo - shift) / 360.0), math.floor((hi - shift) / 360.0) + 1)
+        for i, lv in enumerate(levels):
+            hl = a_ang.axhline(lv, color="0.45", linestyle=style, linewidth=0.9, label=name if i == 0 else "_nolegend_")
+            hl.set_gid(gid_)
+    a_ang.yaxis.set_major_locator(MultipleLocator(90.0 if hi - lo <= 1080 else 360.0))
+    a_ang.set_xlim(0.0, n_periods * ts * tscale)
+    a_ang.set_xlabel(f"time $t$ ({tunit})")
+    a_ang.set_ylabel("Sun angle $\\theta_s$ from the synodic $X$ axis (deg, unwrapped)")
+    a_ang.grid(True, linewidth=0.3, alpha=0.5)
+    a_ang.legend(loc="upper right", fontsize=7.5)
+    if created:
+        fig.suptitle(f"apparent Sun motion in the synodic frame ({sys_.name}): clockwise, one turn in $T_s$ = {ts * tscale:.2f} {tname}")
+    return fig
+
+
+def plot_sun_resonant(
+    family: OrbitFamily,
+    ax=None,
+    ks: Iterable[int] = (1, 2, 3, 4),
+    *,
+    units: str = "LU",
+    samples: int = 600,
+    primaries: bool = True,
+) -> Figure:
+    """The Sun-resonant members of a planar family in the synodic frame (thesis Fig. 34): for each
+    K in ``ks`` the member with T = Ts / K (``family.resonant(K, "sun")``; the Sun then returns
+    to the same direction relative to the orbit after K revolutions), propagated over one period
+    with ``samples`` points (``gid="sun-resonant-K"``, labelled with T, T in days and x0) and its
+    start (x0, 0) marked (``gid="start"``). A K whose period lies outside the family's range is
+    not drawn but listed in a note (``gid="missing-resonances"``): for the Earth-Moon DROs the 1:1
+    member (T = Ts = 29.49 d) is longer than the family's longest period (27.39 d, where the DROs
+    reach the Earth). ``units``: ``"LU"`` or ``"km"``; ``primaries`` marks the Earth and the Moon.
+    Raises ValueError (naming ``ks``) when no K is in range. Returns the Figure.
+    """
+    fam = _check_family(family)
+    try:
+        ks = [ks] if isinstance(ks, (int, np.integer)) else list(ks)
+    except TypeError:
+        ks = None
+    if not ks or not all(isinstance(k, (int, np.integer)) and not isinstance(k, bool) and k >= 1 for k in ks):
+        raise ValueError(f"invalid argument `ks`: must be a non-empty sequence of integers >= 1, got {ks!r}")
+    samples = _count(samples, "samples", 2)
+    sys_ = fam.system
+    scale, unit = _length_scale(sys_, units)
+    found, missing = [], []
+    for k in ks:
+        try:
+            found.append((int(k), fam.resonant(int(k), "sun")))
+        except ValueError:
+            missing.append(int(k))
+    if not found:
+        raise ValueError(f"invalid argument `ks`: no Sun-resonant member 1:K (T = Ts/K) for K in {tuple(ks)} lies in the "
+                         f"{fam.kind} family's period range [{fam.period_days.min():.2f}, {fam.period_days.max():.2f}] d")
+    created = ax is None
+    fig, (a,) = _axes(ax, 1, figsize=(7.2, 6.2))
+    cm = matplotlib.colormaps["viridis"]
+    for i, (k, o) in enumerate(found):
+        color = cm(0.85 * i / max(1, len(found) - 1))
+        tr = o.propagate(t_eval=np.linspace(0.0, o.period, samples))
+        p = tr.y[:, :2] * scale
+        (h,) = a.plot(p[:, 0], p[:, 1], color=color, linewidth=1.5,
+                      label=f"1:{k} Sun: $T = T_s/{k}$ = {o.period_days:.2f} d, $x_0$ = {o.x0:.4f} LU")
+        h.set_gid(f"sun-resonant-{k}")
+        (s,) = a.plot([p[0, 0]], [p[0, 1]], "o", color=color, markersize=4)
+        s.set_gid("start")
+    if primaries:
+        allp = np.vstack([ln.get_xydata() for ln in a.get_lines() if (ln.get_gid() or "").startswith("sun-resonant-")])
+        lo, hi = allp.min(axis=0), allp.max(axis=0)
+        pad = 0.25 * np.max(hi - lo)
+        e, m = sys_.primary_positions() * scale
+        for pos, name, style, gid in ((e, "Earth", _EARTH, "earth"), (m, "Moon", _MOON, "moon")):
+            near = bool(np.all((pos[:2] >= lo - pad) & (pos[:2] <= hi + pad)))
+            if near:
+                (h,) = a.plot([pos[0]], [pos[1]], zorder=4, **style)
+                dx, dy, ha = _LABEL_OFFSETS[name]
+                a.annotate(name, (pos[0], pos[1]), xytext=(dx, dy), textcoords="offset points", fontsize=8, ha=ha)
+            else:  # drawn, but kept out of the data limits: an arrow at the edge points to it
+                h = a.add_artist(Line2D([pos[0]], [pos[1]], **style))
+                a.annotate(f"$\\leftarrow$ {name} at $x$ = {pos[0]:.4g} {unit}" if pos[0] < lo[0] else f"{name} at $x$ = {pos[0]:.4g} {unit} $\\rightarrow$",
+                           xy=(0.0 if pos[0] < lo[0] else 1.0, 0.5), xycoords="axes fraction", xytext=(4 if pos[0] < lo[0] else -4, 8),
+                           textcoords="offset points", ha="left" if pos[0] < lo[0] else "right", va="center", fontsize=8,
+                           color="0.3").set_gid(f"{gid}-direction")
+            h.set_gid(gid)
+    if missing:
+        txt = ", ".join(f"1:{k} ($T$ = {SUN_SYNODIC_PERIOD / k * sys_.tu_days:.2f} d)" for k in missing)
+        note = a.text(0.02, 0.02, f"not in the family's period range [{fam.period_days.min():.2f}, {fam.period_days.max():.2f}] d: {txt}",
+                      transform=a.transAxes, fontsize=7.5, color="0.35", ha="left", va="bottom")
+        note.set_gid("missing-resonances")
+    a.set_xlabel(f"x ({unit}), synodic frame")
+    a.set_ylabel(f"y ({unit})")
+    a.set_aspect("equal", adjustable="datalim")
+    a.grid(True, linewidth=0.3, alpha=0.5)
+    a.legend(loc="upper left", fontsize=7.5)
+    if created:
+        a.set_title(f"Sun-resonant {fam.kind.upper() if fam.kind == 'dro' else fam.kind} orbits ($T = T_s/K$, $T_s$ = {SUN_SYNODIC_PERIOD * sys_.tu_days:.2f} d), synodic frame")
+    return fig
+
+
+# --- periodicity maps over (eps, rate) ----------------------------------------------------------
+def srp_map(
+    orbit: PeriodicOrbit,
+    *,
+    kz: float,
+    wz0,
+    eps,
+    cs: float = 0.0,
+    cd: float = 0.0,
+    theta0: float = 0.0,
+    phi0: float = 0.0,
+    n_periods: int | None = None,
+    solve: bool = True,
+    kinds: Sequence[str] = ("periodic",),
+    steps: int = 4,
+):
+    """A flat-plate SRP periodicity map of one orbit over (eps, initial rate), for
+    :func:`plot_srp_map` (thesis Figs. 35-36, 40-41).
+
+    ``orbit``: a planar orbit, normally Sun-resonant (T = Ts / K, from
+    ``family.resonant(K, "sun")``); ``n_periods`` (default: that K, required for other orbits):
+    the revolutions after which periodicity is checked. ``eps``: increasing plate amplitudes (any
+    sign), ``wz0``: increasing INERTIAL initial rates; the plate has ``cs``, ``cd`` (ca = 1 - cs -
+    cd) and the Sun phase ``theta0`` (:class:`librate.FlatPlateSRP`, :class:`librate.SunModel`);
+    the body has ``kz``; every motion starts at ``phi0``. The grid runs in one engine sweep:
+    ``dwz`` = wz(KT) - wz0, ``dphi`` = phi(KT) - phi0 wrapped to (-pi, pi], ``phi_T`` (unwrapped)
+    and ``status`` over dims (eps, wz0).
+
+    With ``solve``, the solutions: SRP breaks the mirror symmetry, so with phi0 fixed there is no
+    curve of solutions in the plane (the two zero contours cross only at isolated points); the
+    solutions shown are BRANCHES with phi0 free (PHYSICS.md sec. 6), continued by
+    :func:`librate.continue_srp` through the grid's eps values (``steps`` per interval) until
+    the grid ends or the branch folds: from eps = 0, the gravity-only solutions of the listed
+    ``kinds`` with wz0 in the window (:func:`librate.find_periodic_attitudes`), away from 0 on
+    each side (``branch_origin="gravity"``); and from each far end of the grid (the largest
+    eps, and the most negative), the solutions found there (:func:`librate.find_periodic_attitudes`
+    with that plate, scanned from phi0 and phi0 + pi/2, pi, -pi/2) that no branch from eps = 0
+    reached, back towards 0 (``"end"``: e.g. the
+    SRP-dominated motions of large eps, which the gravity-only branches do not reach before
+    they fold; such a branch may end at eps = 0 on a gravity-only solution with another phi0).
+    Variables: ``sol_*`` along ``solution`` (the solutions AT the grid's eps values:
+    ``sol_eps``, ``sol_wz0``, ``sol_phidot0``, ``sol_phi0`` wrapped to [-pi, pi], ``sol_n``,
+    ``sol_kind``, ``sol_branch``, ``sol_trace``, ``sol_stable``, ``sol_residual``), ``path_*``
+    along ``path`` (every continuation point, sorted by eps within a branch: ``path_branch``,
+    ``path_eps``, ``path_wz0``, ``path_phi0``, ``path_trace``) and ``branch_*`` along ``branch``
+    (``branch_n``, ``branch_kind``, ``branch_origin``, ``branch_start_eps``,
+    ``branch_end_eps`` / ``branch_end_wz0`` where it stopped short of the grid's
+    end, NaN otherwise, ``branch_fold`` True when that end is a fold: the monodromy trace within
+    0.05 of 2 there, where Phi - I is singular; otherwise the continuation failed, e.g. at once
+    for a strongly unstable start, trace ~1e5; and ``branch_end_reason`` from
+    :func:`librate.continue_srp`). Returns an xarray Dataset.
+    """
+    import xarray as xr
+
+    from . import __version__
+    from .periodicity import _check_kz, _check_orbit, _sweep, continue_srp, find_periodic_attitudes, orbit_forcing
+    from .srp import FlatPlateSRP, SunModel
+
+    orbit = _check_orbit(orbit)
+    kz = _check_kz(kz)
+    kinds = _check_kinds(kinds)
+    if n_periods is None:
+        n_periods = _sun_resonance(orbit)
+        if n_periods is None:
+            raise ValueError(f"invalid argument `n_periods`: the orbit (T = {orbit.period_days:.4f} d) is not Sun-resonant "
+                             f"(T = Ts/K, Ts = {SUN_SYNODIC_PERIOD * orbit.system.tu_days:.2f} d); give the revolutions K")
+    n_periods = _count(n_periods, "n_periods", 1)
+    steps = _count(steps, "steps", 1)
+    es = np.asarray(eps, dtype=np.float64).ravel()
+    if es.size < 2 or not np.all(np.isfinite(es)) or np.any(np.diff(es) <= 0):
+        raise ValueError(f"invalid argument `eps`: must be a finite, strictly increasing array of at least 2 values, got {eps!r}")
+    wz = np.asarray(wz0, dtype=np.float64).ravel()
+    if wz.size < 2 or not np.all(np.isfinite(wz)) or np.any(np.diff(wz) <= 0):
+        raise ValueError("invalid argument `wz0`: must be a finite, strictly increasing array of at least 2 rates")
+    phi0 = _number(phi0, "phi0")
+    plate = FlatPlateSRP(0.0, cs, cd, SunModel(theta0=theta0))
+    e_grid, w_grid = np.meshgrid(es, wz, indexing="ij")
+    r = _sweep(orbit_forcing(orbit), n_periods * orbit.period, phi0, w_grid, kz, srp=plate, eps=e_grid)
+    shape = (es.size, wz.size)
+    data = {k: np.asarray(r[k]).reshape(shape) for k in ("dwz", "dphi", "phi_t", "status")}
+
+    sols, path, branches = [], [], []
+    if solve:
+        window = (float(wz[0]), float(wz[-1]))
+
+        def follow(start, e_start, values, origin):
+            """Continue ``start`` (at e_start) through the grid ``values`` in order; one branch."""
+            b = len(branches)
+            path.append((b, e_start, start.wz0, start.phi0, start.trace))
+            end = (math.nan, math.nan, False, "reached the end of the eps grid")
+            cur = start
+            for e in values:
+                c = continue_srp(cur, plate.with_eps(float(e)), steps=steps)
+                path.extend((b, float(ei), si.wz0, si.phi0, si.trace) for ei, si in zip(c.eps[1:], c.solutions[1:]))
+                if not c.reached:
+                    last = c.solutions[-1]
+                    fold = c.fold is not None and abs(float(c.fold.get("trace", math.nan)) - 2.0) < _FOLD_TRACE_TOL
+                    end = (float(c.fold["eps"]) if fold else float(c.eps[-1]), last.wz0, fold, c.end_reason)
+                    break
+                cur = c.solutions[-1]
+                sols.append((b, float(e), cur))
+            branches.append((start.n, start.kind, origin, e_start) + end)
+
+        pos, neg = es[es > 0], es[es < 0][::-1]
+        for s0 in find_periodic_attitudes(orbit, kz=kz, wz0_range=window, phi0=phi0, kinds=kinds, n_periods=n_periods):
+            if 0.0 in es:
+                sols.append((len(branches), 0.0, s0))
+            for side in (pos, neg):
+                if side.size:
+                    follow(s0, 0.0, side, "gravity")
+        # Solutions at the grid's far ends (SRP-dominated ones too), continued back towards eps = 0
+        # unless a branch from eps = 0 already reached them.
+        zero = np.array([0.0] if 0.0 in es else [])
+        ends = (([(float(es[-1]), np.concatenate([pos[::-1][1:], zero]))] if es[-1] > 0 else [])
+                + ([(float(es[0]), np.concatenate([neg[::-1][1:], zero]))] if es[0] < 0 else []))
+        for e_end, inward in ends:
+            known = [s for _, e, s in sols if e == e_end]
+            found = []
+            for seed in (0.0, 0.5 * math.pi, math.pi, -0.5 * math.pi):  # phi0 is free: scan from four initial attitudes
+                found += find_periodic_attitudes(orbit, kz=kz, wz0_range=window, phi0=phi0 + seed, kinds=kinds,
+                                                 n_periods=n_periods, srp=plate.with_eps(e_end))
+            for s1 in sorted(found, key=lambda x: x.wz0):
+                if any(k.n == s1.n and k.kind == s1.kind and abs(k.wz0 - s1.wz0) < 1e-7
+                       and abs(math.remainder(k.phi0 - s1.phi0, 2 * math.pi)) < 1e-7 for k in known):
+                    continue
+                sols.append((len(branches), e_end, s1))
+                known.append(s1)
+                follow(s1, e_end, inward, "end")
+        path.sort(key=lambda p: (p[0], p[1]))
+    sol_arr = lambda f, dt=float: np.array([f(b, e, s) for b, e, s in sols], dtype=dt)  # noqa: E731
+    ds = xr.Dataset(
+        {
+            "dwz": (("eps", "wz0"), data["dwz"], {"units": "1/TU", "long_name": "wz(KT) - wz(0)"}),
+            "dphi": (("eps", "wz0"), data["dphi"], {"units": "rad", "long_name": "phi(KT) - phi0 wrapped to (-pi, pi]"}),
+            "phi_T": (("eps", "wz0"), data["phi_t"], {"units": "rad", "long_name": "phi(KT), unwrapped"}),
+            "status": (("eps", "wz0"), data["status"].astype(np.uint8), {"flag_values": "0 ok, 1 max steps, 2 failed"}),
+            "sol_eps": ("solution", sol_arr(lambda b, e, s: e)),
+            "sol_branch": ("solution", sol_arr(lambda b, e, s: b, np.int64)),
+            "sol_wz0": ("solution", sol_arr(lambda b, e, s: s.wz0), {"units": "1/TU"}),
+            "sol_phidot0": ("solution", sol_arr(lambda b, e, s: s.phidot0), {"units": "1/TU"}),
+            "sol_phi0": ("solution", sol_arr(lambda b, e, s: math.remainder(s.phi0, 2 * math.pi)), {"units": "rad",
+                         "long_name": "phi0 wrapped to [-pi, pi]"}),
+            "sol_n": ("solution", sol_arr(lambda b, e, s: s.n, np.int64)),
+            "sol_kind": ("solution", sol_arr(lambda b, e, s: s.kind, "<U9")),
+            "sol_trace": ("solution", sol_arr(lambda b, e, s: s.trace)),
+            "sol_stable": ("solution", sol_arr(lambda b, e, s: s.stable, bool)),
+            "sol_residual": ("solution", sol_arr(lambda b, e, s: s.residual)),
+            "path_branch": ("path", np.array([p[0] for p in path], dtype=np.int64)),
+            "path_eps": ("path", np.array([p[1] for p in path], dtype=float)),
+            "path_wz0": ("path", np.array([p[2] for p in path], dtype=float), {"units": "1/TU"}),
+            "path_phi0": ("path", np.array([math.remainder(p[3], 2 * math.pi) for p in path], dtype=float), {"units": "rad"}),
+            "path_trace": ("path", np.array([p[4] for p in path], dtype=float)),
+            "branch_n": ("branch", np.array([x[0] for x in branches], dtype=np.int64)),
+            "branch_kind": ("branch", np.array([x[1] for x in branches], dtype="<U9")),
+            "branch_origin": ("branch", np.array([x[2] for x in branches], dtype="<U7")),
+            "branch_start_eps": ("branch", np.array([x[3] for x in branches], dtype=float)),
+            "branch_end_eps": ("branch", np.array([x[4] for x in branches], dtype=float)),
+            "branch_end_wz0": ("branch", np.array([x[5] for x in branches], dtype=float), {"units": "1/TU"}),
+            "branch_fold": ("branch", np.array([x[6] for x in branches], dtype=bool)),
+            "branch_end_reason": ("branch", np.array([str(x[7]) for x in branches], dtype=str)),
+        },
+        coords={
+            "eps": ("eps", es, {"long_name": "flat-plate SRP amplitude P A d TU^2 / Iz"}),
+            "wz0": ("wz0", wz, {"units": "1/TU", "long_name": "initial inertial angular rate"}),
+            "phidot0": ("wz0", wz - 1.0, {"units": "1/TU", "long_name": "initial rate relative to the synodic frame"}),
+        },
+        attrs={
+            "title": "librate flat-plate SRP periodicity map over (eps, wz0)",
+            "map": "srp-eps",
+            "kz": kz,
+            "cs": float(plate.cs),
+            "cd": float(plate.cd),
+            "ca": float(plate.ca),
+            "theta0": float(theta0),
+            "phi0": phi0,
+            "n_periods": n_periods,
+            "x0": orbit.x0,
+            "period": orbit.period,
+            "period_days": orbit.period_days,
+            "sun_resonance": _sun_resonance(orbit) or 0,
+            "system_name": orbit.system.name,
+            "mu": orbit.system.mu,
+            "tu_s": orbit.system.tu_s,
+            "librate_version": __version__,
+        },
+    )
+    if not solve:
+        ds = ds.drop_vars([v for v in ds.data_vars if v.startswith(("sol_", "path_", "branch_"))])
+    return ds
+
+
+def _check_srp_map(ds, name: str = "ds"):
+    names = getattr(ds, "variables", None)
+    if (not hasattr(ds, "data_vars") or names is None or getattr(ds, "attrs", {}).get("map") != "srp-eps"
+            or not all(v in names for v in ("dwz", "dphi", "phi_T", "eps", "wz0"))):
+        raise ValueError(f"invalid argument `{name}`: must be an xarray Dataset from librate.plotting.srp_map, got {type(ds).__name__}")
+    return ds
+
+
+def _orbit_name(attrs) -> str:
+    k = int(attrs.get("sun_resonance", 0) or 0)
+    what = f"1:{k} Sun-resonant orbit" if k else "orbit"
+    return f"{what} ($T$ = {attrs['period_days']:.2f} d, $x_0$ = {attrs['x0']:.4f}), $K$ = {attrs['n_periods']}"
+
+
+def plot_srp_map(
+    ds,
+    ax=None,
+    *,
+    rate: str = "relative",
+    solutions: bool = True,
+    branches: bool = True,
+    kinds: Sequence[str] = _KINDS,
+    half_turn_contours: bool = False,
+    reference: float | tuple[float, str] | None = None,
+    legend: bool = True,
+    markersize: float = 3.5,
+) -> Figure:
+    """A flat-plate SRP periodicity map over (eps, initial rate) for one orbit (thesis Figs.
+    35-36; one panel of Figs. 40-41), from :func:`srp_map`.
+
+    Drawn: the zero contours of Dwz = wz(KT) - wz0 (``gid="contour-dwz"``) and of Dphi =
+    phi(KT) - phi0 (``gid="contour-dphi"``, on the unwrapped phi(KT): no false contour along the
+    +-pi wrap; ``half_turn_contours`` adds Dphi = pi, ``"contour-dphi-half"``), all for the map's
+    fixed phi0, exactly as :func:`plot_map` draws them; with ``solutions``, the solutions at the
+    grid's eps values (``gid="solutions"``, colour by N, circle periodic / diamond half-turn,
+    filled when linearly stable, at (eps, rate)); with ``branches``, each branch through all its
+    continuation points (``gid="branch-{kind}-N{N:+d}"``; solid from the gravity-only solution at
+    eps = 0, dotted from the map's far end) and, where it stopped, a cross: ``gid="fold"`` (black X)
+    at a fold (monodromy trace 2) or ``gid="branch-end"`` (grey x) where the continuation failed
+    otherwise. The branch solutions have phi0 FREE (SRP breaks the symmetry; the contours are for
+    the fixed phi0): the gravity-only ones start on the contours' crossings at eps = 0 and leave
+    them. ``reference``:
+    an eps (or (eps, label)) marked by a vertical line (``gid="eps-reference"``; only named in the
+    legend when outside the map's range), e.g. the plate of a given A/m. ``rate``: ``"relative"`` (phidot(0) = wz(0) - 1, default) or ``"inertial"``.
+    ``kinds``: the solutions shown. Returns the Figure.
+    """
+    ds = _check_srp_map(ds)
+    offset, ylabel = _rate_axis(rate)
+    kinds = _check_kinds(kinds)
+    ref_label = None
+    if reference is not None:
+        if isinstance(reference, tuple) and len(reference) == 2:
+            reference, ref_label = reference
+        reference = _number(reference, "reference")
+    x = np.asarray(ds["eps"].values, dtype=float)
+    y = np.asarray(ds["wz0"].values, dtype=float) - offset
+    phi0 = float(ds.attrs.get("phi0", 0.0))
+    created = ax is None
+    fig, (a,) = _axes(ax, 1, figsize=(8.6, 5.8))
+    handles = _map_contours(a, x, y, np.asarray(ds["dwz"].values, dtype=float).T, np.asarray(ds["phi_T"].values, dtype=float).T,
+                            np.asarray(ds["dphi"].values, dtype=float).T, phi0, half_turn_contours)
+    if branches and "branch_n" in ds.variables:
+        pb = np.asarray(ds["path_branch"].values)
+        drawn_end = {"fold": False, "branch-end": False}
+        for b in range(ds.sizes.get("branch", 0)):
+            kind, nn = str(ds["branch_kind"].values[b]), int(ds["branch_n"].values[b])
+            if kind not in kinds:
+                continue
+            sel = pb == b
+            far = str(ds["branch_origin"].values[b]) == "end"
+            (h,) = a.plot(ds["path_eps"].values[sel], ds["path_wz0"].values[sel] - offset, color=_n_color(nn),
+                          linewidth=1.3 if far else 1.0, alpha=0.85, linestyle=":" if far else "--" if kind == "half-turn" else "-",
+                          zorder=4)
+            h.set_gid(f"branch-{kind}-N{nn:+d}")
+            ee = float(ds["branch_end_eps"].values[b])
+            if math.isfinite(ee):
+                fold = bool(ds["branch_fold"].values[b])
+                gid_ = "fold" if fold else "branch-end"
+                (h,) = a.plot([ee], [float(ds["branch_end_wz0"].values[b]) - offset], linestyle="none", zorder=6,
+                              **(dict(marker="X", color="k", markersize=8) if fold else dict(marker="x", color="0.4", markersize=7)))
+                h.set_gid(gid_)
+                drawn_end[gid_] = True
+        origins = set(np.asarray(ds["branch_origin"].values).tolist())
+        if "gravity" in origins:
+            handles.append(Line2D([], [], color="0.3", linewidth=1.0, label="branch continued from $\\varepsilon$ = 0 ($\\varphi_0$ free)"))
+        if "end" in origins:
+            handles.append(Line2D([], [], color="0.3", linewidth=1.3, linestyle=":",
+                                  label="branch continued from the map's end ($\\varphi_0$ free)"))
+        if drawn_end["fold"]:
+            handles.append(Line2D([], [], linestyle="none", marker="X", color="k", markersize=8, label="fold (trace $M$ = 2)"))
+        if drawn_end["branch-end"]:
+            handles.append(Line2D([], [], linestyle="none", marker="x", color="0.4", markersize=7, label="continuation stopped"))
+    if solutions and "sol_eps" in ds.variables and ds.sizes.get("solution", 0):
+        kind = np.asarray(ds["sol_kind"].values)
+        m = np.isin(kind, kinds)
+        if m.any():
+            n = np.asarray(ds["sol_n"].values)[m]
+            st = np.asarray(ds["sol_stable"].values)[m]
+            _draw_solutions(a, np.asarray(ds["sol_eps"].values)[m], np.asarray(ds["sol_wz0"].values)[m] - offset, n, kind[m], st,
+                            markersize=markersize)
+            handles += _solution_legend(n, kind[m], st)
+    if reference is not None:
+        inside = x[0] <= reference <= x[-1]
+        if inside:
+            v = a.axvline(reference, color="0.2", linestyle="-.", linewidth=1.0)
+            v.set_gid("eps-reference")
+        handles.append(Line2D([], [], color="0.2", linestyle="-.", linewidth=1.0,
+                              label=(ref_label or f"$\\varepsilon$ = {reference:.4g}") + ("" if inside else " (beyond this map)")))
+    a.set_xlim(x[0], x[-1])
+    a.set_ylim(y[0], y[-1])
+    a.set_xlabel("SRP amplitude $\\varepsilon = P A d\\, TU^2 / I_z$ (nondimensional)")
+    a.set_ylabel(ylabel)
+    a.grid(True, linewidth=0.3, alpha=0.5)
+    if legend:
+        a.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=7.5, borderaxespad=0.0)
+    if created:
+        at = ds.attrs
+        a.set_title(f"SRP periodicity map, {_orbit_name(at)}\n$K_z$ = {at['kz']:g}, $C_s$ = {at['cs']:g}, $C_d$ = {at['cd']:g}, "
+                    f"$\\theta_{{s0}}$ = {math.degrees(at['theta0']):.4g} deg, $\\varphi_0$ = {at['phi0']:g} rad", fontsize=10)
+    return fig
+
+
+_MAP_PARAMETERS = (("kz", "$K_z$"), ("cs", "$C_s$"), ("cd", "$C_d$"), ("theta0", "$\\theta_{s0}$"), ("eps", "$\\varepsilon$"))
+_MAP_UNITS = {"theta0": " deg"}
+
+
+def _map_parameters(ds) -> dict:
+    """The fixed parameters of a map (srp_map or periodicity_map Dataset), by the names above."""
+    at = ds.attrs
+    if at.get("map") == "srp-eps":
+        return {"kz": at["kz"], "cs": at["cs"], "cd": at["cd"], "theta0": math.degrees(at["theta0"])}
+    out = {"cs": at.get("srp_cs", 0.0), "cd": at.get("srp_cd", 0.0), "theta0": math.degrees(at.get("sun_theta0", 0.0)),
+           "eps": at.get("srp_eps", 0.0)}
+    if ds.sizes.get("kz", 0) == 1:
+        out["kz"] = float(ds["kz"].values[0])
+    return out
+
+
+def plot_srp_maps(maps, ax=None, *, titles: Sequence[str] | None = None, **kwargs) -> Figure:
+    """Several periodicity maps side by side, one panel per parameter value (thesis Figs. 40-41:
+    several Cs, several Kz): each :func:`srp_map` Dataset drawn by :func:`plot_srp_map`, each
+    :func:`librate.periodicity_map` Dataset by :func:`plot_map` (``kwargs`` are passed on). Each
+    panel's title names the parameter values that differ between the maps (e.g. "$C_s$ = 0.4";
+    among Kz, Cs, Cd, the Sun phase and eps), or ``titles`` (one per map); the legend is drawn
+    beside the last panel only; with ``ax=None`` the suptitle names the common values. ``ax``: one
+    Axes per map. Returns the Figure.
+    """
+    try:
+        maps = list(maps)
+    except TypeError:
+        maps = []
+    if not maps:
+        raise ValueError("invalid argument `maps`: must be a non-empty sequence of map Datasets (srp_map or periodicity_map)")
+    for i, ds in enumerate(maps):
+        if getattr(ds, "attrs", {}).get("map") != "srp-eps":
+            _check_map(ds, "maps")
+    if titles is not None and (isinstance(titles, str) or len(titles) != len(maps)):
+        raise ValueError(f"invalid argument `titles`: need one title per map ({len(maps)}), got {titles!r}")
+    params = [_map_parameters(ds) for ds in maps]
+    names = [k for k, _ in _MAP_PARAMETERS if all(k in p for p in params)]
+    varying = [k for k in names if len({round(p[k], 12) for p in params}) > 1]
+    common = [k for k in names if k not in varying]
+    label = dict(_MAP_PARAMETERS)
+    created = ax is None
+    fig, axs = _axes(ax, len(maps), figsize=(8.6, 5.8) if len(maps) == 1 else (5.0 * min(len(maps), 3) + 2.6, 5.4 * math.ceil(len(maps) / 3)))
+    import inspect
+
+    takes = {f: set(inspect.signature(f).parameters) - {"ds", "ax"} for f in (plot_srp_map, plot_map)}
+    for k in kwargs:
+        if not any(k in t for t in takes.values()):
+            raise ValueError(f"invalid argument `{k}`: neither plot_srp_map nor plot_map takes it")
+    for i, (ds, a) in enumerate(zip(maps, axs)):
+        last = i == len(maps) - 1
+        f = plot_srp_map if ds.attrs.get("map") == "srp-eps" else plot_map
+        kw = {k: v for k, v in kwargs.items() if k in takes[f]}  # e.g. reference= only for SRP maps
+        kw.setdefault("legend", last)
+        f(ds, a, **kw)
+        if titles is not None:
+            title = titles[i]
+        else:
+            shown = varying or names
+            title = ", ".join(f"{label[k]} = {params[i][k]:.4g}{_MAP_UNITS.get(k, '')}" for k in shown)
+        a.set_title(title, fontsize=10)
+        if len(maps) > 1:  # the short label; the suptitle says relative or inertial
+            a.set_ylabel(a.get_ylabel().split(",")[0] + " (1/TU)")
+    if created:
+        first = maps[0].attrs
+        where = _orbit_name(first) if first.get("map") == "srp-eps" else f"{first.get('family', '') or 'orbit'} family"
+        fixed = ", ".join(f"{label[k]} = {params[0][k]:.4g}{_MAP_UNITS.get(k, '')}" for k in common)
+        rates = "inertial rates" if kwargs.get("rate") == "inertial" else "rates relative to the synodic frame"
+        fig.suptitle(f"periodicity maps, {where}" + (f"; {fixed}" if fixed else "") + f" ({rates})", fontsize=11)
+    return fig
+
+
+# --- gravity-only vs SRP, Sun-pointing (Figs. 37-39) ---------------------------------------------
+def plot_srp_comparison(
+    gravity_solution,
+    srp_solution,
+    ax=None,
+    *,
+    n_periods: float | None = None,
+    rate: str = "relative",
+    degrees: bool = True,
+    samples: int = 400,
+) -> Figure:
+    """A gravity-only periodic motion and its SRP counterpart (thesis Figs. 37-38, a small and a
+    large SRP effect): the rotation angle phi(t) (left; ``gid="gravity-angle"``, dashed black, and
+    ``gid="srp-angle"``, red) and the angular velocity (right; ``"gravity-rate"``, ``"srp-rate"``)
+    against time in orbital periods t / T, over ``n_periods`` revolutions (default: the SRP
+    solution's K, ``srp_solution.n_periods``, after which it repeats), ``samples`` points per
+    revolution, each from ``solution.propagate(n_periods)``. Vertical lines mark each K
+    revolutions (``gid="repeat"``). Both solutions must be on the same orbit (e.g. ``srp_solution``
+    from :func:`librate.continue_srp` of ``gravity_solution``). phi unwrapped from the synodic X
+    axis, in degrees unless ``degrees=False``; ``rate``: ``"relative"`` (phidot = wz - 1, default)
+    or ``"inertial"`` (wz). ``ax``: two Axes. Returns the Figure.
+    """
+    from .periodicity import AttitudeSolution
+
+    for name, s in (("gravity_solution", gravity_solution), ("srp_solution", srp_solution)):
+        if not isinstance(s, AttitudeSolution):
+            raise ValueError(f"invalid argument `{name}`: must be a librate.AttitudeSolution, got {type(s).__name__}")
+    g, s = gravity_solution, srp_solution
+    same = (g.orbit.system.mu == s.orbit.system.mu and abs(g.orbit.period - s.orbit.period) <= 1e-9 * g.orbit.period
+            and np.allclose(g.orbit.state0, s.orbit.state0, rtol=0.0, atol=1e-9))
+    if not same:
+        raise ValueError("invalid argument `srp_solution`: must be on the same orbit as `gravity_solution`")
+    k_rep = int(s.n_periods)
+    n = float(k_rep) if n_periods is None else _number(n_periods, "n_periods", positive=True)
+    samples = _count(samples, "samples", 2)
+    offset, ylabel = _rate_axis(rate, initial=False)
+    kdeg = 180.0 / math.pi if degrees else 1.0
+    T = s.orbit.period
+    t = np.linspace(0.0, n * T, max(2, int(math.ceil(samples * n)) + 1))
+    created = ax is None
+    fig, (a_ang, a_rate) = _axes(ax, 2, figsize=(12.4, 4.8))
+    for key, sol, color, ls in (("gravity", g, _GRAVITY_COLOR, "--"), ("srp", s, _SRP_COLOR, "-")):
+        tr = sol.propagate(n, t_eval=t)
+        eps = 0.0 if sol.srp is None else float(sol.srp.eps)
+        what = "gravity only" if sol.srp is None or eps == 0.0 else f"SRP $\\varepsilon$ = {eps:.4g}"
+        label = (f"{what}: $N$ = {sol.n}, $\\varphi_0$ = {math.degrees(sol.phi0):.3f} deg, $\\dot\\varphi(0)$ = {sol.phidot0:.4f}, "
+                 f"{'stable' if sol.stable else 'unstable'}")
+        (h,) = a_ang.plot(tr.t / T, kdeg * tr.phi, color=color, linestyle=ls, linewidth=1.4, label=label)
+        h.set_gid(f"{key}-angle")
+        (h,) = a_rate.plot(tr.t / T, tr.wz - offset, color=color, linestyle=ls, linewidth=1.4, label=label)
+        h.set_gid(f"{key}-rate")
+    for a in (a_ang, a_rate):
+        for j in range(1, int(math.floor(n / k_rep + 1e-9)) + 1):
+            v = a.axvline(j * k_rep, color="0.5", linestyle=":", linewidth=0.9)
+            v.set_gid("repeat")
+        a.set_xlabel("time $t/T$ (orbital periods)")
+        a.set_xlim(0.0, n)
+        a.margins(y=0.25)
+        a.grid(True, linewidth=0.3, alpha=0.5)
+        a.legend(fontsize=7.5, loc="best")
+    a_ang.set_ylabel(f"rotation angle $\\varphi$ from the synodic $X$ axis ({'deg' if degrees else 'rad'})")
+    a_rate.set_ylabel(ylabel.replace(", relative", "\nrelative"))
+    if created:
+        k = _sun_resonance(s.orbit)
+        where = f"1:{k} Sun-resonant orbit" if k else "orbit"
+        fig.suptitle(f"gravity-only vs SRP periodic motion, {where} (T = {s.orbit.period_days:.2f} d), $K_z$ = {s.kz:g}, "
+                     f"{k_rep} revolution{'s' if k_rep > 1 else ''} per repeat")
+    return fig
+
+
+def sun_pointing_accelerations(system, body_or_plate, t, *, orbit: PeriodicOrbit, offset: float = 0.0, kz: float | None = None,
+                               sun=None) -> tuple[np.ndarray, np.ndarray]:
+    """The angular accelerations (1/TU^2) on a body held pointing at the Sun, phi(t) = theta_s(t)
+    + ``offset``, along ``orbit`` at times ``t`` (TU): (gravity gradient, SRP). Gravity gradient:
+    1.5 Kz [S cos 2 phi - C sin 2 phi] with S, C of the orbit's forcing
+    (:func:`librate.periodicity.orbit_forcing`); SRP: ``plate.wzdot(t, phi)`` for a
+    :class:`librate.FlatPlateSRP` (then ``kz`` is required and the Sun is the plate's), or the z
+    torque of a :class:`librate.FacetBody`'s facets over Iz, times TU^2 (``kz`` from its inertia,
+    the Sun from ``sun``, default :class:`librate.SunModel`; planar: body z along synodic Z, the
+    Sun at the angle -offset in body axes)."""
+    from .periodicity import orbit_forcing
+    from .srp import FacetBody, FlatPlateSRP, SunModel, force_torque
+    from .constants import SOLAR_PRESSURE_1AU
+
+    sys_ = _check_system(system)
+    if not isinstance(orbit, PeriodicOrbit):
+        raise ValueError(f"invalid argument `orbit`: must be a librate.PeriodicOrbit, got {type(orbit).__name__}")
+    if orbit.state0[2] != 0.0 or orbit.state0[5] != 0.0:
+        raise ValueError("invalid argument `orbit`: the planar attitude model needs a planar orbit (z = zd = 0)")
+    offset = _number(offset, "offset")
+    if isinstance(body_or_plate, FlatPlateSRP):
+        if sun is not None:
+            raise ValueError("invalid argument `sun`: a FlatPlateSRP carries its own SunModel (plate.sun)")
+        if kz is None:
+            raise ValueError("invalid argument `kz`: a number in [-1, 1] is needed with a FlatPlateSRP")
+        kz = _number(kz, "kz")
+        if abs(kz) > 1:
+            raise ValueError(f"invalid argument `kz`: must be in [-1, 1], got {kz!r}")
+        sun_ = body_or_plate.sun
+    elif isinstance(body_or_plate, FacetBody):
+        if kz is not None:
+            raise ValueError("invalid argument `kz`: a FacetBody's inertia sets Kz (leave kz=None)")
+        kz = float(body_or_plate.kz)
+        sun_ = SunModel() if sun is None else sun
+        if not isinstance(sun_, SunModel):
+            raise ValueError(f"invalid argument `sun`: must be a librate.SunModel, got {sun!r}")
+    else:
+        raise ValueError(f"invalid argument `body_or_plate`: must be a librate.FlatPlateSRP or a librate.FacetBody, got {type(body_or_plate).__name__}")
+    t = np.asarray(t, dtype=float)
+    if not np.all(np.isfinite(t)):
+        raise ValueError("invalid argument `t`: times must be finite")
+    phi = _sun_angle(sun_.theta0, t) + offset
+    s_, c_ = orbit_forcing(orbit).sc(np.ascontiguousarray(t.ravel()))
+    s_, c_ = np.asarray(s_).reshape(t.shape), np.asarray(c_).reshape(t.shape)
+    gg = 1.5 * kz * (s_ * np.cos(2 * phi) - c_ * np.sin(2 * phi))
+    if isinstance(body_or_plate, FlatPlateSRP):
+        srp = np.asarray(body_or_plate.wzdot(t, phi), dtype=float)
+    else:
+        alpha = (_sun_angle(sun_.theta0, t) - phi).ravel()
+        scale = sun_.pressure / SOLAR_PRESSURE_1AU * sys_.tu_s**2 / body_or_plate.iz
+        srp = np.array([force_torque(body_or_plate.facets, (math.cos(v), math.sin(v), 0.0))[1][2] for v in alpha]) * scale
+        srp = srp.reshape(t.shape)
+    return gg, srp
+
+
+def plot_sun_pointing(
+    system,
+    body_or_plate,
+    ax=None,
+    *,
+    orbit: PeriodicOrbit,
+    offset: float = 0.0,
+    kz: float | None = None,
+    sun=None,
+    n_periods: float | None = None,
+    samples: int = 1500,
+    units: str = "days",
+) -> Figure:
+    """Angular accelerations on a Sun-pointing spacecraft (thesis Fig. 39): the body is held at
+    phi(t) = theta_s(t) + ``offset`` (``offset`` = 0: body x axis, the plate's normal, at the Sun;
+    it then turns at the Sun's rate, phidot = omega_sun, wz = 1 + omega_sun = n_sun, constant), along
+    ``orbit``; drawn against time: the gravity-gradient angular acceleration 1.5 Kz [S cos 2 phi
+    - C sin 2 phi] (``gid="gravity-gradient"``), the SRP one (``gid="srp"``; constant for a body
+    fixed relative to the Sun) and their sum (``gid="total"``, dashed), which a control torque
+    must cancel to hold the pointing (see :func:`sun_pointing_accelerations` for the models and
+    ``kz`` / ``sun``). ``body_or_plate``: a :class:`librate.FlatPlateSRP` (with ``kz``) or a
+    :class:`librate.FacetBody`. ``n_periods``: orbital periods shown (default: the whole number
+    covering one apparent solar period, ceil(Ts / T), after which a Sun-resonant orbit's pattern
+    repeats), ``samples`` points per period; ``units``: ``"days"`` or ``"TU"``. Accelerations in
+    1/TU^2 (nondimensional torque per Iz). Returns the Figure.
+    """
+    sys_ = _check_system(system)
+    if not isinstance(orbit, PeriodicOrbit):
+        raise ValueError(f"invalid argument `orbit`: must be a librate.PeriodicOrbit, got {type(orbit).__name__}")
+    if n_periods is None:
+        n_periods = max(1, math.ceil(SUN_SYNODIC_PERIOD / orbit.period - 1e-6))
+    n_periods = _number(n_periods, "n_periods", positive=True)
+    samples = _count(samples, "samples", 2)
+    tscale, tunit = _time_scale(sys_, units)
+    t = np.linspace(0.0, n_periods * orbit.period, max(2, int(math.ceil(samples * n_periods)) + 1))
+    gg, srp = sun_pointing_accelerations(sys_, body_or_plate, t, orbit=orbit, offset=offset, kz=kz, sun=sun)
+    from .srp import FlatPlateSRP
+
+    if isinstance(body_or_plate, FlatPlateSRP):
+        what = f"flat plate $\\varepsilon$ = {body_or_plate.eps:.4g}, $C_s$ = {body_or_plate.cs:g}, $C_d$ = {body_or_plate.cd:g}"
+        kz_value = float(kz)
+    else:
+        what = f"{len(body_or_plate.facets)}-facet body"
+        kz_value = float(body_or_plate.kz)
+    created = ax is None
+    fig, (a,) = _axes(ax, 1, figsize=(8.4, 4.8))
+    z = a.axhline(0.0, color="0.5", linewidth=0.7)
+    z.set_gid("zero")
+    (h,) = a.plot(t * tscale, gg, color="tab:blue", linewidth=1.4,
+                  label=f"gravity gradient $\\frac{{3}}{{2}} K_z (S\\cos 2\\varphi - C\\sin 2\\varphi)$, max |.| = {np.max(np.abs(gg)):.3g}")
+    h.set_gid("gravity-gradient")
+    (h,) = a.plot(t * tscale, srp, color=_SRP_COLOR, linewidth=1.4, label=f"SRP ({what}), max |.| = {np.max(np.abs(srp)):.3g}")
+    h.set_gid("srp")
+    (h,) = a.plot(t * tscale, gg + srp, color="k", linestyle="--", linewidth=1.1, label="total (a control torque cancels it)")
+    h.set_gid("total")
+    k = _sun_resonance(orbit)
+    for j in range(1, int(math.floor(n_periods + 1e-9)) + 1):
+        v = a.axvline(j * orbit.period * tscale, color="0.7", linestyle=":", linewidth=0.8)
+        v.set_gid("period")
+    a.set_xlim(0.0, t[-1] * tscale)
+    a.set_xlabel(f"time $t$ ({tunit}); dotted: orbital periods")
+    a.set_ylabel("angular acceleration $\\dot\\omega_z$ (1/TU$^2$)")
+    a.margins(y=0.3)
+    a.grid(True, linewidth=0.3, alpha=0.5)
+    a.legend(fontsize=7.5, loc="upper right")
+    if created:
+        where = f"1:{k} Sun-resonant orbit" if k else "orbit"
+        a.set_title(f"Sun-pointing spacecraft ($\\varphi = \\theta_s + {math.degrees(offset):.4g}$ deg), {where} "
+                    f"($T$ = {orbit.period_days:.2f} d), $K_z$ = {kz_value:.4g}", fontsize=10)
     return fig
 
 
