@@ -799,8 +799,9 @@ def continue_srp(solution: AttitudeSolution, srp, *, steps: int = 10, min_step: 
     """Continue ``solution`` (gravity-only, or with SRP) to the plate ``srp`` (its eps is the
     target; cs, cd and the Sun phase are kept along the way) by natural continuation in eps:
     linear extrapolation of (phi0, wz0), Newton in (phi0, wz0) with [Phi(KT) - I], steps halved on
-    failure or on a jump (a change of (phi0, wz0) five times the trend), and the fold detected
-    where the monodromy's trace crosses 2 (det(Phi - I) = 2 - trace changes sign)."""
+    failure or on a jump (the corrector landing farther than a quarter of the predicted step from
+    the prediction), and the fold detected where the monodromy's trace crosses 2
+    (det(Phi - I) = 2 - trace changes sign) or where the step collapses next to trace 2."""
     srp = _check_srp(srp)
     if srp is None:
         raise ValueError("invalid argument `srp`: the target plate is required")
@@ -831,10 +832,12 @@ def continue_srp(solution: AttitudeSolution, srp, *, steps: int = 10, min_step: 
         except ConvergenceError:
             ok = False
         if ok:
-            jump = max(abs(s.wz0 - guess[1]), abs(s.phi0 - guess[0]))
+            # On a smooth branch the corrector lands within a small fraction of the predicted
+            # step (the predictor's error is second order in the step); a landing farther off is
+            # another branch, or the fold coming up: shorten the step instead.
+            jump = math.hypot(s.wz0 - guess[1], s.phi0 - guess[0])
             if len(sols) >= 2:
-                trend = max(abs(a.wz0 - sols[-2].wz0), abs(a.phi0 - sols[-2].phi0)) * abs(e - eps[-1]) / abs(eps[-1] - eps[-2])
-                ok = jump <= 5 * trend + 1e-9
+                ok = jump <= 0.25 * math.hypot(guess[1] - a.wz0, guess[0] - a.phi0) + 1e-9
             else:
                 ok = jump <= 1e-2
             ok = ok and s.residual <= 1e-8

@@ -136,7 +136,9 @@ class FlatPlateSRP:
     """The simplified planar SRP model (PHYSICS.md sec. 6): one two-sided flat plate with normal
     x_B and centre of pressure offset d along y_B; with alpha the Sun's angle in body axes,
     wzdot_srp = eps [(1 + Cs) cos(alpha)|cos(alpha)| + (2/3) Cd cos(alpha)],
-    eps = P A d TU^2 / Iz (nondimensional; about 10 d/k^2 per metre for A/m = 0.016 m^2/kg)."""
+    eps = P A d TU^2 / Iz (nondimensional; eps = P (A/m) TU^2 d / k^2 = 1.03e4 d/k^2 with d and k
+    in metres for A/m = 0.016 m^2/kg and the default TU: PHYSICS.md says "about 10 d/k^2 per
+    metre", which holds with d and k in km)."""
 
     eps: float
     cs: float = 0.0
