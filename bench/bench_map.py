@@ -59,14 +59,13 @@ import tempfile
 import threading
 import time
 
-import numpy as np
-import xarray  # noqa: F401  (imported here so the large-map timings do not include it)
-from scipy.integrate import solve_ivp
-
 import heyoka as hy
 import librate
+import numpy as np
+import xarray  # noqa: F401  (imported here so the large-map timings do not include it)
 from librate import _core
 from librate.periodicity import MAP_ATOL, MAP_RTOL, _sweep
+from scipy.integrate import solve_ivp
 
 X0 = 0.70
 KZ = 0.8

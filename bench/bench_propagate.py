@@ -25,10 +25,9 @@ import argparse
 import os
 import time
 
+import librate
 import numpy as np
 from scipy.integrate import solve_ivp
-
-import librate
 
 LIBRATE_TOL = 1e-11
 SCIPY_LADDER = (1e-10, 1e-11, 1e-12, 1e-13)

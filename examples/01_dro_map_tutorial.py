@@ -14,10 +14,9 @@ Units: LU, TU (rates in 1/TU; phidot0 = wz0 - 1 is relative to the synodic frame
 import sys
 from pathlib import Path
 
-import numpy as np
-
 import librate
 import librate.plotting as lp
+import numpy as np
 from librate.results import save_dataset
 
 out = Path(sys.argv[1] if len(sys.argv) > 1 else "examples-out") / "tutorial"

@@ -11,10 +11,9 @@ constant), the period and the stability indices. The family is saved as netCDF a
 import sys
 from pathlib import Path
 
-import numpy as np
-
 import librate
 import librate.plotting as lp
+import numpy as np
 
 out = Path(sys.argv[1] if len(sys.argv) > 1 else "examples-out") / "halo"
 em = librate.System.preset("earth-moon")

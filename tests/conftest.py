@@ -1,7 +1,5 @@
-import numpy as np
-import pytest
-
 import librate
+import pytest
 
 
 @pytest.fixture(scope="session")

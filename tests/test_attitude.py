@@ -4,11 +4,10 @@ integrated motion."""
 
 import math
 
+import librate
 import numpy as np
 import pytest
 from scipy.linalg import expm
-
-import librate
 
 IZ = 96.95e6  # thesis Table 3, kg m^2
 TABLE3 = {"canonical": (12.12e6, 89.68e6), "debra-delp": (109.07e6, 118.76e6), "resonance": (40.39e6, 72.71e6)}

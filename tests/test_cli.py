@@ -10,11 +10,10 @@ import json
 import sys
 import types
 
+import librate
 import numpy as np
 import pytest
 from click.testing import CliRunner
-
-import librate
 from librate.cli import main
 
 TINY = ["--set", "orbits.x0={start = 0.9, stop = 0.5, num = 3}", "--set", "rates.wz0.num=50"]

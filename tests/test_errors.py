@@ -2,10 +2,9 @@
 
 import math
 
+import librate
 import numpy as np
 import pytest
-
-import librate
 
 EM = librate.System.preset("earth-moon")
 S0 = [0.85, 0, 0, 0, 0.47, 0]

@@ -2,10 +2,9 @@
 
 import math
 
+import librate
 import numpy as np
 import pytest
-
-import librate
 from librate.continuation import geometry
 
 

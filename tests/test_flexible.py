@@ -6,12 +6,11 @@ test names its reference and tolerance."""
 
 import math
 
+import librate
 import numpy as np
 import pytest
-from scipy.linalg import expm
-
-import librate
 from librate.flexible import FlexibleModes
+from scipy.linalg import expm
 
 EM = librate.System.preset("earth-moon")
 TU = EM.tu_s

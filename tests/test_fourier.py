@@ -3,12 +3,11 @@ orbit, an independent integrator and the CR3BP equations of motion."""
 
 import math
 
+import librate
 import numpy as np
 import pytest
-from scipy.integrate import solve_ivp
-
-import librate
 from helpers import cr3bp_rhs, dro_with_period
+from scipy.integrate import solve_ivp
 
 
 def jacobi_numpy(mu, states):

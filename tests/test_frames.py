@@ -3,10 +3,9 @@ near-1:1 DROs of thesis Table 1 (PHYSICS.md section 3)."""
 
 import math
 
+import librate
 import numpy as np
 import pytest
-
-import librate
 from helpers import continue_dros, dro_with_period
 
 

@@ -2,12 +2,11 @@
 
 import math
 
+import librate
 import numpy as np
 import pytest
-from scipy.integrate import solve_ivp
-
-import librate
 from helpers import continue_dros, cr3bp_rhs
+from scipy.integrate import solve_ivp
 
 
 @pytest.mark.parametrize("x0", [0.95, 0.9, 0.8])

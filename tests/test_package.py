@@ -2,9 +2,8 @@
 
 import importlib.resources
 
-from click.testing import CliRunner
-
 import librate
+from click.testing import CliRunner
 from librate.cli import main
 
 

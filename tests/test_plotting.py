@@ -24,13 +24,12 @@ import matplotlib
 
 matplotlib.use("Agg")
 
+import librate  # noqa: E402
+import librate.plotting as lp  # noqa: E402
 import matplotlib.image as mpimg  # noqa: E402
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import pytest  # noqa: E402
-
-import librate  # noqa: E402
-import librate.plotting as lp  # noqa: E402
 from helpers import dro_with_period  # noqa: E402
 from librate.constants import SUN_SYNODIC_PERIOD  # noqa: E402
 
@@ -288,7 +287,7 @@ def test_plot_attitude_response(tmp_path):
     tr = librate.propagate_attitude(em, s0, (q0, [0, 0, n]), librate.RigidBody(12.12e6, 89.68e6, 96.95e6), 3 * T,
                                     torques=("gravity_gradient_earth",), t_eval=np.linspace(0, 3 * T, 300))
     fig = lp.plot_attitude(tr, period=T, relative_to="earth")
-    lines = {l.get_gid(): l for a in fig.axes for l in a.get_lines() if l.get_gid()}
+    lines = {ln.get_gid(): ln for a in fig.axes for ln in a.get_lines() if ln.get_gid()}
     np.testing.assert_allclose(lines["rate-2"].get_ydata(), tr.w[:, 2])
     np.testing.assert_allclose(lines["angle-2"].get_xdata()[-1], 3.0)
     pitch = np.degrees(np.unwrap(tr.relative_to_vertical("earth")[:, 2]))

@@ -9,12 +9,11 @@ import matplotlib
 
 matplotlib.use("Agg")
 
+import librate  # noqa: E402
+import librate.plotting as lp  # noqa: E402
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import pytest  # noqa: E402
-
-import librate  # noqa: E402
-import librate.plotting as lp  # noqa: E402
 from test_plotting import assert_png, gid  # noqa: E402
 
 EM = librate.System.preset("earth-moon")

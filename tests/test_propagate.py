@@ -3,12 +3,11 @@ differences, analytic event times."""
 
 import math
 
+import librate
 import numpy as np
 import pytest
-from scipy.integrate import solve_ivp
-
-import librate
 from helpers import cr3bp_rhs
+from scipy.integrate import solve_ivp
 
 
 def test_matches_scipy_dop853(em):

@@ -7,10 +7,9 @@ import sys
 import textwrap
 import time
 
+import librate
 import numpy as np
 import pytest
-
-import librate
 from librate.runner import run_map
 
 WZ = np.linspace(-3, 2, 1500)

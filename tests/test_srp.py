@@ -3,10 +3,9 @@ periodic solutions, continuation in the SRP amplitude with folds."""
 
 import math
 
+import librate
 import numpy as np
 import pytest
-
-import librate
 from librate.constants import SUN_SYNODIC_PERIOD
 
 

@@ -8,12 +8,11 @@ Round trips are checked for exact equality of the saved numbers.
 import copy
 import json
 import math
-import tomllib
-
-import numpy as np
-import pytest
 
 import librate
+import numpy as np
+import pytest
+import tomllib
 from librate.results import read_attrs, save_dataset, save_family
 from librate.study import EXAMPLE_STUDY, Study, StudyError, apply_overrides
 

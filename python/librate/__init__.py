@@ -6,20 +6,29 @@ All quantities are nondimensional (CR3BP units) unless a name says otherwise
 """
 
 from ._core import __version__
-from .attitude import AttitudeTrajectory, RigidBody, propagate_attitude, quaternion_from_euler
 from ._errors import ConvergenceError, IntegrationError, LibrateError
+from .attitude import AttitudeTrajectory, RigidBody, propagate_attitude, quaternion_from_euler
 from .families import OrbitFamily, dro, dro_family, halo, halo_family, lyapunov, lyapunov_family
+from .flexible import Appendage, FlexibleBody, flexible_periodic, frequency_scan, quasi_static
 from .fourier import FourierOrbit, fit_fourier
 from .frames import MeanElements, OsculatingElements, eci_to_synodic, mean_elements, osculating_elements, synodic_to_eci
 from .orbits import PeriodicOrbit, correct_dro, correct_periodic, correct_symmetric
-from .periodicity import AttitudeFamily, AttitudeSolution, SrpContinuation, attitude_family, continue_srp, find_periodic_attitudes, periodic_attitude, periodicity_map
-from .srp import Facet, FacetBody, FlatPlateSRP, SunModel
-from .runner import run_map
+from .periodicity import (
+    AttitudeFamily,
+    AttitudeSolution,
+    SrpContinuation,
+    attitude_family,
+    continue_srp,
+    find_periodic_attitudes,
+    periodic_attitude,
+    periodicity_map,
+)
 from .propagation import BatchResult, Event, EventHit, Stats, Trajectory, propagate, propagate_many
-from .system import System
-from .flexible import Appendage, FlexibleBody, flexible_periodic, frequency_scan, quasi_static
 from .results import open_result
+from .runner import run_map
+from .srp import Facet, FacetBody, FlatPlateSRP, SunModel
 from .study import Study, StudyError
+from .system import System
 
 __all__ = [
     "__version__",

@@ -1,11 +1,42 @@
 """Type stubs of the private Rust extension. Use the `librate` package API instead."""
 
-from typing import Any, TypedDict
+from typing import Any, TypedDict, final
 
 import numpy as np
 import numpy.typing as npt
 
 __version__: str
+__all__ = [
+    "ConvergenceError",
+    "IntegrationError",
+    "LibrateError",
+    "OrbitForcing",
+    "__version__",
+    "attitude_propagate",
+    "attitude_torques",
+    "facets_force_torque",
+    "flexible_body_check",
+    "flexible_energies",
+    "flexible_propagate",
+    "flexible_quasi_static",
+    "flexible_quasi_static_point",
+    "flexible_rates",
+    "fourier_evaluate",
+    "jacobi",
+    "lagrange_points",
+    "map_sweep",
+    "multiple_shooting",
+    "planar_propagate",
+    "preset_names",
+    "propagate",
+    "propagate_many",
+    "rigid_body_kz",
+    "stability",
+    "symmetric_correct",
+    "symmetric_evaluate",
+    "system_preset",
+    "system_validate",
+]
 
 class LibrateError(Exception): ...
 
@@ -68,19 +99,25 @@ def multiple_shooting(
 def fourier_evaluate(
     period: float, a0: _F64, cos: _F64, sin: _F64, t: _F64, *, quantity: str
 ) -> _F64: ...
+_FacetTuple = tuple[float, list[float], list[float], float, float, float]
+
 def attitude_propagate(
     mu: float, inertia: list[float], torques: list[str], orbit_mode: str, state0: list[float], t0: float, tf: float, *,
-    options: _Options, stm: bool, t_eval: _F64 | None, inertia_nd: list[float] | None = None
+    options: _Options, stm: bool, t_eval: _F64 | None, inertia_nd: list[float] | None = None,
+    facets: list[_FacetTuple] | None = None, sun: tuple[float, float, float] = ..., tu_s: float = 1.0,
+    srp_force: tuple[float, float] | None = None,
 ) -> dict[str, Any]: ...
+def facets_force_torque(facets: list[_FacetTuple], s_body: list[float]) -> tuple[list[float], list[float]]: ...
 def planar_propagate(
     mu: float, kz: float, primaries: list[bool], held: bool, orbit0: list[float], phi0: float, wz0: float, t0: float, tf: float, *,
-    options: _Options, stm: bool, t_eval: _F64 | None
+    options: _Options, stm: bool, t_eval: _F64 | None, plate: tuple[float, float, float, float, float] | None = None
 ) -> dict[str, Any]: ...
 def attitude_torques(mu: float, inertia: list[float], torques: list[str], t: _F64, states: _F64) -> _F64: ...
 def rigid_body_kz(ix: float, iy: float, iz: float) -> float: ...
 
+@final
 class OrbitForcing:
-    def __init__(self, mu: float, state0: list[float], period: float, *, primaries: list[bool] = ..., tol: float = 1e-13) -> None: ...
+    def __new__(cls, mu: float, state0: list[float], period: float, *, primaries: list[bool] = ..., tol: float = 1e-12) -> OrbitForcing: ...
     @property
     def period(self) -> float: ...
     @property
@@ -91,7 +128,8 @@ class OrbitForcing:
 
 def map_sweep(
     forcing: OrbitForcing, t_final: float, phi0: _F64, wz0: _F64, kz: _F64, *,
-    rtol: float, atol: float, max_steps: int, stm: bool, chunk: int, threads: int | None
+    rtol: float, atol: float, max_steps: int, stm: bool, chunk: int, threads: int | None,
+    eps: _F64 | None = None, cs: _F64 | None = None, cd: _F64 | None = None, theta_sun0: _F64 | None = None,
 ) -> dict[str, Any]: ...
 
 _FlexBody = tuple[float, list[float], list[tuple[float, list[float], list[float], float, float]]]

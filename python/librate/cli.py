@@ -76,7 +76,8 @@ def info() -> None:
 @click.option("--out", "out_dir", default="librate-out", show_default=True, type=click.Path(file_okay=False), help="Output folder for the map (netCDF).")
 def demo(system_name: str, kz: float, n_orbits: int, n_rates: int, out_dir: str) -> None:
     """The main job on a default study: the attitude periodicity map of the DRO family (thesis
-    Fig. 24), its periodic solutions refined by Newton, saved as netCDF.
+    Fig. 24), its periodic solutions refined by Newton and grouped into families by N (Figs.
+    27-29), saved as netCDF with PNG figures in the output folder.
 
     Computes the DRO family by continuation, integrates the planar attitude of a body with the
     given Kz along every member for a grid of initial rates (Rust engine, SIMD lanes, all
@@ -117,6 +118,22 @@ def demo(system_name: str, kz: float, n_orbits: int, n_rates: int, out_dir: str)
     path = out / f"dro_map_kz{kz:g}.nc"
     ds.to_netcdf(path, engine="scipy")
     click.echo(f"written: {path} (xarray Dataset: dwz, dphi, phi_T over (orbit, kz, wz0), solutions, units and parameters)")
+    try:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        from . import plotting as lp
+    except ImportError:
+        click.echo("figures skipped: matplotlib is not installed (pip install 'librate[plot]')")
+        return
+    figures = {
+        "map.png": lp.plot_map(ds),
+        "solution_families.png": lp.plot_solution_families(ds, n=(1, 0, -1)),
+        "family.png": lp.plot_family(fam),
+    }
+    for name, fig in figures.items():
+        lp.save_figure(fig, out / name, close=True)
+    click.echo(f"figures: {', '.join(str(out / n) for n in figures)} (thesis Fig. 24, Figs. 27-29, Fig. 3)")
 
 
 @main.command(name="dros", context_settings=_CONTEXT)

@@ -8,8 +8,8 @@ adaptive steps and clean termination with a reason.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Callable
 
 import numpy as np
 

@@ -45,15 +45,15 @@ from __future__ import annotations
 
 import json
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import Sequence
 
 import numpy as np
 
 from . import _core
 from ._checks import as_state, as_time_span
-from .attitude import AttitudeTrajectory, RigidBody, TORQUES
+from .attitude import TORQUES, AttitudeTrajectory, RigidBody
 from .propagation import Stats, _options
 from .system import System, resolve_system
 

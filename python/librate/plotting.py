@@ -1820,9 +1820,9 @@ def sun_pointing_accelerations(system, body_or_plate, t, *, orbit: PeriodicOrbit
     torque of a :class:`librate.FacetBody`'s facets over Iz, times TU^2 (``kz`` from its inertia,
     the Sun from ``sun``, default :class:`librate.SunModel`; planar: body z along synodic Z, the
     Sun at the angle -offset in body axes)."""
+    from .constants import SOLAR_PRESSURE_1AU
     from .periodicity import orbit_forcing
     from .srp import FacetBody, FlatPlateSRP, SunModel, force_torque
-    from .constants import SOLAR_PRESSURE_1AU
 
     sys_ = _check_system(system)
     if not isinstance(orbit, PeriodicOrbit):

@@ -14,13 +14,22 @@ from __future__ import annotations
 
 import hashlib
 import json
-import os
 import sys
 from pathlib import Path
 
 import numpy as np
 
-from .periodicity import MAP_ATOL, MAP_RTOL, _check_orbit, _check_srp, _orbits_of, _solutions_dataset, _solutions_from_row, _sweep, orbit_forcing
+from .periodicity import (
+    MAP_ATOL,
+    MAP_RTOL,
+    _check_orbit,
+    _check_srp,
+    _orbits_of,
+    _solutions_dataset,
+    _solutions_from_row,
+    _sweep,
+    orbit_forcing,
+)
 
 __all__ = ["run_map"]
 
