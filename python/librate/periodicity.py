@@ -417,9 +417,7 @@ def periodicity_map(
     Cs) adds an ``srp`` dimension (orbit, srp, kz, wz0) with their parameters as coordinates. With SRP the mirror symmetry is broken
     and solutions are refined in (phi0, wz0) together (PHYSICS.md sec. 6).
     """
-    import xarray as xr
 
-    from . import __version__
 
     olist, family = _orbits_of(orbits)
     for o in olist:
@@ -432,14 +430,7 @@ def periodicity_map(
                                 progress=progress, rtol=rtol, atol=atol, chunk=chunk, threads=threads, srp=p) for p in plates]
         return _stack_srp(maps, plates)
     srp = _check_srp(srp)
-    kzs = np.atleast_1d(np.asarray(kz, dtype=np.float64))
-    if kzs.ndim != 1 or kzs.size == 0 or not np.all(np.isfinite(kzs)) or np.any(np.abs(kzs) > 1):
-        raise ValueError(f"invalid argument `kz`: values must be finite and in [-1, 1], got {kz!r}")
-    wz = np.asarray(wz0, dtype=np.float64).ravel()
-    if wz.size < 2 or not np.all(np.isfinite(wz)) or np.any(np.diff(wz) <= 0):
-        raise ValueError("invalid argument `wz0`: must be a finite, strictly increasing array of at least 2 rates")
-    if not isinstance(n_periods, (int, np.integer)) or n_periods < 1:
-        raise ValueError(f"invalid argument `n_periods`: must be an integer >= 1, got {n_periods!r}")
+    kzs, wz = _map_grid(kz, wz0, n_periods)
     no, nk, nw = len(olist), kzs.size, wz.size
     dwz = np.full((no, nk, nw), np.nan)
     dphi = np.full((no, nk, nw), np.nan)
@@ -463,23 +454,57 @@ def periodicity_map(
     except KeyboardInterrupt:
         complete = False
         warnings.warn(f"periodicity_map interrupted: {int(done.sum())} of {no} orbits finished and kept", stacklevel=2)
-    ds = xr.Dataset(
+    grid = {"dwz": dwz, "dphi": dphi, "phi_T": phi_t, "status": status}
+    ds = _map_dataset(olist, family, kzs, wz, grid, done, phi0=phi0, n_periods=n_periods, rtol=rtol, atol=atol, srp=srp, complete=complete)
+    if solve:
+        ds = ds.merge(_solutions_dataset(sols))
+    return ds
+
+
+
+def _map_grid(kz, wz0, n_periods):
+    """Validated Kz values and (strictly increasing) inertial rates of a map."""
+    kzs = np.atleast_1d(np.asarray(kz, dtype=np.float64))
+    if kzs.ndim != 1 or kzs.size == 0 or not np.all(np.isfinite(kzs)) or np.any(np.abs(kzs) > 1):
+        raise ValueError(f"invalid argument `kz`: values must be finite and in [-1, 1], got {kz!r}")
+    wz = np.asarray(wz0, dtype=np.float64).ravel()
+    if wz.size < 2 or not np.all(np.isfinite(wz)) or np.any(np.diff(wz) <= 0):
+        raise ValueError("invalid argument `wz0`: must be a finite, strictly increasing array of at least 2 rates")
+    if not isinstance(n_periods, (int, np.integer)) or n_periods < 1:
+        raise ValueError(f"invalid argument `n_periods`: must be an integer >= 1, got {n_periods!r}")
+    return kzs, wz
+
+
+def _map_coords(olist, kzs, wz) -> dict:
+    """name -> (dimension, values, attributes) of a map's coordinates."""
+    return {
+        "orbit": ("orbit", np.arange(len(olist)), {}),
+        "x0": ("orbit", np.array([o.x0 for o in olist]), {"units": "LU"}),
+        "period": ("orbit", np.array([o.period for o in olist]), {"units": "TU"}),
+        "period_days": ("orbit", np.array([o.period_days for o in olist]), {"units": "d"}),
+        "kz": ("kz", kzs, {"long_name": "(Iy - Ix) / Iz"}),
+        "wz0": ("wz0", wz, {"units": "1/TU", "long_name": "initial inertial angular rate"}),
+        "phidot0": ("wz0", wz - 1.0, {"units": "1/TU", "long_name": "initial rate relative to the synodic frame"}),
+    }
+
+
+def _map_dataset(olist, family, kzs, wz, grid, done, *, phi0, n_periods, rtol, atol, srp, complete, attrs=None):
+    """The map's Dataset: residual grids over (orbit, kz, wz0), coordinates with units and the
+    parameters as attributes (shared by periodicity_map and run_map)."""
+    import xarray as xr
+
+    from . import __version__
+
+    dims = ("orbit", "kz", "wz0")
+    return xr.Dataset(
         {
-            "dwz": (("orbit", "kz", "wz0"), dwz, {"units": "1/TU", "long_name": "wz(T) - wz(0)"}),
-            "dphi": (("orbit", "kz", "wz0"), dphi, {"units": "rad", "long_name": "phi(T) - phi0 wrapped to (-pi, pi]"}),
-            "phi_T": (("orbit", "kz", "wz0"), phi_t, {"units": "rad", "long_name": "phi(T), unwrapped"}),
-            "status": (("orbit", "kz", "wz0"), status, {"flag_values": "0 ok, 1 max steps, 2 failed, 255 not computed"}),
-            "computed": ("orbit", done),
+            "dwz": (dims, grid["dwz"], {"units": "1/TU", "long_name": "wz(T) - wz(0)"}),
+            "dphi": (dims, grid["dphi"], {"units": "rad", "long_name": "phi(T) - phi0 wrapped to (-pi, pi]"}),
+            "phi_T": (dims, grid["phi_T"], {"units": "rad", "long_name": "phi(T), unwrapped"}),
+            "status": (dims, grid["status"], {"flag_values": "0 ok, 1 max steps, 2 failed, 255 not computed"}),
+            "computed": ("orbit", np.asarray(done, dtype=bool).copy()),
         },
-        coords={
-            "orbit": np.arange(no),
-            "x0": ("orbit", np.array([o.x0 for o in olist]), {"units": "LU"}),
-            "period": ("orbit", np.array([o.period for o in olist]), {"units": "TU"}),
-            "period_days": ("orbit", np.array([o.period_days for o in olist]), {"units": "d"}),
-            "kz": ("kz", kzs, {"long_name": "(Iy - Ix) / Iz"}),
-            "wz0": ("wz0", wz, {"units": "1/TU", "long_name": "initial inertial angular rate"}),
-            "phidot0": ("wz0", wz - 1.0, {"units": "1/TU", "long_name": "initial rate relative to the synodic frame"}),
-        },
+        coords=_map_coords(olist, kzs, wz),
         attrs={
             "title": "librate attitude periodicity map",
             "phi0": float(phi0),
@@ -497,12 +522,9 @@ def periodicity_map(
             "srp_cs": float(srp.cs) if srp is not None else 0.0,
             "srp_cd": float(srp.cd) if srp is not None else 0.0,
             "sun_theta0": float(srp.sun.theta0) if srp is not None else 0.0,
+            **(attrs or {}),
         },
     )
-    if solve:
-        ds = ds.merge(_solutions_dataset(sols))
-    return ds
-
 
 def _stack_srp(maps, plates):
     """Maps for several plates stacked along an ``srp`` dimension (coordinates eps, cs, cd and

@@ -24,6 +24,9 @@ from .periodicity import (
     MAP_RTOL,
     _check_orbit,
     _check_srp,
+    _map_coords,
+    _map_dataset,
+    _map_grid,
     _orbits_of,
     _solutions_dataset,
     _solutions_from_row,
@@ -127,34 +130,15 @@ def run_map(
     and ETA on stderr (default: only when stderr is a terminal). ``attrs``: extra attributes
     (e.g. the study as JSON). Without ``out`` nothing is written (and nothing can be resumed).
     """
-    import xarray as xr
-
-    from . import __version__
-
     olist, family = _orbits_of(orbits)
     for o in olist:
         _check_orbit(o)
     if isinstance(srp, (list, tuple)):
         raise ValueError("invalid argument `srp`: run_map takes one plate; use periodicity_map for a list")
     srp = _check_srp(srp)
-    kzs = np.atleast_1d(np.asarray(kz, dtype=np.float64))
-    if kzs.ndim != 1 or kzs.size == 0 or not np.all(np.isfinite(kzs)) or np.any(np.abs(kzs) > 1):
-        raise ValueError(f"invalid argument `kz`: values must be finite and in [-1, 1], got {kz!r}")
-    wz = np.asarray(wz0, dtype=np.float64).ravel()
-    if wz.size < 2 or not np.all(np.isfinite(wz)) or np.any(np.diff(wz) <= 0):
-        raise ValueError("invalid argument `wz0`: must be a finite, strictly increasing array of at least 2 rates")
-    if not isinstance(n_periods, (int, np.integer)) or n_periods < 1:
-        raise ValueError(f"invalid argument `n_periods`: must be an integer >= 1, got {n_periods!r}")
+    kzs, wz = _map_grid(kz, wz0, n_periods)
     no, nk, nw = len(olist), kzs.size, wz.size
-    coords = {
-        "orbit": ("orbit", np.arange(no), {}),
-        "x0": ("orbit", np.array([o.x0 for o in olist]), {"units": "LU"}),
-        "period": ("orbit", np.array([o.period for o in olist]), {"units": "TU"}),
-        "period_days": ("orbit", np.array([o.period_days for o in olist]), {"units": "d"}),
-        "kz": ("kz", kzs, {"long_name": "(Iy - Ix) / Iz"}),
-        "wz0": ("wz0", wz, {"units": "1/TU", "long_name": "initial inertial angular rate"}),
-        "phidot0": ("wz0", wz - 1.0, {"units": "1/TU", "long_name": "initial rate relative to the synodic frame"}),
-    }
+    coords = _map_coords(olist, kzs, wz)
     fp = _fingerprint(olist, kzs, wz, phi0, n_periods, srp, rtol, atol)
     args = (kzs, wz, float(phi0), int(n_periods), srp, float(rtol), float(atol))
     if out is not None:
@@ -202,36 +186,8 @@ def run_map(
         bar.close()
 
     grid = {k: (store[k][:] if store is not None else mem[k]) for k in (*_GRID, "status")}
-    ds = xr.Dataset(
-        {
-            "dwz": (("orbit", "kz", "wz0"), grid["dwz"], {"units": "1/TU", "long_name": "wz(T) - wz(0)"}),
-            "dphi": (("orbit", "kz", "wz0"), grid["dphi"], {"units": "rad", "long_name": "phi(T) - phi0 wrapped to (-pi, pi]"}),
-            "phi_T": (("orbit", "kz", "wz0"), grid["phi_T"], {"units": "rad", "long_name": "phi(T), unwrapped"}),
-            "status": (("orbit", "kz", "wz0"), grid["status"], {"flag_values": "0 ok, 1 max steps, 2 failed, 255 not computed"}),
-            "computed": ("orbit", done.copy()),
-        },
-        coords={k: (d, v, a) for k, (d, v, a) in coords.items()},
-        attrs={
-            "title": "librate attitude periodicity map",
-            "phi0": float(phi0),
-            "n_periods": int(n_periods),
-            "rtol": float(rtol),
-            "atol": float(atol),
-            "complete": int(done.all()),
-            "mu": olist[0].system.mu,
-            "lu_km": olist[0].system.lu_km,
-            "tu_s": olist[0].system.tu_s,
-            "system_name": olist[0].system.name,
-            "family": family.kind if family is not None else "",
-            "librate_version": __version__,
-            "srp_eps": float(srp.eps) if srp is not None else 0.0,
-            "srp_cs": float(srp.cs) if srp is not None else 0.0,
-            "srp_cd": float(srp.cd) if srp is not None else 0.0,
-            "sun_theta0": float(srp.sun.theta0) if srp is not None else 0.0,
-            "fingerprint": fp,
-            **(attrs or {}),
-        },
-    )
+    ds = _map_dataset(olist, family, kzs, wz, grid, done, phi0=phi0, n_periods=n_periods, rtol=rtol, atol=atol, srp=srp,
+                      complete=done.all(), attrs={"fingerprint": fp, **(attrs or {})})
     if solve:
         sols = []
         for i, o in enumerate(olist):
