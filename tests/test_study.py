@@ -334,3 +334,49 @@ def test_a_map_is_exported_to_netcdf_too(tmp_path, base, monkeypatch):
     for v in ("dwz", "dphi", "phi_T", "sol_wz0", "sol_kz"):
         assert np.array_equal(nc[v].values, zr[v].values, equal_nan=True), v
     assert nc["sol_stable"].values.astype(bool).tolist() == zr["sol_stable"].values.tolist()
+
+
+def _flex_study(tmp_path, flexible, purpose="solve"):
+    from librate.study import Study
+
+    d = {"orbits": {"kind": "dro", "x0": [0.8, 0.75]}, "body": {"flexible": flexible},
+         "rates": {"wz0": {"start": -2.0, "stop": 1.5, "num": 200}}}
+    return Study.from_dict(d, purpose=purpose, base_dir=tmp_path)
+
+
+def test_flexible_body_in_a_study(tmp_path):
+    """Issue 8: studies accept a flexible body (preset or TOML file). `solve` finds the rigid
+    solutions of the composite body and reports each one's first-order shift from flexibility
+    (PHYSICS.md sec. 7): negligible for the real-scale station (0.1 Hz arrays: < 1e-9), large for
+    its low-frequency variant (> 1e-4 rad/TU somewhere)."""
+    real, _ = _flex_study(tmp_path, "sample-station").run_solve(out=tmp_path / "real")
+    low, _ = _flex_study(tmp_path, "sample-station-low-frequency").run_solve(out=tmp_path / "low")
+    assert real.sizes["solution"] > 0 and real.flex_dwz0.attrs["units"] == "1/TU"
+    assert np.max(np.abs(real.flex_dwz0.values)) < 1e-9
+    assert np.max(np.abs(low.flex_dwz0.values)) > 1e-4
+    # the composite body's Kz is thesis Table 3's 0.8; a FlexibleBody TOML file gives the same
+    (tmp_path / "station.toml").write_text(librate.FlexibleBody.sample_station().to_toml())
+    st = _flex_study(tmp_path, "station.toml")
+    assert st.kz_values()[0] == pytest.approx(0.8, abs=1e-3)
+    assert st.kz_values()[0] == _flex_study(tmp_path, "sample-station").kz_values()[0]
+
+
+@pytest.mark.parametrize("body, key", [
+    ({"flexible": "sample-station", "kz": 0.8}, "body.kz"),
+    ({"flexible": "tower"}, "body.flexible"),
+])
+def test_flexible_body_errors(body, key):
+    from librate.study import Study, StudyError
+
+    d = {"orbits": {"kind": "dro", "x0": [0.8]}, "body": body, "rates": {"wz0": {"start": -2.0, "stop": 1.5, "num": 20}}}
+    with pytest.raises(StudyError) as info:
+        Study.from_dict(d, purpose="solve")
+    assert len(info.value.problems) == 1 and info.value.problems[0].startswith(key)
+
+
+def test_flexible_body_cannot_be_mapped(tmp_path):
+    from librate.study import StudyError
+
+    with pytest.raises(StudyError) as info:
+        _flex_study(tmp_path, "sample-station", purpose="map")
+    assert info.value.problems[0].startswith("body.flexible") and "solve" in info.value.problems[0]

@@ -127,9 +127,14 @@ class OrbitsSection(_Table):
     max_members: int | None = Field(None, ge=2, le=5_000)
 
 
-class BodySection(_Table):
-    """[body]: Kz, or the principal moments of inertia in kg m^2."""
+FLEXIBLE_PRESETS = ("sample-station", "sample-station-low-frequency")
 
+
+class BodySection(_Table):
+    """[body]: Kz, or the principal moments of inertia in kg m^2, or a flexible spacecraft
+    (``flexible``: a preset name or the path of a FlexibleBody TOML file)."""
+
+    flexible: str | None = None
     kz: KzGrid | None = None
     ix: float | None = Field(None, gt=0)
     iy: float | None = Field(None, gt=0)
@@ -421,12 +426,22 @@ def _check_sections(s: dict[str, _Table], given: dict, purpose: str | None) -> l
     body = s.get("body")
     if body is not None:
         moments = {k: getattr(body, k) for k in ("ix", "iy", "iz") if getattr(body, k) is not None}
-        if body.kz is not None and moments:
+        if body.flexible is not None and (body.kz is not None or moments):
+            for k in ["kz", *moments]:
+                if getattr(body, k) is not None:
+                    problems.append(_problem(f"body.{k}", _grid_raw(body.kz) if k == "kz" else getattr(body, k),
+                                             "cannot be combined with body.flexible (the flexible body defines its inertia)",
+                                             "either body.flexible, or body.kz, or body.ix/iy/iz"))
+        elif body.kz is not None and moments:
             for k, v in moments.items():
                 problems.append(_problem(f"body.{k}", v, "cannot be combined with body.kz (Kz follows from the moments)",
                                          "either body.kz, or body.ix, body.iy and body.iz"))
+        elif body.flexible is not None:
+            if body.flexible not in FLEXIBLE_PRESETS and not body.flexible.endswith(".toml"):
+                problems.append(_problem("body.flexible", body.flexible, "not a flexible-body preset or TOML file",
+                                         f"one of {', '.join(FLEXIBLE_PRESETS)}, or the path of a FlexibleBody TOML file (*.toml)"))
         elif body.kz is None and not moments:
-            problems.append(_missing("body.kz", "missing: give body.kz, or body.ix, body.iy and body.iz in kg m^2"))
+            problems.append(_missing("body.kz", "missing: give body.kz, or body.ix, body.iy and body.iz in kg m^2 (or body.flexible)"))
         elif moments and len(moments) < 3:
             for k in ("ix", "iy", "iz"):
                 if k not in moments:
@@ -489,6 +504,11 @@ def _check_sections(s: dict[str, _Table], given: dict, purpose: str | None) -> l
         if orb is not None and orb.kind == "halo":
             problems.append(_problem("orbits.kind", orb.kind, f"{what} use{'s' if need == 'needs' else ''} the planar attitude model, which needs a planar family",
                                      "'dro' or 'lyapunov'"))
+        if purpose == "map" and body is not None and body.flexible is not None:
+            problems.append(_problem("body.flexible", body.flexible, "the periodicity-map engine integrates rigid bodies; "
+                                     "`librate solve` reports how flexibility moves each periodic solution", "body.kz or body.ix/iy/iz for a map"))
+        if body is not None and body.flexible is not None and tq is not None and tq.srp is not None:
+            problems.append(_problem("torques.srp", "[torques.srp]", "the flexible model has no solar radiation pressure yet", "no [torques.srp] with body.flexible"))
         if tq is not None and sorted(tq.gravity_gradient) != ["earth", "moon"]:
             problems.append(_problem("torques.gravity_gradient", tq.gravity_gradient,
                                      f"the planar engine behind {what} models the gravity gradient of both primaries", "[\"earth\", \"moon\"]"))
@@ -680,9 +700,26 @@ class Study(BaseModel):
         b = self.body
         if b is None:
             raise ValueError("the study has no [body]")
+        if b.flexible is not None:
+            return np.array([self.build_flexible().rigid_body().kz])
         if b.kz is not None:
             return _grid_values(b.kz)
         return np.array([(b.iy - b.ix) / b.iz])
+
+    def build_flexible(self):
+        """The :class:`~librate.FlexibleBody` of ``body.flexible`` (a preset, or a TOML file
+        relative to the study's folder), or None."""
+        from .flexible import FlexibleBody
+
+        b = self.body
+        if b is None or b.flexible is None:
+            return None
+        if b.flexible in FLEXIBLE_PRESETS:
+            return FlexibleBody.preset(b.flexible)
+        path = Path(self.base_dir) / b.flexible
+        if not path.is_file():
+            raise StudyError([_problem("body.flexible", b.flexible, f"no such file: {path}", "an existing FlexibleBody TOML file")])
+        return FlexibleBody.from_toml(path)
 
     def build_body(self):
         """The :class:`~librate.RigidBody` (moments in kg m^2 when given; else normalised from
@@ -788,6 +825,15 @@ class Study(BaseModel):
                 if progress is not None:
                     progress(done, total)
         ds = solutions_dataset(rows, olist, self.kz_values(), self.result_attrs("solutions"))
+        flex = self.build_flexible()
+        if flex is not None and rows:
+            # Flexibility's first-order effect on each rigid solution (closed form, PHYSICS.md sec. 7).
+            from .flexible import flexible_periodic
+
+            res = [flexible_periodic(sol, flex, resolve=False) for _, sol in rows]
+            ds["flex_dphi0"] = ("solution", np.array([r.shift[0] for r in res]), {"units": "rad", "long_name": "first-order shift of phi0 from flexibility"})
+            ds["flex_dwz0"] = ("solution", np.array([r.shift[1] for r in res]), {"units": "1/TU", "long_name": "first-order shift of wz0 from flexibility"})
+            ds["flex_max_dphi"] = ("solution", np.array([r.max_dphi for r in res]), {"units": "rad", "long_name": "largest attitude departure over a period"})
         folder = self.output_dir(out)
         path = save_dataset(ds, folder / ("solutions.zarr" if self.output.format == "zarr" else "solutions.nc"))
         return ds, path
@@ -909,6 +955,8 @@ kz = 0.8                       # Kz = (Iy - Ix) / Iz in [-1, 1]; a list [0.2, 0.
 # iy = 89.68e6
 # iz = 96.95e6
 # mass_kg = 4.0e5
+# flexible = "sample-station"  # or a flexible spacecraft (a preset, or a FlexibleBody .toml file);
+#                              # `librate solve` then reports how flexibility moves each solution
 
 [torques]
 gravity_gradient = ["earth", "moon"]   # the planar engine models both primaries
