@@ -123,7 +123,7 @@ def test_from_toml_paths_and_syntax_errors(tmp_path):
 CASES = [
     # unknown keys
     ({"sytem": {"preset": "earth-moon"}}, None, "sytem", '{preset = "earth-moon"}', "allowed keys in the top level", "did you mean `system`"),
-    ({"body.kzz": 0.8}, None, "body.kzz", "0.8", "allowed keys in [body]: kz, ix, iy, iz, mass_kg", "did you mean `body.kz`"),
+    ({"body.kzz": 0.8}, None, "body.kzz", "0.8", "allowed keys in [body]: kz, ix, iy, iz, mass_kg, flexible", "did you mean `body.kz`"),
     ({"orbits.x0.step": 0.1}, None, "orbits.x0.step", "0.1", "allowed keys in [orbits.x0]: start, stop, num", None),
     ({"torques.srp": {"eps": 0.01, "colour": "red"}}, None, "torques.srp.colour", '"red"', "allowed keys in [torques.srp]", None),
     # wrong types

@@ -134,12 +134,12 @@ class BodySection(_Table):
     """[body]: Kz, or the principal moments of inertia in kg m^2, or a flexible spacecraft
     (``flexible``: a preset name or the path of a FlexibleBody TOML file)."""
 
-    flexible: str | None = None
     kz: KzGrid | None = None
     ix: float | None = Field(None, gt=0)
     iy: float | None = Field(None, gt=0)
     iz: float | None = Field(None, gt=0)
     mass_kg: float | None = Field(None, gt=0)
+    flexible: str | None = None
 
 
 class SrpSection(_Table):
