@@ -31,6 +31,20 @@ pub fn forcing_sc(mu: f64, pos: &[f64], primaries: [bool; 2]) -> (f64, f64) {
     (s, c)
 }
 
+/// The orbit part (first six components) of a state's derivative: the CR3BP, or zero for a
+/// body held at its initial position (as at the Lagrange points).
+#[inline(always)]
+pub(crate) fn orbit_derivative(mu: f64, held: bool, t: f64, y: &[f64], dy: &mut [f64]) {
+    if held {
+        dy[..6].fill(0.0);
+    } else {
+        let s: [f64; 6] = std::array::from_fn(|i| y[i]);
+        let mut d = [0.0; 6];
+        Cr3bp { mu }.derivative(t, &s, &mut d);
+        dy[..6].copy_from_slice(&d);
+    }
+}
+
 /// A precomputed orbit's S(t), C(t).
 pub trait Forcing: Sync {
     fn sc(&self, t: f64) -> (f64, f64);
@@ -77,14 +91,7 @@ pub struct PlanarAlongOrbit {
 impl PlanarAlongOrbit {
     #[inline(always)]
     fn orbit_and_attitude(&self, t: f64, y: &[f64], dy: &mut [f64]) -> f64 {
-        if self.held {
-            dy[..6].fill(0.0);
-        } else {
-            let s: [f64; 6] = std::array::from_fn(|i| y[i]);
-            let mut d = [0.0; 6];
-            Cr3bp { mu: self.mu }.derivative(t, &s, &mut d);
-            dy[..6].copy_from_slice(&d);
-        }
+        orbit_derivative(self.mu, self.held, t, y, dy);
         let (s, c) = forcing_sc(self.mu, &y[..3], self.primaries);
         let (dphi, dwz, k) = attitude_rhs(self.kz, s, c, t, y[6], y[7], &self.srp);
         dy[6] = dphi;

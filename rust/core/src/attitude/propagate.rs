@@ -130,8 +130,8 @@ pub fn propagate_planar(
     y0[6] = phi0;
     y0[7] = wz0;
     // The plate law is C1 only: integrate piecewise between the terminator crossings.
-    let kink12 = srp.map(|p| move |t: f64, y: &[f64; 12]| (p.sun.omega * t + p.sun.theta0 - y[6]).cos());
-    let kink8 = srp.map(|p| move |t: f64, y: &[f64; 8]| (p.sun.omega * t + p.sun.theta0 - y[6]).cos());
+    let kink12 = srp.map(|p| move |t: f64, y: &[f64; 12]| p.terminator(t, y[6]));
+    let kink8 = srp.map(|p| move |t: f64, y: &[f64; 8]| p.terminator(t, y[6]));
     let (t, rows, width, stm, stats) = if with_stm {
         y0[8] = 1.0;
         y0[11] = 1.0;
@@ -177,8 +177,8 @@ pub fn propagate_planar_forced(
     check_kz(kz)?;
     check_finite("attitude", &[phi0, wz0])?;
     let sys = PlanarForced { kz, forcing, srp };
-    let kink6 = srp.map(|p| move |t: f64, y: &[f64; 6]| (p.sun.omega * t + p.sun.theta0 - y[0]).cos());
-    let kink2 = srp.map(|p| move |t: f64, y: &[f64; 2]| (p.sun.omega * t + p.sun.theta0 - y[0]).cos());
+    let kink6 = srp.map(|p| move |t: f64, y: &[f64; 6]| p.terminator(t, y[0]));
+    let kink2 = srp.map(|p| move |t: f64, y: &[f64; 2]| p.terminator(t, y[0]));
     let (t, rows, width, stm, stats) = if with_stm {
         let y0 = [phi0, wz0, 1.0, 0.0, 0.0, 1.0];
         let sol = match &kink6 {

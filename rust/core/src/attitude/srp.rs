@@ -187,6 +187,13 @@ impl FlatPlate {
         Ok(Self { eps, cs, cd, sun })
     }
 
+    /// cos(alpha) = cos(theta_sun(t) - phi): zero where the plate is edge-on to the Sun, where
+    /// the law cos(alpha)|cos(alpha)| has its kinks (integrations stop there).
+    #[inline]
+    pub fn terminator(&self, t: f64, phi: f64) -> f64 {
+        (self.sun.omega * t + self.sun.theta0 - phi).cos()
+    }
+
     /// wzdot from SRP and its derivative with respect to phi.
     #[inline]
     pub fn wzdot(&self, t: f64, phi: f64) -> (f64, f64) {

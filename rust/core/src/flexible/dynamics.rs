@@ -4,7 +4,6 @@
 use nalgebra::Complex;
 
 use super::body::{cross, dot, FlexibleBody};
-use crate::cr3bp::Cr3bp;
 use crate::integrate::System;
 
 /// The tidal field of the enabled primaries [larger, smaller] at a synodic position:
@@ -217,14 +216,7 @@ impl System<Vec<f64>> for FlexibleAlongOrbit<'_> {
     #[inline]
     fn derivative(&self, t: f64, y: &Vec<f64>, dy: &mut Vec<f64>) {
         let n = self.body.n();
-        if self.held {
-            dy[..6].fill(0.0);
-        } else {
-            let s: [f64; 6] = std::array::from_fn(|i| y[i]);
-            let mut d = [0.0; 6];
-            Cr3bp { mu: self.mu }.derivative(t, &s, &mut d);
-            dy[..6].copy_from_slice(&d);
-        }
+        crate::attitude::planar::orbit_derivative(self.mu, self.held, t, y, dy);
         let (w, p) = tidal_field(self.mu, &y[..3], self.primaries);
         let field = BodyField::new(w, p, y[6]);
         let wz = y[7];
