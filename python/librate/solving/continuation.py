@@ -1,0 +1,505 @@
+"""The continuation driver: one place for predictor, step-size rules, jump guards, folds and
+bifurcations, shared by every family in librate (periodic orbits, periodic attitude motions in
+Kz, in the SRP amplitude or across an orbit family, flexible re-solves).
+
+A *problem* owns the equations and their corrector (in the Rust core); the driver never runs a
+Newton iteration itself. The problem's unknowns and parameter form one vector ``x`` (the
+parameter at ``problem.parameter_index``), and its ``correct`` solves the equations together
+with one linear condition ``a . x = b`` that the driver chooses:
+
+- natural-parameter continuation fixes the parameter: ``a = e_p``, ``b = p``;
+- pseudo-arclength continuation fixes the step along the unit tangent ``t_k`` at the last point:
+  ``a = t_k``, ``b = t_k . x_k + ds``.
+
+Both modes share the step rules: a step that fails to correct, or whose corrected point lands
+farther from the prediction than ``jump`` times the step (a silent jump to another branch), is
+halved; an easy step (at most ``easy_iterations`` corrector iterations) grows the next one by
+``growth``, up to ``ds_max``; the run ends with a reason when the step falls below ``ds_min``.
+The problem may add its own guard (orbit families check Jacobi-constant continuity and winding
+numbers).
+
+Folds (turning points in the parameter) are detected where the parameter component of the
+tangent changes sign between two accepted points and are then *located*: the arclength between
+the two points is searched (Illinois regula falsi on that tangent component) until the fold's
+parameter is known to ``fold_tol``. Bifurcations are detected where a problem's test function
+(for example a stability index minus one) changes sign, and located the same way.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from typing import Any, Protocol
+
+import numpy as np
+
+from .._errors import LibrateError
+
+__all__ = [
+    "Point",
+    "Constraint",
+    "Fold",
+    "Bifurcation",
+    "Branch",
+    "ContinuationProblem",
+    "CorrectionFailed",
+    "StepRules",
+    "natural",
+    "arclength",
+]
+
+
+class CorrectionFailed(LibrateError):
+    """A problem's corrector did not converge for the requested condition."""
+
+
+@dataclass(frozen=True)
+class Point:
+    """One corrected point: the vector ``x`` (unknowns and parameter), the problem's payload
+    (e.g. a PeriodicOrbit or an AttitudeSolution) and the corrector's iteration count."""
+
+    x: np.ndarray
+    data: Any = None
+    iterations: int = 0
+
+
+@dataclass(frozen=True)
+class Constraint:
+    """The linear condition a . x = b that closes the problem's equations."""
+
+    a: np.ndarray
+    b: float
+
+    @staticmethod
+    def fix(n: int, index: int, value: float) -> Constraint:
+        a = np.zeros(n)
+        a[index] = 1.0
+        return Constraint(a, float(value))
+
+    @property
+    def fixed_index(self) -> int | None:
+        """The component the condition fixes, when it fixes one (natural continuation)."""
+        nz = np.flatnonzero(self.a)
+        return int(nz[0]) if nz.size == 1 and self.a[nz[0]] == 1.0 else None
+
+
+@dataclass(frozen=True)
+class Fold:
+    """A turning point in the parameter: ``parameter`` located to ``tolerance`` (``located``
+    False when the search could not be carried out and the value is interpolated)."""
+
+    parameter: float
+    point: Point
+    located: bool
+    tolerance: float
+
+
+@dataclass(frozen=True)
+class Bifurcation:
+    """Where the problem's test function ``name`` changes sign."""
+
+    name: str
+    parameter: float
+    point: Point
+    located: bool
+
+
+@dataclass
+class Branch:
+    """A continued branch: its points in order, the folds and bifurcations met on the way, why
+    it ended, and how many steps were rejected as jumps."""
+
+    points: list[Point]
+    folds: list[Fold] = field(default_factory=list)
+    bifurcations: list[Bifurcation] = field(default_factory=list)
+    end_reason: str = ""
+    rejected_jumps: int = 0
+    reached: bool = False
+
+    def parameter(self, index: int) -> np.ndarray:
+        return np.array([p.x[index] for p in self.points])
+
+
+class ContinuationProblem(Protocol):
+    """What the driver needs from a problem.
+
+    ``parameter_index``: the parameter's component in x. ``scale``: per-component scales that
+    make distances in x comparable (steps, jump guard). ``correct(guess, constraint)``: solve
+    the problem's equations together with ``constraint`` from ``guess``; raise
+    CorrectionFailed (or any LibrateError) on failure. ``tangent(point)``: the (unnormalised)
+    null vector of the equations' Jacobian at the point (None: the driver uses secants).
+    Optional: ``guard(points, new, ratio)`` returns a reason to reject ``new`` (a jump) or None;
+    ``tests(point)`` returns named bifurcation test functions.
+    """
+
+    parameter_index: int
+    scale: np.ndarray
+
+    def correct(self, guess: np.ndarray, constraint: Constraint) -> Point: ...
+
+    def tangent(self, point: Point) -> np.ndarray | None: ...
+
+
+@dataclass(frozen=True)
+class StepRules:
+    """The one set of step-size rules and jump guards.
+
+    ``ds``, ``ds_min``, ``ds_max``: initial, smallest and largest step (scaled units).
+    ``growth``: factor after an easy step (at most ``easy_iterations`` corrector iterations).
+    ``jump``: largest accepted distance of the corrected point from the prediction, as a
+    fraction of the step. ``max_turn``: largest angle (rad) between consecutive tangents.
+    """
+
+    ds: float = 1e-2
+    ds_min: float = 1e-7
+    ds_max: float = 5e-2
+    growth: float = 1.5
+    easy_iterations: int = 3
+    jump: float = 0.5
+    max_turn: float = 0.5
+
+    def __post_init__(self):
+        for name in ("ds", "ds_min", "ds_max", "growth", "jump", "max_turn"):
+            v = getattr(self, name)
+            if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
+                raise ValueError(f"invalid argument `{name}`: must be a finite number > 0, got {v!r}")
+        if not self.ds_min <= self.ds_max:
+            raise ValueError(f"invalid argument `ds_min`: must not exceed ds_max ({self.ds_max}), got {self.ds_min}")
+        if self.growth < 1:
+            raise ValueError(f"invalid argument `growth`: must be >= 1, got {self.growth}")
+
+
+def _try(problem, guess, constraint) -> Point | None:
+    try:
+        pt = problem.correct(np.asarray(guess, dtype=float), constraint)
+    except LibrateError:
+        return None
+    if not np.all(np.isfinite(pt.x)):
+        return None
+    return pt
+
+
+def _norm(problem, v) -> float:
+    return float(np.linalg.norm(np.asarray(v) / problem.scale))
+
+
+def _unit_tangent(problem, point: Point, reference: np.ndarray | None, fallback: np.ndarray | None) -> np.ndarray | None:
+    """Unit tangent in scaled coordinates, oriented along ``reference``."""
+    t = problem.tangent(point)
+    if t is None or not np.all(np.isfinite(t)) or not np.any(t):
+        t = fallback
+    if t is None:
+        return None
+    t = np.asarray(t, dtype=float) / problem.scale
+    n = np.linalg.norm(t)
+    if n == 0 or not math.isfinite(n):
+        return None
+    t = t / n
+    if reference is not None and float(np.dot(t, reference)) < 0:
+        t = -t
+    return t
+
+
+def _tests(problem, point) -> dict[str, float]:
+    f = getattr(problem, "tests", None)
+    return dict(f(point)) if f is not None else {}
+
+
+def _guard(problem, points, new, ratio) -> str | None:
+    f = getattr(problem, "guard", None)
+    return f(points, new, ratio) if f is not None else None
+
+
+def natural(
+    problem: ContinuationProblem,
+    first: Point,
+    targets: Sequence[float],
+    *,
+    rules: StepRules | None = None,
+    stop: Callable[[Point], str | None] | None = None,
+) -> Branch:
+    """Natural-parameter continuation through the parameter values ``targets`` (the points
+    returned are exactly at them). Prediction: linear extrapolation of every component from the
+    last two corrected points (thesis eq. 20-22). Between targets the step is halved on a failed
+    correction or a jump and doubled after a success; the run ends at the last target, at a
+    ``stop`` reason, or when the step falls below ``rules.ds_min`` (in the parameter) with the
+    reason. A fold ahead shows as the step collapsing: the end reason then names the last
+    parameter reached."""
+    rules = rules or StepRules()
+    k = problem.parameter_index
+    n = first.x.size
+    history = [first]
+    out: list[Point] = []
+    branch = Branch(out)
+    for target in (float(v) for v in np.atleast_1d(np.asarray(targets, dtype=float))):
+        cur = float(history[-1].x[k])
+        if target == cur:
+            out.append(history[-1])
+            continue
+        h = target - cur
+        while True:
+            trial = target if abs(h) >= abs(target - cur) * (1 - 1e-6) else cur + h
+            last = history[-1]
+            if len(history) >= 2:
+                prev = history[-2]
+                dk = last.x[k] - prev.x[k]
+                guess = last.x + (last.x - prev.x) * ((trial - last.x[k]) / dk) if dk != 0 else last.x.copy()
+                prev_step = abs(dk)
+            else:
+                guess = last.x.copy()
+                prev_step = abs(trial - last.x[k])
+            guess[k] = trial
+            pt = _try(problem, guess, Constraint.fix(n, k, trial))
+            status = "fail"
+            if pt is not None:
+                ratio = abs(trial - last.x[k]) / max(prev_step, 1e-300)
+                moved = _norm(problem, pt.x - guess)
+                if len(history) >= 2 and moved > rules.jump * _norm(problem, guess - last.x) + 1e-9 * (1 + _norm(problem, last.x)):
+                    status = "jump"
+                elif _guard(problem, history, pt, ratio):
+                    status = "jump"
+                else:
+                    status = "ok"
+            if status == "ok":
+                history.append(pt)
+                why = stop(pt) if stop else None
+                if why:
+                    branch.end_reason = why
+                    return branch
+                cur = trial
+                if trial == target:
+                    out.append(pt)
+                    break
+                h *= 2.0
+            else:
+                branch.rejected_jumps += status == "jump"
+                h *= 0.5
+                if abs(h) < rules.ds_min:
+                    branch.end_reason = f"step floor: could not continue past parameter = {cur:.12g} (step below {rules.ds_min:g}; a fold or the branch's end)"
+                    return branch
+    branch.end_reason = "completed: reached the last requested value"
+    branch.reached = True
+    return branch
+
+
+def arclength(
+    problem: ContinuationProblem,
+    first: Point,
+    *,
+    direction: np.ndarray | int = 1,
+    rules: StepRules | None = None,
+    max_points: int = 500,
+    bounds: tuple[float, float] | None = None,
+    target: float | None = None,
+    locate: bool = True,
+    fold_tol: float = 1e-8,
+    stop_at_fold: bool = False,
+    stop: Callable[[Point], str | None] | None = None,
+) -> Branch:
+    """Pseudo-arclength continuation from ``first``, through folds.
+
+    ``direction``: the initial sense, a vector in x or +-1 for the sense of the parameter.
+    ``bounds``: the parameter's range; the branch ends on the bound it reaches (the last point
+    corrected exactly there). ``target``: a parameter value at which to stop, landing exactly on
+    it (``Branch.reached``). Folds are located to ``fold_tol`` in the parameter and bifurcations
+    (sign changes of ``problem.tests``) to the same tolerance when ``locate``; a fold is passed
+    and the branch followed on, back in the parameter, unless ``stop_at_fold`` (then the branch
+    ends at the located fold, its points all before it).
+    """
+    rules = rules or StepRules()
+    k = problem.parameter_index
+    n = first.x.size
+    lo, hi = bounds if bounds is not None else (-math.inf, math.inf)
+    if isinstance(direction, (int, np.integer)):
+        if direction not in (-1, 1):
+            raise ValueError(f"invalid argument `direction`: must be -1, +1 or a vector, got {direction!r}")
+        ref = np.zeros(n)
+        ref[k] = float(direction)
+    else:
+        ref = np.asarray(direction, dtype=float) / problem.scale
+    t = _unit_tangent(problem, first, ref, None)
+    if t is None:
+        raise LibrateError("continuation: the tangent at the first point is undefined (singular Jacobian)")
+    if t[k] * ref[k] < 0 or (ref[k] == 0 and float(np.dot(t, ref)) < 0):
+        t = -t
+    points = [first]
+    branch = Branch(points)
+    tests_prev = _tests(problem, first)
+    ds = rules.ds
+    sx = problem.scale
+
+    def constraint(base: Point, tb: np.ndarray, s: float) -> Constraint:
+        # t (scaled) . (x - x_k)/scale = s  <=>  (t/scale) . x = (t/scale) . x_k + s
+        a = tb / sx
+        return Constraint(a, float(np.dot(a, base.x)) + s)
+
+    def at(base: Point, tb: np.ndarray, s: float) -> Point | None:
+        return _try(problem, base.x + s * tb * sx, constraint(base, tb, s))
+
+    def finish_at(value: float, reason: str, reached: bool) -> Branch:
+        last = points[-1]
+        dp = t[k] * sx[k]
+        guess = last.x + (value - last.x[k]) / dp * t * sx if dp != 0 else last.x.copy()
+        guess[k] = value
+        pt = _try(problem, guess, Constraint.fix(n, k, value))
+        if pt is not None and _norm(problem, pt.x - guess) <= rules.jump * max(_norm(problem, guess - last.x), rules.ds_min) + 1e-9:
+            points.append(pt)
+            branch.reached = reached
+            branch.end_reason = reason
+        else:
+            branch.end_reason = f"stopped at parameter = {last.x[k]:.12g}: could not land on {value:.12g}"
+        return branch
+
+    while len(points) < max_points:
+        base = points[-1]
+        while True:
+            pred = base.x + ds * t * sx
+            p_pred = pred[k]
+            # the parameter range or the target lies within this step: land exactly on it
+            for edge, reason, reached in ((target, "reached the target parameter", True), (lo, "parameter range end", False), (hi, "parameter range end", False)):
+                if edge is not None and math.isfinite(edge) and (base.x[k] - edge) * (p_pred - edge) < 0 and base.x[k] != edge:
+                    return finish_at(edge, f"{reason}: {edge:.12g}", reached)
+            new = at(base, t, ds)
+            status = "fail"
+            t_new = None
+            if new is not None:
+                moved = _norm(problem, new.x - pred)
+                if moved > rules.jump * ds + 1e-12:
+                    status = "jump"
+                elif _guard(problem, points, new, 1.0):
+                    status = "jump"
+                else:
+                    t_new = _unit_tangent(problem, new, t, (new.x - base.x))
+                    if t_new is None:
+                        status = "fail"
+                    elif math.acos(max(-1.0, min(1.0, float(np.dot(t_new, t))))) > rules.max_turn:
+                        status = "jump"
+                    else:
+                        status = "ok"
+            if status == "ok":
+                break
+            branch.rejected_jumps += status == "jump"
+            ds *= 0.5
+            if ds < rules.ds_min:
+                branch.end_reason = f"step floor: arclength step below {rules.ds_min:g} at parameter = {base.x[k]:.12g} after {len(points)} points"
+                return branch
+        assert t_new is not None and new is not None
+        # a fold: the parameter component of the tangent changes sign
+        if t[k] * t_new[k] < 0:
+            fold = _locate_fold(problem, base, t, ds, new, t_new, at, fold_tol) if locate else Fold(float(new.x[k]), new, False, abs(new.x[k] - base.x[k]))
+            branch.folds.append(fold)
+            if stop_at_fold:
+                branch.end_reason = f"fold at parameter = {fold.parameter:.12g}" + ("" if fold.located else f" (not located: within {fold.tolerance:.2g})")
+                return branch
+        tests_new = _tests(problem, new)
+        for name, v in tests_new.items():
+            u = tests_prev.get(name)
+            if u is not None and math.isfinite(u) and math.isfinite(v) and u * v < 0:
+                branch.bifurcations.append(_locate_sign(problem, name, base, t, ds, u, v, new, at, fold_tol) if locate else Bifurcation(name, float(new.x[k]), new, False))
+        tests_prev = tests_new
+        points.append(new)
+        t = t_new
+        why = stop(new) if stop else None
+        if why:
+            branch.end_reason = why
+            return branch
+        if new.iterations <= rules.easy_iterations:
+            ds = min(ds * rules.growth, rules.ds_max)
+    branch.end_reason = f"completed: max_points = {max_points} reached"
+    return branch
+
+
+def _illinois(f, a: float, fa: float, b: float, fb: float, done: Callable[[float, float], bool], max_iter: int = 60):
+    """Regula falsi (Illinois) on [a, b] with f(a) f(b) < 0; ``f`` returns (value, payload) or
+    None where it cannot be evaluated (then the interval is bisected)."""
+    side = 0
+    best = None
+    for _ in range(max_iter):
+        if done(a, b):
+            break
+        c = b - fb * (b - a) / (fb - fa) if fb != fa else 0.5 * (a + b)
+        if not (min(a, b) < c < max(a, b)):
+            c = 0.5 * (a + b)
+        r = f(c)
+        if r is None:
+            c = 0.5 * (a + b)
+            r = f(c)
+            if r is None:
+                return best, False
+        fc, payload = r
+        best = (c, payload)
+        if fc == 0:
+            return best, True
+        if (fc > 0) == (fb > 0):
+            b, fb = c, fc
+            if side == 1:
+                fa *= 0.5
+            side = 1
+        else:
+            a, fa = c, fc
+            if side == -1:
+                fb *= 0.5
+            side = -1
+    return best, True
+
+
+def _locate_fold(problem, base, t, ds, new, t_new, at, tol) -> Fold:
+    """The turning point between ``base`` and ``new``: the arclength s in (0, ds) where the
+    tangent's parameter component vanishes. p(s) is quadratic about the fold, so the search
+    stops when the parameter values of the bracket's ends (and the best point) agree to tol."""
+    k = problem.parameter_index
+    cache: dict[float, tuple[float, Point]] = {0.0: (float(t[k]), base), ds: (float(t_new[k]), new)}
+
+    def f(s):
+        pt = at(base, t, s)
+        if pt is None:
+            return None
+        tt = _unit_tangent(problem, pt, t, pt.x - base.x)
+        if tt is None:
+            return None
+        cache[s] = (float(tt[k]), pt)
+        return float(tt[k]), pt
+
+    def done(a, b):
+        pa, pb = cache[a][1].x[k], cache[b][1].x[k]
+        return abs(pa - pb) <= tol and abs(b - a) <= 1e-3 * ds or abs(b - a) <= 1e-14 * ds
+
+    best, ok = _illinois(f, 0.0, float(t[k]), ds, float(t_new[k]), done)
+    if best is None:
+        return Fold(float(new.x[k]), new, False, abs(new.x[k] - base.x[k]))
+    # the fold's parameter: the extremum of p over the evaluated points near it
+    pts = [v[1] for v in cache.values()]
+    sign = 1.0 if t[k] > 0 else -1.0  # p increases up to the fold
+    top = max(pts, key=lambda p: sign * p.x[k])
+    spread = max(abs(top.x[k] - cache[s][1].x[k]) for s in cache if abs(s - best[0]) <= 1e-3 * ds) if ok else math.inf
+    return Fold(float(top.x[k]), top, ok and spread <= tol, float(spread))
+
+
+def _locate_sign(problem, name, base, t, ds, u, v, new, at, tol) -> Bifurcation:
+    k = problem.parameter_index
+
+    def f(s):
+        pt = at(base, t, s)
+        if pt is None:
+            return None
+        val = _tests(problem, pt).get(name)
+        if val is None or not math.isfinite(val):
+            return None
+        return val, pt
+
+    state = {"last": None}
+
+    def g(s):
+        r = f(s)
+        if r is not None:
+            state["last"] = r[1]
+        return r
+
+    def done(a, b):
+        return abs(b - a) * max(abs(t[k]), 1e-16) * problem.scale[k] <= tol
+
+    best, ok = _illinois(g, 0.0, u, ds, v, done)
+    if best is None:
+        return Bifurcation(name, float(new.x[k]), new, False)
+    return Bifurcation(name, float(best[1].x[k]), best[1], ok)
