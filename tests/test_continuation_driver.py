@@ -83,6 +83,13 @@ def test_stop_at_fold():
     assert br.end_reason.startswith("fold at parameter = 0.38490")
 
 
+def test_marks_corrected_exactly_on_both_sides_of_a_fold():
+    br = arclength(circle(), Point(np.array([0.0, 1.0])), direction=1, marks=[0.5, 0.9], rules=StepRules(ds=0.1), max_points=30)
+    got = [(round(p.x[0], 15), round(p.x[1], 12)) for p in br.marked]
+    s5, s9 = math.sqrt(0.75), math.sqrt(1 - 0.81)
+    assert got[:4] == [(0.5, round(s5, 12)), (0.9, round(s9, 12)), (0.9, round(-s9, 12)), (0.5, round(-s5, 12))]
+
+
 def test_target_reached_exactly():
     br = arclength(cubic(), Point(np.array([0.0, 1.0])), direction=-1, target=-0.2, rules=StepRules(ds=0.03))
     assert br.reached and br.points[-1].x[0] == -0.2

@@ -116,6 +116,8 @@ class Branch:
     end_reason: str = ""
     rejected_jumps: int = 0
     reached: bool = False
+    #: points corrected exactly at requested parameter values met on the way (``marks``), in order
+    marked: list[Point] = field(default_factory=list)
 
     def parameter(self, index: int) -> np.ndarray:
         return np.array([p.x[index] for p in self.points])
@@ -295,6 +297,7 @@ def arclength(
     locate: bool = True,
     fold_tol: float = 1e-8,
     stop_at_fold: bool = False,
+    marks: Sequence[float] = (),
     stop: Callable[[Point], str | None] | None = None,
 ) -> Branch:
     """Pseudo-arclength continuation from ``first``, through folds.
@@ -305,7 +308,9 @@ def arclength(
     it (``Branch.reached``). Folds are located to ``fold_tol`` in the parameter and bifurcations
     (sign changes of ``problem.tests``) to the same tolerance when ``locate``; a fold is passed
     and the branch followed on, back in the parameter, unless ``stop_at_fold`` (then the branch
-    ends at the located fold, its points all before it).
+    ends at the located fold, its points all before it). ``marks``: parameter values at which
+    the branch is also corrected exactly, each time a step crosses one (``Branch.marked``; a
+    branch that folds back over a value marks it again).
     """
     rules = rules or StepRules()
     k = problem.parameter_index
@@ -398,6 +403,14 @@ def arclength(
             if u is not None and math.isfinite(u) and math.isfinite(v) and u * v < 0:
                 branch.bifurcations.append(_locate_sign(problem, name, base, t, ds, u, v, new, at, fold_tol) if locate else Bifurcation(name, float(new.x[k]), new, False))
         tests_prev = tests_new
+        for m in marks:
+            if (base.x[k] - m) * (new.x[k] - m) < 0 or new.x[k] == m:
+                w = (m - base.x[k]) / (new.x[k] - base.x[k])
+                guess = base.x + w * (new.x - base.x)
+                guess[k] = m
+                pm = new if new.x[k] == m else _try(problem, guess, Constraint.fix(n, k, m))
+                if pm is not None and _norm(problem, pm.x - guess) <= rules.jump * ds + 1e-12:
+                    branch.marked.append(pm)
         points.append(new)
         t = t_new
         why = stop(new) if stop else None
