@@ -10,7 +10,6 @@ import math
 
 import numpy as np
 import pytest
-
 from librate.solving.continuation import Constraint, CorrectionFailed, Point, StepRules, arclength, natural
 
 
