@@ -1,8 +1,10 @@
 """Continuation of symmetric periodic-orbit families (thesis eq. 20-22 and pseudo-arclength).
 
-The numerical kernels (shooting with the STM and event location) are in Rust; this module runs
-the continuation loop: prediction, correction, guards against silent jumps to another family,
-adaptive steps and clean termination with a reason.
+The numerical kernels (shooting with the STM and event location) are in Rust; the loop
+(prediction, step rules, jump guards, termination with a reason) is the shared continuation
+driver of :mod:`librate.solving.continuation`. This module defines the orbit family as a
+problem for it: the corrector call and the family's own guards (Jacobi-constant and period
+continuity, winding numbers).
 """
 
 from __future__ import annotations
@@ -16,6 +18,7 @@ import numpy as np
 from . import _core
 from ._errors import LibrateError
 from .orbits import SHOOT_ATOL, SHOOT_RTOL, PeriodicOrbit, _orbit_from
+from .solving.continuation import Branch, Constraint, Point, StepRules, arclength, natural
 from .system import System
 
 __all__ = ["Geometry", "geometry", "continue_natural", "continue_arclength", "ContinuationResult"]
@@ -79,102 +82,6 @@ def _smooth(history: list[PeriodicOrbit], new: PeriodicOrbit, ratio: float) -> b
     return True
 
 
-def _guarded(system, history, geoms, new, ratio, check_geometry) -> tuple[bool, Geometry | None]:
-    if not _smooth(history, new, ratio):
-        return False, None
-    if not check_geometry:
-        return True, None
-    g = geometry(new)
-    # Winding numbers of the projection on the x-y plane are invariants of planar families
-    # only: a 3-D orbit (a halo whose perilune passes beneath the Moon) changes them smoothly.
-    if new.planar and geoms and geoms[-1] is not None and g.winding != geoms[-1].winding:
-        return False, g
-    return True, g
-
-
-def continue_natural(
-    system: System,
-    first: PeriodicOrbit,
-    var: str,
-    values,
-    *,
-    spatial: bool = False,
-    family: str = "symmetric",
-    min_step: float = 1e-6,
-    check_geometry: bool = True,
-    stop: Callable[[PeriodicOrbit, Geometry | None], str | None] | None = None,
-    t_max: float = 50.0,
-) -> ContinuationResult:
-    """Natural-parameter continuation in ``var`` ("x0", "z0" or "vy0") through ``values``
-    (thesis eq. 20-22: the other unknowns extrapolated linearly from the last two members).
-
-    Between requested values the step is halved on a failed correction or a detected jump
-    (Jacobi-constant or period discontinuity, change of winding numbers) and grows back after
-    a success; the members returned are exactly at ``values``. Ends after the last value, at a
-    ``stop`` reason, or when the step falls below ``min_step`` (with the reason).
-    """
-    k = _VAR_INDEX[var]
-    history = [first]  # every corrected member, intermediate ones included (for extrapolation)
-    g0 = geometry(first) if check_geometry else None
-    geoms = [g0]
-    out: list[PeriodicOrbit] = []
-    geoms_out: list[Geometry | None] = []
-    jumps = 0
-    for target in (float(v) for v in np.atleast_1d(values)):
-        cur = _p(history[-1])[k]
-        if target == cur:
-            out.append(history[-1])
-            geoms_out.append(geoms[-1])
-            continue
-        h = target - cur
-        while True:
-            # snap to the target when the remaining step is (nearly) covered: no sliver steps
-            trial = target if abs(h) >= abs(target - cur) * (1 - 1e-6) else cur + h
-            status = _continue_one(system, history, geoms, k, trial, spatial, family, check_geometry, t_max)
-            if status == "ok":
-                why = stop(history[-1], geoms[-1]) if stop else None
-                if why:
-                    return ContinuationResult(out, geoms_out, why, jumps)
-                cur = trial
-                if trial == target:
-                    out.append(history[-1])
-                    geoms_out.append(geoms[-1])
-                    break
-                h *= 2.0
-            else:
-                jumps += status == "jump"
-                h *= 0.5
-                if abs(h) < min_step:
-                    return ContinuationResult(
-                        out, geoms_out, f"step floor: could not continue past {var} = {cur:.12g} (step below {min_step:g})", jumps
-                    )
-    return ContinuationResult(out, geoms_out, "completed: reached the last requested value", jumps)
-
-
-def _continue_one(system, history, geoms, k, target, spatial, family, check_geometry, t_max) -> str:
-    """Predict (linear extrapolation in the parameter), correct, guard; "ok", "fail" or "jump"."""
-    pl = _p(history[-1])
-    if len(history) >= 2:
-        pp = _p(history[-2])
-        dk = pl[k] - pp[k]
-        guess = pl + (pl - pp) * ((target - pl[k]) / dk) if dk != 0 else pl.copy()
-        prev_step = abs(dk)
-    else:
-        guess = pl.copy()
-        prev_step = abs(target - pl[k])
-    guess[k] = target
-    try:
-        orbit = _correct(system, guess, spatial, "fix", [k, target], family, t_max)
-    except LibrateError:
-        return "fail"
-    ok, g = _guarded(system, history, geoms, orbit, abs(target - pl[k]) / max(prev_step, 1e-300), check_geometry)
-    if not ok:
-        return "jump"
-    history.append(orbit)
-    geoms.append(g)
-    return "ok"
-
-
 def tangent(orbit: PeriodicOrbit, spatial: bool, previous: np.ndarray | None = None, orient: np.ndarray | None = None) -> np.ndarray:
     """Unit tangent of the family at ``orbit`` in p = (x0, z0, vy0): the null vector of the
     symmetric conditions' Jacobian, oriented along ``previous`` (or ``orient``)."""
@@ -195,6 +102,89 @@ def tangent(orbit: PeriodicOrbit, spatial: bool, previous: np.ndarray | None = N
     return t
 
 
+class SymmetricFamilyProblem:
+    """A family of x-z-symmetric periodic orbits for the continuation driver: x = (x0, z0, vy0),
+    corrected by the Rust half-period shooting with the driver's linear condition (a fixed
+    unknown, or the pseudo-arclength condition); guarded by Jacobi-constant and period
+    continuity and, for planar families, by the winding numbers about both primaries."""
+
+    scale = np.ones(3)
+
+    def __init__(self, system: System, *, spatial: bool, family: str, t_max: float, check_geometry: bool, parameter: str = "x0"):
+        self.system, self.spatial, self.family, self.t_max = system, spatial, family, t_max
+        self.check_geometry = check_geometry
+        self.parameter_index = _VAR_INDEX[parameter]
+        self.geometries: dict[int, Geometry | None] = {}
+
+    def point(self, orbit: PeriodicOrbit) -> Point:
+        if id(orbit) not in self.geometries:
+            self.geometries[id(orbit)] = geometry(orbit) if self.check_geometry else None
+        return Point(_p(orbit), orbit, orbit.iterations)
+
+    def correct(self, guess: np.ndarray, c: Constraint) -> Point:
+        k = c.fixed_index
+        if k is not None:
+            kind, values = "fix", [k, c.b]
+        else:  # a . p = b, as the core's arclength condition t . (p - p_k) = ds with p_k = 0
+            kind, values = "arclength", [0.0, 0.0, 0.0, *c.a, c.b]
+        orbit = _correct(self.system, guess, self.spatial, kind, values, self.family, self.t_max)
+        return Point(_p(orbit), orbit, orbit.iterations)
+
+    def tangent(self, pt: Point) -> np.ndarray:
+        return tangent(pt.data, self.spatial)
+
+    def guard(self, points: list[Point], new: Point, ratio: float) -> str | None:
+        if not _smooth([p.data for p in points], new.data, ratio):
+            return "Jacobi constant or period jump"
+        if not self.check_geometry:
+            return None
+        g = geometry(new.data)
+        self.geometries[id(new.data)] = g
+        last = self.geometries.get(id(points[-1].data)) if points else None
+        # Winding numbers of the projection on the x-y plane are invariants of planar families
+        # only: a 3-D orbit (a halo whose perilune passes beneath the Moon) changes them smoothly.
+        if new.data.planar and last is not None and g.winding != last.winding:
+            return f"winding numbers changed {last.winding} -> {g.winding}"
+        return None
+
+
+def _result(problem: SymmetricFamilyProblem, branch: Branch, points: list[Point]) -> ContinuationResult:
+    members = [p.data for p in points]
+    return ContinuationResult(members, [problem.geometries.get(id(m)) for m in members], branch.end_reason, branch.rejected_jumps)
+
+
+def _stop(problem, stop):
+    if stop is None:
+        return None
+    return lambda pt: stop(pt.data, problem.geometries.get(id(pt.data)))
+
+
+def continue_natural(
+    system: System,
+    first: PeriodicOrbit,
+    var: str,
+    values,
+    *,
+    spatial: bool = False,
+    family: str = "symmetric",
+    min_step: float = 1e-6,
+    check_geometry: bool = True,
+    stop: Callable[[PeriodicOrbit, Geometry | None], str | None] | None = None,
+    t_max: float = 50.0,
+) -> ContinuationResult:
+    """Natural-parameter continuation in ``var`` ("x0", "z0" or "vy0") through ``values``
+    (thesis eq. 20-22), by the continuation driver (:func:`librate.solving.continuation.natural`):
+    the other unknowns extrapolated linearly from the last two members, the step halved on a
+    failed correction or a detected jump (Jacobi-constant or period discontinuity, change of
+    winding numbers, a corrected point far from its prediction) and grown back after a
+    success; the members returned are exactly at ``values``. Ends after the last value, at a
+    ``stop`` reason, or when the step falls below ``min_step`` (with the reason).
+    """
+    problem = SymmetricFamilyProblem(system, spatial=spatial, family=family, t_max=t_max, check_geometry=check_geometry, parameter=var)
+    br = natural(problem, problem.point(first), values, rules=StepRules(ds_min=min_step, ds_max=max(min_step, 1.0)), name=var, stop=_stop(problem, stop))
+    return _result(problem, br, br.points)
+
+
 def continue_arclength(
     system: System,
     first: PeriodicOrbit,
@@ -210,42 +200,14 @@ def continue_arclength(
     stop: Callable[[PeriodicOrbit, Geometry | None], str | None] | None = None,
     t_max: float = 50.0,
 ) -> ContinuationResult:
-    """Pseudo-arclength continuation in p = (x0, z0, vy0), through folds.
-
-    Predictor p + ds * tangent, corrector with the arclength condition tangent . (p - p_k) = ds.
-    ds grows by 1.5 after an easy correction (<= 3 iterations), is halved on failure or on a
-    detected jump, and the run ends when ds falls below ``ds_min``, at ``max_members``, or when
-    ``stop`` returns a reason.
+    """Pseudo-arclength continuation in p = (x0, z0, vy0), through folds, by the continuation
+    driver (:func:`librate.solving.continuation.arclength`): predictor along the tangent,
+    corrector with the arclength condition, the driver's step rules (growth by 1.5 after an
+    easy correction, halving on failure or a detected jump) and this family's guards; ends when
+    the step falls below ``ds_min``, at ``max_members``, or when ``stop`` returns a reason.
     """
-    members, geoms = [first], [geometry(first) if check_geometry else None]
-    t = tangent(first, spatial, orient=np.asarray(orient, dtype=float))
-    jumps = 0
-    while len(members) < max_members:
-        last = members[-1]
-        pl = _p(last)
-        ok = False
-        while not ok:
-            guess = pl + ds * t
-            try:
-                orbit = _correct(system, guess, spatial, "arclength", [*pl, *t, ds], family, t_max)
-                ok, g = _guarded(system, members, geoms, orbit, 1.0, check_geometry)
-                if not ok:
-                    jumps += 1
-            except LibrateError:
-                ok = False
-            if not ok:
-                ds *= 0.5
-                if ds < ds_min:
-                    return ContinuationResult(members, geoms, f"step floor: arclength step below {ds_min:g} after {len(members)} members", jumps)
-        members.append(orbit)
-        geoms.append(g)
-        why = stop(orbit, g) if stop else None
-        if why:
-            return ContinuationResult(members, geoms, why, jumps)
-        try:
-            t = tangent(orbit, spatial, previous=t)
-        except LibrateError as err:
-            return ContinuationResult(members, geoms, f"stopped: {err}", jumps)
-        if orbit.iterations <= 3:
-            ds = min(ds * 1.5, ds_max)
-    return ContinuationResult(members, geoms, f"completed: max_members = {max_members} reached", jumps)
+    problem = SymmetricFamilyProblem(system, spatial=spatial, family=family, t_max=t_max, check_geometry=check_geometry)
+    rules = StepRules(ds=ds, ds_min=ds_min, ds_max=ds_max, jump=0.5, max_turn=0.5)
+    br = arclength(problem, problem.point(first), direction=np.asarray(orient, dtype=float), rules=rules, max_points=max_members,
+                   locate=False, name="x0", stop=_stop(problem, stop))
+    return _result(problem, br, br.points)

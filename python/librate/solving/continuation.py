@@ -219,6 +219,7 @@ def natural(
     targets: Sequence[float],
     *,
     rules: StepRules | None = None,
+    name: str = "parameter",
     stop: Callable[[Point], str | None] | None = None,
 ) -> Branch:
     """Natural-parameter continuation through the parameter values ``targets`` (the points
@@ -257,7 +258,10 @@ def natural(
             if pt is not None:
                 ratio = abs(trial - last.x[k]) / max(prev_step, 1e-300)
                 moved = _norm(problem, pt.x - guess)
-                if len(history) >= 2 and moved > rules.jump * _norm(problem, guess - last.x) + 1e-9 * (1 + _norm(problem, last.x)):
+                # the secant predictor's error is a fraction of the larger of this step and the
+                # last one; a corrected point farther off is another branch
+                reach = max(_norm(problem, guess - last.x), _norm(problem, last.x - history[-2].x)) if len(history) >= 2 else 0.0
+                if len(history) >= 2 and moved > rules.jump * reach + 1e-9 * (1 + _norm(problem, last.x)):
                     status = "jump"
                 elif _guard(problem, history, pt, ratio):
                     status = "jump"
@@ -278,7 +282,7 @@ def natural(
                 branch.rejected_jumps += status == "jump"
                 h *= 0.5
                 if abs(h) < rules.ds_min:
-                    branch.end_reason = f"step floor: could not continue past parameter = {cur:.12g} (step below {rules.ds_min:g}; a fold or the branch's end)"
+                    branch.end_reason = f"step floor: could not continue past {name} = {cur:.12g} (step below {rules.ds_min:g})"
                     return branch
     branch.end_reason = "completed: reached the last requested value"
     branch.reached = True
@@ -298,6 +302,7 @@ def arclength(
     fold_tol: float = 1e-8,
     stop_at_fold: bool = False,
     marks: Sequence[float] = (),
+    name: str = "parameter",
     stop: Callable[[Point], str | None] | None = None,
 ) -> Branch:
     """Pseudo-arclength continuation from ``first``, through folds.
@@ -353,7 +358,7 @@ def arclength(
             branch.reached = reached
             branch.end_reason = reason
         else:
-            branch.end_reason = f"stopped at parameter = {last.x[k]:.12g}: could not land on {value:.12g}"
+            branch.end_reason = f"stopped at {name} = {last.x[k]:.12g}: could not land on {value:.12g}"
         return branch
 
     while len(points) < max_points:
@@ -364,7 +369,7 @@ def arclength(
             # the parameter range or the target lies within this step: land exactly on it
             for edge, reason, reached in ((target, "reached the target parameter", True), (lo, "parameter range end", False), (hi, "parameter range end", False)):
                 if edge is not None and math.isfinite(edge) and (base.x[k] - edge) * (p_pred - edge) < 0 and base.x[k] != edge:
-                    return finish_at(edge, f"{reason}: {edge:.12g}", reached)
+                    return finish_at(edge, f"{reason}: {name} = {edge:.12g}", reached)
             new = at(base, t, ds)
             status = "fail"
             t_new = None
@@ -387,7 +392,7 @@ def arclength(
             branch.rejected_jumps += status == "jump"
             ds *= 0.5
             if ds < rules.ds_min:
-                branch.end_reason = f"step floor: arclength step below {rules.ds_min:g} at parameter = {base.x[k]:.12g} after {len(points)} points"
+                branch.end_reason = f"step floor: arclength step below {rules.ds_min:g} at {name} = {base.x[k]:.12g} after {len(points)} points"
                 return branch
         assert t_new is not None and new is not None
         # a fold: the parameter component of the tangent changes sign
@@ -395,7 +400,7 @@ def arclength(
             fold = _locate_fold(problem, base, t, ds, new, t_new, at, fold_tol) if locate else Fold(float(new.x[k]), new, False, abs(new.x[k] - base.x[k]))
             branch.folds.append(fold)
             if stop_at_fold:
-                branch.end_reason = f"fold at parameter = {fold.parameter:.12g}" + ("" if fold.located else f" (not located: within {fold.tolerance:.2g})")
+                branch.end_reason = f"fold at {name} = {fold.parameter:.12g}" + ("" if fold.located else f" (not located: within {fold.tolerance:.2g})")
                 return branch
         tests_new = _tests(problem, new)
         for name, v in tests_new.items():
