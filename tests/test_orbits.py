@@ -45,3 +45,15 @@ def test_convergence_error_is_typed(em):
     with pytest.raises(librate.ConvergenceError) as info:
         librate.correct_dro(em, 0.3, 0.3, max_iter=2)
     assert info.value.iterations >= 1 and info.value.residual > 0
+
+
+def test_correct_dro_far_from_the_moon_is_a_dro(em):
+    """Issue 11: correct_dro(em, 0.7) returned an orbit about the Earth (T = 10.79) labelled
+    "dro". Reference: the DRO family member at x0 = 0.7 (librate.dro, by continuation from the
+    Moon), T = 4.859 TU, to 1e-10; and a ydot0 guess that converges to the Earth orbit raises."""
+    o = librate.correct_dro(em, 0.7)
+    ref = librate.dro(em, x0=0.7)
+    assert o.family == "dro" and abs(o.period - ref.period) < 1e-10 and abs(o.period - 4.8588) < 1e-3
+    assert librate.continuation.geometry(o).winding == (0, -1)
+    with pytest.raises(librate.ConvergenceError, match=r"not a DRO.*\(1, 0\)"):
+        librate.correct_dro(em, 0.7, 0.5393417437774825)

@@ -8,11 +8,11 @@ All quantities are nondimensional (CR3BP units) unless a name says otherwise
 from ._core import __version__
 from ._errors import ConvergenceError, IntegrationError, LibrateError
 from .attitude import AttitudeTrajectory, RigidBody, propagate_attitude, quaternion_from_euler
-from .families import OrbitFamily, dro, dro_family, halo, halo_family, lyapunov, lyapunov_family
+from .families import OrbitFamily, correct_dro, dro, dro_family, halo, halo_family, lyapunov, lyapunov_family
 from .flexible import Appendage, FlexibleBody, flexible_periodic, frequency_scan, quasi_static
 from .fourier import FourierOrbit, fit_fourier
 from .frames import MeanElements, OsculatingElements, eci_to_synodic, mean_elements, osculating_elements, synodic_to_eci
-from .orbits import PeriodicOrbit, correct_dro, correct_periodic, correct_symmetric
+from .orbits import PeriodicOrbit, correct_periodic, correct_symmetric
 from .periodicity import (
     AttitudeFamily,
     AttitudeSolution,

@@ -17,7 +17,7 @@ import numpy as np
 
 from . import __version__
 from ._errors import LibrateError
-from .orbits import correct_dro
+from .families import correct_dro
 from .propagation import propagate
 from .system import System
 

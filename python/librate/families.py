@@ -16,14 +16,14 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from . import _core
-from ._errors import LibrateError
+from ._errors import ConvergenceError, LibrateError
 from .constants import SUN_SYNODIC_PERIOD
-from .continuation import continue_arclength, continue_natural
-from .orbits import SHOOT_ATOL, SHOOT_RTOL, PeriodicOrbit, correct_dro, correct_symmetric
+from .continuation import continue_arclength, continue_natural, geometry
+from .orbits import SHOOT_ATOL, SHOOT_RTOL, PeriodicOrbit, correct_symmetric
 from .propagation import propagate_many
 from .system import System, resolve_system
 
-__all__ = ["OrbitFamily", "dro", "dro_family", "lyapunov", "lyapunov_family", "halo", "halo_family"]
+__all__ = ["OrbitFamily", "correct_dro", "dro", "dro_family", "lyapunov", "lyapunov_family", "halo", "halo_family"]
 
 
 @dataclass
@@ -265,6 +265,70 @@ def _collision_stop(system: System, radii_km: tuple[float, float]):
         return None
 
     return stop
+
+
+#: Winding numbers (turns about the Earth, about the Moon; negative = clockwise in the synodic
+#: frame) shared by every DRO: once clockwise about the Moon, not about the Earth.
+DRO_WINDING = (0, -1)
+
+
+def correct_dro(
+    system: System | str,
+    x0: float,
+    ydot0: float | None = None,
+    *,
+    tol: float = 1e-12,
+    max_iter: int = 30,
+    rtol: float = SHOOT_RTOL,
+    atol: float = SHOOT_ATOL,
+) -> PeriodicOrbit:
+    """Correct the distant retrograde orbit through (x0, 0, 0) with ydot0 > 0 (PHYSICS.md sec. 3).
+
+    Single shooting on the half period (thesis eq. 19): integrate with the STM to the next
+    y = 0 crossing, located in time, and drive xdot there to zero by correcting ydot0 with x0
+    fixed. ``x0`` must lie between the primaries (-mu < x0 < 1 - mu). Without ``ydot0`` the
+    guess is a retrograde circle about the Moon seen in the rotating frame, sqrt(mu/d) + d with
+    d = 1 - mu - x0, where it is good (d <= 0.2); farther from the Moon the family is continued
+    (guarded natural continuation) from x0 = 0.95 to ``x0``.
+
+    The result is always a DRO: it winds once clockwise about the Moon and not about the Earth
+    (winding numbers (0, -1)); a correction that lands on another orbit (e.g. one about the
+    Earth, from a poor ``ydot0``) raises :class:`librate.ConvergenceError` naming what it found.
+    """
+    sys_ = resolve_system(system)
+    mu = sys_.mu
+    if not (isinstance(x0, (int, float, np.integer, np.floating)) and math.isfinite(x0) and -mu < x0 < 1.0 - mu):
+        raise ValueError(f"invalid argument `x0`: a DRO starts between the primaries, -mu < x0 < 1 - mu = ({-mu}, {1 - mu}), got {x0!r}")
+    x0 = float(x0)
+    if ydot0 is not None and not (math.isfinite(ydot0) and ydot0 > 0):
+        raise ValueError(f"invalid argument `ydot0`: must be finite and > 0 (retrograde about the Moon), got {ydot0!r}")
+    if not isinstance(max_iter, (int, np.integer)) or isinstance(max_iter, bool) or max_iter < 1:
+        raise ValueError(f"invalid argument `max_iter`: must be an integer >= 1, got {max_iter!r}")
+    if not (math.isfinite(tol) and tol > 0):
+        raise ValueError(f"invalid argument `tol`: must be a finite number > 0, got {tol!r}")
+    d = 1.0 - mu - x0
+    if ydot0 is None and d > 0.2:
+        start = _correct_dro_at(sys_, 0.95, None, tol, max_iter, rtol, atol)
+        res = continue_natural(sys_, start, "x0", [x0], family="dro")
+        if not res.members:
+            raise ConvergenceError(f"DRO at x0 = {x0}: the family continued from x0 = 0.95 did not reach it ({res.end_reason})")
+        orbit = res.members[-1]
+    else:
+        orbit = _correct_dro_at(sys_, x0, ydot0, tol, max_iter, rtol, atol)
+    g = geometry(orbit)
+    if g.winding != DRO_WINDING:
+        raise ConvergenceError(
+            f"DRO correction at x0 = {x0} converged to an orbit that is not a DRO: ydot0 = {orbit.vy0:.6g}, period {orbit.period:.6g} TU, "
+            f"winding numbers about (Earth, Moon) {g.winding} instead of {DRO_WINDING}; omit ydot0 (the family is then continued) "
+            "or use librate.dro(system, x0=...)")
+    return orbit
+
+
+def _correct_dro_at(sys_, x0, ydot0, tol, max_iter, rtol, atol) -> PeriodicOrbit:
+    if ydot0 is None:
+        d = 1.0 - sys_.mu - x0
+        ydot0 = math.sqrt(sys_.mu / d) + d
+    return correct_symmetric(sys_, (x0, 0.0, ydot0), fix="x0", family="dro", tol=tol, max_iter=max_iter, rtol=rtol, atol=atol)
 
 
 def dro_family(system: System | str = "earth-moon", x0=None, *, check_geometry: bool = True) -> OrbitFamily:

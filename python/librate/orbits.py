@@ -11,7 +11,7 @@ import numpy as np
 from . import _core
 from .system import System, resolve_system
 
-__all__ = ["PeriodicOrbit", "correct_dro", "correct_symmetric", "correct_periodic"]
+__all__ = ["PeriodicOrbit", "correct_symmetric", "correct_periodic"]
 
 _VARS = {"x0": 0, "z0": 1, "vy0": 2}
 # Tolerances of the shooting propagations: the 8th-order solution at 1e-13 puts the
@@ -149,46 +149,6 @@ def correct_symmetric(
 
 def _orbit_from(system: System, r: dict, family: str) -> PeriodicOrbit:
     return PeriodicOrbit(system, r["state0"], r["period"], r["jacobi"], family, r["iterations"], r["residual"], r["evaluation"])
-
-
-def correct_dro(
-    system: System | str,
-    x0: float,
-    ydot0: float | None = None,
-    *,
-    tol: float = 1e-12,
-    max_iter: int = 30,
-    rtol: float = SHOOT_RTOL,
-    atol: float = SHOOT_ATOL,
-) -> PeriodicOrbit:
-    """Correct the distant retrograde orbit through (x0, 0, 0) with ydot0 > 0 (PHYSICS.md sec. 3).
-
-    Single shooting on the half period (thesis eq. 19): integrate with the STM to the next
-    y = 0 crossing, located in time, and drive xdot there to zero by correcting ydot0 with x0
-    fixed. ``x0`` must lie between the primaries (-mu < x0 < 1 - mu). Without ``ydot0`` the
-    guess is a retrograde circle about the Moon seen in the rotating frame, sqrt(mu/d) + d with
-    d = 1 - mu - x0: good near the Moon (d below about 0.2); farther out use :func:`librate.dro`,
-    which continues the family.
-    """
-    sys_ = resolve_system(system)
-    mu = sys_.mu
-    if not (math.isfinite(x0) and -mu < x0 < 1.0 - mu):
-        raise ValueError(f"invalid argument `x0`: a DRO starts between the primaries, -mu < x0 < 1 - mu = ({-mu}, {1 - mu}), got {x0!r}")
-    if ydot0 is None:
-        d = 1.0 - mu - x0
-        ydot0 = math.sqrt(mu / d) + d
-    if not (math.isfinite(ydot0) and ydot0 > 0):
-        raise ValueError(f"invalid argument `ydot0`: must be finite and > 0 (retrograde about the Moon), got {ydot0!r}")
-    if not isinstance(max_iter, int) or max_iter < 1:
-        raise ValueError(f"invalid argument `max_iter`: must be an integer >= 1, got {max_iter!r}")
-    if not (math.isfinite(tol) and tol > 0):
-        raise ValueError(f"invalid argument `tol`: must be a finite number > 0, got {tol!r}")
-    orbit = correct_symmetric(sys_, (x0, 0.0, ydot0), fix="x0", family="dro", tol=tol, max_iter=max_iter, rtol=rtol, atol=atol)
-    if orbit.vy0 <= 0:
-        from ._errors import ConvergenceError
-
-        raise ConvergenceError(f"DRO correction at x0 = {x0} converged to a prograde orbit (ydot0 = {orbit.vy0:.6g}); give a better ydot0 guess")
-    return orbit
 
 
 def correct_periodic(
