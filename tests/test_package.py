@@ -4,7 +4,7 @@ import importlib.resources
 
 import librate
 from click.testing import CliRunner
-from librate.cli import main
+from librate.app.cli import main
 
 
 def test_public_api_is_declared():

@@ -1,6 +1,6 @@
 """Studies (TOML, validated by pydantic before any work) and results on disk (open_result).
 
-Reference for the error paths: the rules written in ``librate.study.ALLOWED`` and the module
+Reference for the error paths: the rules written in ``librate.app.study.ALLOWED`` and the module
 docstring; every message must name the key (dotted), the value given and what is allowed.
 Round trips are checked for exact equality of the saved numbers.
 """
@@ -13,8 +13,8 @@ import librate
 import numpy as np
 import pytest
 import tomllib
-from librate.results import read_attrs, save_dataset, save_family
-from librate.study import EXAMPLE_STUDY, Study, StudyError, apply_overrides
+from librate.app.results import read_attrs, save_dataset, save_family
+from librate.app.study import EXAMPLE_STUDY, Study, StudyError, apply_overrides
 
 TINY = {"orbits.x0": {"start": 0.9, "stop": 0.5, "num": 3}, "rates.wz0.num": 50}
 
@@ -250,7 +250,7 @@ def test_selected_members_are_saved_as_a_family(tmp_path):
 def test_map_and_solutions_round_trip(tmp_path, base, monkeypatch):
     import sys
 
-    monkeypatch.setitem(sys.modules, "librate.runner", None)  # the periodicity_map fallback
+    monkeypatch.setitem(sys.modules, "librate.app.runner", None)  # the periodicity_map fallback
     st = Study.from_dict(base, purpose="map")
     ds, path = st.run_map(tmp_path / "m")
     assert path == tmp_path / "m" / "map.zarr"
@@ -324,7 +324,7 @@ def test_the_stored_study_writes_the_defaults_out():
 def test_a_map_is_exported_to_netcdf_too(tmp_path, base, monkeypatch):
     import sys
 
-    monkeypatch.setitem(sys.modules, "librate.runner", None)
+    monkeypatch.setitem(sys.modules, "librate.app.runner", None)
     st = Study.from_dict(edit(edit(base, "output.format", "netcdf"), "body.kz", [0.5, 0.8]), purpose="map")
     ds, path = st.run_map(tmp_path)
     nc = librate.open_result(tmp_path / "map.nc")
@@ -337,7 +337,7 @@ def test_a_map_is_exported_to_netcdf_too(tmp_path, base, monkeypatch):
 
 
 def _flex_study(tmp_path, flexible, purpose="solve"):
-    from librate.study import Study
+    from librate.app.study import Study
 
     d = {"orbits": {"kind": "dro", "x0": [0.8, 0.75]}, "body": {"flexible": flexible},
          "rates": {"wz0": {"start": -2.0, "stop": 1.5, "num": 200}}}
@@ -366,7 +366,7 @@ def test_flexible_body_in_a_study(tmp_path):
     ({"flexible": "tower"}, "body.flexible"),
 ])
 def test_flexible_body_errors(body, key):
-    from librate.study import Study, StudyError
+    from librate.app.study import Study, StudyError
 
     d = {"orbits": {"kind": "dro", "x0": [0.8]}, "body": body, "rates": {"wz0": {"start": -2.0, "stop": 1.5, "num": 20}}}
     with pytest.raises(StudyError) as info:
@@ -375,7 +375,7 @@ def test_flexible_body_errors(body, key):
 
 
 def test_flexible_body_cannot_be_mapped(tmp_path):
-    from librate.study import StudyError
+    from librate.app.study import StudyError
 
     with pytest.raises(StudyError) as info:
         _flex_study(tmp_path, "sample-station", purpose="map")

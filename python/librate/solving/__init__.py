@@ -1,0 +1,1 @@
+"""The numerical solving layer: continuation driver."""
