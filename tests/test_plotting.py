@@ -612,7 +612,7 @@ def test_plot_sun_motion_fig33(em, tmp_path):
     equals omega_sun t + theta0 (deg) against t in days and falls by 360 deg per Ts = 29.49 d; a
     line at each multiple of Ts; the Earth-Moon line joins the primaries."""
     theta0 = 0.7
-    fig = lp.plot_sun_motion(em, theta0=theta0, n_periods=2)
+    fig = lp.plot_sun_motion(em, theta_sun0=theta0, n_periods=2)
     assert_png(fig, tmp_path / "fig33.png")
     a_geo, a_ang = fig.axes
     rays = gid(a_geo, "sun-direction")
@@ -827,7 +827,7 @@ def test_plot_srp_maps_fig40_41(eps_map, sun12_orbit, kz_map, tmp_path):
 
 SRP_BAD = [
     (lambda m, o: lp.plot_sun_motion("earth-moon"), "`system`"),
-    (lambda m, o: lp.plot_sun_motion(o.system, theta0=math.nan), "`theta0`"),
+    (lambda m, o: lp.plot_sun_motion(o.system, theta_sun0=math.nan), "`theta_sun0`"),
     (lambda m, o: lp.plot_sun_motion(o.system, n_periods=0), "`n_periods`"),
     (lambda m, o: lp.plot_sun_motion(o.system, n_directions=0), "`n_directions`"),
     (lambda m, o: lp.plot_sun_motion(o.system, ax=plt.subplots()[1]), "`ax`"),

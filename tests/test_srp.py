@@ -100,7 +100,7 @@ def test_srp_map_on_the_sun_resonant_orbit(sun12):
     plate = librate.FlatPlate(0.02, cs=0.4, cd=0.1, sun=librate.Sun(theta0=0.3))
     ds = librate.periodicity_map(sun12, kz=0.8, wz0=np.linspace(-1.6, 1.2, 400), n_periods=2, srp=plate)
     assert ds.sizes["solution"] > 0 and np.all(ds.sol_residual.values < 1e-9)
-    assert ds.attrs["srp_eps"] == 0.02 and ds.attrs["sun_theta0"] == 0.3 and ds.attrs["n_periods"] == 2
+    assert ds.attrs["srp_eps"] == 0.02 and ds.attrs["theta_sun0"] == 0.3 and ds.attrs["n_periods"] == 2
     # the symmetry is broken: the solutions' phi0 are free (not all zero)
     assert np.max(np.abs(ds.sol_phi0.values)) > 1e-6
 

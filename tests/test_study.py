@@ -79,7 +79,7 @@ def test_inertia_custom_system_and_srp_geometry():
         "system": {"mu": 0.0121505856, "lu_km": 384400.0, "tu_s": 375190.25852, "radii_km": [6378.0, 1737.0], "name": "my-em"},
         "orbits": {"sun_resonance": [2]},
         "body": {"ix": 12.12e6, "iy": 89.68e6, "iz": 96.95e6, "mass_kg": 4.0e5},
-        "torques": {"srp": {"area_m2": 100.0, "offset_m": 2.0, "cs": 0.4, "theta0": 0.3}},
+        "torques": {"srp": {"area_m2": 100.0, "offset_m": 2.0, "cs": 0.4, "theta_sun0": 0.3}},
         "rates": {"wz0": {"start": -1.6, "stop": 1.2, "num": 50}},
     }, purpose="solve")
     sys_ = st.build_system()
@@ -92,6 +92,19 @@ def test_inertia_custom_system_and_srp_geometry():
     assert plate.eps == pytest.approx(4.56e-6 * 100.0 * 2.0 * 375190.25852**2 / 96.95e6, rel=1e-12)
     assert (plate.cs, plate.cd, plate.sun.theta0) == (0.4, 0.0, 0.3)
     assert st.n_periods() == 2  # the 1:2 Sun-resonant orbit: one Sun period
+
+
+def test_old_sun_phase_key_still_read_with_a_warning():
+    """[torques.srp] theta0 was renamed theta_sun0: the old key still works, with a FutureWarning
+    naming the new one; giving both is an error."""
+    data = {"orbits": {"sun_resonance": [2]}, "body": {"kz": 0.6}, "torques": {"srp": {"eps": 0.02, "theta0": 0.3}},
+            "rates": {"wz0": {"start": -1.6, "stop": 1.2, "num": 50}}}
+    with pytest.warns(FutureWarning, match="theta_sun0"):
+        st = Study.from_dict(data, purpose="solve")
+    assert st.build_srp().sun.theta0 == 0.3 and data["torques"]["srp"] == {"eps": 0.02, "theta0": 0.3}
+    data["torques"]["srp"]["theta_sun0"] = 0.3
+    with pytest.raises(StudyError, match="give only theta_sun0"):
+        Study.from_dict(data)
 
 
 def test_json_round_trip_and_overrides(base):

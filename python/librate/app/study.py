@@ -25,12 +25,13 @@ import json
 import math
 import re
 import sys
+import warnings
 from collections.abc import Callable
 from pathlib import Path
 from typing import Annotated, Any, Literal
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Discriminator, Field, Tag, ValidationError
+from pydantic import BaseModel, ConfigDict, Discriminator, Field, Tag, ValidationError, model_validator
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -150,8 +151,20 @@ class SrpSection(_Table):
     offset_m: float | None = None
     cs: float = Field(0.0, ge=0, le=1)
     cd: float = Field(0.0, ge=0, le=1)
-    theta0: float = 0.0
+    theta_sun0: float = 0.0
     pressure: float | None = Field(None, ge=0)
+
+    @model_validator(mode="before")
+    @classmethod
+    def _old_theta0(cls, data: Any) -> Any:
+        """The Sun's phase was `theta0` before it became `theta_sun0`: still read, with a warning."""
+        if isinstance(data, dict) and "theta0" in data:
+            if "theta_sun0" in data:
+                raise ValueError("theta0 is the old name of theta_sun0; give only theta_sun0")
+            warnings.warn("[torques.srp] theta0 is deprecated and will be removed: write theta_sun0 "
+                          "(the same Sun phase at t = 0, rad)", FutureWarning, stacklevel=2)
+            data = {("theta_sun0" if k == "theta0" else k): v for k, v in data.items()}
+        return data
 
 
 class TorquesSection(_Table):
@@ -228,7 +241,7 @@ ALLOWED: dict[str, str] = {
     "torques.srp.offset_m": "a finite number, the centre-of-pressure offset along y_B in m",
     "torques.srp.cs": "a number in [0, 1], the specular reflection fraction (cs + cd <= 1)",
     "torques.srp.cd": "a number in [0, 1], the diffuse reflection fraction (cs + cd <= 1)",
-    "torques.srp.theta0": "a finite number, the Sun's phase at t = 0 in rad",
+    "torques.srp.theta_sun0": "a finite number, the Sun's phase at t = 0 in rad",
     "torques.srp.pressure": "a number >= 0, the solar pressure in N/m^2 (default 4.56e-6)",
     "rates.wz0": "a list of inertial initial rates (1/TU), strictly increasing, or a table {start, stop, num} with start < stop, num >= 2",
     "rates.phidot0": "a list of initial rates relative to the synodic frame (1/TU), strictly increasing, or a table {start, stop, num} with start < stop, num >= 2",
@@ -741,7 +754,7 @@ class Study(BaseModel):
         p = self.torques.srp
         if p is None:
             return None
-        sun = Sun(theta0=p.theta0) if p.pressure is None else Sun(theta0=p.theta0, pressure=p.pressure)
+        sun = Sun(theta0=p.theta_sun0) if p.pressure is None else Sun(theta0=p.theta_sun0, pressure=p.pressure)
         if p.eps is not None:
             return FlatPlate(p.eps, p.cs, p.cd, sun)
         return FlatPlate.from_geometry(system or self.build_system(), area_m2=p.area_m2, offset_m=p.offset_m, iz_kgm2=self.body.iz,
@@ -963,7 +976,7 @@ gravity_gradient = ["earth", "moon"]   # the planar engine models both primaries
 # [torques.srp]                # solar radiation pressure, a two-sided flat plate
 # eps = 0.02                   # amplitude P A d TU^2 / Iz; or area_m2 = 100 and offset_m = 2 (needs ix/iy/iz)
 # cs = 0.4                     # specular fraction; cd: diffuse fraction (cs + cd <= 1)
-# theta0 = 0.0                 # Sun phase at t = 0 (rad)
+# theta_sun0 = 0.0             # Sun phase at t = 0 (rad)
 # (SRP needs one Sun-resonant orbit: [orbits] sun_resonance = [2], and solver.n_periods = 2)
 
 [rates]

@@ -171,14 +171,14 @@ def map_dataset(olist, family, kzs, wz, grid, done, *, phi0, n_periods, rtol, at
             "srp_eps": float(srp.eps) if srp is not None else 0.0,
             "srp_cs": float(srp.cs) if srp is not None else 0.0,
             "srp_cd": float(srp.cd) if srp is not None else 0.0,
-            "sun_theta0": float(srp.sun.theta0) if srp is not None else 0.0,
+            "theta_sun0": float(srp.sun.theta0) if srp is not None else 0.0,
             **(attrs or {}),
         },
     )
 
 def _stack_srp(maps, plates):
-    """Maps for several plates stacked along an ``srp`` dimension (coordinates eps, cs, cd and
-    the Sun phase); solutions gain ``sol_srp``."""
+    """Maps for several plates stacked along an ``srp`` dimension (coordinates srp_eps, srp_cs,
+    srp_cd and the Sun phase theta_sun0); solutions gain ``sol_srp``."""
     import xarray as xr
 
     grid_vars = ["dwz", "dphi", "phi_T", "status"]
@@ -189,10 +189,10 @@ def _stack_srp(maps, plates):
         srp_eps=("srp", np.array([p.eps for p in plates])),
         srp_cs=("srp", np.array([p.cs for p in plates])),
         srp_cd=("srp", np.array([p.cd for p in plates])),
-        srp_theta0=("srp", np.array([p.sun.theta0 for p in plates])),
+        theta_sun0=("srp", np.array([p.sun.theta0 for p in plates])),
     )
     out["computed"] = out["computed"].all("srp")
-    out.attrs = {k: v for k, v in maps[0].attrs.items() if not k.startswith("srp_") and k != "sun_theta0"}
+    out.attrs = {k: v for k, v in maps[0].attrs.items() if not k.startswith("srp_") and k != "theta_sun0"}
     out.attrs["complete"] = int(all(m.attrs["complete"] for m in maps))
     if "solution" in maps[0].dims:
         sols = []

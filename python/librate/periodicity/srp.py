@@ -135,7 +135,7 @@ def srp_map(
     eps,
     cs: float = 0.0,
     cd: float = 0.0,
-    theta0: float = 0.0,
+    theta_sun0: float = 0.0,
     phi0: float = 0.0,
     n_periods: int | None = None,
     solve: bool = True,
@@ -149,7 +149,7 @@ def srp_map(
     ``family.resonant(K, "sun")``); ``n_periods`` (default: that K, required for other orbits):
     the revolutions after which periodicity is checked. ``eps``: increasing plate amplitudes (any
     sign), ``wz0``: increasing INERTIAL initial rates; the plate has ``cs``, ``cd`` (ca = 1 - cs -
-    cd) and the Sun phase ``theta0`` (:class:`librate.FlatPlate`, :class:`librate.Sun`);
+    cd) and the Sun phase ``theta_sun0`` (``Sun.theta0``; :class:`librate.FlatPlate`, :class:`librate.Sun`);
     the body has ``kz``; every motion starts at ``phi0``. The grid runs in one engine sweep:
     ``dwz`` = wz(KT) - wz0, ``dphi`` = phi(KT) - phi0 wrapped to (-pi, pi], ``phi_T`` (unwrapped)
     and ``status`` over dims (eps, wz0).
@@ -197,7 +197,7 @@ def srp_map(
     if wz.size < 2 or not np.all(np.isfinite(wz)) or np.any(np.diff(wz) <= 0):
         raise ValueError("invalid argument `wz0`: must be a finite, strictly increasing array of at least 2 rates")
     phi0 = as_number(phi0, "phi0")
-    plate = FlatPlate(0.0, cs, cd, Sun(theta0=theta0))
+    plate = FlatPlate(0.0, cs, cd, Sun(theta0=theta_sun0))
     e_grid, w_grid = np.meshgrid(es, wz, indexing="ij")
     r = sweep(orbit_forcing(orbit), n_periods * orbit.period, phi0, w_grid, kz, srp=plate, eps=e_grid)
     shape = (es.size, wz.size)
@@ -295,7 +295,7 @@ def srp_map(
             "cs": float(plate.cs),
             "cd": float(plate.cd),
             "ca": float(plate.ca),
-            "theta0": float(theta0),
+            "theta_sun0": float(theta_sun0),
             "phi0": phi0,
             "n_periods": n_periods,
             "x0": orbit.x0,

@@ -29,12 +29,16 @@ label it wz(0)); ``rate="inertial"`` plots wz, and the axis label says which. Ar
 - :func:`plot_attitude_motion`: phi(t) and the rate of periodic motions (Figs. 30-31)
 - :func:`plot_sun_motion`: the apparent Sun motion in the synodic frame (Fig. 33)
 - :func:`plot_sun_resonant`: the Sun-resonant members T = Ts / K of a family (Fig. 34)
-- :func:`srp_map` (data) and :func:`plot_srp_map`: flat-plate SRP periodicity maps of one orbit
-  over (eps, rate), zero contours and solution branches with folds (Figs. 35-36)
+- :func:`plot_srp_map`: flat-plate SRP periodicity maps of one orbit over (eps, rate), zero
+  contours and solution branches with folds (Figs. 35-36), from the data of
+  :func:`librate.periodicity.srp_map` (also importable from here)
 - :func:`plot_srp_maps`: several maps side by side, one per Cs, Kz, ... (Figs. 40-41)
 - :func:`plot_srp_comparison`: a gravity-only periodic motion and its SRP counterpart (Figs. 37-38)
-- :func:`sun_pointing_accelerations` (data) and :func:`plot_sun_pointing`: gravity-gradient and
-  SRP angular accelerations on a Sun-pointing spacecraft (Fig. 39)
+- :func:`plot_sun_pointing`: gravity-gradient and SRP angular accelerations on a Sun-pointing
+  spacecraft (Fig. 39), computed by :func:`librate.periodicity.sun_pointing_accelerations` (also
+  importable from here)
+
+This package only draws: the data come from :mod:`librate.periodicity` and the layers below.
 - :func:`save_figure`: write a figure to a file
 
 The SRP amplitude of the flat plate is eps = P A d TU^2 / Iz = P (A/m) d TU^2 / k^2 (k the radius
@@ -1125,14 +1129,14 @@ def plot_sun_motion(
     system,
     ax=None,
     *,
-    theta0: float = 0.0,
+    theta_sun0: float = 0.0,
     n_periods: float = 1,
     n_directions: int = 8,
     units: str = "days",
 ) -> Figure:
     """The apparent motion of the Sun in the synodic frame (thesis Fig. 33).
 
-    The Sun direction s(t) = (cos theta_s, sin theta_s, 0), theta_s(t) = omega_sun t + theta0
+    The Sun direction s(t) = (cos theta_s, sin theta_s, 0), theta_s(t) = omega_sun t + theta_sun0
     (PHYSICS.md sec. 6; parallax neglected, so it is the same everywhere in the system), turns
     CLOCKWISE at omega_sun = -(1 - n_sun) = :data:`librate.constants.OMEGA_SUN` (1/TU): one
     apparent solar period Ts = 2 pi / (1 - n_sun) (29.49 d with the Earth-Moon TU).
@@ -1146,12 +1150,12 @@ def plot_sun_motion(
     (``gid="sun-angle"``), a vertical line at each multiple of Ts (``gid="solar-period"``) and the
     angles at which the Sun lies on the Earth-Moon line: beyond the Moon (theta_s = 0 mod 360 deg,
     new Moon, ``gid="sun-beyond-moon"``) and behind the Earth (180 deg mod 360, full Moon,
-    ``gid="sun-behind-earth"``). ``theta0``: the Sun's phase at t = 0 (rad, as
-    :class:`librate.Sun`); ``units``: ``"days"`` or ``"TU"``; ``ax``: two Axes. Returns the
+    ``gid="sun-behind-earth"``). ``theta_sun0``: the Sun's phase at t = 0 (rad, the
+    ``theta0`` of a :class:`librate.Sun`); ``units``: ``"days"`` or ``"TU"``; ``ax``: two Axes. Returns the
     Figure.
     """
     sys_ = check_system(system)
-    theta0 = as_number(theta0, "theta0")
+    theta_sun0 = as_number(theta_sun0, "theta_sun0")
     n_periods = as_number(n_periods, "n_periods", positive=True)
     n_directions = as_count(n_directions, "n_directions", 1)
     tscale, tunit = _time_scale(sys_, units)
@@ -1167,24 +1171,24 @@ def plot_sun_motion(
     (h,) = a_geo.plot([e[0], m[0]], [e[1], m[1]], color="0.25", linewidth=1.8, zorder=3, label="Earth-Moon line (synodic $X$ axis)")
     h.set_gid("earth-moon-line")
     t_path = np.linspace(0.0, ts, 361)
-    th = sun_angle(theta0, t_path)
+    th = sun_angle(theta_sun0, t_path)
     (h,) = a_geo.plot(radius * np.cos(th), radius * np.sin(th), color=_SUN_COLOR, linewidth=1.0, linestyle="--", zorder=1,
                       label=f"Sun direction over one apparent solar period $T_s$ = {ts * tscale:.2f} {tname}")
     h.set_gid("sun-path")
     for f in (0.06, 0.31, 0.56, 0.81):  # arrow heads: the clockwise sense
         t1, t2 = f * ts, (f + 0.02) * ts
-        p1, p2 = [radius * np.array([math.cos(v), math.sin(v)]) for v in sun_angle(theta0, [t1, t2])]
+        p1, p2 = [radius * np.array([math.cos(v), math.sin(v)]) for v in sun_angle(theta_sun0, [t1, t2])]
         arr = a_geo.annotate("", xy=p2, xytext=p1, arrowprops=dict(arrowstyle="-|>", color=_SUN_COLOR, linewidth=1.2,
                                                                   mutation_scale=14))
         arr.set_gid("sun-path-arrow")
     cm = matplotlib.colormaps["plasma"]
     for k in range(n_directions):
         tk = k * ts / n_directions
-        ang = float(sun_angle(theta0, tk))
+        ang = float(sun_angle(theta_sun0, tk))
         c, s = math.cos(ang), math.sin(ang)
         color = cm(0.85 * k / n_directions)
         (h,) = a_geo.plot([0.0, radius * c], [0.0, radius * s], color=color, linewidth=2.0 if k == 0 else 1.0, zorder=2,
-                          label=f"Sun direction at $t$ = 0 ($\\theta_{{s0}}$ = {math.degrees(theta0):.4g} deg)" if k == 0 else "_nolegend_")
+                          label=f"Sun direction at $t$ = 0 ($\\theta_{{s0}}$ = {math.degrees(theta_sun0):.4g} deg)" if k == 0 else "_nolegend_")
         h.set_gid("sun-direction")
         (h,) = a_geo.plot([radius * c], [radius * s], marker="o", markersize=11 if k == 0 else 8, color=_SUN_COLOR,
                           markeredgecolor=color, markeredgewidth=1.5, linestyle="none", zorder=4)
@@ -1207,7 +1211,7 @@ def plot_sun_motion(
 
     # --- the Sun's angle against time
     t = np.linspace(0.0, n_periods * ts, max(2, int(math.ceil(360 * n_periods)) + 1))
-    deg = np.degrees(sun_angle(theta0, t))
+    deg = np.degrees(sun_angle(theta_sun0, t))
     (h,) = a_ang.plot(t * tscale, deg, color=_SUN_COLOR, linewidth=1.8,
                       label=f"$\\theta_s(t) = \\omega_s t + \\theta_{{s0}}$, $\\omega_s$ = {OMEGA_SUN:.4f} 1/TU = "
                             f"{math.degrees(OMEGA_SUN) / sys_.tu_days:.2f} deg/d")
@@ -1322,7 +1326,7 @@ def _check_srp_map(ds, name: str = "ds"):
     names = getattr(ds, "variables", None)
     if (not hasattr(ds, "data_vars") or names is None or getattr(ds, "attrs", {}).get("map") != "srp-eps"
             or not all(v in names for v in ("dwz", "dphi", "phi_T", "eps", "wz0"))):
-        raise ValueError(f"invalid argument `{name}`: must be an xarray Dataset from librate.plotting.srp_map, got {type(ds).__name__}")
+        raise ValueError(f"invalid argument `{name}`: must be an xarray Dataset from librate.periodicity.srp_map, got {type(ds).__name__}")
     return ds
 
 
@@ -1436,20 +1440,20 @@ def plot_srp_map(
     if created:
         at = ds.attrs
         a.set_title(f"SRP periodicity map, {_orbit_name(at)}\n$K_z$ = {at['kz']:g}, $C_s$ = {at['cs']:g}, $C_d$ = {at['cd']:g}, "
-                    f"$\\theta_{{s0}}$ = {math.degrees(at['theta0']):.4g} deg, $\\varphi_0$ = {at['phi0']:g} rad", fontsize=10)
+                    f"$\\theta_{{s0}}$ = {math.degrees(at['theta_sun0']):.4g} deg, $\\varphi_0$ = {at['phi0']:g} rad", fontsize=10)
     return fig
 
 
-_MAP_PARAMETERS = (("kz", "$K_z$"), ("cs", "$C_s$"), ("cd", "$C_d$"), ("theta0", "$\\theta_{s0}$"), ("eps", "$\\varepsilon$"))
-_MAP_UNITS = {"theta0": " deg"}
+_MAP_PARAMETERS = (("kz", "$K_z$"), ("cs", "$C_s$"), ("cd", "$C_d$"), ("theta_sun0", "$\\theta_{s0}$"), ("eps", "$\\varepsilon$"))
+_MAP_UNITS = {"theta_sun0": " deg"}
 
 
 def _map_parameters(ds) -> dict:
     """The fixed parameters of a map (srp_map or periodicity_map Dataset), by the names above."""
     at = ds.attrs
     if at.get("map") == "srp-eps":
-        return {"kz": at["kz"], "cs": at["cs"], "cd": at["cd"], "theta0": math.degrees(at["theta0"])}
-    out = {"cs": at.get("srp_cs", 0.0), "cd": at.get("srp_cd", 0.0), "theta0": math.degrees(at.get("sun_theta0", 0.0)),
+        return {"kz": at["kz"], "cs": at["cs"], "cd": at["cd"], "theta_sun0": math.degrees(at["theta_sun0"])}
+    out = {"cs": at.get("srp_cs", 0.0), "cd": at.get("srp_cd", 0.0), "theta_sun0": math.degrees(at.get("theta_sun0", 0.0)),
            "eps": at.get("srp_eps", 0.0)}
     if ds.sizes.get("kz", 0) == 1:
         out["kz"] = float(ds["kz"].values[0])
