@@ -146,10 +146,13 @@ def test_free_sun_phase_finds_the_symmetric_phases(sun12, gravity_solution):
     multiple of pi/K for this plate). Freeing the Sun phase from 0.3 converges to such a phase
     (K = 2: a multiple of pi/2, to 1e-9), and the solution repeats (1e-9)."""
     plate = librate.FlatPlate(0.05, cs=0.4, cd=0.1, sun=librate.Sun(theta0=0.3))
-    s = librate.periodic_attitude(sun12, kz=0.8, n=-2, n_periods=2, srp=plate, wz0=gravity_solution.wz0, free="sun_phase")
+    s = librate.periodic_attitude(sun12, kz=0.8, n=-2, n_periods=2, srp=plate, wz0=gravity_solution.wz0, free="theta_sun0")
     assert s.phi0 == 0.0 and s.residual < 1e-9
     k = s.srp.sun.theta0 / (math.pi / 2)
     assert abs(k - round(k)) < 1e-9
+    # the old spelling free="sun_phase" still works, with a DeprecationWarning
+    with pytest.warns(DeprecationWarning, match="theta_sun0"), pytest.raises(ValueError, match="needs srp"):
+        librate.periodic_attitude(sun12, kz=0.8, n=-2, n_periods=2, free="sun_phase")
 
 
 def test_map_over_several_plates(sun12):

@@ -15,6 +15,7 @@ independently (scalar model, orbit integrated alongside, tight tolerance).
 from __future__ import annotations
 
 import math
+import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
@@ -230,8 +231,9 @@ def periodic_attitude(
     (phi0, wz0) together with the full-period Newton step [Phi(T) - I] d = -F (PHYSICS.md: the
     correct form of thesis eq. 53), "auto" picks "half" when it applies. With SRP the mirror
     symmetry is broken (PHYSICS.md sec. 6): ``free="phi0"`` (default) corrects (phi0, wz0);
-    ``free="sun_phase"`` keeps phi0 and corrects (Sun phase, wz0) instead (the returned
-    solution's ``srp.sun.theta0`` is the phase found; d/d(phase) by central differences). ``wz0``: the guess
+    ``free="theta_sun0"`` keeps phi0 and corrects (Sun phase theta_sun0, wz0) instead (the returned
+    solution's ``srp.sun.theta0`` is the phase found; d/d(phase) by central differences; the old
+    spelling ``free="sun_phase"`` still works, with a DeprecationWarning). ``wz0``: the guess
     (default: the torque-free solution 1 + 2 pi turns / T). Raises ConvergenceError.
     """
     orbit = check_orbit(orbit)
@@ -252,11 +254,14 @@ def periodic_attitude(
     if not math.isfinite(w):
         raise ValueError(f"invalid argument `wz0`: must be finite, got {wz0!r}")
     srp = check_srp(srp)
-    if free not in ("phi0", "sun_phase"):
-        raise ValueError(f"invalid argument `free`: must be 'phi0' or 'sun_phase', got {free!r}")
     if free == "sun_phase":
+        warnings.warn("periodic_attitude(free='sun_phase') is deprecated; use free='theta_sun0'", DeprecationWarning, stacklevel=2)
+        free = "theta_sun0"
+    if free not in ("phi0", "theta_sun0"):
+        raise ValueError(f"invalid argument `free`: must be 'phi0' or 'theta_sun0', got {free!r}")
+    if free == "theta_sun0":
         if srp is None:
-            raise ValueError("invalid argument `free`: 'sun_phase' needs srp")
+            raise ValueError("invalid argument `free`: 'theta_sun0' needs srp")
         return _solve_sun_phase(orbit, kz, n, kind, float(phi0), w, srp, n_periods, turns, tol, max_iter)
     symmetric = is_symmetric(orbit, phi0) and (srp is None or srp.eps == 0.0)
     if method == "auto":
