@@ -28,9 +28,9 @@ hub's centre sits where it balances them, h = -sum_j m_j b_j / m0.
   ``traj.flex``);
 - :func:`quasi_static`: high structural frequencies, the closed form q_j = L_j / k_j along the
   rigid solution (L_j the transverse load) and the first-order attitude perturbation;
-- :func:`flexible_periodic`: what flexibility does to a periodic orbit-attitude solution (drift
+- :func:`librate.periodicity.flexible_periodic` (in the periodicity layer): what flexibility does to a periodic orbit-attitude solution (drift
   and first-order shift in closed form; re-solved with the full model at low frequencies);
-- :func:`frequency_scan`: the coupled response against the structural frequency (resonances).
+- :func:`librate.periodicity.frequency_scan`: the coupled response against the structural frequency (resonances).
 
 Two precisions on PHYSICS.md sec. 7. Omega_j = sqrt(k_j / m_j) is the *clamped-hub* frequency:
 with the hub free to rotate and the centre of mass free to shift, the structural modes are

@@ -143,7 +143,7 @@ def srp_map(
     steps: int = 4,
 ):
     """A flat-plate SRP periodicity map of one orbit over (eps, initial rate), for
-    :func:`plot_srp_map` (thesis Figs. 35-36, 40-41).
+    :func:`librate.plotting.plot_srp_map` (thesis Figs. 35-36, 40-41).
 
     ``orbit``: a planar orbit, normally Sun-resonant (T = Ts / K, from
     ``family.resonant(K, "sun")``); ``n_periods`` (default: that K, required for other orbits):
