@@ -81,7 +81,7 @@ from ..orbits.periodic import PeriodicOrbit
 from ..orbits.system import check_system
 from ..periodicity.flexible import FrequencyScan
 from ..periodicity.maps import periodicity_map
-from ..periodicity.solutions import AttitudeSolution, check_kinds
+from ..periodicity.solutions import KINDS, AttitudeSolution, check_kinds
 from ..periodicity.srp import srp_map, sun_angle, sun_pointing_accelerations, sun_resonance
 
 if TYPE_CHECKING:
@@ -588,7 +588,6 @@ def plot_attitude(traj, ax=None, *, period: float | None = None, relative_to: st
 
 
 # --- periodic attitude motions: residuals, maps, families, motions (Figs. 23-31) --------------
-_KINDS = ("periodic", "half-turn")
 _KIND_MARKER = {"periodic": "o", "half-turn": "D"}
 # Solutions are coloured by N (the same N, the same colour in every figure), |N| > 3 in one grey;
 # blue and orange are left to the residuals Dwz and Dphi (curves in Fig. 23, contours in Fig. 24).
@@ -658,7 +657,7 @@ def _kz_mask(tab, kz: float) -> np.ndarray:
 def _draw_solutions(a, x, y, n, kind, stable, *, markersize: float = 6.5) -> None:
     """Markers for solutions: colour by N, circle periodic / diamond half-turn, filled when
     linearly stable, hollow when not; one Line2D per group, all with ``gid="solutions"``."""
-    for k in _KINDS:
+    for k in KINDS:
         for nn in sorted(set(n[kind == k].tolist()), reverse=True):
             for st in (True, False):
                 m = (kind == k) & (n == nn) & (stable == st)
@@ -720,7 +719,7 @@ def plot_residuals(
     phi0: float = 0.0,
     rate: str = "relative",
     solutions: bool = True,
-    kinds: Sequence[str] = _KINDS,
+    kinds: Sequence[str] = KINDS,
     annotate: bool = True,
 ) -> Figure:
     """The residuals after one orbital period against the initial rate, for one orbit and one
@@ -1343,7 +1342,7 @@ def plot_srp_map(
     rate: str = "relative",
     solutions: bool = True,
     branches: bool = True,
-    kinds: Sequence[str] = _KINDS,
+    kinds: Sequence[str] = KINDS,
     half_turn_contours: bool = False,
     reference: float | tuple[float, str] | None = None,
     legend: bool = True,
