@@ -20,7 +20,7 @@ Reference and accuracy metric
     |wz_ref(T)|). Target: <= 2e-10.
 
 Methods
-    * librate: `_sweep` (the Rust SIMD-lane engine) on the orbit forcing table; tolerance =
+    * librate: `sweep` (the Rust SIMD-lane engine) on the orbit forcing table; tolerance =
       the loosest rung of a 1-2-5 ladder (2e-8 ... 1e-14) meeting the target. Timed on
       all cores and on 1 thread (perf_counter); the one-off forcing table is timed separately
       (built uncached, best of 15) and added to the total.
@@ -64,7 +64,7 @@ import librate
 import numpy as np
 import xarray  # noqa: F401  (imported here so the large-map timings do not include it)
 from librate import _core
-from librate.periodicity import MAP_ATOL, MAP_RTOL, _sweep
+from librate.periodicity import MAP_ATOL, MAP_RTOL, clear_forcing_cache, sweep
 from scipy.integrate import solve_ivp
 
 X0 = 0.70
@@ -318,7 +318,7 @@ def main():
           f"{forcing.max_error:.1e}, built in {t_forcing * 1e3:.2f} ms (best of {repeat}, uncached)")
 
     def lib_sweep(tol, threads=None):
-        return _sweep(forcing, T, PHI0, wz0, KZ, rtol=tol, atol=tol, threads=threads)
+        return sweep(forcing, T, PHI0, wz0, KZ, rtol=tol, atol=tol, threads=threads)
 
     lib_sweep(1e-12)  # warm-up (thread pool)
     lib_ladder = []
@@ -524,7 +524,7 @@ def main():
     big_t = {tol: [] for tol in tols}
     for _ in range(1 if q else 2):  # alternate the tolerances; best of the passes
         for tol in tols:
-            librate.periodicity._FORCINGS.clear()  # include every orbit's forcing table
+            clear_forcing_cache()  # include every orbit's forcing table
             t0 = time.perf_counter()
             ds = librate.periodicity_map(fam, kz=kzs, wz0=wzb, solve=False, rtol=tol, atol=tol)
             big_t[tol].append(time.perf_counter() - t0)
@@ -534,7 +534,7 @@ def main():
         print(f"solve=False, rtol = atol = {tol:.0e}: {n_traj} trajectories in {t:.2f} s = {n_traj / t:,.0f} traj/s "
               f"(forcing tables included; best of {len(big_t[tol])}: {', '.join(f'{x:.2f}' for x in big_t[tol])} s)")
     print(f"  trajectories not ok in the last pass: {bad}")
-    librate.periodicity._FORCINGS.clear()
+    clear_forcing_cache()
     t0 = time.perf_counter()
     ds = librate.periodicity_map(fam, kz=kzs, wz0=wzb, solve=True)
     t = time.perf_counter() - t0

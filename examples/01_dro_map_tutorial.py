@@ -17,7 +17,7 @@ from pathlib import Path
 import librate
 import librate.plotting as lp
 import numpy as np
-from librate.results import save_dataset
+from librate.app.results import save_dataset
 
 out = Path(sys.argv[1] if len(sys.argv) > 1 else "examples-out") / "tutorial"
 em = librate.System.preset("earth-moon")

@@ -24,7 +24,7 @@ print(f"1:2 Sun-resonant DRO: x0 = {orbit.x0:.6f} LU, T = {orbit.period_days:.3f
 gravity = librate.periodic_attitude(orbit, kz=0.8, n=-2, n_periods=2)
 print(f"gravity gradient only: wz0 = {gravity.wz0:.8f} 1/TU, phi0 = {gravity.phi0:.3g} rad, residual {gravity.residual:.1e}")
 
-plate = librate.FlatPlateSRP(0.02, cs=0.4)
+plate = librate.FlatPlate(0.02, cs=0.4)
 path = librate.continue_srp(gravity, plate)
 srp = path.solutions[-1]
 print(f"continued to eps = {path.eps[-1]:g} in {len(path.eps) - 1} steps ({path.end_reason}):")

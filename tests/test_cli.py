@@ -1,7 +1,7 @@
 """The `librate` command line end to end, in a temporary folder (click's CliRunner).
 
 init -> map from the study on a tiny grid (3 DROs x 50 rates) -> plot from the saved file; the
-map runner's interface (a fake `librate.runner.run_map` via monkeypatch, and the
+map runner's interface (a fake `librate.app.runner.run_map` via monkeypatch, and the
 `periodicity_map` fallback when the runner is absent); family, solve, invalid studies (exit 2,
 nothing written), foreign output folders refused; demo, dros and info unchanged.
 """
@@ -14,7 +14,7 @@ import librate
 import numpy as np
 import pytest
 from click.testing import CliRunner
-from librate.cli import main
+from librate.app.cli import main
 
 TINY = ["--set", "orbits.x0={start = 0.9, stop = 0.5, num = 3}", "--set", "rates.wz0.num=50"]
 
@@ -35,15 +35,15 @@ def run(tmp_path, monkeypatch):
 
 @pytest.fixture
 def no_runner(monkeypatch):
-    """Make `import librate.runner` fail: the periodicity_map fallback."""
-    monkeypatch.setitem(sys.modules, "librate.runner", None)
+    """Make `import librate.app.runner` fail: the periodicity_map fallback."""
+    monkeypatch.setitem(sys.modules, "librate.app.runner", None)
 
 
 @pytest.fixture
 def fake_runner(monkeypatch):
-    """A stand-in `librate.runner` with the agreed `run_map` signature, recording its calls."""
+    """A stand-in `librate.app.runner` with the agreed `run_map` signature, recording its calls."""
     calls = []
-    mod = types.ModuleType("librate.runner")
+    mod = types.ModuleType("librate.app.runner")
 
     def run_map(orbits, *, kz, wz0, phi0=0.0, n_periods=1, srp=None, out=None, resume=True, scheduler=None, progress=None, solve=True, attrs=None):
         calls.append(dict(orbits=orbits, kz=kz, wz0=wz0, phi0=phi0, n_periods=n_periods, srp=srp, out=out, resume=resume,
@@ -54,7 +54,7 @@ def fake_runner(monkeypatch):
         return ds
 
     mod.run_map = run_map
-    monkeypatch.setitem(sys.modules, "librate.runner", mod)
+    monkeypatch.setitem(sys.modules, "librate.app.runner", mod)
     return calls
 
 
@@ -136,7 +136,7 @@ def test_fallback_without_the_runner(run, tmp_path, no_runner):
     assert again["kz"].values.tolist() == [0.5] and not np.array_equal(again["dwz"].values, first, equal_nan=True)
     # a scheduler needs the runner
     res = run("map", "study.toml", "--scheduler", "tcp://127.0.0.1:8786", *TINY, code=1)
-    assert "librate.runner" in res.output
+    assert "librate.app.runner" in res.output
 
 
 def test_foreign_output_folder_is_refused(run, tmp_path, no_runner):
@@ -189,7 +189,7 @@ def test_family_from_options_and_from_a_study(run, tmp_path):
     assert f"written: {path}" in res.output and "dro family" not in res.output
     back = librate.open_result(path)
     assert back.x0.tolist() == pytest.approx([0.9, 0.7], abs=1e-15)
-    attrs = librate.results.read_attrs(path)
+    attrs = librate.app.results.read_attrs(path)
     assert json.loads(attrs["study"])["orbits"]["x0"] == [0.9, 0.7]
     # a halo family by options (a spatial family: fine for `family`, refused by `map`)
     res = run("family", "--kind", "halo", "--point", "2", "--branch", "north", "--set", "orbits.max_members=30", "--out", "halo")
@@ -250,7 +250,7 @@ def test_srp_study_solve_and_map(run, tmp_path, no_runner):
     assert ds.sizes["solution"] >= 1 and set(ds["sol_n_periods"].values.tolist()) == {2}
     # the gravity-gradient N = -2 motion continued to eps = 0.02 (examples/03) is among them
     orbit = librate.dro_family("earth-moon").resonant(2, "sun")
-    ref = librate.continue_srp(librate.periodic_attitude(orbit, kz=0.8, n=-2, n_periods=2), librate.FlatPlateSRP(0.02, cs=0.4)).solutions[-1]
+    ref = librate.continue_srp(librate.periodic_attitude(orbit, kz=0.8, n=-2, n_periods=2), librate.FlatPlate(0.02, cs=0.4)).solutions[-1]
     assert np.min(np.abs(ds["sol_wz0"].values - ref.wz0)) < 1e-9
     assert f"{ref.wz0:>13.8f}" in res.output
     run("map", "srp.toml", "--quiet")
@@ -260,7 +260,7 @@ def test_srp_study_solve_and_map(run, tmp_path, no_runner):
 
 
 def test_progress_only_in_a_terminal(monkeypatch, capsys):
-    from librate import cli
+    from librate.app import cli
 
     monkeypatch.setattr(sys.stderr, "isatty", lambda: False, raising=False)
     assert cli._progress(False) is None

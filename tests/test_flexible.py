@@ -9,7 +9,7 @@ import math
 import librate
 import numpy as np
 import pytest
-from librate.flexible import FlexibleModes
+from librate.attitude.flexible import FlexibleModes
 from scipy.linalg import expm
 
 EM = librate.System.preset("earth-moon")

@@ -54,6 +54,6 @@ def test_correct_dro_far_from_the_moon_is_a_dro(em):
     o = librate.correct_dro(em, 0.7)
     ref = librate.dro(em, x0=0.7)
     assert o.family == "dro" and abs(o.period - ref.period) < 1e-10 and abs(o.period - 4.8588) < 1e-3
-    assert librate.continuation.geometry(o).winding == (0, -1)
+    assert librate.orbits.geometry(o).winding == (0, -1)
     with pytest.raises(librate.ConvergenceError, match=r"not a DRO.*\(1, 0\)"):
         librate.correct_dro(em, 0.7, 0.5393417437774825)

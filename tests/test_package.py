@@ -3,8 +3,9 @@
 import importlib.resources
 
 import librate
+import pytest
 from click.testing import CliRunner
-from librate.cli import main
+from librate.app.cli import main
 
 
 def test_public_api_is_declared():
@@ -13,6 +14,16 @@ def test_public_api_is_declared():
     assert librate.__version__.count(".") == 2
     files = importlib.resources.files("librate")
     assert files.joinpath("py.typed").is_file() and files.joinpath("_core.pyi").is_file()
+
+
+@pytest.mark.parametrize(("old", "new"), [("FlatPlateSRP", "FlatPlate"), ("SunModel", "Sun")])
+def test_renamed_classes_keep_a_deprecated_alias(old, new):
+    """The old names still import from librate, with a DeprecationWarning naming the new one."""
+    with pytest.warns(DeprecationWarning, match=f"librate.{new}"):
+        assert getattr(librate, old) is getattr(librate, new)
+    assert old not in librate.__all__ and new in librate.__all__
+    with pytest.raises(AttributeError):
+        librate.NoSuchName  # noqa: B018
 
 
 def test_cli_info_dros_and_demo(tmp_path):

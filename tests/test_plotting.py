@@ -612,7 +612,7 @@ def test_plot_sun_motion_fig33(em, tmp_path):
     equals omega_sun t + theta0 (deg) against t in days and falls by 360 deg per Ts = 29.49 d; a
     line at each multiple of Ts; the Earth-Moon line joins the primaries."""
     theta0 = 0.7
-    fig = lp.plot_sun_motion(em, theta0=theta0, n_periods=2)
+    fig = lp.plot_sun_motion(em, theta_sun0=theta0, n_periods=2)
     assert_png(fig, tmp_path / "fig33.png")
     a_geo, a_ang = fig.axes
     rays = gid(a_geo, "sun-direction")
@@ -689,7 +689,7 @@ def test_srp_map_solutions_and_plot_fig35(eps_map, sun12_orbit, tmp_path):
         assert np.min(np.abs(col - s.phidot0)) < step
     rng = np.random.default_rng(3)
     for i in rng.choice(ds.sizes["solution"], 4, replace=False):
-        plate = librate.FlatPlateSRP(float(ds.sol_eps.values[i]), cs=0.4, cd=0.1)
+        plate = librate.FlatPlate(float(ds.sol_eps.values[i]), cs=0.4, cd=0.1)
         phi0, wz0, n = float(ds.sol_phi0.values[i]), float(ds.sol_wz0.values[i]), int(ds.sol_n.values[i])
         T = 2 * sun12_orbit.period
         tr = librate.propagate_attitude(sun12_orbit.system, sun12_orbit.state0, (phi0, wz0), librate.RigidBody.from_kz(0.6), T,
@@ -725,7 +725,7 @@ def test_srp_map_without_solutions(sun12_orbit):
 @pytest.fixture(scope="module")
 def srp_pair(sun12_orbit):
     g = librate.periodic_attitude(sun12_orbit, kz=0.6, n=0, n_periods=2, wz0=1 - 0.066)
-    s = librate.continue_srp(g, librate.FlatPlateSRP(0.1, cs=0.4, cd=0.1)).solutions[-1]
+    s = librate.continue_srp(g, librate.FlatPlate(0.1, cs=0.4, cd=0.1)).solutions[-1]
     return g, s
 
 
@@ -763,8 +763,8 @@ def test_plot_sun_pointing_fig39(em, sun12_orbit, tmp_path):
     state); a two-sided facet panel of the same geometry gives the same SRP curve."""
     from librate.periodicity import orbit_forcing
 
-    sun = librate.SunModel(theta0=0.4)
-    plate = librate.FlatPlateSRP(0.3, cs=0.4, cd=0.1, sun=sun)
+    sun = librate.Sun(theta0=0.4)
+    plate = librate.FlatPlate(0.3, cs=0.4, cd=0.1, sun=sun)
     offset, kz = 0.2, 0.6
     fig = lp.plot_sun_pointing(em, plate, orbit=sun12_orbit, kz=kz, offset=offset)
     assert_png(fig, tmp_path / "fig39.png")
@@ -790,7 +790,7 @@ def test_plot_sun_pointing_fig39(em, sun12_orbit, tmp_path):
     area, d, iz = 100.0, 0.02, 1.0e7
     ix, iy = 0.5 * (1 - kz) * iz, 0.5 * (1 + kz) * iz
     body = librate.FacetBody.two_sided_panel(area, center=(0, d, 0), ca=0.5, cs=0.4, cd=0.1, inertia=(ix, iy, iz))
-    plate2 = librate.FlatPlateSRP.from_geometry(em, area_m2=area, offset_m=d, iz_kgm2=iz, cs=0.4, cd=0.1, sun=sun)
+    plate2 = librate.FlatPlate.from_geometry(em, area_m2=area, offset_m=d, iz_kgm2=iz, cs=0.4, cd=0.1, sun=sun)
     gg_p, srp_p = lp.sun_pointing_accelerations(em, plate2, t[idx], orbit=sun12_orbit, offset=offset, kz=kz)
     gg_b, srp_b = lp.sun_pointing_accelerations(em, body, t[idx], orbit=sun12_orbit, offset=offset, sun=sun)
     np.testing.assert_allclose(srp_b, srp_p, rtol=1e-12)
@@ -827,7 +827,7 @@ def test_plot_srp_maps_fig40_41(eps_map, sun12_orbit, kz_map, tmp_path):
 
 SRP_BAD = [
     (lambda m, o: lp.plot_sun_motion("earth-moon"), "`system`"),
-    (lambda m, o: lp.plot_sun_motion(o.system, theta0=math.nan), "`theta0`"),
+    (lambda m, o: lp.plot_sun_motion(o.system, theta_sun0=math.nan), "`theta_sun0`"),
     (lambda m, o: lp.plot_sun_motion(o.system, n_periods=0), "`n_periods`"),
     (lambda m, o: lp.plot_sun_motion(o.system, n_directions=0), "`n_directions`"),
     (lambda m, o: lp.plot_sun_motion(o.system, ax=plt.subplots()[1]), "`ax`"),
@@ -850,11 +850,11 @@ SRP_BAD = [
     (lambda m, o: lp.plot_srp_comparison(librate.periodic_attitude(o, kz=0.6, n=0, n_periods=2),
                                          librate.periodic_attitude(librate.dro(o.system, period_days=12.66), kz=0.8, n=0)),
      "`srp_solution`"),
-    (lambda m, o: lp.plot_sun_pointing(o.system, librate.FlatPlateSRP(0.1), orbit=o), "`kz`"),
+    (lambda m, o: lp.plot_sun_pointing(o.system, librate.FlatPlate(0.1), orbit=o), "`kz`"),
     (lambda m, o: lp.plot_sun_pointing(o.system, librate.RigidBody(1, 2, 2.5), orbit=o), "`body_or_plate`"),
-    (lambda m, o: lp.plot_sun_pointing(o.system, librate.FlatPlateSRP(0.1), orbit=o, kz=0.5, sun=librate.SunModel()), "`sun`"),
-    (lambda m, o: lp.plot_sun_pointing(o.system, librate.FlatPlateSRP(0.1), orbit="dro", kz=0.5), "`orbit`"),
-    (lambda m, o: lp.plot_sun_pointing(o.system, librate.FlatPlateSRP(0.1), orbit=o, kz=0.5, n_periods=-1), "`n_periods`"),
+    (lambda m, o: lp.plot_sun_pointing(o.system, librate.FlatPlate(0.1), orbit=o, kz=0.5, sun=librate.Sun()), "`sun`"),
+    (lambda m, o: lp.plot_sun_pointing(o.system, librate.FlatPlate(0.1), orbit="dro", kz=0.5), "`orbit`"),
+    (lambda m, o: lp.plot_sun_pointing(o.system, librate.FlatPlate(0.1), orbit=o, kz=0.5, n_periods=-1), "`n_periods`"),
     (lambda m, o: lp.plot_sun_pointing(o.system, librate.FacetBody.flat_plate(1.0, inertia=(1, 2, 2.5)), orbit=o, kz=0.5), "`kz`"),
 ]
 

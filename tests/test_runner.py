@@ -10,7 +10,7 @@ import time
 import librate
 import numpy as np
 import pytest
-from librate.runner import run_map
+from librate.app.runner import run_map
 
 WZ = np.linspace(-3, 2, 1500)
 KZ = [0.4, 0.8]
@@ -44,7 +44,7 @@ def test_sigkill_and_resume_is_bit_identical(tmp_path, fam, reference):
     out = tmp_path / "map.zarr"
     script = textwrap.dedent(f"""
         import numpy as np, librate
-        from librate.runner import run_map
+        from librate.app.runner import run_map
         em = librate.System.preset("earth-moon")
         fam = librate.dro_family(em, x0={X0!r})
         run_map(fam, kz={KZ!r}, wz0=np.linspace(-3, 2, 1500), out={str(out)!r}, progress=False)
@@ -83,7 +83,7 @@ def test_sigkill_and_resume_is_bit_identical(tmp_path, fam, reference):
 def test_interrupt_keeps_finished_rows(tmp_path, fam, reference, monkeypatch):
     """KeyboardInterrupt (Ctrl-C) during a row: the finished rows stay in the store; resuming
     completes the map identically."""
-    import librate.runner as runner
+    import librate.app.runner as runner
 
     real = runner._row
     calls = {"n": 0}

@@ -29,8 +29,8 @@ def test_plate_model_equals_the_facet_model_in_3d(em, sun12):
     area, d, iz = 100.0, 3.0, 2.0e8  # eps = 0.96
     ix, iy = 0.5 * (1 - 0.6) * iz, 0.5 * (1 + 0.6) * iz  # Kz = 0.6, triangle inequality with equality
     body = librate.FacetBody.two_sided_panel(area, normal=(1, 0, 0), center=(0, d, 0), ca=0.5, cs=0.4, cd=0.1, inertia=(ix, iy, iz))
-    sun = librate.SunModel(theta0=0.7)
-    plate = librate.FlatPlateSRP.from_geometry(em, area_m2=area, offset_m=d, iz_kgm2=iz, cs=0.4, cd=0.1, sun=sun)
+    sun = librate.Sun(theta0=0.7)
+    plate = librate.FlatPlate.from_geometry(em, area_m2=area, offset_m=d, iz_kgm2=iz, cs=0.4, cd=0.1, sun=sun)
     assert 0.01 < plate.eps < 10
     T = 2 * sun12.period
     t = np.linspace(0, T, 9)
@@ -49,7 +49,7 @@ def test_srp_solutions_tend_to_the_gravity_solution(sun12, gravity_solution):
     g = gravity_solution
     dist = []
     for eps in (4e-3, 2e-3, 1e-3):
-        s = librate.periodic_attitude(sun12, kz=0.8, n=-2, n_periods=2, srp=librate.FlatPlateSRP(eps, cs=0.4, cd=0.1),
+        s = librate.periodic_attitude(sun12, kz=0.8, n=-2, n_periods=2, srp=librate.FlatPlate(eps, cs=0.4, cd=0.1),
                                       phi0=g.phi0, wz0=g.wz0, method="newton")
         dist.append(math.hypot(s.wz0 - g.wz0, s.phi0 - g.phi0))
     assert dist[0] / dist[1] == pytest.approx(2, rel=0.02) and dist[1] / dist[2] == pytest.approx(2, rel=0.02)
@@ -60,8 +60,8 @@ def test_srp_solution_repeats_over_k_revolutions_in_the_facet_model(em, sun12, g
     plate solution re-propagated with the 3-D facet model of the same panel (independent)."""
     area, d, iz = 20.0, 2.0, 1.5e8  # eps = P A d TU^2 / Iz = 0.17, below the branch's fold at 0.52
     ix, iy = 0.1 * iz, 0.9 * iz  # Kz = 0.8
-    sun = librate.SunModel()
-    plate = librate.FlatPlateSRP.from_geometry(em, area_m2=area, offset_m=d, iz_kgm2=iz, cs=0.4, cd=0.1, sun=sun)
+    sun = librate.Sun()
+    plate = librate.FlatPlate.from_geometry(em, area_m2=area, offset_m=d, iz_kgm2=iz, cs=0.4, cd=0.1, sun=sun)
     g = gravity_solution
     s = librate.continue_srp(g, plate).solutions[-1]
     assert s.srp.eps == plate.eps and s.residual < 1e-9
@@ -77,7 +77,7 @@ def test_srp_solution_repeats_over_k_revolutions_in_the_facet_model(em, sun12, g
 def test_continuation_reports_the_fold(gravity_solution):
     """Continuing to a large eps, the branch folds: the fold is reported with the trace at 2
     (Phi - I singular), and no solution past it (from another branch) is returned."""
-    c = librate.continue_srp(gravity_solution, librate.FlatPlateSRP(1.0, cs=0.4, cd=0.1))
+    c = librate.continue_srp(gravity_solution, librate.FlatPlate(1.0, cs=0.4, cd=0.1))
     assert not c.reached and c.fold is not None and "fold" in c.end_reason
     assert 0 < c.fold["eps"] < 1.0 and abs(c.fold["trace"] - 2.0) < 1e-3
     assert np.all(np.diff(c.eps) >= 0) and c.eps[-1] <= c.fold["eps"] + 1e-12
@@ -88,19 +88,19 @@ def test_continuation_reports_the_fold(gravity_solution):
     # another branch at eps = 0.43 and run on to 0.66; the branch folds at eps = 0.3775.
     orbit = gravity_solution.orbit
     n0 = [x for x in librate.find_periodic_attitudes(orbit, kz=0.6, wz0_range=(0.0, 0.5), n_periods=2, kinds=("periodic",)) if x.n == 0][0]
-    c0 = librate.continue_srp(n0, librate.FlatPlateSRP(1.0, cs=0.4, cd=0.1))
+    c0 = librate.continue_srp(n0, librate.FlatPlate(1.0, cs=0.4, cd=0.1))
     assert c0.fold["eps"] == pytest.approx(0.3775, abs=1e-3) and c0.eps[-1] < 0.378
-    ok = librate.continue_srp(gravity_solution, librate.FlatPlateSRP(0.05, cs=0.4, cd=0.1))
+    ok = librate.continue_srp(gravity_solution, librate.FlatPlate(0.05, cs=0.4, cd=0.1))
     assert ok.reached and ok.eps[-1] == 0.05 and all(s.residual < 1e-9 for s in ok.solutions)
 
 
 def test_srp_map_on_the_sun_resonant_orbit(sun12):
     """A periodicity map with SRP over K = 2 revolutions: its refined solutions repeat (1e-9) and
     the parameters are stored."""
-    plate = librate.FlatPlateSRP(0.02, cs=0.4, cd=0.1, sun=librate.SunModel(theta0=0.3))
+    plate = librate.FlatPlate(0.02, cs=0.4, cd=0.1, sun=librate.Sun(theta0=0.3))
     ds = librate.periodicity_map(sun12, kz=0.8, wz0=np.linspace(-1.6, 1.2, 400), n_periods=2, srp=plate)
     assert ds.sizes["solution"] > 0 and np.all(ds.sol_residual.values < 1e-9)
-    assert ds.attrs["srp_eps"] == 0.02 and ds.attrs["sun_theta0"] == 0.3 and ds.attrs["n_periods"] == 2
+    assert ds.attrs["srp_eps"] == 0.02 and ds.attrs["theta_sun0"] == 0.3 and ds.attrs["n_periods"] == 2
     # the symmetry is broken: the solutions' phi0 are free (not all zero)
     assert np.max(np.abs(ds.sol_phi0.values)) > 1e-6
 
@@ -122,10 +122,10 @@ BAD = [
     ("coefficients not summing to one", lambda: librate.Facet(1.0, (1, 0, 0), ca=0.5, cs=0.5, cd=0.5), "sum"),
     ("negative area", lambda: librate.Facet(-1.0, (1, 0, 0)), "area"),
     ("zero normal", lambda: librate.Facet(1.0, (0, 0, 0)), "normal"),
-    ("plate cs + cd > 1", lambda: librate.FlatPlateSRP(0.1, cs=0.8, cd=0.5), "cs"),
-    ("plate eps not finite", lambda: librate.FlatPlateSRP(math.inf), "eps"),
+    ("plate cs + cd > 1", lambda: librate.FlatPlate(0.1, cs=0.8, cd=0.5), "cs"),
+    ("plate eps not finite", lambda: librate.FlatPlate(math.inf), "eps"),
     ("facet body without facets", lambda: librate.FacetBody(1.0, 2.0, 2.5), "facets"),
-    ("negative pressure", lambda: librate.SunModel(pressure=-1.0), "pressure"),
+    ("negative pressure", lambda: librate.Sun(pressure=-1.0), "pressure"),
 ]
 
 
@@ -145,18 +145,21 @@ def test_free_sun_phase_finds_the_symmetric_phases(sun12, gravity_solution):
     """PHYSICS.md sec. 6: with phi0 = 0 kept, solutions survive only for special Sun phases (a
     multiple of pi/K for this plate). Freeing the Sun phase from 0.3 converges to such a phase
     (K = 2: a multiple of pi/2, to 1e-9), and the solution repeats (1e-9)."""
-    plate = librate.FlatPlateSRP(0.05, cs=0.4, cd=0.1, sun=librate.SunModel(theta0=0.3))
-    s = librate.periodic_attitude(sun12, kz=0.8, n=-2, n_periods=2, srp=plate, wz0=gravity_solution.wz0, free="sun_phase")
+    plate = librate.FlatPlate(0.05, cs=0.4, cd=0.1, sun=librate.Sun(theta0=0.3))
+    s = librate.periodic_attitude(sun12, kz=0.8, n=-2, n_periods=2, srp=plate, wz0=gravity_solution.wz0, free="theta_sun0")
     assert s.phi0 == 0.0 and s.residual < 1e-9
     k = s.srp.sun.theta0 / (math.pi / 2)
     assert abs(k - round(k)) < 1e-9
+    # the old spelling free="sun_phase" still works, with a DeprecationWarning
+    with pytest.warns(DeprecationWarning, match="theta_sun0"), pytest.raises(ValueError, match="needs srp"):
+        librate.periodic_attitude(sun12, kz=0.8, n=-2, n_periods=2, free="sun_phase")
 
 
 def test_map_over_several_plates(sun12):
     """A list of plates adds an srp dimension; the eps = 0 slice equals the gravity-only map bit
     for bit; solutions carry their plate index."""
     wz = np.linspace(-1.6, 1.2, 150)
-    plates = [librate.FlatPlateSRP(e, cs=0.4, cd=0.1) for e in (0.0, 0.03)]
+    plates = [librate.FlatPlate(e, cs=0.4, cd=0.1) for e in (0.0, 0.03)]
     ds = librate.periodicity_map(sun12, kz=0.8, wz0=wz, n_periods=2, srp=plates)
     assert ds.dwz.dims == ("orbit", "srp", "kz", "wz0") and ds.srp_eps.values.tolist() == [0.0, 0.03]
     grav = librate.periodicity_map(sun12, kz=0.8, wz0=wz, n_periods=2, solve=False)

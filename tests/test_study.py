@@ -1,6 +1,6 @@
 """Studies (TOML, validated by pydantic before any work) and results on disk (open_result).
 
-Reference for the error paths: the rules written in ``librate.study.ALLOWED`` and the module
+Reference for the error paths: the rules written in ``librate.app.study.ALLOWED`` and the module
 docstring; every message must name the key (dotted), the value given and what is allowed.
 Round trips are checked for exact equality of the saved numbers.
 """
@@ -13,8 +13,8 @@ import librate
 import numpy as np
 import pytest
 import tomllib
-from librate.results import read_attrs, save_dataset, save_family
-from librate.study import EXAMPLE_STUDY, Study, StudyError, apply_overrides
+from librate.app.results import read_attrs, save_dataset, save_family
+from librate.app.study import EXAMPLE_STUDY, Study, StudyError, apply_overrides
 
 TINY = {"orbits.x0": {"start": 0.9, "stop": 0.5, "num": 3}, "rates.wz0.num": 50}
 
@@ -79,7 +79,7 @@ def test_inertia_custom_system_and_srp_geometry():
         "system": {"mu": 0.0121505856, "lu_km": 384400.0, "tu_s": 375190.25852, "radii_km": [6378.0, 1737.0], "name": "my-em"},
         "orbits": {"sun_resonance": [2]},
         "body": {"ix": 12.12e6, "iy": 89.68e6, "iz": 96.95e6, "mass_kg": 4.0e5},
-        "torques": {"srp": {"area_m2": 100.0, "offset_m": 2.0, "cs": 0.4, "theta0": 0.3}},
+        "torques": {"srp": {"area_m2": 100.0, "offset_m": 2.0, "cs": 0.4, "theta_sun0": 0.3}},
         "rates": {"wz0": {"start": -1.6, "stop": 1.2, "num": 50}},
     }, purpose="solve")
     sys_ = st.build_system()
@@ -92,6 +92,19 @@ def test_inertia_custom_system_and_srp_geometry():
     assert plate.eps == pytest.approx(4.56e-6 * 100.0 * 2.0 * 375190.25852**2 / 96.95e6, rel=1e-12)
     assert (plate.cs, plate.cd, plate.sun.theta0) == (0.4, 0.0, 0.3)
     assert st.n_periods() == 2  # the 1:2 Sun-resonant orbit: one Sun period
+
+
+def test_old_sun_phase_key_still_read_with_a_warning():
+    """[torques.srp] theta0 was renamed theta_sun0: the old key still works, with a FutureWarning
+    naming the new one; giving both is an error."""
+    data = {"orbits": {"sun_resonance": [2]}, "body": {"kz": 0.6}, "torques": {"srp": {"eps": 0.02, "theta0": 0.3}},
+            "rates": {"wz0": {"start": -1.6, "stop": 1.2, "num": 50}}}
+    with pytest.warns(FutureWarning, match="theta_sun0"):
+        st = Study.from_dict(data, purpose="solve")
+    assert st.build_srp().sun.theta0 == 0.3 and data["torques"]["srp"] == {"eps": 0.02, "theta0": 0.3}
+    data["torques"]["srp"]["theta_sun0"] = 0.3
+    with pytest.raises(StudyError, match="give only theta_sun0"):
+        Study.from_dict(data)
 
 
 def test_json_round_trip_and_overrides(base):
@@ -250,7 +263,7 @@ def test_selected_members_are_saved_as_a_family(tmp_path):
 def test_map_and_solutions_round_trip(tmp_path, base, monkeypatch):
     import sys
 
-    monkeypatch.setitem(sys.modules, "librate.runner", None)  # the periodicity_map fallback
+    monkeypatch.setitem(sys.modules, "librate.app.runner", None)  # the periodicity_map fallback
     st = Study.from_dict(base, purpose="map")
     ds, path = st.run_map(tmp_path / "m")
     assert path == tmp_path / "m" / "map.zarr"
@@ -324,7 +337,7 @@ def test_the_stored_study_writes_the_defaults_out():
 def test_a_map_is_exported_to_netcdf_too(tmp_path, base, monkeypatch):
     import sys
 
-    monkeypatch.setitem(sys.modules, "librate.runner", None)
+    monkeypatch.setitem(sys.modules, "librate.app.runner", None)
     st = Study.from_dict(edit(edit(base, "output.format", "netcdf"), "body.kz", [0.5, 0.8]), purpose="map")
     ds, path = st.run_map(tmp_path)
     nc = librate.open_result(tmp_path / "map.nc")
@@ -337,7 +350,7 @@ def test_a_map_is_exported_to_netcdf_too(tmp_path, base, monkeypatch):
 
 
 def _flex_study(tmp_path, flexible, purpose="solve"):
-    from librate.study import Study
+    from librate.app.study import Study
 
     d = {"orbits": {"kind": "dro", "x0": [0.8, 0.75]}, "body": {"flexible": flexible},
          "rates": {"wz0": {"start": -2.0, "stop": 1.5, "num": 200}}}
@@ -366,7 +379,7 @@ def test_flexible_body_in_a_study(tmp_path):
     ({"flexible": "tower"}, "body.flexible"),
 ])
 def test_flexible_body_errors(body, key):
-    from librate.study import Study, StudyError
+    from librate.app.study import Study, StudyError
 
     d = {"orbits": {"kind": "dro", "x0": [0.8]}, "body": body, "rates": {"wz0": {"start": -2.0, "stop": 1.5, "num": 20}}}
     with pytest.raises(StudyError) as info:
@@ -375,7 +388,7 @@ def test_flexible_body_errors(body, key):
 
 
 def test_flexible_body_cannot_be_mapped(tmp_path):
-    from librate.study import StudyError
+    from librate.app.study import StudyError
 
     with pytest.raises(StudyError) as info:
         _flex_study(tmp_path, "sample-station", purpose="map")

@@ -5,14 +5,53 @@ All quantities are nondimensional (CR3BP units) unless a name says otherwise
 (``period_days``, ``distance_km``).
 """
 
+import warnings as _warnings
+
 from ._core import __version__
 from ._errors import ConvergenceError, IntegrationError, LibrateError
-from .attitude import AttitudeTrajectory, RigidBody, propagate_attitude, quaternion_from_euler
-from .families import OrbitFamily, correct_dro, dro, dro_family, halo, halo_family, lyapunov, lyapunov_family
-from .flexible import Appendage, FlexibleBody, flexible_periodic, frequency_scan, quasi_static
-from .fourier import FourierOrbit, fit_fourier
-from .frames import MeanElements, OsculatingElements, eci_to_synodic, mean_elements, osculating_elements, synodic_to_eci
-from .orbits import PeriodicOrbit, correct_periodic, correct_symmetric
+from .app import Study, StudyError, open_result, run_map
+from .attitude import (
+    Appendage,
+    AttitudeTrajectory,
+    Facet,
+    FacetBody,
+    FlatPlate,
+    FlexibleBody,
+    RigidBody,
+    Sun,
+    propagate_attitude,
+    quasi_static,
+    quaternion_from_euler,
+)
+from .orbits import (
+    BatchResult,
+    Event,
+    EventHit,
+    FourierOrbit,
+    MeanElements,
+    OrbitFamily,
+    OsculatingElements,
+    PeriodicOrbit,
+    Stats,
+    System,
+    Trajectory,
+    correct_dro,
+    correct_periodic,
+    correct_symmetric,
+    dro,
+    dro_family,
+    eci_to_synodic,
+    fit_fourier,
+    halo,
+    halo_family,
+    lyapunov,
+    lyapunov_family,
+    mean_elements,
+    osculating_elements,
+    propagate,
+    propagate_many,
+    synodic_to_eci,
+)
 from .periodicity import (
     AttitudeFamily,
     AttitudeSolution,
@@ -20,15 +59,11 @@ from .periodicity import (
     attitude_family,
     continue_srp,
     find_periodic_attitudes,
+    flexible_periodic,
+    frequency_scan,
     periodic_attitude,
     periodicity_map,
 )
-from .propagation import BatchResult, Event, EventHit, Stats, Trajectory, propagate, propagate_many
-from .results import open_result
-from .runner import run_map
-from .srp import Facet, FacetBody, FlatPlateSRP, SunModel
-from .study import Study, StudyError
-from .system import System
 
 __all__ = [
     "__version__",
@@ -57,10 +92,10 @@ __all__ = [
     "periodicity_map",
     "AttitudeFamily",
     "attitude_family",
-    "SunModel",
+    "Sun",
     "Facet",
     "FacetBody",
-    "FlatPlateSRP",
+    "FlatPlate",
     "continue_srp",
     "run_map",
     "SrpContinuation",
@@ -88,3 +123,14 @@ __all__ = [
     "StudyError",
     "open_result",
 ]
+
+#: Old names kept importable for a while: ``librate.<old>`` warns and returns the new object.
+_DEPRECATED = {"FlatPlateSRP": ("FlatPlate", FlatPlate), "SunModel": ("Sun", Sun)}
+
+
+def __getattr__(name: str):
+    if name in _DEPRECATED:
+        new, obj = _DEPRECATED[name]
+        _warnings.warn(f"librate.{name} is deprecated; use librate.{new}", DeprecationWarning, stacklevel=2)
+        return obj
+    raise AttributeError(f"module 'librate' has no attribute {name!r}")

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 
@@ -43,3 +45,16 @@ def as_direction(direction, name: str = "direction") -> int:
     if direction not in (-1, 0, 1):
         raise ValueError(f"invalid argument `{name}`: must be -1 (decreasing), 0 (both) or +1 (increasing), got {direction!r}")
     return int(direction)
+
+
+def as_number(value, name: str, *, positive: bool = False) -> float:
+    ok = isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, bool) and math.isfinite(value)
+    if not ok or (positive and value <= 0):
+        raise ValueError(f"invalid argument `{name}`: must be a finite number{' > 0' if positive else ''}, got {value!r}")
+    return float(value)
+
+
+def as_count(value, name: str, minimum: int) -> int:
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < minimum:
+        raise ValueError(f"invalid argument `{name}`: must be an integer >= {minimum}, got {value!r}")
+    return int(value)

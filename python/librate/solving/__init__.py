@@ -1,1 +1,1 @@
-"""The numerical solving layer: the continuation driver shared by every family in librate."""
+"""The numerical solving layer: continuation driver."""

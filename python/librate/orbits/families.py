@@ -1,6 +1,6 @@
 """Families of symmetric periodic orbits: DROs, planar Lyapunov orbits, halos and NRHOs.
 
-A family is computed by continuation (``librate.continuation``), every member's stability from
+A family is computed by continuation (``librate.orbits.continuation``), every member's stability from
 its monodromy matrix (batch-propagated on all cores), and bifurcations located where a
 stability index crosses +1 or -1. :class:`OrbitFamily` holds the members, finds members by x0,
 z0, period or Jacobi constant by root finding on the family (returning a corrected orbit),
@@ -15,11 +15,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import _core
-from ._errors import ConvergenceError, LibrateError
-from .constants import SUN_SYNODIC_PERIOD
+from .. import _core
+from .._errors import ConvergenceError, LibrateError
+from ..constants import SUN_SYNODIC_PERIOD
 from .continuation import continue_arclength, continue_natural, geometry
-from .orbits import SHOOT_ATOL, SHOOT_RTOL, PeriodicOrbit, correct_symmetric
+from .periodic import SHOOT_ATOL, SHOOT_RTOL, PeriodicOrbit, correct_symmetric
 from .propagation import propagate_many
 from .system import System, resolve_system
 
@@ -178,7 +178,7 @@ class OrbitFamily:
         """The family as an xarray Dataset with units and the system's constants as attributes."""
         import xarray as xr
 
-        from . import __version__
+        from .._core import __version__
 
         comp = ["x", "y", "z", "xd", "yd", "zd"]
         ds = xr.Dataset(

@@ -24,7 +24,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._checks import as_state
+from .._checks import as_state
 from .propagation import propagate
 from .system import System, resolve_system
 

@@ -2,9 +2,9 @@
 
 Two models: the general one (any list of :class:`Facet`, force and torque, lit only when facing
 the Sun; no self-shadowing) attached to a body as a :class:`FacetBody`, used by the 3-D model;
-and the simplified planar one, a two-sided flat plate with a single amplitude, :class:`FlatPlateSRP`,
+and the simplified planar one, a two-sided flat plate with a single amplitude, :class:`FlatPlate`,
 used by the planar model, periodic solutions and periodicity maps. The Sun direction turns
-clockwise in the synodic frame at omega_sun = -(1 - n_sun); ``SunModel.theta0`` is its phase at
+clockwise in the synodic frame at omega_sun = -(1 - n_sun); ``Sun.theta0`` is its phase at
 t = 0.
 """
 
@@ -15,15 +15,15 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import _core
-from .attitude import RigidBody
-from .constants import OMEGA_SUN, SOLAR_PRESSURE_1AU
+from .. import _core
+from ..constants import OMEGA_SUN, SOLAR_PRESSURE_1AU
+from .body import RigidBody
 
-__all__ = ["SunModel", "Facet", "FacetBody", "FlatPlateSRP"]
+__all__ = ["Sun", "Facet", "FacetBody", "FlatPlate"]
 
 
 @dataclass(frozen=True)
-class SunModel:
+class Sun:
     """The apparent Sun: phase ``theta0`` (rad, from the synodic X axis at t = 0) and pressure
     (N/m^2, 4.56e-6 at 1 AU)."""
 
@@ -132,7 +132,7 @@ class FacetBody(RigidBody):
 
 
 @dataclass(frozen=True)
-class FlatPlateSRP:
+class FlatPlate:
     """The simplified planar SRP model (PHYSICS.md sec. 6): one two-sided flat plate with normal
     x_B and centre of pressure offset d along y_B; with alpha the Sun's angle in body axes,
     wzdot_srp = eps [(1 + Cs) cos(alpha)|cos(alpha)| + (2/3) Cd cos(alpha)],
@@ -143,7 +143,7 @@ class FlatPlateSRP:
     eps: float
     cs: float = 0.0
     cd: float = 0.0
-    sun: SunModel = field(default_factory=SunModel)
+    sun: Sun = field(default_factory=Sun)
 
     def __post_init__(self):
         if not math.isfinite(self.eps):
@@ -153,23 +153,23 @@ class FlatPlateSRP:
                 raise ValueError(f"invalid argument `{name}`: must be in [0, 1], got {v!r}")
         if self.cs + self.cd > 1 + 1e-12:
             raise ValueError(f"invalid argument `cs`: cs + cd must not exceed one (ca = 1 - cs - cd), got {self.cs + self.cd}")
-        if not isinstance(self.sun, SunModel):
-            raise ValueError("invalid argument `sun`: must be a librate.SunModel")
+        if not isinstance(self.sun, Sun):
+            raise ValueError("invalid argument `sun`: must be a librate.Sun")
 
     @property
     def ca(self) -> float:
         return 1.0 - self.cs - self.cd
 
     @classmethod
-    def from_geometry(cls, system, *, area_m2: float, offset_m: float, iz_kgm2: float, cs: float = 0.0, cd: float = 0.0, sun: SunModel | None = None):
+    def from_geometry(cls, system, *, area_m2: float, offset_m: float, iz_kgm2: float, cs: float = 0.0, cd: float = 0.0, sun: Sun | None = None):
         """eps = P A d TU^2 / Iz from the plate's area, offset and the body's Iz (SI units)."""
-        sun = sun or SunModel()
+        sun = sun or Sun()
         if not (area_m2 > 0 and iz_kgm2 > 0 and math.isfinite(offset_m)):
             raise ValueError("invalid argument: need area_m2 > 0, iz_kgm2 > 0 and a finite offset_m")
         return cls(sun.pressure * area_m2 * offset_m * system.tu_s**2 / iz_kgm2, cs, cd, sun)
 
-    def with_eps(self, eps: float) -> FlatPlateSRP:
-        return FlatPlateSRP(float(eps), self.cs, self.cd, self.sun)
+    def with_eps(self, eps: float) -> FlatPlate:
+        return FlatPlate(float(eps), self.cs, self.cd, self.sun)
 
     def wzdot(self, t, phi) -> np.ndarray:
         """The SRP angular acceleration (1/TU^2) at times t and attitudes phi."""

@@ -6,8 +6,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import _core
-from ._checks import as_states
+from .. import _core
+from .._checks import as_states
 
 __all__ = ["System"]
 
@@ -117,3 +117,10 @@ def resolve_system(system) -> System:
     if isinstance(system, str):
         return System.preset(system)
     raise ValueError(f"invalid argument `system`: must be a librate.System or a preset name ({', '.join(System.presets())}), got {system!r}")
+
+
+def check_system(system) -> System:
+    """``system`` itself when it is a :class:`System` (no names resolved)."""
+    if not isinstance(system, System):
+        raise ValueError(f"invalid argument `system`: must be a librate.System, got {type(system).__name__}")
+    return system

@@ -46,7 +46,7 @@ def result_kind(ds) -> str | None:
     return None
 
 
-def _resolve(path: str | Path) -> Path:
+def resolve_result_path(path: str | Path) -> Path:
     p = Path(path)
     if not p.exists():
         raise FileNotFoundError(f"no result at {str(p)!r}")
@@ -76,7 +76,7 @@ def _open_dataset(p: Path):
 def read_attrs(path: str | Path) -> dict:
     """The attributes of a saved result (``librate_result``, ``study`` as JSON,
     ``librate_version``, units and constants), without loading its data."""
-    p = _resolve(path)
+    p = resolve_result_path(path)
     ds = _open_dataset(p)
     try:
         return dict(ds.attrs)
@@ -92,9 +92,9 @@ def open_result(path: str | Path):
     ``path``: a ``.zarr`` folder or a ``.nc`` file, or an output folder holding exactly one of
     map/family/solutions. Raises ``FileNotFoundError`` or ``ValueError`` (not a librate result).
     """
-    from .families import OrbitFamily
+    from ..orbits.families import OrbitFamily
 
-    p = _resolve(path)
+    p = resolve_result_path(path)
     ds = _open_dataset(p)
     kind = result_kind(ds)
     if kind is None:
@@ -165,10 +165,10 @@ def solutions_dataset(rows, orbits, kz, attrs: dict | None = None):
     """The periodic solutions ``rows`` ((orbit index, AttitudeSolution) pairs) as a Dataset over
     ``solution``, with the orbits (x0, period) and Kz values as coordinates and units."""
 
-    from .periodicity import _solutions_dataset
+    from ..periodicity.maps import map_solutions_dataset
 
     olist = list(orbits)
-    ds = _solutions_dataset(rows)
+    ds = map_solutions_dataset(rows)
     idx = ds["sol_orbit"].values
     x0 = np.array([o.x0 for o in olist])
     per = np.array([o.period for o in olist])
@@ -214,7 +214,7 @@ def run_map_to(
     attrs: dict[str, Any] | None = None,
 ):
     """A periodicity map written to the Zarr ``store`` (a ``.zarr`` folder). Uses
-    ``librate.runner.run_map`` (chunked, resumable, optionally on a Dask scheduler) when it is
+    ``librate.app.runner.run_map`` (chunked, resumable, optionally on a Dask scheduler) when it is
     installed; otherwise :func:`librate.periodicity_map` in this process, written with
     ``to_zarr`` (an existing store with the same study and complete is reused; a store of
     another study is refused unless ``resume=False``; a foreign folder is always refused).
@@ -234,8 +234,8 @@ def run_map_to(
                 kw[name] = value
         return run_map(orbits, **kw), store
     if scheduler is not None:
-        raise RuntimeError("a Dask scheduler needs librate.runner (chunked, distributed maps), which is not installed in this librate")
-    from .periodicity import periodicity_map
+        raise RuntimeError("a Dask scheduler needs librate.app.runner (chunked, distributed maps), which is not installed in this librate")
+    from ..periodicity.maps import periodicity_map
 
     if store.exists():
         try:

@@ -10,7 +10,7 @@ written before the study is valid.
 
 The ``build_*`` helpers turn a valid study into librate objects (:class:`~librate.System`, the
 :class:`~librate.OrbitFamily` or a list of :class:`~librate.PeriodicOrbit`, the Kz values, the
-:class:`~librate.FlatPlateSRP` plate, the array of inertial initial rates); the ``run_*``
+:class:`~librate.FlatPlate` plate, the array of inertial initial rates); the ``run_*``
 methods do what the ``librate family``, ``librate solve`` and ``librate map`` commands do.
 
 Units: rates in 1/TU (nondimensional: the synodic frame turns at rate 1), angles in rad, the
@@ -25,12 +25,13 @@ import json
 import math
 import re
 import sys
+import warnings
 from collections.abc import Callable
 from pathlib import Path
 from typing import Annotated, Any, Literal
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Discriminator, Field, Tag, ValidationError
+from pydantic import BaseModel, ConfigDict, Discriminator, Field, Tag, ValidationError, model_validator
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -150,8 +151,20 @@ class SrpSection(_Table):
     offset_m: float | None = None
     cs: float = Field(0.0, ge=0, le=1)
     cd: float = Field(0.0, ge=0, le=1)
-    theta0: float = 0.0
+    theta_sun0: float = 0.0
     pressure: float | None = Field(None, ge=0)
+
+    @model_validator(mode="before")
+    @classmethod
+    def _old_theta0(cls, data: Any) -> Any:
+        """The Sun's phase was `theta0` before it became `theta_sun0`: still read, with a warning."""
+        if isinstance(data, dict) and "theta0" in data:
+            if "theta_sun0" in data:
+                raise ValueError("theta0 is the old name of theta_sun0; give only theta_sun0")
+            warnings.warn("[torques.srp] theta0 is deprecated and will be removed: write theta_sun0 "
+                          "(the same Sun phase at t = 0, rad)", FutureWarning, stacklevel=2)
+            data = {("theta_sun0" if k == "theta0" else k): v for k, v in data.items()}
+        return data
 
 
 class TorquesSection(_Table):
@@ -228,7 +241,7 @@ ALLOWED: dict[str, str] = {
     "torques.srp.offset_m": "a finite number, the centre-of-pressure offset along y_B in m",
     "torques.srp.cs": "a number in [0, 1], the specular reflection fraction (cs + cd <= 1)",
     "torques.srp.cd": "a number in [0, 1], the diffuse reflection fraction (cs + cd <= 1)",
-    "torques.srp.theta0": "a finite number, the Sun's phase at t = 0 in rad",
+    "torques.srp.theta_sun0": "a finite number, the Sun's phase at t = 0 in rad",
     "torques.srp.pressure": "a number >= 0, the solar pressure in N/m^2 (default 4.56e-6)",
     "rates.wz0": "a list of inertial initial rates (1/TU), strictly increasing, or a table {start, stop, num} with start < stop, num >= 2",
     "rates.phidot0": "a list of initial rates relative to the synodic frame (1/TU), strictly increasing, or a table {start, stop, num} with start < stop, num >= 2",
@@ -255,7 +268,7 @@ def _allowed(key: str) -> str | None:
         last = key.rsplit(".", 1)[-1]
         text = _RANGE_ALLOWED.get(last)
     if text and "{presets}" in text:
-        from .system import System
+        from ..orbits.system import System
 
         text = text.format(presets=", ".join(repr(p) for p in System.presets()))
     return text
@@ -370,7 +383,7 @@ def _check_increasing(key: str, g, problems: list[str]) -> None:
 def _check_sections(s: dict[str, _Table], given: dict, purpose: str | None) -> list[str]:
     """Consistency checks on the sections that passed type validation (``s``); ``given`` is the
     raw study as written (to tell a missing section from a defaulted one)."""
-    from .system import System
+    from ..orbits.system import System
 
     problems: list[str] = []
     # [system]
@@ -639,7 +652,7 @@ class Study(BaseModel):
     # --- librate objects -----------------------------------------------------------------------
     def build_system(self):
         """The :class:`~librate.System`."""
-        from .system import System
+        from ..orbits.system import System
 
         s = self.system
         if s.mu is None:
@@ -651,7 +664,7 @@ class Study(BaseModel):
         """The orbit family this study works on (computed by continuation, takes 0.1 s to a few
         s): for DROs with ``orbits.x0``, exactly those members; otherwise the whole family (DRO
         0.985 -> 0.005; Lyapunov or halo at ``orbits.point`` up to ``orbits.max_members``)."""
-        from .families import dro_family, halo_family, lyapunov_family
+        from ..orbits.families import dro_family, halo_family, lyapunov_family
 
         system = system or self.build_system()
         o = self.orbits
@@ -709,7 +722,7 @@ class Study(BaseModel):
     def build_flexible(self):
         """The :class:`~librate.FlexibleBody` of ``body.flexible`` (a preset, or a TOML file
         relative to the study's folder), or None."""
-        from .flexible import FlexibleBody
+        from ..attitude.flexible import FlexibleBody
 
         b = self.body
         if b is None or b.flexible is None:
@@ -724,7 +737,7 @@ class Study(BaseModel):
     def build_body(self):
         """The :class:`~librate.RigidBody` (moments in kg m^2 when given; else normalised from
         the single Kz), or None without [body] or with several Kz values."""
-        from .attitude import RigidBody
+        from ..attitude.body import RigidBody
 
         b = self.body
         if b is None:
@@ -735,16 +748,16 @@ class Study(BaseModel):
         return RigidBody.from_kz(float(kz[0])) if kz.size == 1 else None
 
     def build_srp(self, system=None):
-        """The :class:`~librate.FlatPlateSRP` plate of [torques.srp], or None."""
-        from .srp import FlatPlateSRP, SunModel
+        """The :class:`~librate.FlatPlate` plate of [torques.srp], or None."""
+        from ..attitude.srp import FlatPlate, Sun
 
         p = self.torques.srp
         if p is None:
             return None
-        sun = SunModel(theta0=p.theta0) if p.pressure is None else SunModel(theta0=p.theta0, pressure=p.pressure)
+        sun = Sun(theta0=p.theta_sun0) if p.pressure is None else Sun(theta0=p.theta_sun0, pressure=p.pressure)
         if p.eps is not None:
-            return FlatPlateSRP(p.eps, p.cs, p.cd, sun)
-        return FlatPlateSRP.from_geometry(system or self.build_system(), area_m2=p.area_m2, offset_m=p.offset_m, iz_kgm2=self.body.iz,
+            return FlatPlate(p.eps, p.cs, p.cd, sun)
+        return FlatPlate.from_geometry(system or self.build_system(), area_m2=p.area_m2, offset_m=p.offset_m, iz_kgm2=self.body.iz,
                                           cs=p.cs, cd=p.cd, sun=sun)
 
     def wz0_values(self) -> np.ndarray:
@@ -781,7 +794,7 @@ class Study(BaseModel):
     def result_attrs(self, kind: str) -> dict:
         """Attributes every result carries: the result kind, the full study (JSON) and the
         package version."""
-        from . import __version__
+        from .._core import __version__
 
         return {"librate_result": kind, "study": self.to_json(), "librate_version": __version__}
 
@@ -806,7 +819,7 @@ class Study(BaseModel):
         saved as ``solutions.zarr`` (or ``.nc``). Returns ``(dataset, path)``; the Dataset has a
         ``solution`` dimension (orbit index, x0, period, Kz, N, kind, wz0, phidot0, phi0,
         stability, residual)."""
-        from .periodicity import find_periodic_attitudes
+        from ..periodicity.solutions import find_periodic_attitudes
         from .results import save_dataset, solutions_dataset
 
         orbits = self.build_orbits()
@@ -828,7 +841,7 @@ class Study(BaseModel):
         flex = self.build_flexible()
         if flex is not None and rows:
             # Flexibility's first-order effect on each rigid solution (closed form, PHYSICS.md sec. 7).
-            from .flexible import flexible_periodic
+            from ..periodicity.flexible import flexible_periodic
 
             res = [flexible_periodic(sol, flex, resolve=False) for _, sol in rows]
             ds["flex_dphi0"] = ("solution", np.array([r.shift[0] for r in res]), {"units": "rad", "long_name": "first-order shift of phi0 from flexibility"})
@@ -840,7 +853,7 @@ class Study(BaseModel):
 
     def run_map(self, out: str | Path | None = None, *, scheduler=None, progress=None, resume: bool = True):
         """The attitude periodicity map (grids of wz(T) - wz0 and phi(T) - phi0 over orbit x Kz
-        x wz0, and the refined solutions) through ``librate.runner.run_map`` into
+        x wz0, and the refined solutions) through ``librate.app.runner.run_map`` into
         ``map.zarr`` in the output folder (resumable), or, when the runner is not installed,
         through :func:`librate.periodicity_map` written with ``to_zarr``. With
         ``output.format = "netcdf"`` a ``map.nc`` copy is exported too. Returns
@@ -863,7 +876,7 @@ class Study(BaseModel):
 
 
 def _sun_period() -> float:
-    from .constants import SUN_SYNODIC_PERIOD
+    from ..constants import SUN_SYNODIC_PERIOD
 
     return SUN_SYNODIC_PERIOD
 
@@ -880,7 +893,7 @@ def _subset(fam, idx):
 
 def _family_of(fam, orbits):
     """An OrbitFamily holding the corrected members ``orbits`` of ``fam`` (for saving)."""
-    from .families import OrbitFamily
+    from ..orbits.families import OrbitFamily
 
     return OrbitFamily.from_members(fam.system, fam.kind, fam.spatial, [_with_crossing(o) for o in orbits], fam.end_reason,
                                     {**fam.parameters, "selected": True})
@@ -892,13 +905,13 @@ def _with_crossing(o):
         return o
     import dataclasses
 
-    from .propagation import propagate
+    from ..orbits.propagation import propagate
 
     half = propagate(o.system, o.state0, 0.5 * o.period, rtol=1e-13, atol=1e-13).y[-1]
     return dataclasses.replace(o, _evaluation={"crossing": half})
 
 
-def _parse_value(text: str) -> Any:
+def parse_value(text: str) -> Any:
     try:
         return tomllib.loads(f"v = {text}")["v"]
     except tomllib.TOMLDecodeError:
@@ -912,7 +925,7 @@ def apply_overrides(data: dict, overrides: dict) -> dict:
     out = copy.deepcopy(data)
     for key, value in overrides.items():
         if isinstance(value, str):
-            value = _parse_value(value)
+            value = parse_value(value)
         parts = key.split(".")
         d = out
         for p in parts[:-1]:
@@ -963,7 +976,7 @@ gravity_gradient = ["earth", "moon"]   # the planar engine models both primaries
 # [torques.srp]                # solar radiation pressure, a two-sided flat plate
 # eps = 0.02                   # amplitude P A d TU^2 / Iz; or area_m2 = 100 and offset_m = 2 (needs ix/iy/iz)
 # cs = 0.4                     # specular fraction; cd: diffuse fraction (cs + cd <= 1)
-# theta0 = 0.0                 # Sun phase at t = 0 (rad)
+# theta_sun0 = 0.0             # Sun phase at t = 0 (rad)
 # (SRP needs one Sun-resonant orbit: [orbits] sun_resonance = [2], and solver.n_periods = 2)
 
 [rates]

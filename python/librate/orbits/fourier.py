@@ -21,9 +21,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import _core
-from ._checks import as_state
-from ._errors import ConvergenceError
+from .. import _core
+from .._checks import as_state
+from .._errors import ConvergenceError
 from .propagation import propagate
 from .system import System, resolve_system
 

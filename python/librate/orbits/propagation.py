@@ -9,8 +9,8 @@ from typing import Literal
 
 import numpy as np
 
-from . import _core
-from ._checks import as_direction, as_state, as_states, as_time_span
+from .. import _core
+from .._checks import as_direction, as_state, as_states, as_time_span
 from .system import System, resolve_system
 
 __all__ = ["Event", "EventHit", "Stats", "Trajectory", "BatchResult", "propagate", "propagate_many"]
@@ -132,7 +132,7 @@ class BatchResult:
     stats: np.ndarray | None = None
 
 
-def _options(rtol, atol, h0, h_min, h_max, max_steps, safety, fixed_step) -> dict:
+def integration_options(rtol, atol, h0, h_min, h_max, max_steps, safety, fixed_step) -> dict:
     if not isinstance(max_steps, (int, np.integer)) or max_steps < 1:
         raise ValueError(f"invalid argument `max_steps`: must be an integer >= 1, got {max_steps!r}")
     return dict(
@@ -191,7 +191,7 @@ def propagate(
     te = None if t_eval is None else np.ascontiguousarray(t_eval, dtype=np.float64).ravel()
     r = _core.propagate(
         sys_.mu, s, t0, tf, stm=bool(stm), t_eval=te, events=[e._spec(sys_) for e in evs],
-        options=_options(rtol, atol, h0, h_min, h_max, max_steps, safety, fixed_step),
+        options=integration_options(rtol, atol, h0, h_min, h_max, max_steps, safety, fixed_step),
     )
     return Trajectory(
         system=sys_,
@@ -246,7 +246,7 @@ def propagate_many(
         raise ValueError(f"invalid argument `threads`: must be an integer >= 1 or None (all cores), got {threads!r}")
     r = _core.propagate_many(
         sys_.mu, arr, float(t0), tf, stm=bool(stm), threads=None if threads is None else int(threads),
-        options=_options(rtol, atol, h0, h_min, h_max, max_steps, safety, fixed_step),
+        options=integration_options(rtol, atol, h0, h_min, h_max, max_steps, safety, fixed_step),
     )
     result = BatchResult(y=r["y"], stm=r["stm"], ok=r["ok"], errors=dict(r["errors"]), stats=r["stats"])
     if result.errors and on_error == "raise":

@@ -8,7 +8,7 @@ from functools import cached_property
 
 import numpy as np
 
-from . import _core
+from .. import _core
 from .system import System, resolve_system
 
 __all__ = ["PeriodicOrbit", "correct_symmetric", "correct_periodic"]
@@ -144,10 +144,10 @@ def correct_symmetric(
         sys_.mu, [float(v) for v in g], spatial=bool(spatial), constraint=kind, values=values,
         tol=float(tol), max_iter=int(max_iter), t_max=float(t_max), rtol=float(rtol), atol=float(atol),
     )
-    return _orbit_from(sys_, r, family)
+    return orbit_from_core(sys_, r, family)
 
 
-def _orbit_from(system: System, r: dict, family: str) -> PeriodicOrbit:
+def orbit_from_core(system: System, r: dict, family: str) -> PeriodicOrbit:
     return PeriodicOrbit(system, r["state0"], r["period"], r["jacobi"], family, r["iterations"], r["residual"], r["evaluation"])
 
 

@@ -15,11 +15,11 @@ from pathlib import Path
 import click
 import numpy as np
 
-from . import __version__
-from ._errors import LibrateError
-from .families import correct_dro
-from .propagation import propagate
-from .system import System
+from .._core import __version__
+from .._errors import LibrateError
+from ..orbits.families import correct_dro
+from ..orbits.propagation import propagate
+from ..orbits.system import System
 
 _CONTEXT = {"help_option_names": ["-h", "--help"], "max_content_width": 100}
 
@@ -61,7 +61,7 @@ def info() -> None:
         click.echo(f"  {name:16s} mu = {s.mu:.15g}  LU = {s.lu_km} km  TU = {s.tu_s} s ({s.tu_days:.6f} d)  L1 x = {l1:.15f}")
     parts = {
         "figures (matplotlib)": importlib.util.find_spec("matplotlib") is not None,
-        "chunked, resumable map runner (librate.runner)": importlib.util.find_spec("librate.runner") is not None,
+        "chunked, resumable map runner (librate.app.runner)": importlib.util.find_spec("librate.app.runner") is not None,
         "distributed runs (dask.distributed)": importlib.util.find_spec("dask") is not None,
     }
     for what, ok in parts.items():
@@ -85,8 +85,8 @@ def demo(system_name: str, kz: float, n_orbits: int, n_rates: int, out_dir: str)
     """
     import pathlib
 
-    from .families import dro_family
-    from .periodicity import periodicity_map
+    from ..orbits.families import dro_family
+    from ..periodicity.maps import periodicity_map
 
     system = System.preset(system_name)
     t0 = time.perf_counter()
@@ -122,7 +122,7 @@ def demo(system_name: str, kz: float, n_orbits: int, n_rates: int, out_dir: str)
         import matplotlib
 
         matplotlib.use("Agg")
-        from . import plotting as lp
+        from .. import plotting as lp
     except ImportError:
         click.echo("figures skipped: matplotlib is not installed (pip install 'librate[plot]')")
         return
@@ -252,14 +252,14 @@ def init(path: str, force: bool) -> None:
 def _x0_option(text: str):
     """'START:STOP:NUM' -> a range table, 'a,b,c' -> a list (left as text when unparsable, for
     the study's own error message)."""
-    from .study import _parse_value
+    from .study import parse_value
 
     if ":" in text:
-        parts = [_parse_value(v) for v in text.split(":")]
+        parts = [parse_value(v) for v in text.split(":")]
         if len(parts) == 3:
             return {"start": parts[0], "stop": parts[1], "num": parts[2]}
         return text
-    vals = [_parse_value(v) for v in text.split(",")]
+    vals = [parse_value(v) for v in text.split(",")]
     return vals
 
 
@@ -375,7 +375,7 @@ def solve(study, sets, out_dir, quiet) -> None:
 @click.argument("study", type=click.Path(exists=True, dir_okay=False))
 @click.option("--out", "out_dir", type=click.Path(file_okay=False), help="Output folder (default: output.folder of the study); the map goes to OUT/map.zarr.")
 @click.option("--quiet", "-q", is_flag=True, help="No progress bar and no summary; print only the written paths.")
-@click.option("--scheduler", metavar="tcp://HOST:PORT", help="Run the map's chunks on this Dask scheduler (needs librate.runner and dask.distributed).")
+@click.option("--scheduler", metavar="tcp://HOST:PORT", help="Run the map's chunks on this Dask scheduler (needs librate.app.runner and dask.distributed).")
 @click.option("--resume/--no-resume", default=True, show_default=True, help="Continue an interrupted map in OUT/map.zarr from its finished chunks; --no-resume recomputes it.")
 @click.option("--set", "sets", multiple=True, metavar="KEY=VALUE", help=_SET_HELP)
 def map_(study, out_dir, quiet, scheduler, resume, sets) -> None:
@@ -447,14 +447,14 @@ def plot(result_path, quiet) -> None:
                  solutions.png (solution families across the orbits)
       solutions  solutions.png (initial rates phidot0 of the solutions against x0)
     """
-    from .results import _resolve, open_result
+    from .results import open_result, resolve_result_path
 
     try:
-        p = _resolve(result_path)
+        p = resolve_result_path(result_path)
         res = open_result(p)
     except (ValueError, FileNotFoundError) as err:
         raise click.ClickException(str(err)) from None
-    from .families import OrbitFamily
+    from ..orbits.families import OrbitFamily
 
     if isinstance(res, OrbitFamily):
         _echo(quiet, f"{res.kind} family: {len(res)} members")
@@ -479,11 +479,11 @@ def _figures(result, folder: Path, names, quiet: bool) -> list[Path]:
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
 
-        from . import plotting as lp
+        from .. import plotting as lp
     except ImportError:
         click.echo("figures skipped: matplotlib is not installed (pip install 'librate[plot]')", err=True)
         return []
-    from .families import OrbitFamily
+    from ..orbits.families import OrbitFamily
 
     jobs = []
     if isinstance(result, OrbitFamily):

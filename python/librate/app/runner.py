@@ -19,20 +19,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .periodicity import (
-    MAP_ATOL,
-    MAP_RTOL,
-    _check_orbit,
-    _check_srp,
-    _map_coords,
-    _map_dataset,
-    _map_grid,
-    _orbits_of,
-    _solutions_dataset,
-    _solutions_from_row,
-    _sweep,
-    orbit_forcing,
-)
+from ..periodicity.maps import map_coords, map_dataset, map_grid, map_solutions_dataset, orbits_of, solutions_from_row
+from ..periodicity.solutions import MAP_ATOL, MAP_RTOL, check_orbit, check_srp, orbit_forcing, sweep
 
 __all__ = ["run_map"]
 
@@ -42,13 +30,13 @@ _GRID = ("dwz", "dphi", "phi_T")
 def _row(orbit, kzs, wz, phi0, n_periods, srp, rtol, atol):
     """One orbit's residual grids (kz x wz0): the unit of work (picklable for Dask)."""
     kz_grid, wz_grid = np.meshgrid(kzs, wz, indexing="ij")
-    r = _sweep(orbit_forcing(orbit), n_periods * orbit.period, phi0, wz_grid, kz_grid, rtol=rtol, atol=atol, srp=srp)
+    r = sweep(orbit_forcing(orbit), n_periods * orbit.period, phi0, wz_grid, kz_grid, rtol=rtol, atol=atol, srp=srp)
     shape = (len(kzs), len(wz))
     return {k: r[src].reshape(shape) for k, src in (("dwz", "dwz"), ("dphi", "dphi"), ("phi_T", "phi_t"), ("status", "status"))}
 
 
 def _fingerprint(olist, kzs, wz, phi0, n_periods, srp, rtol, atol) -> str:
-    from . import __version__
+    from .._core import __version__
 
     h = hashlib.sha256()
     for o in olist:
@@ -130,15 +118,15 @@ def run_map(
     and ETA on stderr (default: only when stderr is a terminal). ``attrs``: extra attributes
     (e.g. the study as JSON). Without ``out`` nothing is written (and nothing can be resumed).
     """
-    olist, family = _orbits_of(orbits)
+    olist, family = orbits_of(orbits)
     for o in olist:
-        _check_orbit(o)
+        check_orbit(o)
     if isinstance(srp, (list, tuple)):
         raise ValueError("invalid argument `srp`: run_map takes one plate; use periodicity_map for a list")
-    srp = _check_srp(srp)
-    kzs, wz = _map_grid(kz, wz0, n_periods)
+    srp = check_srp(srp)
+    kzs, wz = map_grid(kz, wz0, n_periods)
     no, nk, nw = len(olist), kzs.size, wz.size
-    coords = _map_coords(olist, kzs, wz)
+    coords = map_coords(olist, kzs, wz)
     fp = _fingerprint(olist, kzs, wz, phi0, n_periods, srp, rtol, atol)
     args = (kzs, wz, float(phi0), int(n_periods), srp, float(rtol), float(atol))
     if out is not None:
@@ -186,14 +174,14 @@ def run_map(
         bar.close()
 
     grid = {k: (store[k][:] if store is not None else mem[k]) for k in (*_GRID, "status")}
-    ds = _map_dataset(olist, family, kzs, wz, grid, done, phi0=phi0, n_periods=n_periods, rtol=rtol, atol=atol, srp=srp,
+    ds = map_dataset(olist, family, kzs, wz, grid, done, phi0=phi0, n_periods=n_periods, rtol=rtol, atol=atol, srp=srp,
                       complete=done.all(), attrs={"fingerprint": fp, **(attrs or {})})
     if solve:
         sols = []
         for i, o in enumerate(olist):
             for j, k in enumerate(kzs):
-                sols += [(i, s) for s in _solutions_from_row(o, float(k), float(phi0), wz, grid["phi_T"][i, j], int(n_periods), srp)]
-        ds = ds.merge(_solutions_dataset(sols))
+                sols += [(i, s) for s in solutions_from_row(o, float(k), float(phi0), wz, grid["phi_T"][i, j], int(n_periods), srp)]
+        ds = ds.merge(map_solutions_dataset(sols))
     if store is not None:
         sol_vars = [v for v in ds.data_vars if v.startswith("sol_")]
         if sol_vars:

@@ -15,10 +15,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import _core
-from ._errors import LibrateError
-from .orbits import SHOOT_ATOL, SHOOT_RTOL, PeriodicOrbit, _orbit_from
-from .solving.continuation import Branch, Constraint, Point, StepRules, arclength, natural
+from .. import _core
+from .._errors import LibrateError
+from ..solving.continuation import Branch, Constraint, Point, StepRules, arclength, natural
+from .periodic import SHOOT_ATOL, SHOOT_RTOL, PeriodicOrbit, orbit_from_core
 from .system import System
 
 __all__ = ["Geometry", "geometry", "continue_natural", "continue_arclength", "ContinuationResult"]
@@ -62,7 +62,7 @@ def _correct(system: System, p, spatial: bool, kind: str, values, family: str, t
         system.mu, [float(v) for v in p], spatial=spatial, constraint=kind, values=[float(v) for v in values],
         tol=1e-12, max_iter=25, t_max=t_max, rtol=SHOOT_RTOL, atol=SHOOT_ATOL,
     )
-    return _orbit_from(system, r, family)
+    return orbit_from_core(system, r, family)
 
 
 def _p(o: PeriodicOrbit) -> np.ndarray:

@@ -12,65 +12,18 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
 
 import numpy as np
 
-from . import _core
-from ._checks import as_state, as_time_span
-from .propagation import Stats, _options
-from .system import System, resolve_system
+from .. import _core
+from .._checks import as_state, as_time_span
+from ..orbits.propagation import Stats, integration_options
+from ..orbits.system import System, resolve_system
+from .body import EULER_SEQUENCES, TORQUES, RigidBody
+from .flexible import FlexibleBody, FlexibleResponse, enabled_primaries, flexible_attitude, initial_deflection
+from .srp import FacetBody, FlatPlate, Sun
 
-if TYPE_CHECKING:
-    from .flexible import FlexibleResponse
-
-__all__ = ["RigidBody", "AttitudeTrajectory", "propagate_attitude", "quaternion_from_euler", "TORQUES"]
-
-#: Torque model names accepted by ``torques=``.
-TORQUES = ("gravity_gradient", "gravity_gradient_earth", "gravity_gradient_moon", "srp")
-_EULER = {"123": "XYZ", "321": "ZYX", "313": "ZXZ"}
-
-
-@dataclass(frozen=True)
-class RigidBody:
-    """Principal moments of inertia about the body axes x, y, z (kg m^2, or normalised: only
-    ratios matter for gravity-gradient dynamics). ``mass_kg`` is needed only for the orbital
-    coupling term (thesis eq. 37). Validated: positive, triangle inequality."""
-
-    ix: float
-    iy: float
-    iz: float
-    mass_kg: float | None = None
-
-    def __post_init__(self) -> None:
-        _core.rigid_body_kz(float(self.ix), float(self.iy), float(self.iz))
-        if self.mass_kg is not None and not (math.isfinite(self.mass_kg) and self.mass_kg > 0):
-            raise ValueError(f"invalid argument `mass_kg`: must be finite and > 0, got {self.mass_kg!r}")
-
-    @classmethod
-    def from_kz(cls, kz: float) -> RigidBody:
-        """A planar body with Kz = (Iy - Ix)/Iz in [-1, 1] (Iz = 1, Ix + Iy = 1)."""
-        if not (math.isfinite(kz) and -1 <= kz <= 1):
-            raise ValueError(f"invalid argument `kz`: must be in [-1, 1], got {kz!r}")
-        return cls(0.5 * (1 - kz), 0.5 * (1 + kz), 1.0)
-
-    @property
-    def kz(self) -> float:
-        """Kz = (Iy - Ix) / Iz."""
-        return (self.iy - self.ix) / self.iz
-
-    @property
-    def moments(self) -> tuple[float, float, float]:
-        return (float(self.ix), float(self.iy), float(self.iz))
-
-
-def quaternion_from_euler(angles: Sequence[float], sequence: str = "123") -> np.ndarray:
-    """Scalar-last quaternion of the body relative to the synodic frame from Euler angles
-    (rad) in a named sequence ("123" = rotations about x, then the new y, then the new z, the
-    thesis's convention; also "321", "313" or any scipy sequence)."""
-    from scipy.spatial.transform import Rotation
-
-    return Rotation.from_euler(_EULER.get(sequence, sequence), angles).as_quat()
+__all__ = ["AttitudeTrajectory", "propagate_attitude"]
 
 
 @dataclass(frozen=True)
@@ -79,7 +32,7 @@ class AttitudeTrajectory:
     last), ``w`` (n, 3, inertial rate in body axes); planar runs also ``phi`` and ``wz`` (n,).
     ``stm``: 13x13 (3-D) or 2x2 (planar, d(phi, wz)) at the final time, when asked.
     ``flex``: for a :class:`~librate.FlexibleBody`, the deflections ``flex.q`` (n, appendages; m)
-    and their rates ``flex.qdot`` (m/TU) (:class:`~librate.flexible.FlexibleResponse`); else None."""
+    and their rates ``flex.qdot`` (m/TU) (:class:`~librate.attitude.FlexibleResponse`); else None."""
 
     system: System
     body: RigidBody
@@ -105,7 +58,7 @@ class AttitudeTrajectory:
         """(n, 3) Euler angles of the body relative to the synodic frame (rad)."""
         from scipy.spatial.transform import Rotation
 
-        return Rotation.from_quat(self.q).as_euler(_EULER.get(sequence, sequence))
+        return Rotation.from_quat(self.q).as_euler(EULER_SEQUENCES.get(sequence, sequence))
 
     def local_vertical_frame(self, primary: str | int = "earth") -> np.ndarray:
         """(n, 3, 3) matrices whose columns are the local-vertical axes of ``primary`` in synodic
@@ -128,7 +81,7 @@ class AttitudeTrajectory:
         from scipy.spatial.transform import Rotation
 
         a_bl = self.dcm() @ self.local_vertical_frame(primary)
-        return Rotation.from_matrix(np.transpose(a_bl, (0, 2, 1))).as_euler(_EULER.get(sequence, sequence))
+        return Rotation.from_matrix(np.transpose(a_bl, (0, 2, 1))).as_euler(EULER_SEQUENCES.get(sequence, sequence))
 
     def torques(self) -> np.ndarray:
         """(n, 3) gravity-gradient torque of the run in body axes (inertia units / TU^2)."""
@@ -174,9 +127,9 @@ def propagate_attitude(
     Lagrange points) or "coupled" (with the second-order extended-body acceleration, thesis
     eq. 37, which needs ``body.mass_kg``; inertia in kg m^2 and the system's LU).
 
-    Solar radiation pressure: planar runs take ``srp=FlatPlateSRP(...)`` (the simplified plate);
+    Solar radiation pressure: planar runs take ``srp=FlatPlate(...)`` (the simplified plate);
     3-D runs take a :class:`librate.FacetBody` with "srp" among ``torques`` (inertia in kg m^2),
-    the Sun from ``sun`` (a :class:`librate.SunModel`, default phase 0), and ``srp_force=True``
+    the Sun from ``sun`` (a :class:`librate.Sun`, default phase 0), and ``srp_force=True``
     adds the SRP force to the orbit (needs ``body.mass_kg``; off by default). Both SRP models
     are integrated piecewise between the faces' Sun-terminator crossings (the plate law is C1).
 
@@ -187,27 +140,23 @@ def propagate_attitude(
     sys_ = resolve_system(system)
     s = as_state(orbit_state, "orbit_state")
     t0, tf = as_time_span(t_span)
-    from .flexible import FlexibleBody, _propagate_flexible
-
     if not isinstance(body, (RigidBody, FlexibleBody)):
         raise ValueError(f"invalid argument `body`: must be a librate.RigidBody or librate.FlexibleBody, got {body!r}")
-    from .srp import FacetBody, FlatPlateSRP, SunModel
-
     names = tuple(torques)
     for n in names:
         if n not in TORQUES:
             raise ValueError(f"invalid argument `torques`: unknown torque {n!r}; known: {', '.join(TORQUES)}")
-    if srp is not None and not (planar and isinstance(srp, FlatPlateSRP)):
-        raise ValueError("invalid argument `srp`: a librate.FlatPlateSRP, for planar runs (3-D runs use a FacetBody with torques including 'srp')")
+    if srp is not None and not (planar and isinstance(srp, FlatPlate)):
+        raise ValueError("invalid argument `srp`: a librate.FlatPlate, for planar runs (3-D runs use a FacetBody with torques including 'srp')")
     if planar and "srp" in names:
-        raise ValueError("invalid argument `torques`: planar runs take the SRP plate through srp=FlatPlateSRP(...)")
+        raise ValueError("invalid argument `torques`: planar runs take the SRP plate through srp=FlatPlate(...)")
     if not planar and ("srp" in names or srp_force) and not isinstance(body, FacetBody):
         raise ValueError("invalid argument `body`: the SRP torque or force needs a librate.FacetBody")
-    if sun is not None and not isinstance(sun, SunModel):
-        raise ValueError(f"invalid argument `sun`: must be a librate.SunModel, got {sun!r}")
+    if sun is not None and not isinstance(sun, Sun):
+        raise ValueError(f"invalid argument `sun`: must be a librate.Sun, got {sun!r}")
     if orbit not in ("integrate", "held", "coupled"):
         raise ValueError(f"invalid argument `orbit`: must be 'integrate', 'held' or 'coupled', got {orbit!r}")
-    opts = _options(rtol, atol, h0, h_min, h_max, max_steps, safety, fixed_step)
+    opts = integration_options(rtol, atol, h0, h_min, h_max, max_steps, safety, fixed_step)
     te = None if t_eval is None else np.ascontiguousarray(t_eval, dtype=np.float64).ravel()
     if isinstance(body, FlexibleBody):
         if srp is not None or "srp" in names or srp_force:
@@ -240,7 +189,7 @@ def propagate_attitude(
     state0 = [*map(float, s), *map(float, q0), *map(float, w0)]
     extra = {}
     if isinstance(body, FacetBody):
-        sun = sun or SunModel()
+        sun = sun or Sun()
         extra = dict(facets=[f._tuple() for f in body.facets], sun=(float(sun.theta0), float(sun.omega), float(sun.pressure)), tu_s=float(sys_.tu_s))
         if srp_force:
             if body.mass_kg is None:
@@ -275,3 +224,23 @@ def _quaternion_and_rate(attitude) -> tuple[np.ndarray, np.ndarray]:
     if abs(n - 1) > 1e-6:
         raise ValueError(f"invalid argument `attitude`: q must be a unit quaternion, |q| = {n}")
     return q / n, w
+
+
+def _propagate_flexible(sys_, s, attitude, body, t0, tf, names, orbit, opts, te, deflection, stm) -> AttitudeTrajectory:
+    """The branch of :func:`librate.propagate_attitude` for a :class:`FlexibleBody`."""
+    if stm:
+        raise ValueError("invalid argument `stm`: the flexible model has no STM; use stm=False")
+    if orbit not in ("integrate", "held"):
+        raise ValueError(f"invalid argument `orbit`: the flexible model takes 'integrate' or 'held', got {orbit!r}")
+    phi0, wz0 = flexible_attitude(attitude)
+    primaries = enabled_primaries(names)
+    held = orbit == "held"
+    q0, qd0 = initial_deflection(deflection, sys_, body, primaries, held, s, phi0, wz0)
+    r = _core.flexible_propagate(sys_.mu, body._core_arg(sys_.tu_s), primaries, held, [float(v) for v in s], phi0, wz0, q0, qd0,
+                                 t0, tf, options=opts, t_eval=te)
+    phi, wz = r["phi"], r["wz"]
+    zero = np.zeros_like(phi)
+    quat = np.stack([zero, zero, np.sin(0.5 * phi), np.cos(0.5 * phi)], axis=1)
+    w = np.stack([zero, zero, wz], axis=1)
+    flex = FlexibleResponse(sys_, body, tuple(primaries), r["t"], r["orbit"], phi, wz, r["q"], r["qdot"])
+    return AttitudeTrajectory(sys_, body, tuple(names), True, r["t"], r["orbit"], quat, w, phi, wz, None, Stats(*r["stats"]), flex=flex)

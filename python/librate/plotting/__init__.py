@@ -29,12 +29,16 @@ label it wz(0)); ``rate="inertial"`` plots wz, and the axis label says which. Ar
 - :func:`plot_attitude_motion`: phi(t) and the rate of periodic motions (Figs. 30-31)
 - :func:`plot_sun_motion`: the apparent Sun motion in the synodic frame (Fig. 33)
 - :func:`plot_sun_resonant`: the Sun-resonant members T = Ts / K of a family (Fig. 34)
-- :func:`srp_map` (data) and :func:`plot_srp_map`: flat-plate SRP periodicity maps of one orbit
-  over (eps, rate), zero contours and solution branches with folds (Figs. 35-36)
+- :func:`plot_srp_map`: flat-plate SRP periodicity maps of one orbit over (eps, rate), zero
+  contours and solution branches with folds (Figs. 35-36), from the data of
+  :func:`librate.periodicity.srp_map` (also importable from here)
 - :func:`plot_srp_maps`: several maps side by side, one per Cs, Kz, ... (Figs. 40-41)
 - :func:`plot_srp_comparison`: a gravity-only periodic motion and its SRP counterpart (Figs. 37-38)
-- :func:`sun_pointing_accelerations` (data) and :func:`plot_sun_pointing`: gravity-gradient and
-  SRP angular accelerations on a Sun-pointing spacecraft (Fig. 39)
+- :func:`plot_sun_pointing`: gravity-gradient and SRP angular accelerations on a Sun-pointing
+  spacecraft (Fig. 39), computed by :func:`librate.periodicity.sun_pointing_accelerations` (also
+  importable from here)
+
+This package only draws: the data come from :mod:`librate.periodicity` and the layers below.
 - :func:`save_figure`: write a figure to a file
 
 The SRP amplitude of the flat plate is eps = P A d TU^2 / Iz = P (A/m) d TU^2 / k^2 (k the radius
@@ -66,10 +70,19 @@ try:
 except ImportError as exc:  # pragma: no cover - depends on the environment
     raise ImportError('librate.plotting needs matplotlib >= 3.6: pip install "librate[plot]"') from exc
 
-from .constants import OMEGA_SUN, SUN_SYNODIC_PERIOD
-from .families import OrbitFamily
-from .frames import synodic_to_eci
-from .orbits import PeriodicOrbit
+from .._checks import as_count, as_number
+from ..attitude.flexible import FlexibleBody, QuasiStaticResponse
+from ..attitude.propagate import AttitudeTrajectory
+from ..attitude.srp import FlatPlate
+from ..constants import OMEGA_SUN, SUN_SYNODIC_PERIOD
+from ..orbits.families import OrbitFamily
+from ..orbits.frames import synodic_to_eci
+from ..orbits.periodic import PeriodicOrbit
+from ..orbits.system import check_system
+from ..periodicity.flexible import FrequencyScan
+from ..periodicity.maps import periodicity_map
+from ..periodicity.solutions import KINDS, AttitudeSolution, check_kinds
+from ..periodicity.srp import srp_map, sun_angle, sun_pointing_accelerations, sun_resonance
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -546,8 +559,6 @@ def plot_attitude(traj, ax=None, *, period: float | None = None, relative_to: st
     vertical (the two-body convention of Fig. 16-18), else relative to the synodic frame.
     Rates are the inertial angular velocity components in body axes (1/TU).
     """
-    from .attitude import AttitudeTrajectory
-
     if not isinstance(traj, AttitudeTrajectory):
         raise ValueError(f"invalid argument `traj`: must be a librate.AttitudeTrajectory, got {type(traj).__name__}")
     if period is not None and not (math.isfinite(period) and period > 0):
@@ -577,7 +588,6 @@ def plot_attitude(traj, ax=None, *, period: float | None = None, relative_to: st
 
 
 # --- periodic attitude motions: residuals, maps, families, motions (Figs. 23-31) --------------
-_KINDS = ("periodic", "half-turn")
 _KIND_MARKER = {"periodic": "o", "half-turn": "D"}
 # Solutions are coloured by N (the same N, the same colour in every figure), |N| > 3 in one grey;
 # blue and orange are left to the residuals Dwz and Dphi (curves in Fig. 23, contours in Fig. 24).
@@ -603,13 +613,6 @@ def _rate_axis(rate: str, *, initial: bool = True) -> tuple[float, str]:
     if rate == "inertial":
         return 0.0, f"{what} $\\omega_z{t}$, inertial (1/TU)"
     raise ValueError(f"invalid argument `rate`: must be 'relative' (wz - 1, the thesis figures' axis) or 'inertial', got {rate!r}")
-
-
-def _check_kinds(kinds) -> tuple[str, ...]:
-    ks = (kinds,) if isinstance(kinds, str) else tuple(kinds)
-    if not ks or any(k not in _KINDS for k in ks):
-        raise ValueError(f"invalid argument `kinds`: must be 'periodic' and/or 'half-turn', got {kinds!r}")
-    return ks
 
 
 def _check_map(ds, name: str = "ds"):
@@ -654,7 +657,7 @@ def _kz_mask(tab, kz: float) -> np.ndarray:
 def _draw_solutions(a, x, y, n, kind, stable, *, markersize: float = 6.5) -> None:
     """Markers for solutions: colour by N, circle periodic / diamond half-turn, filled when
     linearly stable, hollow when not; one Line2D per group, all with ``gid="solutions"``."""
-    for k in _KINDS:
+    for k in KINDS:
         for nn in sorted(set(n[kind == k].tolist()), reverse=True):
             for st in (True, False):
                 m = (kind == k) & (n == nn) & (stable == st)
@@ -716,7 +719,7 @@ def plot_residuals(
     phi0: float = 0.0,
     rate: str = "relative",
     solutions: bool = True,
-    kinds: Sequence[str] = _KINDS,
+    kinds: Sequence[str] = KINDS,
     annotate: bool = True,
 ) -> Figure:
     """The residuals after one orbital period against the initial rate, for one orbit and one
@@ -736,7 +739,7 @@ def plot_residuals(
     (wz(0)); the axis label says which. Returns the Figure.
     """
     offset, xlabel = _rate_axis(rate)
-    kinds = _check_kinds(kinds)
+    kinds = check_kinds(kinds)
     if isinstance(orbit_or_ds, PeriodicOrbit):
         if kz is None:
             raise ValueError("invalid argument `kz`: a number in [-1, 1] is needed with an orbit")
@@ -744,8 +747,6 @@ def plot_residuals(
             raise ValueError("invalid argument `wz0`: the inertial initial rates to scan are needed with an orbit")
         if orbit_index not in (None, 0):
             raise ValueError(f"invalid argument `orbit_index`: one orbit was given, got {orbit_index!r}")
-        from .periodicity import periodicity_map
-
         ds = periodicity_map(orbit_or_ds, kz=kz, wz0=wz0, phi0=phi0, solve=bool(solutions))
         i = j = 0
     else:
@@ -875,7 +876,7 @@ def plot_map(
     j = _index(kz_index, ds.sizes["kz"], "kz_index")
     xv, xlabel = _orbit_axis(ds, against)
     offset, ylabel = _rate_axis(rate)
-    kinds = _check_kinds(kinds)
+    kinds = check_kinds(kinds)
     if half_turn_contours is None:
         half_turn_contours = "half-turn" in kinds
     if xv.size < 2:
@@ -964,7 +965,7 @@ def plot_solution_families(
     tab = _solution_table(ds)
     if tab is None:
         raise ValueError("invalid argument `ds`: the map holds no solutions (compute it with solve=True)")
-    kinds = _check_kinds(kinds)
+    kinds = check_kinds(kinds)
     xv, xlabel = _orbit_axis(ds, against)
     offset, ylabel = _rate_axis(rate)
     if max_jump is not None and not (isinstance(max_jump, (int, float, np.integer, np.floating)) and max_jump > 0):
@@ -1058,8 +1059,6 @@ def plot_attitude_motion(
     phi0 + 360 N deg after each period. ``rate``: ``"relative"`` (phidot = wz - 1, relative to
     the synodic frame, default) or ``"inertial"`` (wz). ``ax``: two Axes. Returns the Figure.
     """
-    from .periodicity import AttitudeSolution
-
     offset, ylabel = _rate_axis(rate, initial=False)
     sols = [solutions] if isinstance(solutions, AttitudeSolution) else solutions
     try:
@@ -1114,40 +1113,6 @@ def plot_attitude_motion(
 # --- solar radiation pressure (thesis ch. 4, Figs. 33-41) ---------------------------------------
 _SUN_COLOR = "#f2a900"
 _SRP_COLOR, _GRAVITY_COLOR = "tab:red", "0.15"
-# A continuation that stops with the monodromy trace this close to 2 stopped at a fold.
-_FOLD_TRACE_TOL = 0.05
-
-
-def _number(value, name: str, *, positive: bool = False) -> float:
-    ok = isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, bool) and math.isfinite(value)
-    if not ok or (positive and value <= 0):
-        raise ValueError(f"invalid argument `{name}`: must be a finite number{' > 0' if positive else ''}, got {value!r}")
-    return float(value)
-
-
-def _count(value, name: str, minimum: int) -> int:
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < minimum:
-        raise ValueError(f"invalid argument `{name}`: must be an integer >= {minimum}, got {value!r}")
-    return int(value)
-
-
-def _check_system(system):
-    from .system import System
-
-    if not isinstance(system, System):
-        raise ValueError(f"invalid argument `system`: must be a librate.System, got {type(system).__name__}")
-    return system
-
-
-def _sun_resonance(orbit: PeriodicOrbit, tol: float = 1e-6) -> int | None:
-    """K when the orbit is Sun-resonant, K T = Ts (relative tolerance ``tol``), else None."""
-    k = SUN_SYNODIC_PERIOD / orbit.period
-    return int(round(k)) if round(k) >= 1 and abs(k - round(k)) < tol * k else None
-
-
-def _sun_angle(theta0: float, t) -> np.ndarray:
-    """The Sun's angle from the synodic X axis at times t (TU), unwrapped (rad)."""
-    return OMEGA_SUN * np.asarray(t, dtype=float) + theta0
 
 
 def _primaries(a, system, scale: float = 1.0) -> None:
@@ -1163,14 +1128,14 @@ def plot_sun_motion(
     system,
     ax=None,
     *,
-    theta0: float = 0.0,
+    theta_sun0: float = 0.0,
     n_periods: float = 1,
     n_directions: int = 8,
     units: str = "days",
 ) -> Figure:
     """The apparent motion of the Sun in the synodic frame (thesis Fig. 33).
 
-    The Sun direction s(t) = (cos theta_s, sin theta_s, 0), theta_s(t) = omega_sun t + theta0
+    The Sun direction s(t) = (cos theta_s, sin theta_s, 0), theta_s(t) = omega_sun t + theta_sun0
     (PHYSICS.md sec. 6; parallax neglected, so it is the same everywhere in the system), turns
     CLOCKWISE at omega_sun = -(1 - n_sun) = :data:`librate.constants.OMEGA_SUN` (1/TU): one
     apparent solar period Ts = 2 pi / (1 - n_sun) (29.49 d with the Earth-Moon TU).
@@ -1184,14 +1149,14 @@ def plot_sun_motion(
     (``gid="sun-angle"``), a vertical line at each multiple of Ts (``gid="solar-period"``) and the
     angles at which the Sun lies on the Earth-Moon line: beyond the Moon (theta_s = 0 mod 360 deg,
     new Moon, ``gid="sun-beyond-moon"``) and behind the Earth (180 deg mod 360, full Moon,
-    ``gid="sun-behind-earth"``). ``theta0``: the Sun's phase at t = 0 (rad, as
-    :class:`librate.SunModel`); ``units``: ``"days"`` or ``"TU"``; ``ax``: two Axes. Returns the
+    ``gid="sun-behind-earth"``). ``theta_sun0``: the Sun's phase at t = 0 (rad, the
+    ``theta0`` of a :class:`librate.Sun`); ``units``: ``"days"`` or ``"TU"``; ``ax``: two Axes. Returns the
     Figure.
     """
-    sys_ = _check_system(system)
-    theta0 = _number(theta0, "theta0")
-    n_periods = _number(n_periods, "n_periods", positive=True)
-    n_directions = _count(n_directions, "n_directions", 1)
+    sys_ = check_system(system)
+    theta_sun0 = as_number(theta_sun0, "theta_sun0")
+    n_periods = as_number(n_periods, "n_periods", positive=True)
+    n_directions = as_count(n_directions, "n_directions", 1)
     tscale, tunit = _time_scale(sys_, units)
     tname = "d" if tunit == "days" else "TU"
     ts = SUN_SYNODIC_PERIOD
@@ -1205,24 +1170,24 @@ def plot_sun_motion(
     (h,) = a_geo.plot([e[0], m[0]], [e[1], m[1]], color="0.25", linewidth=1.8, zorder=3, label="Earth-Moon line (synodic $X$ axis)")
     h.set_gid("earth-moon-line")
     t_path = np.linspace(0.0, ts, 361)
-    th = _sun_angle(theta0, t_path)
+    th = sun_angle(theta_sun0, t_path)
     (h,) = a_geo.plot(radius * np.cos(th), radius * np.sin(th), color=_SUN_COLOR, linewidth=1.0, linestyle="--", zorder=1,
                       label=f"Sun direction over one apparent solar period $T_s$ = {ts * tscale:.2f} {tname}")
     h.set_gid("sun-path")
     for f in (0.06, 0.31, 0.56, 0.81):  # arrow heads: the clockwise sense
         t1, t2 = f * ts, (f + 0.02) * ts
-        p1, p2 = [radius * np.array([math.cos(v), math.sin(v)]) for v in _sun_angle(theta0, [t1, t2])]
+        p1, p2 = [radius * np.array([math.cos(v), math.sin(v)]) for v in sun_angle(theta_sun0, [t1, t2])]
         arr = a_geo.annotate("", xy=p2, xytext=p1, arrowprops=dict(arrowstyle="-|>", color=_SUN_COLOR, linewidth=1.2,
                                                                   mutation_scale=14))
         arr.set_gid("sun-path-arrow")
     cm = matplotlib.colormaps["plasma"]
     for k in range(n_directions):
         tk = k * ts / n_directions
-        ang = float(_sun_angle(theta0, tk))
+        ang = float(sun_angle(theta_sun0, tk))
         c, s = math.cos(ang), math.sin(ang)
         color = cm(0.85 * k / n_directions)
         (h,) = a_geo.plot([0.0, radius * c], [0.0, radius * s], color=color, linewidth=2.0 if k == 0 else 1.0, zorder=2,
-                          label=f"Sun direction at $t$ = 0 ($\\theta_{{s0}}$ = {math.degrees(theta0):.4g} deg)" if k == 0 else "_nolegend_")
+                          label=f"Sun direction at $t$ = 0 ($\\theta_{{s0}}$ = {math.degrees(theta_sun0):.4g} deg)" if k == 0 else "_nolegend_")
         h.set_gid("sun-direction")
         (h,) = a_geo.plot([radius * c], [radius * s], marker="o", markersize=11 if k == 0 else 8, color=_SUN_COLOR,
                           markeredgecolor=color, markeredgewidth=1.5, linestyle="none", zorder=4)
@@ -1245,7 +1210,7 @@ def plot_sun_motion(
 
     # --- the Sun's angle against time
     t = np.linspace(0.0, n_periods * ts, max(2, int(math.ceil(360 * n_periods)) + 1))
-    deg = np.degrees(_sun_angle(theta0, t))
+    deg = np.degrees(sun_angle(theta_sun0, t))
     (h,) = a_ang.plot(t * tscale, deg, color=_SUN_COLOR, linewidth=1.8,
                       label=f"$\\theta_s(t) = \\omega_s t + \\theta_{{s0}}$, $\\omega_s$ = {OMEGA_SUN:.4f} 1/TU = "
                             f"{math.degrees(OMEGA_SUN) / sys_.tu_days:.2f} deg/d")
@@ -1298,7 +1263,7 @@ def plot_sun_resonant(
         ks = None
     if not ks or not all(isinstance(k, (int, np.integer)) and not isinstance(k, bool) and k >= 1 for k in ks):
         raise ValueError(f"invalid argument `ks`: must be a non-empty sequence of integers >= 1, got {ks!r}")
-    samples = _count(samples, "samples", 2)
+    samples = as_count(samples, "samples", 2)
     sys_ = fam.system
     scale, unit = _length_scale(sys_, units)
     found, missing = [], []
@@ -1356,201 +1321,11 @@ def plot_sun_resonant(
 
 
 # --- periodicity maps over (eps, rate) ----------------------------------------------------------
-def srp_map(
-    orbit: PeriodicOrbit,
-    *,
-    kz: float,
-    wz0,
-    eps,
-    cs: float = 0.0,
-    cd: float = 0.0,
-    theta0: float = 0.0,
-    phi0: float = 0.0,
-    n_periods: int | None = None,
-    solve: bool = True,
-    kinds: Sequence[str] = ("periodic",),
-    steps: int = 4,
-):
-    """A flat-plate SRP periodicity map of one orbit over (eps, initial rate), for
-    :func:`plot_srp_map` (thesis Figs. 35-36, 40-41).
-
-    ``orbit``: a planar orbit, normally Sun-resonant (T = Ts / K, from
-    ``family.resonant(K, "sun")``); ``n_periods`` (default: that K, required for other orbits):
-    the revolutions after which periodicity is checked. ``eps``: increasing plate amplitudes (any
-    sign), ``wz0``: increasing INERTIAL initial rates; the plate has ``cs``, ``cd`` (ca = 1 - cs -
-    cd) and the Sun phase ``theta0`` (:class:`librate.FlatPlateSRP`, :class:`librate.SunModel`);
-    the body has ``kz``; every motion starts at ``phi0``. The grid runs in one engine sweep:
-    ``dwz`` = wz(KT) - wz0, ``dphi`` = phi(KT) - phi0 wrapped to (-pi, pi], ``phi_T`` (unwrapped)
-    and ``status`` over dims (eps, wz0).
-
-    With ``solve``, the solutions: SRP breaks the mirror symmetry, so with phi0 fixed there is no
-    curve of solutions in the plane (the two zero contours cross only at isolated points); the
-    solutions shown are BRANCHES with phi0 free (PHYSICS.md sec. 6), continued by
-    :func:`librate.continue_srp` through the grid's eps values (``steps`` per interval) until
-    the grid ends or the branch folds: from eps = 0, the gravity-only solutions of the listed
-    ``kinds`` with wz0 in the window (:func:`librate.find_periodic_attitudes`), away from 0 on
-    each side (``branch_origin="gravity"``); and from each far end of the grid (the largest
-    eps, and the most negative), the solutions found there (:func:`librate.find_periodic_attitudes`
-    with that plate, scanned from phi0 and phi0 + pi/2, pi, -pi/2) that no branch from eps = 0
-    reached, back towards 0 (``"end"``: e.g. the
-    SRP-dominated motions of large eps, which the gravity-only branches do not reach before
-    they fold; such a branch may end at eps = 0 on a gravity-only solution with another phi0).
-    Variables: ``sol_*`` along ``solution`` (the solutions AT the grid's eps values:
-    ``sol_eps``, ``sol_wz0``, ``sol_phidot0``, ``sol_phi0`` wrapped to [-pi, pi], ``sol_n``,
-    ``sol_kind``, ``sol_branch``, ``sol_trace``, ``sol_stable``, ``sol_residual``), ``path_*``
-    along ``path`` (every continuation point, sorted by eps within a branch: ``path_branch``,
-    ``path_eps``, ``path_wz0``, ``path_phi0``, ``path_trace``) and ``branch_*`` along ``branch``
-    (``branch_n``, ``branch_kind``, ``branch_origin``, ``branch_start_eps``,
-    ``branch_end_eps`` / ``branch_end_wz0`` where it stopped short of the grid's
-    end, NaN otherwise, ``branch_fold`` True when that end is a fold: the monodromy trace within
-    0.05 of 2 there, where Phi - I is singular; otherwise the continuation failed, e.g. at once
-    for a strongly unstable start, trace ~1e5; and ``branch_end_reason`` from
-    :func:`librate.continue_srp`). Returns an xarray Dataset.
-    """
-    import xarray as xr
-
-    from . import __version__
-    from .periodicity import _check_kz, _check_orbit, _sweep, continue_srp, find_periodic_attitudes, orbit_forcing
-    from .srp import FlatPlateSRP, SunModel
-
-    orbit = _check_orbit(orbit)
-    kz = _check_kz(kz)
-    kinds = _check_kinds(kinds)
-    if n_periods is None:
-        n_periods = _sun_resonance(orbit)
-        if n_periods is None:
-            raise ValueError(f"invalid argument `n_periods`: the orbit (T = {orbit.period_days:.4f} d) is not Sun-resonant "
-                             f"(T = Ts/K, Ts = {SUN_SYNODIC_PERIOD * orbit.system.tu_days:.2f} d); give the revolutions K")
-    n_periods = _count(n_periods, "n_periods", 1)
-    steps = _count(steps, "steps", 1)
-    es = np.asarray(eps, dtype=np.float64).ravel()
-    if es.size < 2 or not np.all(np.isfinite(es)) or np.any(np.diff(es) <= 0):
-        raise ValueError(f"invalid argument `eps`: must be a finite, strictly increasing array of at least 2 values, got {eps!r}")
-    wz = np.asarray(wz0, dtype=np.float64).ravel()
-    if wz.size < 2 or not np.all(np.isfinite(wz)) or np.any(np.diff(wz) <= 0):
-        raise ValueError("invalid argument `wz0`: must be a finite, strictly increasing array of at least 2 rates")
-    phi0 = _number(phi0, "phi0")
-    plate = FlatPlateSRP(0.0, cs, cd, SunModel(theta0=theta0))
-    e_grid, w_grid = np.meshgrid(es, wz, indexing="ij")
-    r = _sweep(orbit_forcing(orbit), n_periods * orbit.period, phi0, w_grid, kz, srp=plate, eps=e_grid)
-    shape = (es.size, wz.size)
-    data = {k: np.asarray(r[k]).reshape(shape) for k in ("dwz", "dphi", "phi_t", "status")}
-
-    sols, path, branches = [], [], []
-    if solve:
-        window = (float(wz[0]), float(wz[-1]))
-
-        def follow(start, e_start, values, origin):
-            """Continue ``start`` (at e_start) through the grid ``values`` in order; one branch."""
-            b = len(branches)
-            path.append((b, e_start, start.wz0, start.phi0, start.trace))
-            end = (math.nan, math.nan, False, "reached the end of the eps grid")
-            cur = start
-            for e in values:
-                c = continue_srp(cur, plate.with_eps(float(e)), steps=steps)
-                path.extend((b, float(ei), si.wz0, si.phi0, si.trace) for ei, si in zip(c.eps[1:], c.solutions[1:]))
-                if not c.reached:
-                    last = c.solutions[-1]
-                    fold = c.fold is not None and abs(float(c.fold.get("trace", math.nan)) - 2.0) < _FOLD_TRACE_TOL
-                    end = (float(c.fold["eps"]) if fold else float(c.eps[-1]), last.wz0, fold, c.end_reason)
-                    break
-                cur = c.solutions[-1]
-                sols.append((b, float(e), cur))
-            branches.append((start.n, start.kind, origin, e_start) + end)
-
-        pos, neg = es[es > 0], es[es < 0][::-1]
-        for s0 in find_periodic_attitudes(orbit, kz=kz, wz0_range=window, phi0=phi0, kinds=kinds, n_periods=n_periods):
-            if 0.0 in es:
-                sols.append((len(branches), 0.0, s0))
-            for side in (pos, neg):
-                if side.size:
-                    follow(s0, 0.0, side, "gravity")
-        # Solutions at the grid's far ends (SRP-dominated ones too), continued back towards eps = 0
-        # unless a branch from eps = 0 already reached them.
-        zero = np.array([0.0] if 0.0 in es else [])
-        ends = (([(float(es[-1]), np.concatenate([pos[::-1][1:], zero]))] if es[-1] > 0 else [])
-                + ([(float(es[0]), np.concatenate([neg[::-1][1:], zero]))] if es[0] < 0 else []))
-        for e_end, inward in ends:
-            known = [s for _, e, s in sols if e == e_end]
-            found = []
-            for seed in (0.0, 0.5 * math.pi, math.pi, -0.5 * math.pi):  # phi0 is free: scan from four initial attitudes
-                found += find_periodic_attitudes(orbit, kz=kz, wz0_range=window, phi0=phi0 + seed, kinds=kinds,
-                                                 n_periods=n_periods, srp=plate.with_eps(e_end))
-            for s1 in sorted(found, key=lambda x: x.wz0):
-                if any(k.n == s1.n and k.kind == s1.kind and abs(k.wz0 - s1.wz0) < 1e-7
-                       and abs(math.remainder(k.phi0 - s1.phi0, 2 * math.pi)) < 1e-7 for k in known):
-                    continue
-                sols.append((len(branches), e_end, s1))
-                known.append(s1)
-                follow(s1, e_end, inward, "end")
-        path.sort(key=lambda p: (p[0], p[1]))
-    sol_arr = lambda f, dt=float: np.array([f(b, e, s) for b, e, s in sols], dtype=dt)  # noqa: E731
-    ds = xr.Dataset(
-        {
-            "dwz": (("eps", "wz0"), data["dwz"], {"units": "1/TU", "long_name": "wz(KT) - wz(0)"}),
-            "dphi": (("eps", "wz0"), data["dphi"], {"units": "rad", "long_name": "phi(KT) - phi0 wrapped to (-pi, pi]"}),
-            "phi_T": (("eps", "wz0"), data["phi_t"], {"units": "rad", "long_name": "phi(KT), unwrapped"}),
-            "status": (("eps", "wz0"), data["status"].astype(np.uint8), {"flag_values": "0 ok, 1 max steps, 2 failed"}),
-            "sol_eps": ("solution", sol_arr(lambda b, e, s: e)),
-            "sol_branch": ("solution", sol_arr(lambda b, e, s: b, np.int64)),
-            "sol_wz0": ("solution", sol_arr(lambda b, e, s: s.wz0), {"units": "1/TU"}),
-            "sol_phidot0": ("solution", sol_arr(lambda b, e, s: s.phidot0), {"units": "1/TU"}),
-            "sol_phi0": ("solution", sol_arr(lambda b, e, s: math.remainder(s.phi0, 2 * math.pi)), {"units": "rad",
-                         "long_name": "phi0 wrapped to [-pi, pi]"}),
-            "sol_n": ("solution", sol_arr(lambda b, e, s: s.n, np.int64)),
-            "sol_kind": ("solution", sol_arr(lambda b, e, s: s.kind, "<U9")),
-            "sol_trace": ("solution", sol_arr(lambda b, e, s: s.trace)),
-            "sol_stable": ("solution", sol_arr(lambda b, e, s: s.stable, bool)),
-            "sol_residual": ("solution", sol_arr(lambda b, e, s: s.residual)),
-            "path_branch": ("path", np.array([p[0] for p in path], dtype=np.int64)),
-            "path_eps": ("path", np.array([p[1] for p in path], dtype=float)),
-            "path_wz0": ("path", np.array([p[2] for p in path], dtype=float), {"units": "1/TU"}),
-            "path_phi0": ("path", np.array([math.remainder(p[3], 2 * math.pi) for p in path], dtype=float), {"units": "rad"}),
-            "path_trace": ("path", np.array([p[4] for p in path], dtype=float)),
-            "branch_n": ("branch", np.array([x[0] for x in branches], dtype=np.int64)),
-            "branch_kind": ("branch", np.array([x[1] for x in branches], dtype="<U9")),
-            "branch_origin": ("branch", np.array([x[2] for x in branches], dtype="<U7")),
-            "branch_start_eps": ("branch", np.array([x[3] for x in branches], dtype=float)),
-            "branch_end_eps": ("branch", np.array([x[4] for x in branches], dtype=float)),
-            "branch_end_wz0": ("branch", np.array([x[5] for x in branches], dtype=float), {"units": "1/TU"}),
-            "branch_fold": ("branch", np.array([x[6] for x in branches], dtype=bool)),
-            "branch_end_reason": ("branch", np.array([str(x[7]) for x in branches], dtype=str)),
-        },
-        coords={
-            "eps": ("eps", es, {"long_name": "flat-plate SRP amplitude P A d TU^2 / Iz"}),
-            "wz0": ("wz0", wz, {"units": "1/TU", "long_name": "initial inertial angular rate"}),
-            "phidot0": ("wz0", wz - 1.0, {"units": "1/TU", "long_name": "initial rate relative to the synodic frame"}),
-        },
-        attrs={
-            "title": "librate flat-plate SRP periodicity map over (eps, wz0)",
-            "map": "srp-eps",
-            "kz": kz,
-            "cs": float(plate.cs),
-            "cd": float(plate.cd),
-            "ca": float(plate.ca),
-            "theta0": float(theta0),
-            "phi0": phi0,
-            "n_periods": n_periods,
-            "x0": orbit.x0,
-            "period": orbit.period,
-            "period_days": orbit.period_days,
-            "sun_resonance": _sun_resonance(orbit) or 0,
-            "system_name": orbit.system.name,
-            "mu": orbit.system.mu,
-            "tu_s": orbit.system.tu_s,
-            "librate_version": __version__,
-        },
-    )
-    if not solve:
-        ds = ds.drop_vars([v for v in ds.data_vars if v.startswith(("sol_", "path_", "branch_"))])
-    return ds
-
-
 def _check_srp_map(ds, name: str = "ds"):
     names = getattr(ds, "variables", None)
     if (not hasattr(ds, "data_vars") or names is None or getattr(ds, "attrs", {}).get("map") != "srp-eps"
             or not all(v in names for v in ("dwz", "dphi", "phi_T", "eps", "wz0"))):
-        raise ValueError(f"invalid argument `{name}`: must be an xarray Dataset from librate.plotting.srp_map, got {type(ds).__name__}")
+        raise ValueError(f"invalid argument `{name}`: must be an xarray Dataset from librate.periodicity.srp_map, got {type(ds).__name__}")
     return ds
 
 
@@ -1567,7 +1342,7 @@ def plot_srp_map(
     rate: str = "relative",
     solutions: bool = True,
     branches: bool = True,
-    kinds: Sequence[str] = _KINDS,
+    kinds: Sequence[str] = KINDS,
     half_turn_contours: bool = False,
     reference: float | tuple[float, str] | None = None,
     legend: bool = True,
@@ -1594,12 +1369,12 @@ def plot_srp_map(
     """
     ds = _check_srp_map(ds)
     offset, ylabel = _rate_axis(rate)
-    kinds = _check_kinds(kinds)
+    kinds = check_kinds(kinds)
     ref_label = None
     if reference is not None:
         if isinstance(reference, tuple) and len(reference) == 2:
             reference, ref_label = reference
-        reference = _number(reference, "reference")
+        reference = as_number(reference, "reference")
     x = np.asarray(ds["eps"].values, dtype=float)
     y = np.asarray(ds["wz0"].values, dtype=float) - offset
     phi0 = float(ds.attrs.get("phi0", 0.0))
@@ -1664,20 +1439,20 @@ def plot_srp_map(
     if created:
         at = ds.attrs
         a.set_title(f"SRP periodicity map, {_orbit_name(at)}\n$K_z$ = {at['kz']:g}, $C_s$ = {at['cs']:g}, $C_d$ = {at['cd']:g}, "
-                    f"$\\theta_{{s0}}$ = {math.degrees(at['theta0']):.4g} deg, $\\varphi_0$ = {at['phi0']:g} rad", fontsize=10)
+                    f"$\\theta_{{s0}}$ = {math.degrees(at['theta_sun0']):.4g} deg, $\\varphi_0$ = {at['phi0']:g} rad", fontsize=10)
     return fig
 
 
-_MAP_PARAMETERS = (("kz", "$K_z$"), ("cs", "$C_s$"), ("cd", "$C_d$"), ("theta0", "$\\theta_{s0}$"), ("eps", "$\\varepsilon$"))
-_MAP_UNITS = {"theta0": " deg"}
+_MAP_PARAMETERS = (("kz", "$K_z$"), ("cs", "$C_s$"), ("cd", "$C_d$"), ("theta_sun0", "$\\theta_{s0}$"), ("eps", "$\\varepsilon$"))
+_MAP_UNITS = {"theta_sun0": " deg"}
 
 
 def _map_parameters(ds) -> dict:
     """The fixed parameters of a map (srp_map or periodicity_map Dataset), by the names above."""
     at = ds.attrs
     if at.get("map") == "srp-eps":
-        return {"kz": at["kz"], "cs": at["cs"], "cd": at["cd"], "theta0": math.degrees(at["theta0"])}
-    out = {"cs": at.get("srp_cs", 0.0), "cd": at.get("srp_cd", 0.0), "theta0": math.degrees(at.get("sun_theta0", 0.0)),
+        return {"kz": at["kz"], "cs": at["cs"], "cd": at["cd"], "theta_sun0": math.degrees(at["theta_sun0"])}
+    out = {"cs": at.get("srp_cs", 0.0), "cd": at.get("srp_cd", 0.0), "theta_sun0": math.degrees(at.get("theta_sun0", 0.0)),
            "eps": at.get("srp_eps", 0.0)}
     if ds.sizes.get("kz", 0) == 1:
         out["kz"] = float(ds["kz"].values[0])
@@ -1762,8 +1537,6 @@ def plot_srp_comparison(
     axis, in degrees unless ``degrees=False``; ``rate``: ``"relative"`` (phidot = wz - 1, default)
     or ``"inertial"`` (wz). ``ax``: two Axes. Returns the Figure.
     """
-    from .periodicity import AttitudeSolution
-
     for name, s in (("gravity_solution", gravity_solution), ("srp_solution", srp_solution)):
         if not isinstance(s, AttitudeSolution):
             raise ValueError(f"invalid argument `{name}`: must be a librate.AttitudeSolution, got {type(s).__name__}")
@@ -1773,8 +1546,8 @@ def plot_srp_comparison(
     if not same:
         raise ValueError("invalid argument `srp_solution`: must be on the same orbit as `gravity_solution`")
     k_rep = int(s.n_periods)
-    n = float(k_rep) if n_periods is None else _number(n_periods, "n_periods", positive=True)
-    samples = _count(samples, "samples", 2)
+    n = float(k_rep) if n_periods is None else as_number(n_periods, "n_periods", positive=True)
+    samples = as_count(samples, "samples", 2)
     offset, ylabel = _rate_axis(rate, initial=False)
     kdeg = 180.0 / math.pi if degrees else 1.0
     T = s.orbit.period
@@ -1803,66 +1576,11 @@ def plot_srp_comparison(
     a_ang.set_ylabel(f"rotation angle $\\varphi$ from the synodic $X$ axis ({'deg' if degrees else 'rad'})")
     a_rate.set_ylabel(ylabel.replace(", relative", "\nrelative"))
     if created:
-        k = _sun_resonance(s.orbit)
+        k = sun_resonance(s.orbit)
         where = f"1:{k} Sun-resonant orbit" if k else "orbit"
         fig.suptitle(f"gravity-only vs SRP periodic motion, {where} (T = {s.orbit.period_days:.2f} d), $K_z$ = {s.kz:g}, "
                      f"{k_rep} revolution{'s' if k_rep > 1 else ''} per repeat")
     return fig
-
-
-def sun_pointing_accelerations(system, body_or_plate, t, *, orbit: PeriodicOrbit, offset: float = 0.0, kz: float | None = None,
-                               sun=None) -> tuple[np.ndarray, np.ndarray]:
-    """The angular accelerations (1/TU^2) on a body held pointing at the Sun, phi(t) = theta_s(t)
-    + ``offset``, along ``orbit`` at times ``t`` (TU): (gravity gradient, SRP). Gravity gradient:
-    1.5 Kz [S cos 2 phi - C sin 2 phi] with S, C of the orbit's forcing
-    (:func:`librate.periodicity.orbit_forcing`); SRP: ``plate.wzdot(t, phi)`` for a
-    :class:`librate.FlatPlateSRP` (then ``kz`` is required and the Sun is the plate's), or the z
-    torque of a :class:`librate.FacetBody`'s facets over Iz, times TU^2 (``kz`` from its inertia,
-    the Sun from ``sun``, default :class:`librate.SunModel`; planar: body z along synodic Z, the
-    Sun at the angle -offset in body axes)."""
-    from .constants import SOLAR_PRESSURE_1AU
-    from .periodicity import orbit_forcing
-    from .srp import FacetBody, FlatPlateSRP, SunModel, force_torque
-
-    sys_ = _check_system(system)
-    if not isinstance(orbit, PeriodicOrbit):
-        raise ValueError(f"invalid argument `orbit`: must be a librate.PeriodicOrbit, got {type(orbit).__name__}")
-    if orbit.state0[2] != 0.0 or orbit.state0[5] != 0.0:
-        raise ValueError("invalid argument `orbit`: the planar attitude model needs a planar orbit (z = zd = 0)")
-    offset = _number(offset, "offset")
-    if isinstance(body_or_plate, FlatPlateSRP):
-        if sun is not None:
-            raise ValueError("invalid argument `sun`: a FlatPlateSRP carries its own SunModel (plate.sun)")
-        if kz is None:
-            raise ValueError("invalid argument `kz`: a number in [-1, 1] is needed with a FlatPlateSRP")
-        kz = _number(kz, "kz")
-        if abs(kz) > 1:
-            raise ValueError(f"invalid argument `kz`: must be in [-1, 1], got {kz!r}")
-        sun_ = body_or_plate.sun
-    elif isinstance(body_or_plate, FacetBody):
-        if kz is not None:
-            raise ValueError("invalid argument `kz`: a FacetBody's inertia sets Kz (leave kz=None)")
-        kz = float(body_or_plate.kz)
-        sun_ = SunModel() if sun is None else sun
-        if not isinstance(sun_, SunModel):
-            raise ValueError(f"invalid argument `sun`: must be a librate.SunModel, got {sun!r}")
-    else:
-        raise ValueError(f"invalid argument `body_or_plate`: must be a librate.FlatPlateSRP or a librate.FacetBody, got {type(body_or_plate).__name__}")
-    t = np.asarray(t, dtype=float)
-    if not np.all(np.isfinite(t)):
-        raise ValueError("invalid argument `t`: times must be finite")
-    phi = _sun_angle(sun_.theta0, t) + offset
-    s_, c_ = orbit_forcing(orbit).sc(np.ascontiguousarray(t.ravel()))
-    s_, c_ = np.asarray(s_).reshape(t.shape), np.asarray(c_).reshape(t.shape)
-    gg = 1.5 * kz * (s_ * np.cos(2 * phi) - c_ * np.sin(2 * phi))
-    if isinstance(body_or_plate, FlatPlateSRP):
-        srp = np.asarray(body_or_plate.wzdot(t, phi), dtype=float)
-    else:
-        alpha = (_sun_angle(sun_.theta0, t) - phi).ravel()
-        scale = sun_.pressure / SOLAR_PRESSURE_1AU * sys_.tu_s**2 / body_or_plate.iz
-        srp = np.array([force_torque(body_or_plate.facets, (math.cos(v), math.sin(v), 0.0))[1][2] for v in alpha]) * scale
-        srp = srp.reshape(t.shape)
-    return gg, srp
 
 
 def plot_sun_pointing(
@@ -1885,25 +1603,23 @@ def plot_sun_pointing(
     - C sin 2 phi] (``gid="gravity-gradient"``), the SRP one (``gid="srp"``; constant for a body
     fixed relative to the Sun) and their sum (``gid="total"``, dashed), which a control torque
     must cancel to hold the pointing (see :func:`sun_pointing_accelerations` for the models and
-    ``kz`` / ``sun``). ``body_or_plate``: a :class:`librate.FlatPlateSRP` (with ``kz``) or a
+    ``kz`` / ``sun``). ``body_or_plate``: a :class:`librate.FlatPlate` (with ``kz``) or a
     :class:`librate.FacetBody`. ``n_periods``: orbital periods shown (default: the whole number
     covering one apparent solar period, ceil(Ts / T), after which a Sun-resonant orbit's pattern
     repeats), ``samples`` points per period; ``units``: ``"days"`` or ``"TU"``. Accelerations in
     1/TU^2 (nondimensional torque per Iz). Returns the Figure.
     """
-    sys_ = _check_system(system)
+    sys_ = check_system(system)
     if not isinstance(orbit, PeriodicOrbit):
         raise ValueError(f"invalid argument `orbit`: must be a librate.PeriodicOrbit, got {type(orbit).__name__}")
     if n_periods is None:
         n_periods = max(1, math.ceil(SUN_SYNODIC_PERIOD / orbit.period - 1e-6))
-    n_periods = _number(n_periods, "n_periods", positive=True)
-    samples = _count(samples, "samples", 2)
+    n_periods = as_number(n_periods, "n_periods", positive=True)
+    samples = as_count(samples, "samples", 2)
     tscale, tunit = _time_scale(sys_, units)
     t = np.linspace(0.0, n_periods * orbit.period, max(2, int(math.ceil(samples * n_periods)) + 1))
     gg, srp = sun_pointing_accelerations(sys_, body_or_plate, t, orbit=orbit, offset=offset, kz=kz, sun=sun)
-    from .srp import FlatPlateSRP
-
-    if isinstance(body_or_plate, FlatPlateSRP):
+    if isinstance(body_or_plate, FlatPlate):
         what = f"flat plate $\\varepsilon$ = {body_or_plate.eps:.4g}, $C_s$ = {body_or_plate.cs:g}, $C_d$ = {body_or_plate.cd:g}"
         kz_value = float(kz)
     else:
@@ -1920,7 +1636,7 @@ def plot_sun_pointing(
     h.set_gid("srp")
     (h,) = a.plot(t * tscale, gg + srp, color="k", linestyle="--", linewidth=1.1, label="total (a control torque cancels it)")
     h.set_gid("total")
-    k = _sun_resonance(orbit)
+    k = sun_resonance(orbit)
     for j in range(1, int(math.floor(n_periods + 1e-9)) + 1):
         v = a.axvline(j * orbit.period * tscale, color="0.7", linestyle=":", linewidth=0.8)
         v.set_gid("period")
@@ -1964,8 +1680,6 @@ def save_figure(fig, path, *, dpi: int = 150, close: bool = False, **kwargs) -> 
 # plot_flexible_response: structural response and body rate with lowered frequencies (Figs. 45-46);
 # plot_frequency_scan: quasi-static amplification and attitude departure against frequency.
 def _check_flexible_body(body):
-    from .flexible import FlexibleBody
-
     if not isinstance(body, FlexibleBody):
         raise ValueError(f"invalid argument `body`: must be a librate.FlexibleBody, got {type(body).__name__}")
     return body
@@ -2124,17 +1838,15 @@ def plot_flexible_body(body, ax=None, *, annotate: bool = True, deflection=None,
 def plot_flexible_coordinate(quasi, traj=None, ax=None, *, index=None, period: float | None = None) -> Figure:
     """A flexible coordinate against its closed form (thesis Fig. 44).
 
-    ``quasi``: a :class:`librate.flexible.QuasiStaticResponse` (:func:`librate.quasi_static`):
+    ``quasi``: a :class:`librate.attitude.QuasiStaticResponse` (:func:`librate.quasi_static`):
     the closed-form q_j(t) along the rigid solution (``gid="closed-form-j"``, dashed). ``traj``:
     an optional flexible :class:`librate.AttitudeTrajectory` on the same times, drawn solid
     (``gid="full-j"``) with its difference from the closed form in a second panel
     (``gid="error-j"``). ``index``: the appendage(s) (default all). ``period``: one revolution
     (TU) for the time axis. Deflections in m. Returns the Figure.
     """
-    from .flexible import QuasiStaticResponse
-
     if not isinstance(quasi, QuasiStaticResponse):
-        raise ValueError(f"invalid argument `quasi`: must be a librate.flexible.QuasiStaticResponse, got {type(quasi).__name__}")
+        raise ValueError(f"invalid argument `quasi`: must be a librate.attitude.QuasiStaticResponse, got {type(quasi).__name__}")
     if traj is not None:
         if getattr(traj, "flex", None) is None:
             raise ValueError("invalid argument `traj`: must be a flexible librate.AttitudeTrajectory (propagate_attitude with a FlexibleBody)")
@@ -2178,9 +1890,6 @@ def plot_flexible_response(traj, rigid=None, ax=None, *, index=None, period: flo
     QuasiStaticResponse (its rigid solution). ``index``: the appendage(s) (default all).
     ``period``: one revolution (TU) for the time axis. Returns the Figure.
     """
-    from .attitude import AttitudeTrajectory
-    from .flexible import QuasiStaticResponse
-
     if not isinstance(traj, AttitudeTrajectory) or traj.flex is None:
         raise ValueError("invalid argument `traj`: must be a flexible librate.AttitudeTrajectory (propagate_attitude with a FlexibleBody)")
     if rigid is not None and not isinstance(rigid, (AttitudeTrajectory, QuasiStaticResponse)):
@@ -2214,15 +1923,13 @@ def plot_flexible_response(traj, rigid=None, ax=None, *, index=None, period: flo
 
 
 def plot_frequency_scan(scan, ax=None, *, index=None) -> Figure:
-    """The coupled response against the structural frequency (a :class:`librate.flexible.FrequencyScan`):
+    """The coupled response against the structural frequency (a :class:`librate.periodicity.FrequencyScan`):
     the amplification of the deflections over the quasi-static closed form (left,
     ``gid="amplification-j"``, 1 in the quasi-static regime) and the largest departure of the
     attitude from the rigid solution (right, ``gid="dphi"``), against the clamped frequency of
     the first selected appendage (rad/TU), log-log. Returns the Figure."""
-    from .flexible import FrequencyScan
-
     if not isinstance(scan, FrequencyScan):
-        raise ValueError(f"invalid argument `scan`: must be a librate.flexible.FrequencyScan, got {type(scan).__name__}")
+        raise ValueError(f"invalid argument `scan`: must be a librate.periodicity.FrequencyScan, got {type(scan).__name__}")
     idx = _indices(scan.frequency.shape[1], index)
     fig, (aa, ad) = _axes(ax, 2, figsize=(11, 4.2))
     w = scan.frequency[:, idx[0]]

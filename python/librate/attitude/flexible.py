@@ -28,9 +28,9 @@ hub's centre sits where it balances them, h = -sum_j m_j b_j / m0.
   ``traj.flex``);
 - :func:`quasi_static`: high structural frequencies, the closed form q_j = L_j / k_j along the
   rigid solution (L_j the transverse load) and the first-order attitude perturbation;
-- :func:`flexible_periodic`: what flexibility does to a periodic orbit-attitude solution (drift
+- :func:`librate.periodicity.flexible_periodic` (in the periodicity layer): what flexibility does to a periodic orbit-attitude solution (drift
   and first-order shift in closed form; re-solved with the full model at low frequencies);
-- :func:`frequency_scan`: the coupled response against the structural frequency (resonances).
+- :func:`librate.periodicity.frequency_scan`: the coupled response against the structural frequency (resonances).
 
 Two precisions on PHYSICS.md sec. 7. Omega_j = sqrt(k_j / m_j) is the *clamped-hub* frequency:
 with the hub free to rotate and the centre of mass free to shift, the structural modes are
@@ -51,11 +51,11 @@ from pathlib import Path
 
 import numpy as np
 
-from . import _core
-from ._checks import as_state, as_time_span
-from .attitude import TORQUES, AttitudeTrajectory, RigidBody
-from .propagation import Stats, _options
-from .system import System, resolve_system
+from .. import _core
+from .._checks import as_state, as_time_span
+from ..orbits.propagation import Stats, integration_options
+from ..orbits.system import System, resolve_system
+from .body import TORQUES, RigidBody
 
 __all__ = [
     "Appendage",
@@ -63,11 +63,7 @@ __all__ = [
     "FlexibleModes",
     "FlexibleResponse",
     "QuasiStaticResponse",
-    "FlexiblePeriodic",
-    "FrequencyScan",
     "quasi_static",
-    "flexible_periodic",
-    "frequency_scan",
 ]
 
 #: Relative tolerance of the geometric checks (direction normal to the arm, mass off the CM).
@@ -500,12 +496,12 @@ class FlexibleResponse:
         return e["kinetic"] + e["elastic"] + e["tidal"] - mean_motion / self.system.tu_s * e["momentum"]
 
 
-def _primaries(names: Sequence[str]) -> list[bool]:
+def enabled_primaries(names: Sequence[str]) -> list[bool]:
     return [any(n in ("gravity_gradient", "gravity_gradient_earth") for n in names),
             any(n in ("gravity_gradient", "gravity_gradient_moon") for n in names)]
 
 
-def _pair(attitude) -> tuple[float, float]:
+def flexible_attitude(attitude) -> tuple[float, float]:
     try:
         phi0, wz0 = (float(v) for v in attitude)
     except (TypeError, ValueError):
@@ -515,7 +511,7 @@ def _pair(attitude) -> tuple[float, float]:
     return phi0, wz0
 
 
-def _deflection(deflection, sys_, body, primaries, held, s, phi0, wz0):
+def initial_deflection(deflection, sys_, body, primaries, held, s, phi0, wz0):
     n = body.n
     if deflection is None or (isinstance(deflection, str) and deflection == "rest"):
         return [0.0] * n, [0.0] * n
@@ -535,27 +531,7 @@ def _deflection(deflection, sys_, body, primaries, held, s, phi0, wz0):
     return q0.tolist(), qd0.tolist()
 
 
-def _propagate_flexible(sys_, s, attitude, body, t0, tf, names, orbit, opts, te, deflection, stm) -> AttitudeTrajectory:
-    """The branch of :func:`librate.propagate_attitude` for a :class:`FlexibleBody`."""
-    if stm:
-        raise ValueError("invalid argument `stm`: the flexible model has no STM; use stm=False")
-    if orbit not in ("integrate", "held"):
-        raise ValueError(f"invalid argument `orbit`: the flexible model takes 'integrate' or 'held', got {orbit!r}")
-    phi0, wz0 = _pair(attitude)
-    primaries = _primaries(names)
-    held = orbit == "held"
-    q0, qd0 = _deflection(deflection, sys_, body, primaries, held, s, phi0, wz0)
-    r = _core.flexible_propagate(sys_.mu, body._core_arg(sys_.tu_s), primaries, held, [float(v) for v in s], phi0, wz0, q0, qd0,
-                                 t0, tf, options=opts, t_eval=te)
-    phi, wz = r["phi"], r["wz"]
-    zero = np.zeros_like(phi)
-    quat = np.stack([zero, zero, np.sin(0.5 * phi), np.cos(0.5 * phi)], axis=1)
-    w = np.stack([zero, zero, wz], axis=1)
-    flex = FlexibleResponse(sys_, body, tuple(primaries), r["t"], r["orbit"], phi, wz, r["q"], r["qdot"])
-    return AttitudeTrajectory(sys_, body, tuple(names), True, r["t"], r["orbit"], quat, w, phi, wz, None, Stats(*r["stats"]), flex=flex)
-
-
-def _common(system, orbit_state, body, t_span, torques, orbit):
+def flexible_run_inputs(system, orbit_state, body, t_span, torques, orbit):
     sys_ = resolve_system(system)
     s = as_state(orbit_state, "orbit_state")
     t0, tf = as_time_span(t_span)
@@ -627,238 +603,12 @@ def quasi_static(
     the rigid solution). Valid when Omega_j >> the orbital and attitude rates: the full model
     differs from q by a relative O((rate / Omega)^2).
     """
-    sys_, s, t0, tf, names = _common(system, orbit_state, body, t_span, torques, orbit)
-    phi0, wz0 = _pair(attitude)
-    opts = _options(rtol, atol, None, 0.0, math.inf, max_steps, 0.8, None)
+    sys_, s, t0, tf, names = flexible_run_inputs(system, orbit_state, body, t_span, torques, orbit)
+    phi0, wz0 = flexible_attitude(attitude)
+    opts = integration_options(rtol, atol, None, 0.0, math.inf, max_steps, 0.8, None)
     te = None if t_eval is None else np.ascontiguousarray(t_eval, dtype=np.float64).ravel()
-    r = _core.flexible_quasi_static(sys_.mu, body._core_arg(sys_.tu_s), _primaries(names), orbit == "held", [float(v) for v in s],
+    r = _core.flexible_quasi_static(sys_.mu, body._core_arg(sys_.tu_s), enabled_primaries(names), orbit == "held", [float(v) for v in s],
                                     phi0, wz0, t0, tf, options=opts, t_eval=te)
     tu2 = sys_.tu_s**2
     return QuasiStaticResponse(sys_, body, r["t"], r["orbit"], r["phi"], r["wz"], r["dphi"], r["dwz"], r["q"], r["qdot"], r["qddot"],
                                r["dtau"] / tu2, Stats(*r["stats"]))
-
-
-# --- periodic orbit-attitude solutions ----------------------------------------------------------
-@dataclass(frozen=True)
-class FlexiblePeriodic:
-    """Result of :func:`flexible_periodic`: what flexibility does to a rigid periodic solution.
-
-    First order (closed form, always computed): ``drift`` = (dphi(T), dwz(T)), the flexible
-    motion's departure from the rigid one after one period when started from the rigid initial
-    state on the quasi-static manifold; ``max_dphi``, ``max_dwz`` over the period; ``shift`` =
-    (dphi0, dwz0) = -(M - I)^{-1} drift, the first-order move of the periodic solution (M the
-    rigid monodromy).
-
-    Full model (``method="full"``): ``full_drift`` from a re-propagation of the coupled model over
-    one period, ``full_max_dphi``, ``full_max_dwz``; when re-solved, the periodic solution of the
-    coupled model (``phi0``, ``wz0``, ``q0`` (m), ``qdot0`` (m/TU)) by Newton on all 2 + 2n initial
-    values with a finite-difference Jacobian, its ``residual`` (scaled: rad, rad/TU and q relative
-    to the quasi-static amplitude), ``iterations``, ``multipliers`` (eigenvalues of the coupled
-    monodromy) and ``full_shift`` = (phi0 - phi0_rigid, wz0 - wz0_rigid).
-    """
-
-    solution: object
-    body: FlexibleBody
-    method: str
-    drift: np.ndarray
-    max_dphi: float
-    max_dwz: float
-    shift: np.ndarray
-    full_drift: np.ndarray | None = None
-    full_max_dphi: float | None = None
-    full_max_dwz: float | None = None
-    phi0: float | None = None
-    wz0: float | None = None
-    q0: np.ndarray | None = None
-    qdot0: np.ndarray | None = None
-    residual: float | None = None
-    iterations: int | None = None
-    multipliers: np.ndarray | None = None
-
-    @property
-    def full_shift(self) -> np.ndarray | None:
-        if self.phi0 is None:
-            return None
-        r = self.solution
-        return np.array([self.phi0 - (r.phi0 - self.body.principal_angle), self.wz0 - r.wz0])
-
-    @property
-    def stable(self) -> bool | None:
-        """Coupled solution linearly stable (all multipliers within 1e-6 of the unit circle or inside)."""
-        if self.multipliers is None:
-            return None
-        return bool(np.max(np.abs(self.multipliers)) <= 1 + 1e-6)
-
-
-def flexible_periodic(
-    solution,
-    body: FlexibleBody,
-    *,
-    method: str = "auto",
-    resolve: bool = True,
-    tol: float = 1e-10,
-    max_iter: int = 20,
-    rtol: float = 1e-12,
-    atol: float = 1e-12,
-    max_steps: int = 2_000_000,
-) -> FlexiblePeriodic:
-    """The effect of flexibility on a rigid periodic orbit-attitude solution (an
-    :class:`~librate.AttitudeSolution` of :func:`~librate.periodic_attitude` computed with
-    ``kz=body.kz``, one orbit period).
-
-    ``method``: "quasi-static" (first order in (rate / Omega)^2, closed form: cheap at any
-    stiffness), "full" (the coupled model re-propagated and, with ``resolve``, the periodic
-    solution re-solved), or "auto": "full" when the stiffest mode makes fewer than 2e4 radians per
-    orbit period (the re-propagation is then cheap), else "quasi-static".
-    """
-    from .periodicity import AttitudeSolution
-
-    if not isinstance(solution, AttitudeSolution):
-        raise ValueError(f"invalid argument `solution`: must be a librate.AttitudeSolution, got {type(solution).__name__}")
-    if not isinstance(body, FlexibleBody):
-        raise ValueError(f"invalid argument `body`: must be a librate.FlexibleBody, got {type(body).__name__}")
-    if abs(solution.kz - body.kz) > 1e-9 * max(1.0, abs(body.kz)):
-        raise ValueError(f"invalid argument `solution`: it was computed for Kz = {solution.kz!r}, the body's composite Kz is {body.kz!r}; "
-                         "solve the rigid problem with kz=body.kz")
-    if method not in ("auto", "quasi-static", "full"):
-        raise ValueError(f"invalid argument `method`: must be 'auto', 'quasi-static' or 'full', got {method!r}")
-    orbit = solution.orbit
-    sys_ = orbit.system
-    T = orbit.period
-    if method == "auto":
-        method = "full" if float(np.max(body.frequencies_nd(sys_))) * T <= 2e4 else "quasi-static"
-    phi0 = solution.phi0 - body.principal_angle
-    wz0 = solution.wz0
-    turns = solution.n + (0.5 if solution.kind == "half-turn" else 0.0)
-    te = np.linspace(0.0, T, 401)
-    qs = quasi_static(sys_, orbit.state0, (phi0, wz0), body, T, t_eval=te, rtol=rtol, atol=atol, max_steps=max_steps)
-    drift = np.array([qs.dphi[-1], qs.dwz[-1]])
-    try:
-        shift = -np.linalg.solve(np.asarray(solution.monodromy) - np.eye(2), drift)
-    except np.linalg.LinAlgError:
-        shift = np.full(2, np.nan)
-    out = dict(solution=solution, body=body, method=method, drift=drift, max_dphi=float(np.max(np.abs(qs.dphi))),
-               max_dwz=float(np.max(np.abs(qs.dwz))), shift=shift)
-    if method == "quasi-static":
-        return FlexiblePeriodic(**out)
-
-    opts = _options(rtol, atol, None, 0.0, math.inf, max_steps, 0.8, None)
-    arg = body._core_arg(sys_.tu_s)
-    s0 = [float(v) for v in orbit.state0]
-    n = body.n
-
-    def flow(x, t_eval=None):
-        return _core.flexible_propagate(sys_.mu, arg, [True, True], False, s0, float(x[0]), float(x[1]), list(x[2:2 + n]), list(x[2 + n:]),
-                                        0.0, T, options=opts, t_eval=t_eval)
-
-    x = np.concatenate([[phi0, wz0], qs.q[0], qs.qdot[0]])
-    r = flow(x, te)
-    out.update(full_drift=np.array([r["phi"][-1] - phi0 - 2 * math.pi * turns, r["wz"][-1] - wz0]),
-               full_max_dphi=float(np.max(np.abs(r["phi"] - qs.phi))), full_max_dwz=float(np.max(np.abs(r["wz"] - qs.wz))))
-    if not resolve:
-        return FlexiblePeriodic(**out)
-
-    # Newton on all 2 + 2n initial values, residuals scaled by the quasi-static amplitudes.
-    omega = body.frequencies_nd(sys_)
-    qscale = np.maximum(np.max(np.abs(qs.q), axis=0), 1e-12)
-    scale = np.concatenate([[1.0, 1.0], qscale, qscale * omega])
-    target = np.zeros(2 + 2 * n)
-    target[0] = 2 * math.pi * turns
-
-    def residual(x):
-        y = flow(x)
-        yf = np.concatenate([[y["phi"][-1], y["wz"][-1]], y["q"][-1], y["qdot"][-1]])
-        return (yf - x - target) / scale, yf
-
-    res, _ = residual(x)
-    it = 0
-    jac = None
-    for it in range(1, max_iter + 1):
-        jac = np.empty((2 + 2 * n, 2 + 2 * n))
-        for i in range(2 + 2 * n):
-            h = 1e-6 * scale[i]
-            xp, xm = x.copy(), x.copy()
-            xp[i] += h
-            xm[i] -= h
-            jac[:, i] = (residual(xp)[0] - residual(xm)[0]) / (2 * h) * scale[i]
-        dx = np.linalg.lstsq(jac, -res, rcond=None)[0] * scale
-        step = 1.0
-        for _ in range(8):
-            trial = x + step * dx
-            r_trial, _ = residual(trial)
-            if np.max(np.abs(r_trial)) < np.max(np.abs(res)):
-                break
-            step *= 0.5
-        x, res = trial, r_trial
-        if np.max(np.abs(res)) < tol:
-            break
-    # monodromy of the coupled model: d y(T) / d x = jacobian of the residual + identity (unscaled)
-    mono = (jac * scale[:, None] / scale[None, :]) + np.eye(2 + 2 * n) if jac is not None else None
-    out.update(phi0=float(x[0]), wz0=float(x[1]), q0=x[2:2 + n].copy(), qdot0=x[2 + n:].copy(), residual=float(np.max(np.abs(res))),
-               iterations=it, multipliers=np.linalg.eigvals(mono) if mono is not None else None)
-    return FlexiblePeriodic(**out)
-
-
-# --- low frequencies: the coupled response against the structural frequency --------------------
-@dataclass(frozen=True)
-class FrequencyScan:
-    """Result of :func:`frequency_scan`, one row per frequency factor: ``factors``; ``frequency``
-    (n_f, n) the clamped frequencies (rad/TU); ``max_q`` (n_f, n) the largest deflection of the
-    coupled model (m) and ``max_q_quasi_static`` that of the closed form (m), their ratio
-    ``amplification`` (1 in the quasi-static regime, large near resonances); ``max_dphi``,
-    ``max_dwz``: the largest departure of the attitude from the rigid composite solution (rad,
-    rad/TU); ``max_structural`` (J): the largest structural energy."""
-
-    factors: np.ndarray
-    frequency: np.ndarray
-    max_q: np.ndarray
-    max_q_quasi_static: np.ndarray
-    max_dphi: np.ndarray
-    max_dwz: np.ndarray
-    max_structural: np.ndarray
-
-    @property
-    def amplification(self) -> np.ndarray:
-        return self.max_q / self.max_q_quasi_static
-
-
-def frequency_scan(
-    system: System | str,
-    orbit_state,
-    attitude,
-    body: FlexibleBody,
-    t_span,
-    factors,
-    *,
-    torques: Sequence[str] = ("gravity_gradient",),
-    orbit: str = "integrate",
-    deflection: str = "quasi-static",
-    samples: int = 1001,
-    rtol: float = 1e-11,
-    atol: float = 1e-11,
-    max_steps: int = 2_000_000,
-) -> FrequencyScan:
-    """The coupled response of ``body.scaled(f)`` for each frequency factor ``f`` in ``factors``:
-    the coupled model and the rigid composite model from the same ``attitude`` (and the
-    ``deflection`` start, default the quasi-static one), compared on ``samples`` times. Where a
-    structural frequency meets the orbital and attitude forcing, the deflections exceed the
-    quasi-static ones (amplification) and the attitude departs from the rigid motion: the exchange
-    between structural and attitude motion."""
-    from .attitude import propagate_attitude
-
-    sys_, s, t0, tf, names = _common(system, orbit_state, body, t_span, torques, orbit)
-    fs = np.asarray(factors, dtype=float).ravel()
-    if fs.size == 0 or not np.all(np.isfinite(fs)) or np.any(fs <= 0):
-        raise ValueError(f"invalid argument `factors`: must be positive numbers, got {factors!r}")
-    te = np.linspace(t0, tf, int(samples))
-    rows = []
-    for f in fs:
-        b = body.scaled(float(f))
-        qs = quasi_static(sys_, s, attitude, b, (t0, tf), torques=names, orbit=orbit, t_eval=te, rtol=rtol, atol=atol, max_steps=max_steps)
-        tr = propagate_attitude(sys_, s, attitude, b, (t0, tf), torques=names, orbit=orbit, t_eval=te, deflection=deflection,
-                                rtol=rtol, atol=atol, max_steps=max_steps)
-        e = tr.flex.energies()
-        rows.append((b.frequencies_nd(sys_), np.max(np.abs(tr.flex.q), axis=0), np.max(np.abs(qs.q), axis=0),
-                     float(np.max(np.abs(tr.phi - qs.phi))), float(np.max(np.abs(tr.wz - qs.wz))), float(np.max(e["structural"]))))
-    cols = list(zip(*rows))
-    return FrequencyScan(fs, np.array(cols[0]), np.array(cols[1]), np.array(cols[2]), np.array(cols[3]), np.array(cols[4]), np.array(cols[5]))

@@ -1,0 +1,41 @@
+"""The periodicity layer: periodic orbit-attitude solutions, periodicity maps, attitude families,
+solar radiation pressure continuation and maps, and the effect of flexibility on periodic
+motion."""
+
+from .families import AttitudeFamily, attitude_family
+from .flexible import FlexiblePeriodic, FrequencyScan, flexible_periodic, frequency_scan
+from .maps import periodicity_map, zero_contours
+from .solutions import (
+    MAP_ATOL,
+    MAP_RTOL,
+    AttitudeSolution,
+    clear_forcing_cache,
+    find_periodic_attitudes,
+    orbit_forcing,
+    periodic_attitude,
+    sweep,
+)
+from .srp import SrpContinuation, continue_srp, srp_map, sun_pointing_accelerations
+
+__all__ = [
+    "AttitudeSolution",
+    "periodic_attitude",
+    "find_periodic_attitudes",
+    "orbit_forcing",
+    "sweep",
+    "clear_forcing_cache",
+    "MAP_RTOL",
+    "MAP_ATOL",
+    "periodicity_map",
+    "zero_contours",
+    "AttitudeFamily",
+    "attitude_family",
+    "SrpContinuation",
+    "continue_srp",
+    "srp_map",
+    "sun_pointing_accelerations",
+    "FlexiblePeriodic",
+    "FrequencyScan",
+    "flexible_periodic",
+    "frequency_scan",
+]

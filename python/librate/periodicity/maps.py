@@ -1,0 +1,265 @@
+"""Periodicity maps: residual grids over (orbit, Kz, wz0) and the solutions they contain
+(thesis sec. 3.3, PHYSICS.md sec. 5), and the map Dataset builders shared with
+:func:`librate.app.runner.run_map`.
+
+Grids run in the Rust engine (:func:`~librate.periodicity.solutions.sweep`, one orbit at a
+time); the candidates of each full-period row are refined by
+:func:`~librate.periodicity.solutions.periodic_attitude`.
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from collections.abc import Callable
+
+import numpy as np
+
+from .._core import __version__
+from .._errors import ConvergenceError
+from ..orbits.families import OrbitFamily
+from ..orbits.periodic import PeriodicOrbit
+from .solutions import MAP_ATOL, MAP_RTOL, AttitudeSolution, candidates, check_orbit, check_srp, orbit_forcing, periodic_attitude, sweep
+
+__all__ = ["periodicity_map", "zero_contours", "orbits_of", "map_grid", "map_coords", "map_dataset", "solutions_from_row",
+           "map_solutions_dataset"]
+
+
+def orbits_of(orbits) -> tuple[list[PeriodicOrbit], OrbitFamily | None]:
+    if isinstance(orbits, OrbitFamily):
+        return list(orbits), orbits
+    if isinstance(orbits, PeriodicOrbit):
+        return [orbits], None
+    try:
+        lst = list(orbits)
+    except TypeError:
+        raise ValueError(f"invalid argument `orbits`: must be an OrbitFamily, a PeriodicOrbit or a list of them, got {type(orbits).__name__}") from None
+    if not lst or not all(isinstance(o, PeriodicOrbit) for o in lst):
+        raise ValueError("invalid argument `orbits`: must be a non-empty list of librate.PeriodicOrbit")
+    return lst, None
+
+
+def periodicity_map(
+    orbits,
+    *,
+    kz,
+    wz0,
+    phi0: float = 0.0,
+    n_periods: int = 1,
+    solve: bool = True,
+    progress: Callable[[int, int], None] | None = None,
+    rtol: float = MAP_RTOL,
+    atol: float = MAP_ATOL,
+    chunk: int = 64,
+    threads: int | None = None,
+    srp=None,
+):
+    """Residual grids over (orbit, Kz, wz0) and the periodic solutions they contain.
+
+    ``orbits``: an :class:`OrbitFamily`, a list of planar :class:`PeriodicOrbit` or one orbit;
+    ``kz``: one value or an array; ``wz0``: array of inertial initial rates. Returns an xarray
+    Dataset with ``dwz`` = wz(T) - wz0, ``dphi`` = phi(T) - phi0 wrapped to (-pi, pi] and the
+    unwrapped ``phi_T`` over dims (orbit, kz, wz0), coordinates with units (x0, period,
+    period_days per orbit; phidot0 = wz0 - 1), and, with ``solve``, the refined solutions along a
+    ``solution`` dimension. Work is done one orbit at a time (``progress(done, total)`` after
+    each); on KeyboardInterrupt the finished orbits are kept and returned, with
+    ``attrs["complete"] = 0``. Results are bit-identical for any ``chunk`` and ``threads``.
+    ``srp``: a :class:`librate.FlatPlate` (with ``n_periods`` = K for Sun-resonant orbits,
+    T = Ts / K); its parameters are stored as attributes. A list of plates (e.g. several eps or
+    Cs) adds an ``srp`` dimension (orbit, srp, kz, wz0) with their parameters as coordinates. With SRP the mirror symmetry is broken
+    and solutions are refined in (phi0, wz0) together (PHYSICS.md sec. 6).
+    """
+
+
+    olist, family = orbits_of(orbits)
+    for o in olist:
+        check_orbit(o)
+    if isinstance(srp, (list, tuple)):
+        if not srp:
+            raise ValueError("invalid argument `srp`: an empty list of plates")
+        plates = [check_srp(p) for p in srp]
+        maps = [periodicity_map(olist if family is None else family, kz=kz, wz0=wz0, phi0=phi0, n_periods=n_periods, solve=solve,
+                                progress=progress, rtol=rtol, atol=atol, chunk=chunk, threads=threads, srp=p) for p in plates]
+        return _stack_srp(maps, plates)
+    srp = check_srp(srp)
+    kzs, wz = map_grid(kz, wz0, n_periods)
+    no, nk, nw = len(olist), kzs.size, wz.size
+    dwz = np.full((no, nk, nw), np.nan)
+    dphi = np.full((no, nk, nw), np.nan)
+    phi_t = np.full((no, nk, nw), np.nan)
+    status = np.full((no, nk, nw), 255, dtype=np.uint8)
+    done = np.zeros(no, dtype=bool)
+    sols: list[tuple[int, AttitudeSolution]] = []
+    kz_grid, wz_grid = np.meshgrid(kzs, wz, indexing="ij")
+    complete = True
+    try:
+        for i, o in enumerate(olist):
+            r = sweep(orbit_forcing(o), n_periods * o.period, phi0, wz_grid, kz_grid, rtol=rtol, atol=atol, chunk=chunk, threads=threads, srp=srp)
+            dwz[i], dphi[i], phi_t[i] = (r[k].reshape(nk, nw) for k in ("dwz", "dphi", "phi_t"))
+            status[i] = r["status"].reshape(nk, nw)
+            if solve:
+                for j, k in enumerate(kzs):
+                    sols += [(i, s) for s in solutions_from_row(o, float(k), phi0, wz, phi_t[i, j], n_periods, srp)]
+            done[i] = True
+            if progress is not None:
+                progress(i + 1, no)
+    except KeyboardInterrupt:
+        complete = False
+        warnings.warn(f"periodicity_map interrupted: {int(done.sum())} of {no} orbits finished and kept", stacklevel=2)
+    grid = {"dwz": dwz, "dphi": dphi, "phi_T": phi_t, "status": status}
+    ds = map_dataset(olist, family, kzs, wz, grid, done, phi0=phi0, n_periods=n_periods, rtol=rtol, atol=atol, srp=srp, complete=complete)
+    if solve:
+        ds = ds.merge(map_solutions_dataset(sols))
+    return ds
+
+
+
+def map_grid(kz, wz0, n_periods):
+    """Validated Kz values and (strictly increasing) inertial rates of a map."""
+    kzs = np.atleast_1d(np.asarray(kz, dtype=np.float64))
+    if kzs.ndim != 1 or kzs.size == 0 or not np.all(np.isfinite(kzs)) or np.any(np.abs(kzs) > 1):
+        raise ValueError(f"invalid argument `kz`: values must be finite and in [-1, 1], got {kz!r}")
+    wz = np.asarray(wz0, dtype=np.float64).ravel()
+    if wz.size < 2 or not np.all(np.isfinite(wz)) or np.any(np.diff(wz) <= 0):
+        raise ValueError("invalid argument `wz0`: must be a finite, strictly increasing array of at least 2 rates")
+    if not isinstance(n_periods, (int, np.integer)) or n_periods < 1:
+        raise ValueError(f"invalid argument `n_periods`: must be an integer >= 1, got {n_periods!r}")
+    return kzs, wz
+
+
+def map_coords(olist, kzs, wz) -> dict:
+    """name -> (dimension, values, attributes) of a map's coordinates."""
+    return {
+        "orbit": ("orbit", np.arange(len(olist)), {}),
+        "x0": ("orbit", np.array([o.x0 for o in olist]), {"units": "LU"}),
+        "period": ("orbit", np.array([o.period for o in olist]), {"units": "TU"}),
+        "period_days": ("orbit", np.array([o.period_days for o in olist]), {"units": "d"}),
+        "kz": ("kz", kzs, {"long_name": "(Iy - Ix) / Iz"}),
+        "wz0": ("wz0", wz, {"units": "1/TU", "long_name": "initial inertial angular rate"}),
+        "phidot0": ("wz0", wz - 1.0, {"units": "1/TU", "long_name": "initial rate relative to the synodic frame"}),
+    }
+
+
+def map_dataset(olist, family, kzs, wz, grid, done, *, phi0, n_periods, rtol, atol, srp, complete, attrs=None):
+    """The map's Dataset: residual grids over (orbit, kz, wz0), coordinates with units and the
+    parameters as attributes (shared by periodicity_map and run_map)."""
+    import xarray as xr
+
+    dims = ("orbit", "kz", "wz0")
+    return xr.Dataset(
+        {
+            "dwz": (dims, grid["dwz"], {"units": "1/TU", "long_name": "wz(T) - wz(0)"}),
+            "dphi": (dims, grid["dphi"], {"units": "rad", "long_name": "phi(T) - phi0 wrapped to (-pi, pi]"}),
+            "phi_T": (dims, grid["phi_T"], {"units": "rad", "long_name": "phi(T), unwrapped"}),
+            "status": (dims, grid["status"], {"flag_values": "0 ok, 1 max steps, 2 failed, 255 not computed"}),
+            "computed": ("orbit", np.asarray(done, dtype=bool).copy()),
+        },
+        coords=map_coords(olist, kzs, wz),
+        attrs={
+            "title": "librate attitude periodicity map",
+            "phi0": float(phi0),
+            "n_periods": int(n_periods),
+            "rtol": float(rtol),
+            "atol": float(atol),
+            "complete": int(complete),
+            "mu": olist[0].system.mu,
+            "lu_km": olist[0].system.lu_km,
+            "tu_s": olist[0].system.tu_s,
+            "system_name": olist[0].system.name,
+            "family": family.kind if family is not None else "",
+            "librate_version": __version__,
+            "srp_eps": float(srp.eps) if srp is not None else 0.0,
+            "srp_cs": float(srp.cs) if srp is not None else 0.0,
+            "srp_cd": float(srp.cd) if srp is not None else 0.0,
+            "theta_sun0": float(srp.sun.theta0) if srp is not None else 0.0,
+            **(attrs or {}),
+        },
+    )
+
+def _stack_srp(maps, plates):
+    """Maps for several plates stacked along an ``srp`` dimension (coordinates srp_eps, srp_cs,
+    srp_cd and the Sun phase theta_sun0); solutions gain ``sol_srp``."""
+    import xarray as xr
+
+    grid_vars = ["dwz", "dphi", "phi_T", "status"]
+    out = xr.concat([m[grid_vars + ["computed"]] for m in maps], dim="srp")
+    out = out.transpose("orbit", "srp", "kz", "wz0")
+    out = out.assign_coords(
+        srp=np.arange(len(plates)),
+        srp_eps=("srp", np.array([p.eps for p in plates])),
+        srp_cs=("srp", np.array([p.cs for p in plates])),
+        srp_cd=("srp", np.array([p.cd for p in plates])),
+        theta_sun0=("srp", np.array([p.sun.theta0 for p in plates])),
+    )
+    out["computed"] = out["computed"].all("srp")
+    out.attrs = {k: v for k, v in maps[0].attrs.items() if not k.startswith("srp_") and k != "theta_sun0"}
+    out.attrs["complete"] = int(all(m.attrs["complete"] for m in maps))
+    if "solution" in maps[0].dims:
+        sols = []
+        for i, m in enumerate(maps):
+            if m.sizes.get("solution", 0):
+                part = m[[v for v in m.data_vars if v.startswith("sol_")]]
+                sols.append(part.assign(sol_srp=("solution", np.full(m.sizes["solution"], i))))
+        if sols:
+            out = out.merge(xr.concat(sols, dim="solution"))
+    return out
+
+
+def solutions_from_row(orbit, kz, phi0, wz, phi_t_row, n_periods, srp=None) -> list[AttitudeSolution]:
+    """Candidates from one full-period row (phi(T) - phi0 through multiples of pi), refined."""
+    out: list[AttitudeSolution] = []
+    for k, w in candidates(phi_t_row, phi0, wz, math.pi):
+        kind = "periodic" if k % 2 == 0 else "half-turn"
+        n = k // 2
+        try:
+            sol = periodic_attitude(orbit, kz=kz, n=n, phi0=phi0, wz0=w, kind=kind, n_periods=n_periods, srp=srp)
+        except ConvergenceError:
+            continue
+        if not (wz[0] <= sol.wz0 <= wz[-1]) or sol.residual > 1e-8:
+            continue
+        if any(s.n == sol.n and s.kind == sol.kind and abs(s.wz0 - sol.wz0) < 1e-8 for s in out):
+            continue
+        out.append(sol)
+    return out
+
+
+def map_solutions_dataset(sols):
+    import xarray as xr
+
+    idx = np.array([i for i, _ in sols], dtype=np.int64)
+    s = [x for _, x in sols]
+    return xr.Dataset(
+        {
+            "sol_orbit": ("solution", idx),
+            "sol_kz": ("solution", np.array([x.kz for x in s], dtype=float)),
+            "sol_wz0": ("solution", np.array([x.wz0 for x in s], dtype=float), {"units": "1/TU"}),
+            "sol_phidot0": ("solution", np.array([x.phidot0 for x in s], dtype=float), {"units": "1/TU"}),
+            "sol_phi0": ("solution", np.array([x.phi0 for x in s], dtype=float), {"units": "rad"}),
+            "sol_n": ("solution", np.array([x.n for x in s], dtype=np.int64)),
+            "sol_kind": ("solution", np.array([x.kind for x in s], dtype="<U9")),
+            "sol_residual": ("solution", np.array([x.residual for x in s], dtype=float)),
+            "sol_trace": ("solution", np.array([x.trace for x in s], dtype=float)),
+            "sol_stable": ("solution", np.array([x.stable for x in s], dtype=bool)),
+        }
+    )
+
+
+def zero_contours(ds, var: str = "dwz", kz_index: int = 0) -> np.ndarray:
+    """Points (orbit x0, wz0) where ``var`` crosses zero along wz0, for each orbit row (linear
+    interpolation; for ``dphi`` the wrap jumps at +-pi are not crossings). (m, 2) array."""
+    if var not in ("dwz", "dphi"):
+        raise ValueError(f"invalid argument `var`: must be 'dwz' or 'dphi', got {var!r}")
+    a = ds[var].values[:, kz_index, :]
+    wz = ds["wz0"].values
+    x0 = ds["x0"].values
+    pts = []
+    for i in range(a.shape[0]):
+        row = a[i]
+        for j in range(len(row) - 1):
+            u, v = row[j], row[j + 1]
+            if not (np.isfinite(u) and np.isfinite(v)) or (u > 0) == (v > 0) or u == v:
+                continue
+            if var == "dphi" and abs(u - v) > math.pi:
+                continue
+            pts.append((x0[i], wz[j] + u / (u - v) * (wz[j + 1] - wz[j])))
+    return np.array(pts).reshape(-1, 2)

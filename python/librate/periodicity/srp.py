@@ -1,0 +1,364 @@
+"""Solar radiation pressure on periodic attitude motions (thesis ch. 4, PHYSICS.md sec. 6):
+continuation of a solution in the flat-plate amplitude eps (:func:`continue_srp`), the
+(eps, rate) periodicity map with its solution branches (:func:`srp_map`) and the accelerations on
+a Sun-pointing body (:func:`sun_pointing_accelerations`)."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from .._checks import as_count, as_number
+from .._core import __version__
+from .._errors import ConvergenceError
+from ..attitude.srp import FacetBody, FlatPlate, Sun, force_torque
+from ..constants import OMEGA_SUN, SOLAR_PRESSURE_1AU, SUN_SYNODIC_PERIOD
+from ..orbits.periodic import PeriodicOrbit
+from ..orbits.system import check_system
+from .solutions import (
+    AttitudeSolution,
+    check_kinds,
+    check_kz,
+    check_orbit,
+    check_srp,
+    find_periodic_attitudes,
+    orbit_forcing,
+    periodic_attitude,
+    sweep,
+)
+
+__all__ = ["SrpContinuation", "continue_srp", "srp_map", "sun_pointing_accelerations", "sun_resonance", "sun_angle", "FOLD_TRACE_TOL"]
+
+#: A continuation that stops with the monodromy trace this close to 2 stopped at a fold.
+FOLD_TRACE_TOL = 0.05
+
+
+def sun_resonance(orbit: PeriodicOrbit, tol: float = 1e-6) -> int | None:
+    """K when the orbit is Sun-resonant, K T = Ts (relative tolerance ``tol``), else None."""
+    k = SUN_SYNODIC_PERIOD / orbit.period
+    return int(round(k)) if round(k) >= 1 and abs(k - round(k)) < tol * k else None
+
+
+def sun_angle(theta_sun0: float, t) -> np.ndarray:
+    """The Sun's angle from the synodic X axis at times t (TU), unwrapped (rad), from its phase at t = 0."""
+    return OMEGA_SUN * np.asarray(t, dtype=float) + theta_sun0
+
+
+@dataclass
+class SrpContinuation:
+    """Solutions continued in the flat-plate SRP amplitude ``eps`` from a starting solution.
+    ``reached``: the target eps was reached; otherwise ``fold`` gives where the branch turns
+    back ({"eps", "trace"}: the 2x2 monodromy's trace passes 2 there, where Phi - I is singular)
+    or ``end_reason`` why the continuation stopped. No point of another branch is ever returned."""
+
+    solutions: list[AttitudeSolution]
+    eps: np.ndarray
+    reached: bool
+    fold: dict | None
+    end_reason: str
+
+
+def continue_srp(solution: AttitudeSolution, srp, *, steps: int = 10, min_step: float = 1e-7) -> SrpContinuation:
+    """Continue ``solution`` (gravity-only, or with SRP) to the plate ``srp`` (its eps is the
+    target; cs, cd and the Sun phase are kept along the way) by natural continuation in eps:
+    linear extrapolation of (phi0, wz0), Newton in (phi0, wz0) with [Phi(KT) - I], steps halved on
+    failure or on a jump (the corrector landing farther than a quarter of the predicted step from
+    the prediction), and the fold detected where the monodromy's trace crosses 2
+    (det(Phi - I) = 2 - trace changes sign) or where the step collapses next to trace 2."""
+    srp = check_srp(srp)
+    if srp is None:
+        raise ValueError("invalid argument `srp`: the target plate is required")
+    if not isinstance(solution, AttitudeSolution):
+        raise ValueError("invalid argument `solution`: must be a librate.AttitudeSolution")
+    if not (isinstance(steps, int) and steps >= 1):
+        raise ValueError(f"invalid argument `steps`: must be an integer >= 1, got {steps!r}")
+    e0 = 0.0 if solution.srp is None else float(solution.srp.eps)
+    target = float(srp.eps)
+    sols, eps = [solution], [e0]
+    h_nominal = (target - e0) / steps
+    h = h_nominal / 16.0  # a small first step: there is no trend yet to guard against jumps
+    fold = None
+    reason = "reached the target eps"
+    while eps[-1] != target:
+        e = target if abs(target - eps[-1]) <= abs(h) * (1 + 1e-9) else eps[-1] + h
+        a = sols[-1]
+        if len(sols) >= 2:
+            b = sols[-2]
+            r = (e - eps[-1]) / (eps[-1] - eps[-2])
+            guess = (a.phi0 + r * (a.phi0 - b.phi0), a.wz0 + r * (a.wz0 - b.wz0))
+        else:
+            guess = (a.phi0, a.wz0)
+        ok = True
+        try:
+            s = periodic_attitude(a.orbit, kz=a.kz, n=a.n, kind=a.kind, phi0=guess[0], wz0=guess[1], n_periods=a.n_periods,
+                                  srp=srp.with_eps(e), method="newton")
+        except ConvergenceError:
+            ok = False
+        if ok:
+            # On a smooth branch the corrector lands within a small fraction of the predicted
+            # step (the predictor's error is second order in the step); a landing farther off is
+            # another branch, or the fold coming up: shorten the step instead.
+            jump = math.hypot(s.wz0 - guess[1], s.phi0 - guess[0])
+            if len(sols) >= 2:
+                ok = jump <= 0.25 * math.hypot(guess[1] - a.wz0, guess[0] - a.phi0) + 1e-9
+            else:
+                ok = jump <= 1e-2
+            ok = ok and s.residual <= 1e-8
+        crossing = ok and (2.0 - a.trace) * (2.0 - s.trace) < 0
+        if ok and not crossing:
+            sols.append(s)
+            eps.append(e)
+            h = float(np.sign(h_nominal) * min(abs(h) * 1.5, abs(h_nominal)))
+            continue
+        if abs(h) * 0.5 < min_step:
+            if crossing:
+                w = (2.0 - a.trace) / (s.trace - a.trace)
+                fold = {"eps": eps[-1] + w * (e - eps[-1]), "trace": 2.0}
+                reason = f"fold: the monodromy trace crosses 2 at eps = {fold['eps']:.8g} (Phi - I singular)"
+            else:
+                fold = {"eps": eps[-1], "trace": a.trace}
+                reason = f"fold or end of the branch near eps = {eps[-1]:.8g} (trace {a.trace:.6g}; step below {min_step:g})"
+            break
+        h *= 0.5  # failure, jump, or a trace crossing to pin down: shorten the step
+    return SrpContinuation(sols, np.array(eps), eps[-1] == target, fold, reason)
+
+
+# --- the (eps, rate) map and Sun pointing -----------------------------------------------------------
+def srp_map(
+    orbit: PeriodicOrbit,
+    *,
+    kz: float,
+    wz0,
+    eps,
+    cs: float = 0.0,
+    cd: float = 0.0,
+    theta_sun0: float = 0.0,
+    phi0: float = 0.0,
+    n_periods: int | None = None,
+    solve: bool = True,
+    kinds: Sequence[str] = ("periodic",),
+    steps: int = 4,
+):
+    """A flat-plate SRP periodicity map of one orbit over (eps, initial rate), for
+    :func:`librate.plotting.plot_srp_map` (thesis Figs. 35-36, 40-41).
+
+    ``orbit``: a planar orbit, normally Sun-resonant (T = Ts / K, from
+    ``family.resonant(K, "sun")``); ``n_periods`` (default: that K, required for other orbits):
+    the revolutions after which periodicity is checked. ``eps``: increasing plate amplitudes (any
+    sign), ``wz0``: increasing INERTIAL initial rates; the plate has ``cs``, ``cd`` (ca = 1 - cs -
+    cd) and the Sun phase ``theta_sun0`` (``Sun.theta0``; :class:`librate.FlatPlate`, :class:`librate.Sun`);
+    the body has ``kz``; every motion starts at ``phi0``. The grid runs in one engine sweep:
+    ``dwz`` = wz(KT) - wz0, ``dphi`` = phi(KT) - phi0 wrapped to (-pi, pi], ``phi_T`` (unwrapped)
+    and ``status`` over dims (eps, wz0).
+
+    With ``solve``, the solutions: SRP breaks the mirror symmetry, so with phi0 fixed there is no
+    curve of solutions in the plane (the two zero contours cross only at isolated points); the
+    solutions shown are BRANCHES with phi0 free (PHYSICS.md sec. 6), continued by
+    :func:`librate.continue_srp` through the grid's eps values (``steps`` per interval) until
+    the grid ends or the branch folds: from eps = 0, the gravity-only solutions of the listed
+    ``kinds`` with wz0 in the window (:func:`librate.find_periodic_attitudes`), away from 0 on
+    each side (``branch_origin="gravity"``); and from each far end of the grid (the largest
+    eps, and the most negative), the solutions found there (:func:`librate.find_periodic_attitudes`
+    with that plate, scanned from phi0 and phi0 + pi/2, pi, -pi/2) that no branch from eps = 0
+    reached, back towards 0 (``"end"``: e.g. the
+    SRP-dominated motions of large eps, which the gravity-only branches do not reach before
+    they fold; such a branch may end at eps = 0 on a gravity-only solution with another phi0).
+    Variables: ``sol_*`` along ``solution`` (the solutions AT the grid's eps values:
+    ``sol_eps``, ``sol_wz0``, ``sol_phidot0``, ``sol_phi0`` wrapped to [-pi, pi], ``sol_n``,
+    ``sol_kind``, ``sol_branch``, ``sol_trace``, ``sol_stable``, ``sol_residual``), ``path_*``
+    along ``path`` (every continuation point, sorted by eps within a branch: ``path_branch``,
+    ``path_eps``, ``path_wz0``, ``path_phi0``, ``path_trace``) and ``branch_*`` along ``branch``
+    (``branch_n``, ``branch_kind``, ``branch_origin``, ``branch_start_eps``,
+    ``branch_end_eps`` / ``branch_end_wz0`` where it stopped short of the grid's
+    end, NaN otherwise, ``branch_fold`` True when that end is a fold: the monodromy trace within
+    0.05 of 2 there, where Phi - I is singular; otherwise the continuation failed, e.g. at once
+    for a strongly unstable start, trace ~1e5; and ``branch_end_reason`` from
+    :func:`librate.continue_srp`). Returns an xarray Dataset.
+    """
+    import xarray as xr
+
+    orbit = check_orbit(orbit)
+    kz = check_kz(kz)
+    kinds = check_kinds(kinds)
+    if n_periods is None:
+        n_periods = sun_resonance(orbit)
+        if n_periods is None:
+            raise ValueError(f"invalid argument `n_periods`: the orbit (T = {orbit.period_days:.4f} d) is not Sun-resonant "
+                             f"(T = Ts/K, Ts = {SUN_SYNODIC_PERIOD * orbit.system.tu_days:.2f} d); give the revolutions K")
+    n_periods = as_count(n_periods, "n_periods", 1)
+    steps = as_count(steps, "steps", 1)
+    es = np.asarray(eps, dtype=np.float64).ravel()
+    if es.size < 2 or not np.all(np.isfinite(es)) or np.any(np.diff(es) <= 0):
+        raise ValueError(f"invalid argument `eps`: must be a finite, strictly increasing array of at least 2 values, got {eps!r}")
+    wz = np.asarray(wz0, dtype=np.float64).ravel()
+    if wz.size < 2 or not np.all(np.isfinite(wz)) or np.any(np.diff(wz) <= 0):
+        raise ValueError("invalid argument `wz0`: must be a finite, strictly increasing array of at least 2 rates")
+    phi0 = as_number(phi0, "phi0")
+    plate = FlatPlate(0.0, cs, cd, Sun(theta0=theta_sun0))
+    e_grid, w_grid = np.meshgrid(es, wz, indexing="ij")
+    r = sweep(orbit_forcing(orbit), n_periods * orbit.period, phi0, w_grid, kz, srp=plate, eps=e_grid)
+    shape = (es.size, wz.size)
+    data = {k: np.asarray(r[k]).reshape(shape) for k in ("dwz", "dphi", "phi_t", "status")}
+
+    sols, path, branches = [], [], []
+    if solve:
+        window = (float(wz[0]), float(wz[-1]))
+
+        def follow(start, e_start, values, origin):
+            """Continue ``start`` (at e_start) through the grid ``values`` in order; one branch."""
+            b = len(branches)
+            path.append((b, e_start, start.wz0, start.phi0, start.trace))
+            end = (math.nan, math.nan, False, "reached the end of the eps grid")
+            cur = start
+            for e in values:
+                c = continue_srp(cur, plate.with_eps(float(e)), steps=steps)
+                path.extend((b, float(ei), si.wz0, si.phi0, si.trace) for ei, si in zip(c.eps[1:], c.solutions[1:]))
+                if not c.reached:
+                    last = c.solutions[-1]
+                    fold = c.fold is not None and abs(float(c.fold.get("trace", math.nan)) - 2.0) < FOLD_TRACE_TOL
+                    end = (float(c.fold["eps"]) if fold else float(c.eps[-1]), last.wz0, fold, c.end_reason)
+                    break
+                cur = c.solutions[-1]
+                sols.append((b, float(e), cur))
+            branches.append((start.n, start.kind, origin, e_start) + end)
+
+        pos, neg = es[es > 0], es[es < 0][::-1]
+        for s0 in find_periodic_attitudes(orbit, kz=kz, wz0_range=window, phi0=phi0, kinds=kinds, n_periods=n_periods):
+            if 0.0 in es:
+                sols.append((len(branches), 0.0, s0))
+            for side in (pos, neg):
+                if side.size:
+                    follow(s0, 0.0, side, "gravity")
+        # Solutions at the grid's far ends (SRP-dominated ones too), continued back towards eps = 0
+        # unless a branch from eps = 0 already reached them.
+        zero = np.array([0.0] if 0.0 in es else [])
+        ends = (([(float(es[-1]), np.concatenate([pos[::-1][1:], zero]))] if es[-1] > 0 else [])
+                + ([(float(es[0]), np.concatenate([neg[::-1][1:], zero]))] if es[0] < 0 else []))
+        for e_end, inward in ends:
+            known = [s for _, e, s in sols if e == e_end]
+            found = []
+            for seed in (0.0, 0.5 * math.pi, math.pi, -0.5 * math.pi):  # phi0 is free: scan from four initial attitudes
+                found += find_periodic_attitudes(orbit, kz=kz, wz0_range=window, phi0=phi0 + seed, kinds=kinds,
+                                                 n_periods=n_periods, srp=plate.with_eps(e_end))
+            for s1 in sorted(found, key=lambda x: x.wz0):
+                if any(k.n == s1.n and k.kind == s1.kind and abs(k.wz0 - s1.wz0) < 1e-7
+                       and abs(math.remainder(k.phi0 - s1.phi0, 2 * math.pi)) < 1e-7 for k in known):
+                    continue
+                sols.append((len(branches), e_end, s1))
+                known.append(s1)
+                follow(s1, e_end, inward, "end")
+        path.sort(key=lambda p: (p[0], p[1]))
+    sol_arr = lambda f, dt=float: np.array([f(b, e, s) for b, e, s in sols], dtype=dt)  # noqa: E731
+    ds = xr.Dataset(
+        {
+            "dwz": (("eps", "wz0"), data["dwz"], {"units": "1/TU", "long_name": "wz(KT) - wz(0)"}),
+            "dphi": (("eps", "wz0"), data["dphi"], {"units": "rad", "long_name": "phi(KT) - phi0 wrapped to (-pi, pi]"}),
+            "phi_T": (("eps", "wz0"), data["phi_t"], {"units": "rad", "long_name": "phi(KT), unwrapped"}),
+            "status": (("eps", "wz0"), data["status"].astype(np.uint8), {"flag_values": "0 ok, 1 max steps, 2 failed"}),
+            "sol_eps": ("solution", sol_arr(lambda b, e, s: e)),
+            "sol_branch": ("solution", sol_arr(lambda b, e, s: b, np.int64)),
+            "sol_wz0": ("solution", sol_arr(lambda b, e, s: s.wz0), {"units": "1/TU"}),
+            "sol_phidot0": ("solution", sol_arr(lambda b, e, s: s.phidot0), {"units": "1/TU"}),
+            "sol_phi0": ("solution", sol_arr(lambda b, e, s: math.remainder(s.phi0, 2 * math.pi)), {"units": "rad",
+                         "long_name": "phi0 wrapped to [-pi, pi]"}),
+            "sol_n": ("solution", sol_arr(lambda b, e, s: s.n, np.int64)),
+            "sol_kind": ("solution", sol_arr(lambda b, e, s: s.kind, "<U9")),
+            "sol_trace": ("solution", sol_arr(lambda b, e, s: s.trace)),
+            "sol_stable": ("solution", sol_arr(lambda b, e, s: s.stable, bool)),
+            "sol_residual": ("solution", sol_arr(lambda b, e, s: s.residual)),
+            "path_branch": ("path", np.array([p[0] for p in path], dtype=np.int64)),
+            "path_eps": ("path", np.array([p[1] for p in path], dtype=float)),
+            "path_wz0": ("path", np.array([p[2] for p in path], dtype=float), {"units": "1/TU"}),
+            "path_phi0": ("path", np.array([math.remainder(p[3], 2 * math.pi) for p in path], dtype=float), {"units": "rad"}),
+            "path_trace": ("path", np.array([p[4] for p in path], dtype=float)),
+            "branch_n": ("branch", np.array([x[0] for x in branches], dtype=np.int64)),
+            "branch_kind": ("branch", np.array([x[1] for x in branches], dtype="<U9")),
+            "branch_origin": ("branch", np.array([x[2] for x in branches], dtype="<U7")),
+            "branch_start_eps": ("branch", np.array([x[3] for x in branches], dtype=float)),
+            "branch_end_eps": ("branch", np.array([x[4] for x in branches], dtype=float)),
+            "branch_end_wz0": ("branch", np.array([x[5] for x in branches], dtype=float), {"units": "1/TU"}),
+            "branch_fold": ("branch", np.array([x[6] for x in branches], dtype=bool)),
+            "branch_end_reason": ("branch", np.array([str(x[7]) for x in branches], dtype=str)),
+        },
+        coords={
+            "eps": ("eps", es, {"long_name": "flat-plate SRP amplitude P A d TU^2 / Iz"}),
+            "wz0": ("wz0", wz, {"units": "1/TU", "long_name": "initial inertial angular rate"}),
+            "phidot0": ("wz0", wz - 1.0, {"units": "1/TU", "long_name": "initial rate relative to the synodic frame"}),
+        },
+        attrs={
+            "title": "librate flat-plate SRP periodicity map over (eps, wz0)",
+            "map": "srp-eps",
+            "kz": kz,
+            "cs": float(plate.cs),
+            "cd": float(plate.cd),
+            "ca": float(plate.ca),
+            "theta_sun0": float(theta_sun0),
+            "phi0": phi0,
+            "n_periods": n_periods,
+            "x0": orbit.x0,
+            "period": orbit.period,
+            "period_days": orbit.period_days,
+            "sun_resonance": sun_resonance(orbit) or 0,
+            "system_name": orbit.system.name,
+            "mu": orbit.system.mu,
+            "tu_s": orbit.system.tu_s,
+            "librate_version": __version__,
+        },
+    )
+    if not solve:
+        ds = ds.drop_vars([v for v in ds.data_vars if v.startswith(("sol_", "path_", "branch_"))])
+    return ds
+
+
+def sun_pointing_accelerations(system, body_or_plate, t, *, orbit: PeriodicOrbit, offset: float = 0.0, kz: float | None = None,
+                               sun=None) -> tuple[np.ndarray, np.ndarray]:
+    """The angular accelerations (1/TU^2) on a body held pointing at the Sun, phi(t) = theta_s(t)
+    + ``offset``, along ``orbit`` at times ``t`` (TU): (gravity gradient, SRP). Gravity gradient:
+    1.5 Kz [S cos 2 phi - C sin 2 phi] with S, C of the orbit's forcing
+    (:func:`librate.periodicity.orbit_forcing`); SRP: ``plate.wzdot(t, phi)`` for a
+    :class:`librate.FlatPlate` (then ``kz`` is required and the Sun is the plate's), or the z
+    torque of a :class:`librate.FacetBody`'s facets over Iz, times TU^2 (``kz`` from its inertia,
+    the Sun from ``sun``, default :class:`librate.Sun`; planar: body z along synodic Z, the
+    Sun at the angle -offset in body axes)."""
+    sys_ = check_system(system)
+    if not isinstance(orbit, PeriodicOrbit):
+        raise ValueError(f"invalid argument `orbit`: must be a librate.PeriodicOrbit, got {type(orbit).__name__}")
+    if orbit.state0[2] != 0.0 or orbit.state0[5] != 0.0:
+        raise ValueError("invalid argument `orbit`: the planar attitude model needs a planar orbit (z = zd = 0)")
+    offset = as_number(offset, "offset")
+    if isinstance(body_or_plate, FlatPlate):
+        if sun is not None:
+            raise ValueError("invalid argument `sun`: a FlatPlate carries its own Sun (plate.sun)")
+        if kz is None:
+            raise ValueError("invalid argument `kz`: a number in [-1, 1] is needed with a FlatPlate")
+        kz = as_number(kz, "kz")
+        if abs(kz) > 1:
+            raise ValueError(f"invalid argument `kz`: must be in [-1, 1], got {kz!r}")
+        sun_ = body_or_plate.sun
+    elif isinstance(body_or_plate, FacetBody):
+        if kz is not None:
+            raise ValueError("invalid argument `kz`: a FacetBody's inertia sets Kz (leave kz=None)")
+        kz = float(body_or_plate.kz)
+        sun_ = Sun() if sun is None else sun
+        if not isinstance(sun_, Sun):
+            raise ValueError(f"invalid argument `sun`: must be a librate.Sun, got {sun!r}")
+    else:
+        raise ValueError(f"invalid argument `body_or_plate`: must be a librate.FlatPlate or a librate.FacetBody, got {type(body_or_plate).__name__}")
+    t = np.asarray(t, dtype=float)
+    if not np.all(np.isfinite(t)):
+        raise ValueError("invalid argument `t`: times must be finite")
+    phi = sun_angle(sun_.theta0, t) + offset
+    s_, c_ = orbit_forcing(orbit).sc(np.ascontiguousarray(t.ravel()))
+    s_, c_ = np.asarray(s_).reshape(t.shape), np.asarray(c_).reshape(t.shape)
+    gg = 1.5 * kz * (s_ * np.cos(2 * phi) - c_ * np.sin(2 * phi))
+    if isinstance(body_or_plate, FlatPlate):
+        srp = np.asarray(body_or_plate.wzdot(t, phi), dtype=float)
+    else:
+        alpha = (sun_angle(sun_.theta0, t) - phi).ravel()
+        scale = sun_.pressure / SOLAR_PRESSURE_1AU * sys_.tu_s**2 / body_or_plate.iz
+        srp = np.array([force_torque(body_or_plate.facets, (math.cos(v), math.sin(v), 0.0))[1][2] for v in alpha]) * scale
+        srp = srp.reshape(t.shape)
+    return gg, srp
