@@ -19,8 +19,8 @@
 //!
 //! Every Newton iteration integrates every still-active candidate of the batch in ONE
 //! [`map::sweep`] call with the STM (SIMD lanes, all cores). Newton is globalised per candidate:
-//! the step in wz0 is capped, and a backtracking line search (Armijo-type sufficient decrease
-//! of the residual's max-norm, step halved up to `max_halvings` times) evaluates the trial
+//! the steps in wz0 and in the angle unknown are capped, and a backtracking line search (Armijo-type sufficient decrease
+//! of the residual's 2-norm, step halved up to `max_halvings` times) evaluates the trial
 //! points of all candidates together in the next sweep. Each candidate reports why it stopped
 //! ([`StopReason`]); nothing panics and a non-finite result is never labelled converged.
 //!
@@ -124,8 +124,10 @@ pub struct CorrectorOptions {
     pub rtol: f64,
     pub atol: f64,
     pub max_steps: u32,
-    /// Largest |step| in wz0 (1/TU); the Newton step is scaled down to it.
+    /// Largest |step| in wz0 (1/TU) and in the angle unknown (phi0 or theta_sun0, rad): the
+    /// Newton step is scaled down (direction kept) until both hold.
     pub max_wz_step: f64,
+    pub max_angle_step: f64,
     /// Step halvings of the line search before giving up ([`StopReason::NoDescent`]).
     pub max_halvings: u32,
     /// Central-difference step in theta_sun0 ([`Free::SunPhase`]), rad.
@@ -146,6 +148,7 @@ impl Default for CorrectorOptions {
             atol: 1e-13,
             max_steps: 200_000,
             max_wz_step: 0.5,
+            max_angle_step: 0.5,
             max_halvings: 10,
             phase_step: 1e-6,
             sun_omega: OMEGA_SUN,
@@ -189,6 +192,8 @@ struct Point {
     x: [f64; 2],
     f: [f64; 2],
     norm: f64,
+    /// Line-search merit: the residual's 2-norm.
+    merit: f64,
     /// Row-major 2x2 (Half: j[0] = dg/dwz0 only).
     jac: [f64; 4],
     stm: [f64; 4],
@@ -258,7 +263,7 @@ impl Form {
         let p = match (self.closure, self.free) {
             (Closure::Half, _) => {
                 let g = o[0].phi_t - c.case.phi0 - PI * c.turns;
-                Point { x, f: [g, f64::NAN], norm: g.abs(), jac: [m[1], 0.0, 0.0, 0.0], stm: m }
+                Point { x, f: [g, f64::NAN], norm: g.abs(), merit: g.abs(), jac: [m[1], 0.0, 0.0, 0.0], stm: m }
             }
             (Closure::Full, free) => {
                 let phi0 = if free == Free::Phi0 { x[0] } else { c.case.phi0 };
@@ -269,10 +274,10 @@ impl Form {
                     let k = 0.5 / self.h;
                     [(o[1].phi_t - o[2].phi_t) * k, m[1], (o[1].wz_t - o[2].wz_t) * k, m[3] - 1.0]
                 };
-                Point { x, f, norm: f[0].abs().max(f[1].abs()), jac, stm: m }
+                Point { x, f, norm: f[0].abs().max(f[1].abs()), merit: f[0].hypot(f[1]), jac, stm: m }
             }
         };
-        (p.norm.is_finite() && p.jac.iter().all(|v| v.is_finite())).then_some(p)
+        (p.norm.is_finite() && p.merit.is_finite() && p.jac.iter().all(|v| v.is_finite())).then_some(p)
     }
 
     /// Newton direction at p (minimum-norm step when J is rank-deficient) and whether J was;
@@ -299,7 +304,7 @@ impl Form {
 
 /// Singular values below this fraction of the largest are treated as zero (minimum-norm step).
 const RANK_TOL: f64 = 1e-11;
-/// Armijo constant of the sufficient-decrease test |F(x + l d)| <= (1 - C l) |F(x)|.
+/// Armijo constant of the sufficient-decrease test |F(x + l d)|_2 <= (1 - C l) |F(x)|_2.
 const ARMIJO: f64 = 1e-4;
 
 impl Track {
@@ -328,7 +333,7 @@ impl Track {
             Phase::Trial { lambda, halvings, any_integrated } => {
                 let Some(cur) = self.cur else { return };
                 let integrated = any_integrated || p.is_some();
-                match p.filter(|p| p.norm <= (1.0 - ARMIJO * lambda * self.scale) * cur.norm) {
+                match p.filter(|p| p.merit <= (1.0 - ARMIJO * lambda * self.scale) * cur.merit) {
                     Some(p) => {
                         self.cur = Some(p);
                         self.iterations += 1;
@@ -364,7 +369,8 @@ impl Track {
         match form.direction(&p) {
             None => self.phase = Phase::Done(StopReason::SingularJacobian),
             Some((d, deficient)) => {
-                let scale = if d[1].abs() > opts.max_wz_step { opts.max_wz_step / d[1].abs() } else { 1.0 };
+                let cap = |v: f64, m: f64| if v.abs() > m { m / v.abs() } else { 1.0 };
+                let scale = cap(d[1], opts.max_wz_step).min(cap(d[0], opts.max_angle_step));
                 self.dir = [d[0] * scale, d[1] * scale];
                 self.scale = scale;
                 self.rank_deficient = deficient;
@@ -423,6 +429,7 @@ fn validate(forcing: &OrbitForcing, t_final: f64, closure: Closure, free: Free, 
     check_positive("rtol", opts.rtol)?;
     check_positive("atol", opts.atol)?;
     check_positive("max_wz_step", opts.max_wz_step)?;
+    check_positive("max_angle_step", opts.max_angle_step)?;
     check_positive("phase_step", opts.phase_step)?;
     if !opts.sun_omega.is_finite() {
         return Err(invalid("sun_omega", format!("must be finite, got {}", opts.sun_omega)));
