@@ -114,7 +114,7 @@ impl PySweepResult {
         self.phi_t.bind(py).len()
     }
     fn __repr__(&self, py: Python<'_>) -> PyResult<String> {
-        Ok(format!("SweepResult(n={}, stm={})", self.__len__(py)?, self.stm.is_some()))
+        Ok(format!("SweepResult(n={}, stm={})", self.__len__(py)?, if self.stm.is_some() { "True" } else { "False" }))
     }
 }
 

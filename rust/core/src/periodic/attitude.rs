@@ -625,5 +625,5 @@ pub fn verify_planar_attitudes(
         Ok(r) => PlanarEnd { phi_t: r.phi.last().copied().unwrap_or(f64::NAN), wz_t: r.wz.last().copied().unwrap_or(f64::NAN), stm: r.stm_final.unwrap_or([f64::NAN; 4]), error: None },
         Err(e) => PlanarEnd { phi_t: f64::NAN, wz_t: f64::NAN, stm: [f64::NAN; 4], error: Some(e) },
     };
-    with_threads(threads, || items.par_iter().with_min_len(1).map(one).collect())
+    with_threads(threads, || items.par_iter().map(one).collect())
 }
