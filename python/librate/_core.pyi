@@ -8,10 +8,14 @@ import numpy.typing as npt
 __version__: str
 __all__ = [
     "ConvergenceError",
+    "CorrectionBatch",
     "IntegrationError",
     "LibrateError",
     "OrbitForcing",
+    "PlanarVerification",
+    "SweepResult",
     "__version__",
+    "attitude_correct",
     "attitude_propagate",
     "attitude_torques",
     "facets_force_torque",
@@ -27,6 +31,7 @@ __all__ = [
     "map_sweep",
     "multiple_shooting",
     "planar_propagate",
+    "planar_verify",
     "preset_names",
     "propagate",
     "propagate_many",
@@ -126,11 +131,79 @@ class OrbitForcing:
     def max_error(self) -> float: ...
     def sc(self, t: _F64) -> tuple[_F64, _F64]: ...
 
+@final
+class SweepResult:
+    @property
+    def phi_t(self) -> _F64: ...
+    @property
+    def wz_t(self) -> _F64: ...
+    @property
+    def dwz(self) -> _F64: ...
+    @property
+    def dphi(self) -> _F64: ...
+    @property
+    def stm(self) -> _F64 | None: ...
+    @property
+    def status(self) -> npt.NDArray[np.uint8]: ...
+    @property
+    def steps(self) -> npt.NDArray[np.uint32]: ...
+    def __getitem__(self, name: str, /) -> Any: ...
+    def keys(self) -> list[str]: ...
+    def __len__(self) -> int: ...
+
 def map_sweep(
     forcing: OrbitForcing, t_final: float, phi0: _F64, wz0: _F64, kz: _F64, *,
     rtol: float, atol: float, max_steps: int, stm: bool, chunk: int, threads: int | None,
     eps: _F64 | None = None, cs: _F64 | None = None, cd: _F64 | None = None, theta_sun0: _F64 | None = None,
-) -> dict[str, Any]: ...
+) -> SweepResult: ...
+
+@final
+class CorrectionBatch:
+    @property
+    def phi0(self) -> _F64: ...
+    @property
+    def wz0(self) -> _F64: ...
+    @property
+    def theta_sun0(self) -> _F64: ...
+    @property
+    def residual(self) -> _F64: ...
+    @property
+    def residual_norm(self) -> _F64: ...
+    @property
+    def iterations(self) -> npt.NDArray[np.int64]: ...
+    @property
+    def converged(self) -> npt.NDArray[np.bool_]: ...
+    @property
+    def reason(self) -> list[str]: ...
+    @property
+    def monodromy(self) -> _F64: ...
+    def __len__(self) -> int: ...
+
+def attitude_correct(
+    forcing: OrbitForcing, phi0: _F64, wz0: _F64, kz: _F64, turns: _F64, *,
+    t_final: float, closure: str, free: str = "phi0",
+    eps: _F64 | None = None, cs: _F64 | None = None, cd: _F64 | None = None, theta_sun0: _F64 | None = None,
+    tol: float = 1e-12, max_iter: int = 40, rtol: float = 1e-13, atol: float = 1e-13, max_steps: int = 200000,
+    max_wz_step: float = 0.5, max_angle_step: float = 0.5, threads: int | None = None, chunk: int = 64,
+) -> CorrectionBatch: ...
+
+@final
+class PlanarVerification:
+    @property
+    def phi_t(self) -> _F64: ...
+    @property
+    def wz_t(self) -> _F64: ...
+    @property
+    def stm(self) -> _F64: ...
+    @property
+    def error(self) -> list[str | None]: ...
+    def __len__(self) -> int: ...
+
+def planar_verify(
+    mu: float, orbit_state0: list[float], t_final: float, kz: _F64, phi0: _F64, wz0: _F64, *,
+    eps: _F64 | None = None, cs: _F64 | None = None, cd: _F64 | None = None, theta_sun0: _F64 | None = None,
+    primaries: list[bool] = ..., threads: int | None = None,
+) -> PlanarVerification: ...
 
 _FlexBody = tuple[float, list[float], list[tuple[float, list[float], list[float], float, float]]]
 

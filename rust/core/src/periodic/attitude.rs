@@ -1,0 +1,629 @@
+//! Periodic planar attitude motions along a periodic orbit (thesis sec. 3.3, PHYSICS.md sec. 5
+//! and 6): a batched, globalised Newton corrector on the periodicity-map engine, and a batched
+//! independent verifier on the scalar model.
+//!
+//! Along an orbit of period T, the planar motion (phi0, wz0) is periodic over K revolutions
+//! when phi(KT) = phi0 + 2 pi N and wz(KT) = wz0 (N net body turns; N + 1/2 for the half-turn
+//! motions, which repeat too since the inertia is symmetric under a half turn). Three problem
+//! forms share one driver ([`correct_planar_attitudes`]):
+//!
+//! - [`Closure::Half`]: symmetric half-period shooting. On an x-symmetric orbit started on the x
+//!   axis, with phi0 a multiple of pi/2 and no SRP, the motion is symmetric and periodic when
+//!   g(wz0) = phi(KT/2) - phi0 - pi N = 0 (one unknown, g' = d phi / d wz0 from the STM).
+//! - [`Closure::Full`] with [`Free::Phi0`]: unknowns (phi0, wz0), residuals
+//!   F = (phi(KT) - phi0 - 2 pi N, wz(KT) - wz0), Jacobian Phi(KT) - I (the correct Newton form;
+//!   thesis eq. 53 omits the identity).
+//! - [`Closure::Full`] with [`Free::SunPhase`]: phi0 kept, unknowns (theta_sun0, wz0) for a flat
+//!   plate with SRP; dF/dtheta_sun0 by central differences, from two extra trajectories
+//!   integrated in the same batch as the point itself; dF/dwz0 from the STM.
+//!
+//! Every Newton iteration integrates every still-active candidate of the batch in ONE
+//! [`map::sweep`] call with the STM (SIMD lanes, all cores). Newton is globalised per candidate:
+//! the steps in wz0 and in the angle unknown are capped, and a backtracking line search (Armijo-type sufficient decrease
+//! of the residual's 2-norm, step halved up to `max_halvings` times) evaluates the trial
+//! points of all candidates together in the next sweep. Each candidate reports why it stopped
+//! ([`StopReason`]); nothing panics and a non-finite result is never labelled converged.
+//!
+//! Determinism: candidates keep their order; the sweep of each iteration is bit-identical for
+//! any thread count and chunk size, so the results are too. The lane engine integrates eight
+//! trajectories in lock step with a shared step size, however, so a candidate's last bits
+//! (~1e-14 relative, the integration tolerance's noise) can depend on its batch companions:
+//! correcting it alone, or in another batch, can differ at that level (never in the outcome).
+
+use nalgebra::{Matrix2, Vector2};
+use rayon::prelude::*;
+
+use crate::attitude::{propagate_planar, FlatPlate, OMEGA_SUN};
+use crate::cr3bp::check_mu;
+use crate::error::{check_finite, check_positive, invalid, Error, Result};
+use crate::integrate::{Options, Output};
+use crate::map::{self, Case, LaneOptions, LaneStatus, OrbitForcing, Outcome};
+use crate::propagation::with_threads;
+
+use std::f64::consts::{FRAC_PI_2, PI};
+
+/// How the periodicity condition is closed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Closure {
+    /// Symmetric half-period shooting: `t_final` = K T / 2, unknown wz0, residual
+    /// phi(t_final) - phi0 - pi turns. Needs an x-symmetric orbit started on the x axis,
+    /// phi0 a multiple of pi/2 and no SRP; `free` must be [`Free::Phi0`] (phi0 itself is kept).
+    Half,
+    /// Full closure over `t_final` = K T: residuals (phi - phi0 - 2 pi turns, wz - wz0).
+    Full,
+}
+
+/// The unknown corrected with wz0 in the [`Closure::Full`] form.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Free {
+    /// (phi0, wz0).
+    Phi0,
+    /// (theta_sun0, wz0) with phi0 kept: SRP candidates only (eps != 0).
+    SunPhase,
+}
+
+/// Why the corrector stopped on a candidate.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum StopReason {
+    /// Residual max-norm <= tol.
+    Converged,
+    /// `max_iter` Newton steps taken without convergence.
+    MaxIterations,
+    /// The Jacobian is zero or non-finite, or rank-deficient with no decrease along its
+    /// minimum-norm step (e.g. a fold: trace of the monodromy = 2).
+    SingularJacobian,
+    /// The line search found no sufficient decrease after `max_halvings` halvings.
+    NoDescent,
+    /// The integration failed (lane status not Ok, or non-finite results) at the starting
+    /// point, or at every trial point of the last line search.
+    IntegrationFailed,
+}
+
+impl StopReason {
+    /// "converged", "max_iterations", "singular_jacobian", "no_descent", "integration_failed".
+    pub fn as_str(&self) -> &'static str {
+        match self {
+            Self::Converged => "converged",
+            Self::MaxIterations => "max_iterations",
+            Self::SingularJacobian => "singular_jacobian",
+            Self::NoDescent => "no_descent",
+            Self::IntegrationFailed => "integration_failed",
+        }
+    }
+}
+
+/// One starting point: the trajectory's parameters (its `phi0`, `wz0`, `theta_sun0` are the
+/// initial guesses of the unknowns) and its target number of turns per `t_final` closure
+/// (N, or N + 1/2 for half-turn motions).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Candidate {
+    pub case: Case,
+    pub turns: f64,
+}
+
+impl Candidate {
+    /// A gravity-gradient-only candidate.
+    pub fn new(phi0: f64, wz0: f64, kz: f64, turns: f64) -> Self {
+        Self { case: Case::new(phi0, wz0, kz), turns }
+    }
+
+    /// The same candidate with a flat plate (SRP amplitude `eps`, coefficients, Sun phase).
+    pub fn with_plate(self, eps: f64, cs: f64, cd: f64, theta_sun0: f64) -> Self {
+        Self { case: Case { eps, cs, cd, theta_sun0, ..self.case }, ..self }
+    }
+}
+
+/// Settings of [`correct_planar_attitudes`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CorrectorOptions {
+    /// Convergence: residual max-norm <= tol.
+    pub tol: f64,
+    /// Most Newton steps per candidate.
+    pub max_iter: usize,
+    /// Lane integrator tolerances and step limit.
+    pub rtol: f64,
+    pub atol: f64,
+    pub max_steps: u32,
+    /// Largest |step| in wz0 (1/TU) and in the angle unknown (phi0 or theta_sun0, rad): the
+    /// Newton step is scaled down (direction kept) until both hold.
+    pub max_wz_step: f64,
+    pub max_angle_step: f64,
+    /// Step halvings of the line search before giving up ([`StopReason::NoDescent`]).
+    pub max_halvings: u32,
+    /// Central-difference step in theta_sun0 ([`Free::SunPhase`]), rad.
+    pub phase_step: f64,
+    /// Rate of the Sun direction in the synodic frame (1/TU), for SRP candidates.
+    pub sun_omega: f64,
+    /// Worker threads (None: all cores) and cases per task of the sweeps.
+    pub threads: Option<usize>,
+    pub chunk: usize,
+}
+
+impl Default for CorrectorOptions {
+    fn default() -> Self {
+        Self {
+            tol: 1e-12,
+            max_iter: 40,
+            rtol: 1e-13,
+            atol: 1e-13,
+            max_steps: 200_000,
+            max_wz_step: 0.5,
+            max_angle_step: 0.5,
+            max_halvings: 10,
+            phase_step: 1e-6,
+            sun_omega: OMEGA_SUN,
+            threads: None,
+            chunk: 64,
+        }
+    }
+}
+
+/// The outcome of one candidate.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Correction {
+    /// Final unknowns (the last accepted point; the start when nothing was accepted). Angles
+    /// are not wrapped (the residual is exactly the one of these values).
+    pub phi0: f64,
+    pub wz0: f64,
+    pub theta_sun0: f64,
+    /// Full: (phi(KT) - phi0 - 2 pi turns, wz(KT) - wz0). Half: (phi(KT/2) - phi0 - pi turns,
+    /// NaN). NaN when the starting point could not be integrated.
+    pub residual: [f64; 2],
+    /// Max-norm of the residual (NaN when it could not be evaluated).
+    pub residual_norm: f64,
+    /// Accepted Newton steps.
+    pub iterations: usize,
+    pub reason: StopReason,
+    /// Full-period (K T) monodromy d(phi, wz)(KT)/d(phi0, wz0), row-major, at the final point
+    /// (for Half from one extra batched sweep over 2 `t_final`); NaN when not available.
+    pub monodromy: [f64; 4],
+}
+
+impl Correction {
+    pub fn converged(&self) -> bool {
+        self.reason == StopReason::Converged
+    }
+}
+
+/// Residual, Jacobian and STM at one point of the unknowns.
+#[derive(Debug, Clone, Copy)]
+struct Point {
+    /// (phi0 or theta_sun0, wz0); x[0] is unused (kept) for Half.
+    x: [f64; 2],
+    f: [f64; 2],
+    norm: f64,
+    /// Line-search merit: the residual's 2-norm.
+    merit: f64,
+    /// Row-major 2x2 (Half: j[0] = dg/dwz0 only).
+    jac: [f64; 4],
+    stm: [f64; 4],
+}
+
+#[derive(Debug, Clone, Copy)]
+enum Phase {
+    Start,
+    Trial { lambda: f64, halvings: u32, any_integrated: bool },
+    Done(StopReason),
+}
+
+struct Track {
+    cand: Candidate,
+    start: [f64; 2],
+    cur: Option<Point>,
+    /// Newton direction, already scaled to the wz0 cap; `scale` is that factor (<= 1).
+    dir: [f64; 2],
+    scale: f64,
+    rank_deficient: bool,
+    phase: Phase,
+    iterations: usize,
+}
+
+#[derive(Clone, Copy)]
+struct Form {
+    closure: Closure,
+    free: Free,
+    h: f64,
+}
+
+impl Form {
+    fn cases_per_point(&self) -> usize {
+        if self.closure == Closure::Full && self.free == Free::SunPhase {
+            3
+        } else {
+            1
+        }
+    }
+
+    fn initial(&self, c: &Candidate) -> [f64; 2] {
+        match (self.closure, self.free) {
+            (Closure::Full, Free::SunPhase) => [c.case.theta_sun0, c.case.wz0],
+            _ => [c.case.phi0, c.case.wz0],
+        }
+    }
+
+    fn push_cases(&self, c: &Candidate, x: [f64; 2], out: &mut Vec<Case>) {
+        match (self.closure, self.free) {
+            (Closure::Half, _) => out.push(Case { wz0: x[1], ..c.case }),
+            (Closure::Full, Free::Phi0) => out.push(Case { phi0: x[0], wz0: x[1], ..c.case }),
+            (Closure::Full, Free::SunPhase) => {
+                for th in [x[0], x[0] + self.h, x[0] - self.h] {
+                    out.push(Case { theta_sun0: th, wz0: x[1], ..c.case });
+                }
+            }
+        }
+    }
+
+    /// The point from its trajectories; None when any failed or is non-finite.
+    fn point(&self, c: &Candidate, x: [f64; 2], o: &[Outcome]) -> Option<Point> {
+        let ok = |o: &Outcome| o.status == LaneStatus::Ok && o.phi_t.is_finite() && o.wz_t.is_finite() && o.stm.iter().all(|v| v.is_finite());
+        if !o.iter().all(ok) {
+            return None;
+        }
+        let m = o[0].stm;
+        let p = match (self.closure, self.free) {
+            (Closure::Half, _) => {
+                let g = o[0].phi_t - c.case.phi0 - PI * c.turns;
+                Point { x, f: [g, f64::NAN], norm: g.abs(), merit: g.abs(), jac: [m[1], 0.0, 0.0, 0.0], stm: m }
+            }
+            (Closure::Full, free) => {
+                let phi0 = if free == Free::Phi0 { x[0] } else { c.case.phi0 };
+                let f = [o[0].phi_t - phi0 - 2.0 * PI * c.turns, o[0].wz_t - x[1]];
+                let jac = if free == Free::Phi0 {
+                    [m[0] - 1.0, m[1], m[2], m[3] - 1.0]
+                } else {
+                    let k = 0.5 / self.h;
+                    [(o[1].phi_t - o[2].phi_t) * k, m[1], (o[1].wz_t - o[2].wz_t) * k, m[3] - 1.0]
+                };
+                Point { x, f, norm: f[0].abs().max(f[1].abs()), merit: f[0].hypot(f[1]), jac, stm: m }
+            }
+        };
+        (p.norm.is_finite() && p.merit.is_finite() && p.jac.iter().all(|v| v.is_finite())).then_some(p)
+    }
+
+    /// Newton direction at p (minimum-norm step when J is rank-deficient) and whether J was;
+    /// None when J is zero or non-finite.
+    fn direction(&self, p: &Point) -> Option<([f64; 2], bool)> {
+        if self.closure == Closure::Half {
+            let d = p.jac[0];
+            if d == 0.0 || !d.is_finite() {
+                return None;
+            }
+            return Some(([0.0, -p.f[0] / d], false));
+        }
+        let j = Matrix2::new(p.jac[0], p.jac[1], p.jac[2], p.jac[3]);
+        let svd = j.try_svd(true, true, f64::EPSILON, 200)?;
+        let (s1, s2) = (svd.singular_values[0].max(svd.singular_values[1]), svd.singular_values[0].min(svd.singular_values[1]));
+        if !(s1 > 0.0 && s1.is_finite()) {
+            return None;
+        }
+        let deficient = s2 <= RANK_TOL * s1;
+        let d = svd.solve(&Vector2::new(-p.f[0], -p.f[1]), RANK_TOL * s1).ok()?;
+        (d[0].is_finite() && d[1].is_finite()).then_some(([d[0], d[1]], deficient))
+    }
+}
+
+/// Singular values below this fraction of the largest are treated as zero (minimum-norm step).
+const RANK_TOL: f64 = 1e-11;
+/// Armijo constant of the sufficient-decrease test |F(x + l d)|_2 <= (1 - C l) |F(x)|_2.
+const ARMIJO: f64 = 1e-4;
+
+impl Track {
+    /// The point to integrate in the next sweep, if still active.
+    fn pending(&self) -> Option<[f64; 2]> {
+        match self.phase {
+            Phase::Start => Some(self.start),
+            Phase::Trial { lambda, .. } => {
+                let x = self.cur.as_ref()?.x;
+                Some([x[0] + lambda * self.dir[0], x[1] + lambda * self.dir[1]])
+            }
+            Phase::Done(_) => None,
+        }
+    }
+
+    fn advance(&mut self, form: &Form, x: [f64; 2], o: &[Outcome], opts: &CorrectorOptions) {
+        let p = form.point(&self.cand, x, o);
+        match self.phase {
+            Phase::Start => match p {
+                None => self.phase = Phase::Done(StopReason::IntegrationFailed),
+                Some(p) => {
+                    self.cur = Some(p);
+                    self.next_step(form, opts);
+                }
+            },
+            Phase::Trial { lambda, halvings, any_integrated } => {
+                let Some(cur) = self.cur else { return };
+                let integrated = any_integrated || p.is_some();
+                match p.filter(|p| p.merit <= (1.0 - ARMIJO * lambda * self.scale) * cur.merit) {
+                    Some(p) => {
+                        self.cur = Some(p);
+                        self.iterations += 1;
+                        self.next_step(form, opts);
+                    }
+                    None if halvings >= opts.max_halvings => {
+                        self.phase = Phase::Done(if !integrated {
+                            StopReason::IntegrationFailed
+                        } else if self.rank_deficient {
+                            StopReason::SingularJacobian
+                        } else {
+                            StopReason::NoDescent
+                        })
+                    }
+                    None => self.phase = Phase::Trial { lambda: 0.5 * lambda, halvings: halvings + 1, any_integrated: integrated },
+                }
+            }
+            Phase::Done(_) => {}
+        }
+    }
+
+    /// After accepting a point: stop, or set up the line search along the Newton direction.
+    fn next_step(&mut self, form: &Form, opts: &CorrectorOptions) {
+        let Some(p) = self.cur else { return };
+        if p.norm <= opts.tol {
+            self.phase = Phase::Done(StopReason::Converged);
+            return;
+        }
+        if self.iterations >= opts.max_iter {
+            self.phase = Phase::Done(StopReason::MaxIterations);
+            return;
+        }
+        match form.direction(&p) {
+            None => self.phase = Phase::Done(StopReason::SingularJacobian),
+            Some((d, deficient)) => {
+                let cap = |v: f64, m: f64| if v.abs() > m { m / v.abs() } else { 1.0 };
+                let scale = cap(d[1], opts.max_wz_step).min(cap(d[0], opts.max_angle_step));
+                self.dir = [d[0] * scale, d[1] * scale];
+                self.scale = scale;
+                self.rank_deficient = deficient;
+                self.phase = Phase::Trial { lambda: 1.0, halvings: 0, any_integrated: false };
+            }
+        }
+    }
+
+    fn result(&self, form: &Form, monodromy: [f64; 4]) -> Correction {
+        let reason = match self.phase {
+            Phase::Done(r) => r,
+            _ => StopReason::MaxIterations,
+        };
+        let x = self.cur.map_or(self.start, |p| p.x);
+        let c = &self.cand.case;
+        let (phi0, theta_sun0) = match (form.closure, form.free) {
+            (Closure::Half, _) => (c.phi0, c.theta_sun0),
+            (Closure::Full, Free::Phi0) => (x[0], c.theta_sun0),
+            (Closure::Full, Free::SunPhase) => (c.phi0, x[0]),
+        };
+        Correction {
+            phi0,
+            wz0: x[1],
+            theta_sun0,
+            residual: self.cur.map_or([f64::NAN; 2], |p| p.f),
+            residual_norm: self.cur.map_or(f64::NAN, |p| p.norm),
+            iterations: self.iterations,
+            reason,
+            monodromy,
+        }
+    }
+}
+
+/// Whether the table's S(T - t) = -S(t), C(T - t) = C(t) (an x-symmetric orbit started on the
+/// x axis), to 1e-8 of max(|S|, |C|) at 16 interior times; the largest deviation otherwise.
+fn forcing_asymmetry(f: &OrbitForcing) -> f64 {
+    (0..16)
+        .map(|k| {
+            let t = f.period * (k as f64 + 0.37) / 16.0;
+            let (s1, c1) = f.sc(t);
+            let (s2, c2) = f.sc(f.period - t);
+            (s1 + s2).abs().max((c1 - c2).abs()) / f.scale.max(f64::MIN_POSITIVE)
+        })
+        .fold(0.0, f64::max)
+}
+
+/// Whether `t` is a whole multiple (>= 1) of `unit`, to 1e-9 relative.
+fn is_multiple(t: f64, unit: f64) -> bool {
+    let k = (t / unit).round();
+    k >= 1.0 && (t - k * unit).abs() <= 1e-9 * t
+}
+
+fn validate(forcing: &OrbitForcing, t_final: f64, closure: Closure, free: Free, candidates: &[Candidate], opts: &CorrectorOptions) -> Result<()> {
+    check_positive("t_final", t_final)?;
+    check_positive("tol", opts.tol)?;
+    check_positive("rtol", opts.rtol)?;
+    check_positive("atol", opts.atol)?;
+    check_positive("max_wz_step", opts.max_wz_step)?;
+    check_positive("max_angle_step", opts.max_angle_step)?;
+    check_positive("phase_step", opts.phase_step)?;
+    if !opts.sun_omega.is_finite() {
+        return Err(invalid("sun_omega", format!("must be finite, got {}", opts.sun_omega)));
+    }
+    if opts.max_iter == 0 {
+        return Err(invalid("max_iter", "must be >= 1"));
+    }
+    if opts.max_steps == 0 {
+        return Err(invalid("max_steps", "must be >= 1"));
+    }
+    if opts.max_halvings > 60 {
+        return Err(invalid("max_halvings", format!("must be in [0, 60], got {}", opts.max_halvings)));
+    }
+    if opts.chunk == 0 {
+        return Err(invalid("chunk", "must be >= 1"));
+    }
+    if opts.threads == Some(0) {
+        return Err(invalid("threads", "must be >= 1 (or None for all cores)"));
+    }
+    match closure {
+        Closure::Half => {
+            if free != Free::Phi0 {
+                return Err(invalid("free", "the half-period closure corrects wz0 only: use Free::Phi0 (phi0 is kept), or Closure::Full for the Sun phase"));
+            }
+            if !is_multiple(t_final, 0.5 * forcing.period) {
+                return Err(invalid("t_final", format!("the half-period closure needs t_final = K T / 2 (K >= 1, T = {}), got {t_final}", forcing.period)));
+            }
+            let a = forcing_asymmetry(forcing);
+            if !(a <= 1e-8) {
+                return Err(invalid(
+                    "closure",
+                    format!("the half-period closure needs an x-symmetric orbit started on the x axis: S(T - t) = -S(t), C(T - t) = C(t) fail by {a:.2e} relative (use Closure::Full)"),
+                ));
+            }
+        }
+        Closure::Full => {
+            if !is_multiple(t_final, forcing.period) {
+                return Err(invalid("t_final", format!("the full closure needs t_final = K T (K >= 1, T = {}), got {t_final}", forcing.period)));
+            }
+        }
+    }
+    for (i, c) in candidates.iter().enumerate() {
+        let k = &c.case;
+        if !(k.phi0.is_finite() && k.wz0.is_finite()) {
+            return Err(invalid("wz0", format!("candidate {i}: phi0 and wz0 must be finite, got ({}, {})", k.phi0, k.wz0)));
+        }
+        if !(k.kz.is_finite() && (-1.0..=1.0).contains(&k.kz)) {
+            return Err(invalid("kz", format!("candidate {i}: must be in [-1, 1], got {}", k.kz)));
+        }
+        if !c.turns.is_finite() {
+            return Err(invalid("turns", format!("candidate {i}: must be finite, got {}", c.turns)));
+        }
+        if !(k.eps.is_finite() && k.theta_sun0.is_finite()) {
+            return Err(invalid("eps", format!("candidate {i}: eps and theta_sun0 must be finite, got ({}, {})", k.eps, k.theta_sun0)));
+        }
+        if !(k.cs >= 0.0 && k.cd >= 0.0 && k.cs + k.cd <= 1.0 + 1e-12) {
+            return Err(invalid("cs", format!("candidate {i}: need cs, cd >= 0 and cs + cd <= 1, got ({}, {})", k.cs, k.cd)));
+        }
+        if closure == Closure::Half {
+            if k.eps != 0.0 {
+                return Err(invalid("eps", format!("candidate {i}: the half-period closure needs no SRP (eps = 0), got {} (use Closure::Full)", k.eps)));
+            }
+            let m = k.phi0 / FRAC_PI_2;
+            if (m - m.round()).abs() > 1e-12 {
+                return Err(invalid("phi0", format!("candidate {i}: the half-period closure needs phi0 a multiple of pi/2, got {} (use Closure::Full)", k.phi0)));
+            }
+        }
+        if free == Free::SunPhase && k.eps == 0.0 {
+            return Err(invalid("free", format!("candidate {i}: Free::SunPhase needs an SRP plate (eps != 0)")));
+        }
+    }
+    Ok(())
+}
+
+/// Correct many candidates at once to periodic planar attitude motions along the orbit of
+/// `forcing` (see the module documentation for the three forms). `t_final` is the closure time:
+/// K T for [`Closure::Full`], K T / 2 for [`Closure::Half`] (the monodromy is then over K T).
+///
+/// Returns one [`Correction`] per candidate, in order; `Err` only for invalid arguments (each
+/// naming the parameter and its allowed range, candidate index included). Results do not depend
+/// on `threads` or `chunk`; a candidate's last bits (~1e-14) can depend on its batch companions
+/// (lock-step lanes share their step size).
+pub fn correct_planar_attitudes(
+    forcing: &OrbitForcing,
+    t_final: f64,
+    closure: Closure,
+    free: Free,
+    candidates: &[Candidate],
+    opts: &CorrectorOptions,
+) -> Result<Vec<Correction>> {
+    validate(forcing, t_final, closure, free, candidates, opts)?;
+    let form = Form { closure, free, h: opts.phase_step };
+    let lane = LaneOptions { rtol: opts.rtol, atol: opts.atol, max_steps: opts.max_steps, sun_omega: opts.sun_omega };
+    let per = form.cases_per_point();
+    let mut tracks: Vec<Track> = candidates
+        .iter()
+        .map(|c| Track { cand: *c, start: form.initial(c), cur: None, dir: [0.0; 2], scale: 1.0, rank_deficient: false, phase: Phase::Start, iterations: 0 })
+        .collect();
+    with_threads(opts.threads, || -> Result<Vec<Correction>> {
+        let mut cases = Vec::with_capacity(per * tracks.len());
+        let mut active: Vec<(usize, [f64; 2])> = Vec::with_capacity(tracks.len());
+        loop {
+            cases.clear();
+            active.clear();
+            for (i, t) in tracks.iter().enumerate() {
+                if let Some(x) = t.pending() {
+                    form.push_cases(&t.cand, x, &mut cases);
+                    active.push((i, x));
+                }
+            }
+            if active.is_empty() {
+                break;
+            }
+            let out = map::sweep(forcing, t_final, &cases, &lane, true, opts.chunk, None)?;
+            for (k, &(i, x)) in active.iter().enumerate() {
+                tracks[i].advance(&form, x, &out[k * per..(k + 1) * per], opts);
+            }
+        }
+        let mut mono: Vec<[f64; 4]> = tracks.iter().map(|t| t.cur.map_or([f64::NAN; 4], |p| p.stm)).collect();
+        if closure == Closure::Half {
+            // The full-period monodromy: one more sweep over K T at the final points.
+            let idx: Vec<usize> = (0..tracks.len()).filter(|&i| tracks[i].cur.is_some()).collect();
+            let full: Vec<Case> = idx.iter().map(|&i| Case { wz0: tracks[i].cur.map_or(0.0, |p| p.x[1]), ..tracks[i].cand.case }).collect();
+            let out = map::sweep(forcing, 2.0 * t_final, &full, &lane, true, opts.chunk, None)?;
+            for (&i, o) in idx.iter().zip(&out) {
+                mono[i] = if o.status == LaneStatus::Ok { o.stm } else { [f64::NAN; 4] };
+            }
+        }
+        Ok(tracks.iter().zip(mono).map(|(t, m)| t.result(&form, m)).collect())
+    })?
+}
+
+/// One trajectory to re-propagate with [`verify_planar_attitudes`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PlanarStart {
+    pub kz: f64,
+    pub phi0: f64,
+    pub wz0: f64,
+    /// Optional flat plate (SRP); its Sun carries the phase and rate.
+    pub plate: Option<FlatPlate>,
+}
+
+/// The end of one re-propagated trajectory.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PlanarEnd {
+    pub phi_t: f64,
+    pub wz_t: f64,
+    /// d(phi, wz)(t_final) / d(phi0, wz0), row-major.
+    pub stm: [f64; 4],
+    /// The integration error of this item (then the values are NaN).
+    pub error: Option<Error>,
+}
+
+/// Independent re-propagation of many planar attitude motions along the orbit `orbit_state0`:
+/// the scalar model [`propagate_planar`] with the orbit integrated alongside (not the forcing
+/// table, not the SIMD lanes), rtol = atol = 1e-14, stopping at every terminator crossing of a
+/// plate, with the 2x2 STM. Items run in parallel on rayon (`threads`; None: all cores); each is
+/// independent of the others and of the thread count. `Err` for invalid arguments; an item whose
+/// integration fails carries its error and NaN values.
+pub fn verify_planar_attitudes(
+    mu: f64,
+    orbit_state0: &[f64; 6],
+    t_final: f64,
+    items: &[PlanarStart],
+    primaries: [bool; 2],
+    threads: Option<usize>,
+) -> Result<Vec<PlanarEnd>> {
+    check_mu(mu)?;
+    check_finite("orbit_state0", orbit_state0)?;
+    check_positive("t_final", t_final)?;
+    if orbit_state0[2] != 0.0 || orbit_state0[5] != 0.0 {
+        return Err(invalid("orbit_state0", format!("the planar model needs a planar orbit (z = zd = 0), got z = {}, zd = {}", orbit_state0[2], orbit_state0[5])));
+    }
+    if threads == Some(0) {
+        return Err(invalid("threads", "must be >= 1 (or None for all cores)"));
+    }
+    for (i, it) in items.iter().enumerate() {
+        if !(it.kz.is_finite() && (-1.0..=1.0).contains(&it.kz)) {
+            return Err(invalid("kz", format!("item {i}: must be in [-1, 1], got {}", it.kz)));
+        }
+        if !(it.phi0.is_finite() && it.wz0.is_finite()) {
+            return Err(invalid("wz0", format!("item {i}: phi0 and wz0 must be finite, got ({}, {})", it.phi0, it.wz0)));
+        }
+        if let Some(p) = &it.plate {
+            let ok = p.eps.is_finite() && p.sun.theta0.is_finite() && p.sun.omega.is_finite() && p.cs >= 0.0 && p.cd >= 0.0 && p.cs + p.cd <= 1.0 + 1e-12;
+            if !ok {
+                return Err(invalid("plate", format!("item {i}: eps, the Sun phase and rate must be finite, cs, cd >= 0 with cs + cd <= 1; got {p:?}")));
+            }
+        }
+    }
+    let opts = Options::with_tolerances(1e-14, 1e-14);
+    let one = |it: &PlanarStart| match propagate_planar(mu, it.kz, primaries, false, orbit_state0, it.phi0, it.wz0, 0.0, t_final, &opts, true, Output::Final, it.plate) {
+        Ok(r) => PlanarEnd { phi_t: r.phi.last().copied().unwrap_or(f64::NAN), wz_t: r.wz.last().copied().unwrap_or(f64::NAN), stm: r.stm_final.unwrap_or([f64::NAN; 4]), error: None },
+        Err(e) => PlanarEnd { phi_t: f64::NAN, wz_t: f64::NAN, stm: [f64::NAN; 4], error: Some(e) },
+    };
+    with_threads(threads, || items.par_iter().map(one).collect())
+}
