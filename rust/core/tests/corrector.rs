@@ -8,8 +8,8 @@ use librate_core::attitude::{FlatPlate, Sun};
 use librate_core::integrate::Options;
 use librate_core::map::{sweep, Case, LaneOptions, LaneStatus, OrbitForcing};
 use librate_core::periodic::{
-    correct_planar_attitudes, correct_planar_symmetric, verify_planar_attitudes, Candidate, Closure, Constraint, Correction, CorrectorOptions, Free, PlanarStart,
-    StopReason, SymmetricShooting,
+    correct_bordered, correct_planar_attitudes, correct_planar_symmetric, verify_planar_attitudes, Bordered, Candidate, Closure, Constraint, Correction, CorrectorOptions,
+    Free, Parameter, PlanarStart, StopReason, SymmetricShooting,
 };
 use std::f64::consts::PI;
 
@@ -317,4 +317,50 @@ fn val_corrector_rejects_invalid_arguments() {
     assert_eq!(vname(verify_planar_attitudes(MU, &s0, -1.0, &[item], [true, true], None)), "t_final");
     assert_eq!(vname(verify_planar_attitudes(MU, &[0.8, 0.0, 0.1, 0.0, 0.5, 0.0], t, &[item], [true, true], None)), "orbit_state0");
     assert_eq!(vname(verify_planar_attitudes(MU, &s0, t, &[item], [true, true], Some(0))), "threads");
+}
+
+/// The bordered correction (continuation's corrector). References: (1) with the parameter fixed
+/// (natural condition) it equals the plain correction at that Kz to 1e-11; (2) its parameter
+/// column d g / d Kz matches the implicit-function derivative of the plain solutions,
+/// d wz0 / d Kz = -g_Kz / g_wz0, against central differences of plain corrections at
+/// Kz +- 1e-4 (to 1e-6 relative: second-order truncation); (3) a pseudo-arclength condition
+/// a . x = b lands on the curve (residual <= 1e-12) and on the condition (to 1e-12); (4) eps as
+/// the parameter with the full closure (SRP, phi0 free) equals the plain correction at that
+/// eps (1e-10).
+#[test]
+fn val_bordered_correction_is_the_continuation_corrector() {
+    let (s0, t) = dro1266();
+    let f = table(&s0, t);
+    let opts = CorrectorOptions::default();
+    let plain = |kz: f64| correct_planar_attitudes(&f, 0.5 * t, Closure::Half, Free::Phi0, &[Candidate::new(0.0, -1.45, kz, -1.0)], &opts).unwrap()[0];
+    let p = plain(0.8);
+    assert!(p.converged());
+    let fixed = Bordered::fixed(Parameter::Kz, 0.8);
+    let b = correct_bordered(&f, 0.5 * t, Closure::Half, Free::Phi0, &fixed, &[Candidate::new(0.0, -1.40, 0.75, -1.0)], &opts).unwrap()[0];
+    assert!(b.converged(), "{:?}", b.reason);
+    assert!((b.parameter - 0.8).abs() < 1e-14 && (b.wz0 - p.wz0).abs() < 1e-11, "{} vs {}", b.wz0, p.wz0);
+    // (2) the tangent's slope
+    let slope = -b.jacobian[0][2] / b.jacobian[0][1];
+    let fd = (plain(0.8001).wz0 - plain(0.7999).wz0) / 2e-4;
+    assert!((slope - fd).abs() <= 1e-6 * fd.abs().max(1.0), "{slope} vs {fd}");
+    // (3) an arclength-type condition through the solution, tilted
+    let (tw, tk) = (0.6, 0.8);
+    let arc = Bordered { parameter: Parameter::Kz, a: [0.0, tw, tk], b: tw * p.wz0 + tk * 0.8 + 0.01, step: 1e-6, max_step: 0.5 };
+    let r = correct_bordered(&f, 0.5 * t, Closure::Half, Free::Phi0, &arc, &[Candidate::new(0.0, p.wz0, 0.8, -1.0)], &opts).unwrap()[0];
+    assert!(r.converged() && r.residual_norm <= 1e-12);
+    assert!((tw * r.wz0 + tk * r.parameter - arc.b).abs() <= 1e-12);
+    let check = plain(r.parameter);
+    assert!((check.wz0 - r.wz0).abs() < 1e-10);
+    // (4) eps with SRP, full closure, phi0 free, on the 1:2 Sun-resonant DRO over K = 2
+    let (s2, t2) = sun12();
+    let f2 = table(&s2, t2);
+    let start = Candidate::new(0.0, 0.934, 0.6, 0.0).with_plate(0.0, 0.4, 0.1, 0.0);
+    let e = correct_bordered(&f2, 2.0 * t2, Closure::Full, Free::Phi0, &Bordered::fixed(Parameter::Eps, 0.02), &[start], &opts).unwrap()[0];
+    assert!(e.converged(), "{:?}", e.reason);
+    let pe = correct_planar_attitudes(&f2, 2.0 * t2, Closure::Full, Free::Phi0, &[Candidate::new(e.phi0, e.wz0, 0.6, 0.0).with_plate(0.02, 0.4, 0.1, 0.0)], &opts).unwrap()[0];
+    assert!(pe.converged() && (pe.wz0 - e.wz0).abs() < 1e-10 && (pe.phi0 - e.phi0).abs() < 1e-10);
+    // Kz's range: a condition that would need |Kz| > 1 fails cleanly, never panics
+    let out = Bordered { parameter: Parameter::Kz, a: [0.0, 0.0, 1.0], b: 1.5, step: 1e-6, max_step: 0.5 };
+    let r = correct_bordered(&f, 0.5 * t, Closure::Half, Free::Phi0, &out, &[Candidate::new(0.0, p.wz0, 0.8, -1.0)], &opts).unwrap()[0];
+    assert!(!r.converged());
 }

@@ -30,7 +30,7 @@
 //! (~1e-14 relative, the integration tolerance's noise) can depend on its batch companions:
 //! correcting it alone, or in another batch, can differ at that level (never in the outcome).
 
-use nalgebra::{Matrix2, Vector2};
+use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
 
 use crate::attitude::{propagate_planar, FlatPlate, OMEGA_SUN};
@@ -113,6 +113,39 @@ impl Candidate {
     }
 }
 
+/// The parameter freed by a bordered correction (continuation in Kz or in the SRP amplitude).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Parameter {
+    /// Kz = (Iy - Ix) / Iz, kept in [-1, 1] (one-sided differences at the ends).
+    Kz,
+    /// The flat-plate SRP amplitude eps.
+    Eps,
+}
+
+/// A bordered correction, the corrector of pseudo-arclength (or natural-parameter)
+/// continuation: the parameter becomes an unknown and one linear condition closes the system,
+///   a[0] angle + a[1] wz0 + a[2] parameter = b,
+/// with "angle" the second unknown of the form (phi0, or theta_sun0; a[0] must be 0 for the
+/// half-period closure, which has no angle unknown). d F / d parameter by central differences
+/// (`step`), from two extra trajectories integrated in the same sweep as the point itself.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Bordered {
+    pub parameter: Parameter,
+    pub a: [f64; 3],
+    pub b: f64,
+    /// Central-difference step in the parameter.
+    pub step: f64,
+    /// Largest |Newton step| in the parameter (the step is scaled down, direction kept).
+    pub max_step: f64,
+}
+
+impl Bordered {
+    /// The natural-parameter condition: the parameter fixed at `value`.
+    pub fn fixed(parameter: Parameter, value: f64) -> Self {
+        Self { parameter, a: [0.0, 0.0, 1.0], b: value, step: 1e-6, max_step: 0.5 }
+    }
+}
+
 /// Settings of [`correct_planar_attitudes`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CorrectorOptions {
@@ -177,6 +210,14 @@ pub struct Correction {
     /// Full-period (K T) monodromy d(phi, wz)(KT)/d(phi0, wz0), row-major, at the final point
     /// (for Half from one extra batched sweep over 2 `t_final`); NaN when not available.
     pub monodromy: [f64; 4],
+    /// The freed parameter's final value ([`correct_bordered`]; the candidate's Kz or eps
+    /// otherwise).
+    pub parameter: f64,
+    /// d F / d (angle, wz0, parameter) at the final point, rows F = (phi closure, wz closure)
+    /// (Half: the first row only, d g / d wz0 and d g / d parameter); NaN where not computed
+    /// (the angle column of Half, the parameter column without a bordered correction, the
+    /// second row of Half). The continuation driver takes the family's tangent from it.
+    pub jacobian: [[f64; 3]; 2],
 }
 
 impl Correction {
@@ -185,17 +226,19 @@ impl Correction {
     }
 }
 
-/// Residual, Jacobian and STM at one point of the unknowns.
+/// Residual, Jacobian and STM at one point of the unknowns x = (angle, wz0, parameter): the
+/// angle (phi0, or theta_sun0 for [`Free::SunPhase`]) is unused by Half, the parameter by
+/// corrections that are not bordered.
 #[derive(Debug, Clone, Copy)]
 struct Point {
-    /// (phi0 or theta_sun0, wz0); x[0] is unused (kept) for Half.
-    x: [f64; 2],
-    f: [f64; 2],
+    x: [f64; 3],
+    /// Residual rows (phi closure, wz closure, linear condition); NaN for unused rows.
+    f: [f64; 3],
     norm: f64,
-    /// Line-search merit: the residual's 2-norm.
+    /// Line-search merit: the 2-norm of the used rows.
     merit: f64,
-    /// Row-major 2x2 (Half: j[0] = dg/dwz0 only).
-    jac: [f64; 4],
+    /// d f / d x, row-major 3x3 (unused rows and columns NaN or 0).
+    jac: [f64; 9],
     stm: [f64; 4],
 }
 
@@ -208,10 +251,10 @@ enum Phase {
 
 struct Track {
     cand: Candidate,
-    start: [f64; 2],
+    start: [f64; 3],
     cur: Option<Point>,
-    /// Newton direction, already scaled to the wz0 cap; `scale` is that factor (<= 1).
-    dir: [f64; 2],
+    /// Newton direction, already scaled to the step caps; `scale` is that factor (<= 1).
+    dir: [f64; 3],
     scale: f64,
     rank_deficient: bool,
     phase: Phase,
@@ -223,82 +266,172 @@ struct Form {
     closure: Closure,
     free: Free,
     h: f64,
+    bordered: Option<Bordered>,
 }
+
+const ANGLE: usize = 0;
+const WZ: usize = 1;
+const PARAM: usize = 2;
 
 impl Form {
     fn cases_per_point(&self) -> usize {
+        1 + if self.closure == Closure::Full && self.free == Free::SunPhase { 2 } else { 0 } + if self.bordered.is_some() { 2 } else { 0 }
+    }
+
+    /// The residual rows and unknown columns in use.
+    fn rows(&self) -> &'static [usize] {
+        match (self.closure, self.bordered.is_some()) {
+            (Closure::Half, false) => &[0],
+            (Closure::Half, true) => &[0, 2],
+            (Closure::Full, false) => &[0, 1],
+            (Closure::Full, true) => &[0, 1, 2],
+        }
+    }
+
+    fn cols(&self) -> &'static [usize] {
+        match (self.closure, self.bordered.is_some()) {
+            (Closure::Half, false) => &[WZ],
+            (Closure::Half, true) => &[WZ, PARAM],
+            (Closure::Full, false) => &[ANGLE, WZ],
+            (Closure::Full, true) => &[ANGLE, WZ, PARAM],
+        }
+    }
+
+    fn parameter_of(&self, c: &Case) -> f64 {
+        match self.bordered.map(|b| b.parameter) {
+            Some(Parameter::Eps) => c.eps,
+            _ => c.kz,
+        }
+    }
+
+    fn initial(&self, c: &Candidate) -> [f64; 3] {
+        let angle = if self.closure == Closure::Full && self.free == Free::SunPhase { c.case.theta_sun0 } else { c.case.phi0 };
+        [angle, c.case.wz0, self.parameter_of(&c.case)]
+    }
+
+    /// The trajectory of the point x; None when the parameter leaves its range.
+    fn case_at(&self, c: &Candidate, x: [f64; 3]) -> Option<Case> {
+        let mut k = Case { wz0: x[WZ], ..c.case };
+        if self.closure == Closure::Full {
+            match self.free {
+                Free::Phi0 => k.phi0 = x[ANGLE],
+                Free::SunPhase => k.theta_sun0 = x[ANGLE],
+            }
+        }
+        match self.bordered.map(|b| b.parameter) {
+            Some(Parameter::Kz) if !(-1.0..=1.0).contains(&x[PARAM]) => return None,
+            Some(Parameter::Kz) => k.kz = x[PARAM],
+            Some(Parameter::Eps) => k.eps = x[PARAM],
+            None => {}
+        }
+        Some(k)
+    }
+
+    /// The parameter values of the central difference (one-sided at the ends of Kz's range).
+    fn parameter_pair(&self, p: f64) -> (f64, f64) {
+        let b = self.bordered.expect("bordered");
+        match b.parameter {
+            Parameter::Kz => ((p + b.step).min(1.0), (p - b.step).max(-1.0)),
+            Parameter::Eps => (p + b.step, p - b.step),
+        }
+    }
+
+    /// Push the point's trajectories; false when it cannot be integrated (parameter out of range).
+    fn push_cases(&self, c: &Candidate, x: [f64; 3], out: &mut Vec<Case>) -> bool {
+        let Some(k) = self.case_at(c, x) else { return false };
+        out.push(k);
         if self.closure == Closure::Full && self.free == Free::SunPhase {
-            3
-        } else {
-            1
+            for th in [x[ANGLE] + self.h, x[ANGLE] - self.h] {
+                out.push(Case { theta_sun0: th, ..k });
+            }
         }
+        if let Some(b) = self.bordered {
+            let (pp, pm) = self.parameter_pair(x[PARAM]);
+            for v in [pp, pm] {
+                out.push(match b.parameter {
+                    Parameter::Kz => Case { kz: v, ..k },
+                    Parameter::Eps => Case { eps: v, ..k },
+                });
+            }
+        }
+        true
     }
 
-    fn initial(&self, c: &Candidate) -> [f64; 2] {
-        match (self.closure, self.free) {
-            (Closure::Full, Free::SunPhase) => [c.case.theta_sun0, c.case.wz0],
-            _ => [c.case.phi0, c.case.wz0],
-        }
-    }
-
-    fn push_cases(&self, c: &Candidate, x: [f64; 2], out: &mut Vec<Case>) {
-        match (self.closure, self.free) {
-            (Closure::Half, _) => out.push(Case { wz0: x[1], ..c.case }),
-            (Closure::Full, Free::Phi0) => out.push(Case { phi0: x[0], wz0: x[1], ..c.case }),
-            (Closure::Full, Free::SunPhase) => {
-                for th in [x[0], x[0] + self.h, x[0] - self.h] {
-                    out.push(Case { theta_sun0: th, wz0: x[1], ..c.case });
-                }
+    /// The closure residuals (phi, wz) of one trajectory.
+    fn closure_residual(&self, c: &Candidate, x: [f64; 3], o: &Outcome) -> [f64; 2] {
+        match self.closure {
+            Closure::Half => [o.phi_t - c.case.phi0 - PI * c.turns, f64::NAN],
+            Closure::Full => {
+                let phi0 = if self.free == Free::Phi0 { x[ANGLE] } else { c.case.phi0 };
+                [o.phi_t - phi0 - 2.0 * PI * c.turns, o.wz_t - x[WZ]]
             }
         }
     }
 
     /// The point from its trajectories; None when any failed or is non-finite.
-    fn point(&self, c: &Candidate, x: [f64; 2], o: &[Outcome]) -> Option<Point> {
+    fn point(&self, c: &Candidate, x: [f64; 3], o: &[Outcome]) -> Option<Point> {
         let ok = |o: &Outcome| o.status == LaneStatus::Ok && o.phi_t.is_finite() && o.wz_t.is_finite() && o.stm.iter().all(|v| v.is_finite());
-        if !o.iter().all(ok) {
+        if o.len() != self.cases_per_point() || !o.iter().all(ok) {
             return None;
         }
         let m = o[0].stm;
-        let p = match (self.closure, self.free) {
-            (Closure::Half, _) => {
-                let g = o[0].phi_t - c.case.phi0 - PI * c.turns;
-                Point { x, f: [g, f64::NAN], norm: g.abs(), merit: g.abs(), jac: [m[1], 0.0, 0.0, 0.0], stm: m }
+        let r = self.closure_residual(c, x, &o[0]);
+        let mut f = [r[0], r[1], f64::NAN];
+        let mut jac = [f64::NAN; 9];
+        match self.closure {
+            Closure::Half => {
+                jac[ANGLE] = 0.0;
+                jac[WZ] = m[1];
             }
-            (Closure::Full, free) => {
-                let phi0 = if free == Free::Phi0 { x[0] } else { c.case.phi0 };
-                let f = [o[0].phi_t - phi0 - 2.0 * PI * c.turns, o[0].wz_t - x[1]];
-                let jac = if free == Free::Phi0 {
-                    [m[0] - 1.0, m[1], m[2], m[3] - 1.0]
+            Closure::Full => {
+                if self.free == Free::Phi0 {
+                    jac[ANGLE] = m[0] - 1.0;
+                    jac[3 + ANGLE] = m[2];
                 } else {
                     let k = 0.5 / self.h;
-                    [(o[1].phi_t - o[2].phi_t) * k, m[1], (o[1].wz_t - o[2].wz_t) * k, m[3] - 1.0]
-                };
-                Point { x, f, norm: f[0].abs().max(f[1].abs()), merit: f[0].hypot(f[1]), jac, stm: m }
+                    jac[ANGLE] = (o[1].phi_t - o[2].phi_t) * k;
+                    jac[3 + ANGLE] = (o[1].wz_t - o[2].wz_t) * k;
+                }
+                jac[WZ] = m[1];
+                jac[3 + WZ] = m[3] - 1.0;
             }
-        };
-        (p.norm.is_finite() && p.merit.is_finite() && p.jac.iter().all(|v| v.is_finite())).then_some(p)
+        }
+        if let Some(b) = self.bordered {
+            let j = self.cases_per_point() - 2;
+            let (pp, pm) = self.parameter_pair(x[PARAM]);
+            let (rp, rm) = (self.closure_residual(c, x, &o[j]), self.closure_residual(c, x, &o[j + 1]));
+            jac[PARAM] = (rp[0] - rm[0]) / (pp - pm);
+            jac[3 + PARAM] = (rp[1] - rm[1]) / (pp - pm);
+            f[2] = b.a[0] * x[0] + b.a[1] * x[1] + b.a[2] * x[2] - b.b;
+            jac[6..9].copy_from_slice(&b.a);
+        }
+        let rows = self.rows();
+        let norm = rows.iter().fold(0.0f64, |a, &i| a.max(f[i].abs()));
+        let merit = rows.iter().map(|&i| f[i] * f[i]).sum::<f64>().sqrt();
+        let used = rows.iter().all(|&i| self.cols().iter().all(|&j| jac[3 * i + j].is_finite()));
+        (norm.is_finite() && merit.is_finite() && used).then_some(Point { x, f, norm, merit, jac, stm: m })
     }
 
     /// Newton direction at p (minimum-norm step when J is rank-deficient) and whether J was;
     /// None when J is zero or non-finite.
-    fn direction(&self, p: &Point) -> Option<([f64; 2], bool)> {
-        if self.closure == Closure::Half {
-            let d = p.jac[0];
-            if d == 0.0 || !d.is_finite() {
-                return None;
-            }
-            return Some(([0.0, -p.f[0] / d], false));
-        }
-        let j = Matrix2::new(p.jac[0], p.jac[1], p.jac[2], p.jac[3]);
+    fn direction(&self, p: &Point) -> Option<([f64; 3], bool)> {
+        let (rows, cols) = (self.rows(), self.cols());
+        let n = rows.len();
+        let j = DMatrix::from_fn(n, n, |r, c| p.jac[3 * rows[r] + cols[c]]);
+        let rhs = DVector::from_fn(n, |r, _| -p.f[rows[r]]);
         let svd = j.try_svd(true, true, f64::EPSILON, 200)?;
-        let (s1, s2) = (svd.singular_values[0].max(svd.singular_values[1]), svd.singular_values[0].min(svd.singular_values[1]));
+        let s1 = svd.singular_values.max();
+        let s2 = svd.singular_values.min();
         if !(s1 > 0.0 && s1.is_finite()) {
             return None;
         }
         let deficient = s2 <= RANK_TOL * s1;
-        let d = svd.solve(&Vector2::new(-p.f[0], -p.f[1]), RANK_TOL * s1).ok()?;
-        (d[0].is_finite() && d[1].is_finite()).then_some(([d[0], d[1]], deficient))
+        let d = svd.solve(&rhs, RANK_TOL * s1).ok()?;
+        let mut out = [0.0; 3];
+        for (k, &c) in cols.iter().enumerate() {
+            out[c] = d[k];
+        }
+        out.iter().all(|v| v.is_finite()).then_some((out, deficient))
     }
 }
 
@@ -309,18 +442,18 @@ const ARMIJO: f64 = 1e-4;
 
 impl Track {
     /// The point to integrate in the next sweep, if still active.
-    fn pending(&self) -> Option<[f64; 2]> {
+    fn pending(&self) -> Option<[f64; 3]> {
         match self.phase {
             Phase::Start => Some(self.start),
             Phase::Trial { lambda, .. } => {
                 let x = self.cur.as_ref()?.x;
-                Some([x[0] + lambda * self.dir[0], x[1] + lambda * self.dir[1]])
+                Some(std::array::from_fn(|i| x[i] + lambda * self.dir[i]))
             }
             Phase::Done(_) => None,
         }
     }
 
-    fn advance(&mut self, form: &Form, x: [f64; 2], o: &[Outcome], opts: &CorrectorOptions) {
+    fn advance(&mut self, form: &Form, x: [f64; 3], o: &[Outcome], opts: &CorrectorOptions) {
         let p = form.point(&self.cand, x, o);
         match self.phase {
             Phase::Start => match p {
@@ -370,8 +503,11 @@ impl Track {
             None => self.phase = Phase::Done(StopReason::SingularJacobian),
             Some((d, deficient)) => {
                 let cap = |v: f64, m: f64| if v.abs() > m { m / v.abs() } else { 1.0 };
-                let scale = cap(d[1], opts.max_wz_step).min(cap(d[0], opts.max_angle_step));
-                self.dir = [d[0] * scale, d[1] * scale];
+                let mut scale = cap(d[WZ], opts.max_wz_step).min(cap(d[ANGLE], opts.max_angle_step));
+                if let Some(b) = form.bordered {
+                    scale = scale.min(cap(d[PARAM], b.max_step));
+                }
+                self.dir = d.map(|v| v * scale);
                 self.scale = scale;
                 self.rank_deficient = deficient;
                 self.phase = Phase::Trial { lambda: 1.0, halvings: 0, any_integrated: false };
@@ -388,18 +524,26 @@ impl Track {
         let c = &self.cand.case;
         let (phi0, theta_sun0) = match (form.closure, form.free) {
             (Closure::Half, _) => (c.phi0, c.theta_sun0),
-            (Closure::Full, Free::Phi0) => (x[0], c.theta_sun0),
-            (Closure::Full, Free::SunPhase) => (c.phi0, x[0]),
+            (Closure::Full, Free::Phi0) => (x[ANGLE], c.theta_sun0),
+            (Closure::Full, Free::SunPhase) => (c.phi0, x[ANGLE]),
         };
+        let jac = self.cur.map_or([f64::NAN; 9], |p| p.jac);
+        let mut jacobian = [[jac[0], jac[1], jac[2]], [jac[3], jac[4], jac[5]]];
+        if form.closure == Closure::Half {
+            jacobian[0][ANGLE] = f64::NAN;
+            jacobian[1] = [f64::NAN; 3];
+        }
         Correction {
             phi0,
-            wz0: x[1],
+            wz0: x[WZ],
             theta_sun0,
-            residual: self.cur.map_or([f64::NAN; 2], |p| p.f),
+            residual: self.cur.map_or([f64::NAN; 2], |p| [p.f[0], p.f[1]]),
             residual_norm: self.cur.map_or(f64::NAN, |p| p.norm),
             iterations: self.iterations,
             reason,
             monodromy,
+            parameter: x[PARAM],
+            jacobian,
         }
     }
 }
@@ -520,41 +664,80 @@ pub fn correct_planar_attitudes(
     candidates: &[Candidate],
     opts: &CorrectorOptions,
 ) -> Result<Vec<Correction>> {
-    validate(forcing, t_final, closure, free, candidates, opts)?;
-    let form = Form { closure, free, h: opts.phase_step };
+    run(forcing, t_final, Form { closure, free, h: opts.phase_step, bordered: None }, candidates, opts)
+}
+
+/// The bordered correction of continuation: as [`correct_planar_attitudes`], with the
+/// parameter of `bordered` (Kz or eps) an unknown too and its linear condition closing the
+/// system (pseudo-arclength: the tangent's components and the step; natural: the parameter
+/// fixed). Every candidate starts from its own parameter value (its case's Kz or eps).
+/// [`Correction::parameter`] is the final value and [`Correction::jacobian`] holds d F / d
+/// parameter, from which the driver takes the family's tangent.
+pub fn correct_bordered(
+    forcing: &OrbitForcing,
+    t_final: f64,
+    closure: Closure,
+    free: Free,
+    bordered: &Bordered,
+    candidates: &[Candidate],
+    opts: &CorrectorOptions,
+) -> Result<Vec<Correction>> {
+    check_finite("a", &bordered.a)?;
+    if !bordered.b.is_finite() {
+        return Err(invalid("b", format!("must be finite, got {}", bordered.b)));
+    }
+    check_positive("step", bordered.step)?;
+    check_positive("max_step", bordered.max_step)?;
+    if closure == Closure::Half && bordered.a[0] != 0.0 {
+        return Err(invalid("a", "the half-period closure has no angle unknown: a[0] must be 0"));
+    }
+    if bordered.a.iter().all(|&v| v == 0.0) {
+        return Err(invalid("a", "the linear condition needs a non-zero row"));
+    }
+    if bordered.parameter == Parameter::Eps && closure == Closure::Half {
+        return Err(invalid("parameter", "eps breaks the mirror symmetry: continue in eps with Closure::Full"));
+    }
+    run(forcing, t_final, Form { closure, free, h: opts.phase_step, bordered: Some(*bordered) }, candidates, opts)
+}
+
+fn run(forcing: &OrbitForcing, t_final: f64, form: Form, candidates: &[Candidate], opts: &CorrectorOptions) -> Result<Vec<Correction>> {
+    validate(forcing, t_final, form.closure, form.free, candidates, opts)?;
     let lane = LaneOptions { rtol: opts.rtol, atol: opts.atol, max_steps: opts.max_steps, sun_omega: opts.sun_omega };
     let per = form.cases_per_point();
     let mut tracks: Vec<Track> = candidates
         .iter()
-        .map(|c| Track { cand: *c, start: form.initial(c), cur: None, dir: [0.0; 2], scale: 1.0, rank_deficient: false, phase: Phase::Start, iterations: 0 })
+        .map(|c| Track { cand: *c, start: form.initial(c), cur: None, dir: [0.0; 3], scale: 1.0, rank_deficient: false, phase: Phase::Start, iterations: 0 })
         .collect();
     with_threads(opts.threads, || -> Result<Vec<Correction>> {
         let mut cases = Vec::with_capacity(per * tracks.len());
-        let mut active: Vec<(usize, [f64; 2])> = Vec::with_capacity(tracks.len());
+        let mut active: Vec<(usize, [f64; 3], Option<usize>)> = Vec::with_capacity(tracks.len());
         loop {
             cases.clear();
             active.clear();
             for (i, t) in tracks.iter().enumerate() {
                 if let Some(x) = t.pending() {
-                    form.push_cases(&t.cand, x, &mut cases);
-                    active.push((i, x));
+                    let at = cases.len();
+                    let pushed = form.push_cases(&t.cand, x, &mut cases);
+                    active.push((i, x, pushed.then_some(at)));
                 }
             }
             if active.is_empty() {
                 break;
             }
-            let out = map::sweep(forcing, t_final, &cases, &lane, true, opts.chunk, None)?;
-            for (k, &(i, x)) in active.iter().enumerate() {
-                tracks[i].advance(&form, x, &out[k * per..(k + 1) * per], opts);
+            let out = if cases.is_empty() { Vec::new() } else { map::sweep(forcing, t_final, &cases, &lane, true, opts.chunk, None)? };
+            for &(i, x, at) in &active {
+                let o = at.map_or(&out[0..0], |k| &out[k..k + per]);
+                tracks[i].advance(&form, x, o, opts);
             }
         }
         let mut mono: Vec<[f64; 4]> = tracks.iter().map(|t| t.cur.map_or([f64::NAN; 4], |p| p.stm)).collect();
-        if closure == Closure::Half {
+        if form.closure == Closure::Half {
             // The full-period monodromy: one more sweep over K T at the final points.
-            let idx: Vec<usize> = (0..tracks.len()).filter(|&i| tracks[i].cur.is_some()).collect();
-            let full: Vec<Case> = idx.iter().map(|&i| Case { wz0: tracks[i].cur.map_or(0.0, |p| p.x[1]), ..tracks[i].cand.case }).collect();
-            let out = map::sweep(forcing, 2.0 * t_final, &full, &lane, true, opts.chunk, None)?;
-            for (&i, o) in idx.iter().zip(&out) {
+            let full: Vec<(usize, Case)> =
+                (0..tracks.len()).filter_map(|i| tracks[i].cur.and_then(|p| form.case_at(&tracks[i].cand, p.x)).map(|k| (i, k))).collect();
+            let cases: Vec<Case> = full.iter().map(|&(_, k)| k).collect();
+            let out = if cases.is_empty() { Vec::new() } else { map::sweep(forcing, 2.0 * t_final, &cases, &lane, true, opts.chunk, None)? };
+            for (&(i, _), o) in full.iter().zip(&out) {
                 mono[i] = if o.status == LaneStatus::Ok { o.stm } else { [f64::NAN; 4] };
             }
         }

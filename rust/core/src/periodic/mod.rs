@@ -11,4 +11,7 @@ mod symmetric;
 pub use multiple::{correct_multiple_shooting, MemberCondition, ShotOrbit};
 pub use stability::{broucke_indices, monodromy, Stability};
 pub use symmetric::{correct_planar_symmetric, Constraint, Evaluation, SymmetricOrbit, SymmetricShooting, Var};
-pub use attitude::{correct_planar_attitudes, verify_planar_attitudes, Candidate, Closure, Correction, CorrectorOptions, Free, PlanarEnd, PlanarStart, StopReason};
+pub use attitude::{
+    correct_bordered, correct_planar_attitudes, verify_planar_attitudes, Bordered, Candidate, Closure, Correction, CorrectorOptions, Free, Parameter, PlanarEnd,
+    PlanarStart, StopReason,
+};
