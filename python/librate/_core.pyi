@@ -177,6 +177,10 @@ class CorrectionBatch:
     def reason(self) -> list[str]: ...
     @property
     def monodromy(self) -> _F64: ...
+    @property
+    def parameter(self) -> _F64: ...
+    @property
+    def jacobian(self) -> _F64: ...
     def __len__(self) -> int: ...
 
 def attitude_correct(
@@ -185,6 +189,8 @@ def attitude_correct(
     eps: _F64 | None = None, cs: _F64 | None = None, cd: _F64 | None = None, theta_sun0: _F64 | None = None,
     tol: float = 1e-12, max_iter: int = 40, rtol: float = 1e-13, atol: float = 1e-13, max_steps: int = 200000,
     max_wz_step: float = 0.5, max_angle_step: float = 0.5, threads: int | None = None, chunk: int = 64,
+    parameter: str | None = None, condition: tuple[float, float, float, float] | None = None,
+    parameter_step: float = 1e-6, max_parameter_step: float = 0.5,
 ) -> CorrectionBatch: ...
 
 @final

@@ -2,7 +2,7 @@
 
 use librate_core::attitude::{FlatPlate, Sun};
 use librate_core::map::{self, Case, LaneOptions};
-use librate_core::periodic::{correct_planar_attitudes, verify_planar_attitudes, Candidate, Closure, CorrectorOptions, Free, PlanarStart};
+use librate_core::periodic::{correct_bordered, correct_planar_attitudes, verify_planar_attitudes, Bordered, Candidate, Closure, CorrectorOptions, Free, Parameter, PlanarStart};
 use numpy::{IntoPyArray, PyArrayMethods, PyReadonlyArray1};
 use pyo3::exceptions::{PyKeyError, PyValueError};
 use pyo3::prelude::*;
@@ -198,6 +198,8 @@ pub struct PyCorrectionBatch {
     converged: Py<PyAny>,
     reason: Vec<&'static str>,
     monodromy: Py<PyAny>,
+    parameter: Py<PyAny>,
+    jacobian: Py<PyAny>,
 }
 
 #[pymethods]
@@ -248,6 +250,16 @@ impl PyCorrectionBatch {
     fn monodromy(&self, py: Python<'_>) -> Py<PyAny> {
         self.monodromy.clone_ref(py)
     }
+    /// The freed parameter's final value (bordered corrections; else each candidate's Kz), (n,).
+    #[getter]
+    fn parameter(&self, py: Python<'_>) -> Py<PyAny> {
+        self.parameter.clone_ref(py)
+    }
+    /// d F / d (angle, wz0, parameter) at the final point, (n, 2, 3); NaN where not computed.
+    #[getter]
+    fn jacobian(&self, py: Python<'_>) -> Py<PyAny> {
+        self.jacobian.clone_ref(py)
+    }
     fn __len__(&self) -> usize {
         self.reason.len()
     }
@@ -261,7 +273,8 @@ impl PyCorrectionBatch {
 /// (one Rust call for all Newton iterations; see librate_core::periodic::correct_planar_attitudes).
 #[pyfunction]
 #[pyo3(signature = (forcing, phi0, wz0, kz, turns, *, t_final, closure, free="phi0", eps=None, cs=None, cd=None, theta_sun0=None,
-    tol=1e-12, max_iter=40, rtol=1e-13, atol=1e-13, max_steps=200_000, max_wz_step=0.5, max_angle_step=0.5, threads=None, chunk=64))]
+    tol=1e-12, max_iter=40, rtol=1e-13, atol=1e-13, max_steps=200_000, max_wz_step=0.5, max_angle_step=0.5, threads=None, chunk=64,
+    parameter=None, condition=None, parameter_step=1e-6, max_parameter_step=0.5))]
 #[allow(clippy::too_many_arguments)]
 fn attitude_correct<'py>(
     py: Python<'py>,
@@ -286,7 +299,23 @@ fn attitude_correct<'py>(
     max_angle_step: f64,
     threads: Option<usize>,
     chunk: usize,
+    parameter: Option<&str>,
+    condition: Option<(f64, f64, f64, f64)>,
+    parameter_step: f64,
+    max_parameter_step: f64,
 ) -> PyResult<PyCorrectionBatch> {
+    let bordered = match (parameter, condition) {
+        (None, None) => None,
+        (Some(name), Some((a0, a1, a2, b))) => {
+            let parameter = match name {
+                "kz" => Parameter::Kz,
+                "eps" => Parameter::Eps,
+                other => return Err(PyValueError::new_err(format!("invalid argument `parameter`: must be 'kz' or 'eps', got {other:?}"))),
+            };
+            Some(Bordered { parameter, a: [a0, a1, a2], b, step: parameter_step, max_step: max_parameter_step })
+        }
+        _ => return Err(PyValueError::new_err("invalid argument `condition`: `parameter` and `condition` (a_angle, a_wz0, a_parameter, b) go together")),
+    };
     let closure = match closure {
         "half" => Closure::Half,
         "full" => Closure::Full,
@@ -306,7 +335,12 @@ fn attitude_correct<'py>(
     let cands: Vec<Candidate> = (0..n).map(|i| Candidate::new(p[i], w[i], k[i], tu[i]).with_plate(e[i], s[i], d[i], th[i])).collect();
     let opts = CorrectorOptions { tol, max_iter, rtol, atol, max_steps, max_wz_step, max_angle_step, threads, chunk, ..CorrectorOptions::default() };
     let f = &forcing.inner;
-    let out = py.detach(|| correct_planar_attitudes(f, t_final, closure, free, &cands, &opts)).map_err(to_py)?;
+    let out = py
+        .detach(|| match &bordered {
+            None => correct_planar_attitudes(f, t_final, closure, free, &cands, &opts),
+            Some(b) => correct_bordered(f, t_final, closure, free, b, &cands, &opts),
+        })
+        .map_err(to_py)?;
     let col = |g: &dyn Fn(&librate_core::periodic::Correction) -> f64| out.iter().map(g).collect::<Vec<f64>>();
     Ok(PyCorrectionBatch {
         phi0: col(&|c| c.phi0).into_pyarray(py).into_any().unbind(),
@@ -318,6 +352,8 @@ fn attitude_correct<'py>(
         converged: out.iter().map(|c| c.converged()).collect::<Vec<bool>>().into_pyarray(py).into_any().unbind(),
         reason: out.iter().map(|c| c.reason.as_str()).collect(),
         monodromy: out.iter().flat_map(|c| c.monodromy).collect::<Vec<f64>>().into_pyarray(py).reshape([n, 2, 2])?.into_any().unbind(),
+        parameter: col(&|c| c.parameter).into_pyarray(py).into_any().unbind(),
+        jacobian: out.iter().flat_map(|c| c.jacobian.into_iter().flatten()).collect::<Vec<f64>>().into_pyarray(py).reshape([n, 2, 3])?.into_any().unbind(),
     })
 }
 
