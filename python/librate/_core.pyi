@@ -6,11 +6,20 @@ import numpy as np
 import numpy.typing as npt
 
 __version__: str
+#: Physical constants of the core (librate_core::constants).
+N_SUN: float
+OMEGA_SUN: float
+SOLAR_PRESSURE_1AU: float
+SUN_SYNODIC_PERIOD: float
 __all__ = [
     "ConvergenceError",
     "IntegrationError",
     "LibrateError",
+    "N_SUN",
+    "OMEGA_SUN",
     "OrbitForcing",
+    "SOLAR_PRESSURE_1AU",
+    "SUN_SYNODIC_PERIOD",
     "__version__",
     "attitude_propagate",
     "attitude_torques",

@@ -410,6 +410,11 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     attitude::register(m)?;
     map::register(m)?;
     flexible::register(m)?;
+    // Physical constants, read from the core (one definition: librate_core::constants).
+    m.add("N_SUN", librate_core::constants::N_SUN)?;
+    m.add("OMEGA_SUN", librate_core::constants::OMEGA_SUN)?;
+    m.add("SOLAR_PRESSURE_1AU", librate_core::constants::SOLAR_PRESSURE_1AU)?;
+    m.add("SUN_SYNODIC_PERIOD", librate_core::constants::SUN_SYNODIC_PERIOD)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

@@ -17,12 +17,9 @@ use super::dual::Real;
 use super::torque::{cross, mat_vec, Torque, TorqueInput, D13};
 use crate::error::{check_finite, invalid, Result};
 
-/// Sidereal month / sidereal year: the Sun's mean motion in units of the Moon's.
-pub const N_SUN: f64 = 27.321661 / 365.25636;
-/// Rate of the Sun direction in the synodic frame (clockwise), 1/TU.
-pub const OMEGA_SUN: f64 = -(1.0 - N_SUN);
-/// Solar pressure at 1 AU, N/m^2.
-pub const P0: f64 = 4.56e-6;
+pub use crate::constants::{N_SUN, OMEGA_SUN, SOLAR_PRESSURE_1AU};
+/// Former name of [`SOLAR_PRESSURE_1AU`] (kept for existing callers).
+pub use crate::constants::SOLAR_PRESSURE_1AU as P0;
 
 /// The apparent Sun: its initial phase and the pressure.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -34,7 +31,7 @@ pub struct Sun {
 
 impl Default for Sun {
     fn default() -> Self {
-        Self { theta0: 0.0, omega: OMEGA_SUN, pressure: P0 }
+        Self { theta0: 0.0, omega: OMEGA_SUN, pressure: SOLAR_PRESSURE_1AU }
     }
 }
 

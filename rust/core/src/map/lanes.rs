@@ -85,7 +85,7 @@ pub struct LaneOptions {
 
 impl Default for LaneOptions {
     fn default() -> Self {
-        Self { rtol: 1e-12, atol: 1e-12, max_steps: 200_000, sun_omega: crate::attitude::OMEGA_SUN }
+        Self { rtol: 1e-12, atol: 1e-12, max_steps: 200_000, sun_omega: crate::constants::OMEGA_SUN }
     }
 }
 
