@@ -1,6 +1,6 @@
 //! Bindings of the attitude models: convert, call the core with the GIL released, convert.
 
-use librate_core::attitude::{self, gravity_gradient_by_name, Facet, FacetSrp, FlatPlate, GravityGradient, OrbitMode, RigidBody, Sun, Torque};
+use librate_core::attitude::{self, gravity_gradient_by_name, Facet, FacetBody, FlatPlate, GravityGradient, OrbitMode, RigidBody, Sun, Torque};
 use librate_core::integrate::{Options, Output};
 use numpy::{IntoPyArray, PyArrayMethods, PyReadonlyArray1};
 use pyo3::exceptions::PyValueError;
@@ -19,9 +19,9 @@ fn output<'a>(t_eval: &'a Option<Vec<f64>>) -> Output<'a> {
 /// Facets as (area, normal[3], center[3], ca, cs, cd) tuples -> validated core facets.
 type FacetTuple = (f64, [f64; 3], [f64; 3], f64, f64, f64);
 
-fn facet_model(facets: Vec<FacetTuple>, sun: (f64, f64, f64), tu_s: f64) -> PyResult<FacetSrp> {
+fn facet_model(facets: Vec<FacetTuple>, sun: (f64, f64, f64), tu_s: f64) -> PyResult<FacetBody> {
     let facets = facets.into_iter().map(|(a, n, c, ca, cs, cd)| Facet::new(a, n, c, ca, cs, cd)).collect::<Result<Vec<_>, _>>().map_err(to_py)?;
-    Ok(FacetSrp { facets, sun: Sun { theta0: sun.0, omega: sun.1, pressure: sun.2 }, tu_s })
+    Ok(FacetBody { facets, sun: Sun { theta0: sun.0, omega: sun.1, pressure: sun.2 }, tu_s })
 }
 
 /// SRP force (N) and torque (N m) in body axes of facets for a Sun direction in body axes.

@@ -39,7 +39,7 @@ pub struct Coupled<'a> {
     pub orbit: OrbitMode,
     /// Solar radiation pressure force on the orbit (facets, spacecraft mass in kg, LU in m);
     /// off (None) by default, as for the maps.
-    pub orbit_srp: Option<(&'a super::srp::FacetSrp, f64, f64)>,
+    pub orbit_srp: Option<(&'a super::srp::FacetBody, f64, f64)>,
 }
 
 /// Attitude matrix A(q)/|q|^2 (synodic -> body), scalar-last quaternion.

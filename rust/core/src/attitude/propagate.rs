@@ -33,8 +33,8 @@ pub fn propagate_attitude(
     opts: &Options,
     with_stm: bool,
     output: Output<'_>,
-    orbit_srp: Option<(&super::srp::FacetSrp, f64, f64)>,
-    terminators: Option<&super::srp::FacetSrp>,
+    orbit_srp: Option<(&super::srp::FacetBody, f64, f64)>,
+    terminators: Option<&super::srp::FacetBody>,
 ) -> Result<AttitudeTrajectory> {
     check_mu(mu)?;
     RigidBody::new(body.ix, body.iy, body.iz)?;

@@ -94,16 +94,17 @@ impl Facet {
     }
 }
 
-/// A body as a list of facets: SRP force and torque (a [`Torque`] model).
+/// A body as a list of facets: SRP force and torque (a [`Torque`] model); the Rust side of
+/// the Python `librate.FacetBody`.
 #[derive(Debug, Clone, PartialEq)]
-pub struct FacetSrp {
+pub struct FacetBody {
     pub facets: Vec<Facet>,
     pub sun: Sun,
     /// TU in seconds: torques are returned in kg m^2 / TU^2.
     pub tu_s: f64,
 }
 
-impl FacetSrp {
+impl FacetBody {
     /// Total force (N) and torque (N m) in body axes for the Sun direction `s_body`.
     pub fn force_torque(&self, s_body: &[f64; 3]) -> ([f64; 3], [f64; 3]) {
         self.eval(s_body)
@@ -144,7 +145,7 @@ impl FacetSrp {
     }
 }
 
-impl Torque for FacetSrp {
+impl Torque for FacetBody {
     fn name(&self) -> &'static str {
         "srp"
     }
