@@ -42,7 +42,6 @@ __all__ = [
     "rigid_body_kz",
     "stability",
     "symmetric_correct",
-    "symmetric_evaluate",
     "system_preset",
     "system_validate",
 ]
@@ -100,7 +99,6 @@ def preset_names() -> list[str]: ...
 def symmetric_correct(
     mu: float, p: list[float], *, spatial: bool, constraint: str, values: list[float], tol: float, max_iter: int, t_max: float, rtol: float, atol: float
 ) -> dict[str, Any]: ...
-def symmetric_evaluate(mu: float, p: list[float], *, spatial: bool, t_max: float, rtol: float, atol: float) -> dict[str, Any]: ...
 def stability(m: _F64, planar: bool) -> tuple[npt.NDArray[np.complex128], npt.NDArray[np.complex128]]: ...
 def multiple_shooting(
     mu: float, patches: _F64, period: float, *, condition: str, value: float, tol: float, max_iter: int, rtol: float, atol: float

@@ -4,12 +4,11 @@
 //!   C = sum_i mu_i cos(2 theta_i) / r_i^3 = sum_i mu_i (x_i^2 - y_i^2) / r_i^5,
 //! with (x_i, y_i) the position relative to primary i (the atan2-free form). S and C depend on
 //! the orbit only: the orbit is integrated with the attitude, held at a point, or supplied
-//! precomputed through the [`Forcing`] trait (e.g. a Fourier series of the orbit).
+//! precomputed through the [`Forcing`] trait (e.g. the map engine's Chebyshev table).
 //! Optional 2x2 attitude STM: d/dt [dphi, dwz] = [[0, 1], [-3 Kz (S sin 2phi + C cos 2phi), 0]].
 
 use super::srp::FlatPlate;
 use crate::cr3bp::Cr3bp;
-use crate::fourier::FourierOrbit;
 use crate::integrate::System;
 
 /// S and C at a synodic position, for the enabled primaries [larger, smaller].
@@ -48,19 +47,6 @@ pub(crate) fn orbit_derivative(mu: f64, held: bool, t: f64, y: &[f64], dy: &mut 
 /// A precomputed orbit's S(t), C(t).
 pub trait Forcing: Sync {
     fn sc(&self, t: f64) -> (f64, f64);
-}
-
-/// S, C from a Fourier-series orbit.
-pub struct FourierForcing<'a> {
-    pub mu: f64,
-    pub orbit: &'a FourierOrbit,
-    pub primaries: [bool; 2],
-}
-
-impl Forcing for FourierForcing<'_> {
-    fn sc(&self, t: f64) -> (f64, f64) {
-        forcing_sc(self.mu, &self.orbit.position(t), self.primaries)
-    }
 }
 
 /// (phidot, wzdot) and the STM coefficient d(wzdot)/d(phi) from S, C (and the flat-plate SRP).
