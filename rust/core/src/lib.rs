@@ -5,6 +5,7 @@
 //! - [`propagation`]: CR3BP propagation with the STM and events; batches on all cores.
 //! - [`periodic`]: symmetric periodic orbits by half-period shooting.
 //! - [`constants`]: physical constants (the Sun's motion, solar pressure).
+//! - [`scalar`]: the scalar traits equations are written over (f64, dual numbers, SIMD lanes).
 //! - [`fourier`]: periodic orbits as truncated Fourier series, with analytic derivatives.
 
 // Intentional patterns: `!(x <= tol)` is the NaN-safe test (a NaN must fail it); numerical
@@ -21,5 +22,6 @@ pub mod integrate;
 pub mod map;
 pub mod periodic;
 pub mod propagation;
+pub mod scalar;
 
 pub use error::{Error, IntegrationError, Result};
