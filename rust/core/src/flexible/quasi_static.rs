@@ -50,18 +50,16 @@ pub struct QuasiStaticPoint {
 /// axes: (w, w', w'', wz', wz'', wz''').
 #[inline]
 fn chain(body: &FlexibleBody, wsyn: [Complex<f64>; 3], phi: f64, wz: f64) -> ([Complex<f64>; 3], [f64; 3]) {
-    let kappa = 1.5 / body.inertia();
-    let z0c = body.asymmetry().conj();
     let (s2, c2) = (2.0 * phi).sin_cos();
     let e = Complex::new(c2, -s2);
     let i = Complex::new(0.0, 1.0);
     let p1 = wz - 1.0;
     let w0 = wsyn[0] * e;
-    let wz1 = kappa * (z0c * w0).im;
+    let wz1 = body.rigid_response(w0);
     let w1 = (wsyn[1] - i * 2.0 * p1 * wsyn[0]) * e;
-    let wz2 = kappa * (z0c * w1).im;
+    let wz2 = body.rigid_response(w1);
     let w2 = (wsyn[2] - i * 4.0 * p1 * wsyn[1] - i * 2.0 * wz1 * wsyn[0] - wsyn[0] * 4.0 * p1 * p1) * e;
-    let wz3 = kappa * (z0c * w2).im;
+    let wz3 = body.rigid_response(w2);
     ([w0, w1, w2], [wz1, wz2, wz3])
 }
 
@@ -104,7 +102,17 @@ impl FlexibleBody {
     /// wzdot of the rigid composite model (the flexible body frozen undeformed).
     #[inline]
     pub fn rigid_wzdot(&self, field: &BodyField) -> f64 {
-        1.5 * (self.asymmetry().conj() * field.w).im / self.inertia()
+        self.rigid_response(field.w)
+    }
+
+    /// (3/2) Im(conj(Z0) w) / I0: the rigid composite body's gravity-gradient angular
+    /// acceleration for the body-axes field w, i.e. the planar law
+    /// [`crate::attitude::gravity_gradient_wzdot`] for a body turned by its principal angle
+    /// (tests/flexible.rs checks the two agree); linear in w, so applied to w', w'' it gives
+    /// the rate's higher derivatives.
+    #[inline(always)]
+    fn rigid_response(&self, w: Complex<f64>) -> f64 {
+        1.5 * (self.asymmetry().conj() * w).im / self.inertia()
     }
 }
 

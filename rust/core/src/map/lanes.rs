@@ -23,6 +23,7 @@
 use wide::f64x8;
 
 use super::forcing::OrbitForcing;
+use crate::attitude::gravity_gradient_wzdot;
 use crate::integrate::tableau::{A, B8, C, ERR};
 
 type V = f64x8;
@@ -121,13 +122,10 @@ fn rhs<const D: usize, const SRP: bool>(f: &OrbitForcing, t: f64, y: &[V; D], p:
     let c2 = cp * cp - sp * sp;
     let s2 = (cp + cp) * sp;
     dy[0] = w;
-    let mut dwz = p.kz15 * (s * c2 - c * s2);
+    // k (d wzdot / d phi) is only used with the STM: unused, it is compiled away
+    let (mut dwz, mut k) = gravity_gradient_wzdot(p.kz15, s, c, c2, s2);
     dy[2] = -(w * sp);
     dy[3] = w * cp;
-    let mut k = V::ZERO;
-    if D == 8 {
-        k = -(p.kz15 + p.kz15) * (s * s2 + c * c2);
-    }
     if SRP {
         // Sun angle theta = w t + theta0_l; alpha = theta - phi
         let (swt, cwt) = (p.omega * t).sin_cos();
