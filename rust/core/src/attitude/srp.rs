@@ -14,6 +14,7 @@
 //! gradient is proportional to the inertia and accepts the same units).
 
 use super::dual::Real;
+use crate::scalar::Lane;
 use super::torque::{cross, mat_vec, Torque, TorqueInput, D13};
 use crate::error::{check_finite, invalid, Result};
 
@@ -36,10 +37,17 @@ impl Default for Sun {
 }
 
 impl Sun {
+    /// The Sun's angle from the synodic x axis, theta_sun(t) = omega t + theta0: the one place
+    /// the Sun's motion is written (direction, plate law, terminators, map lanes).
+    #[inline(always)]
+    pub fn angle(&self, t: f64) -> f64 {
+        self.omega * t + self.theta0
+    }
+
     /// Unit vector to the Sun in synodic components.
     #[inline]
     pub fn direction(&self, t: f64) -> [f64; 3] {
-        let (s, c) = (self.omega * t + self.theta0).sin_cos();
+        let (s, c) = self.angle(t).sin_cos();
         [c, s, 0.0]
     }
 }
@@ -185,20 +193,41 @@ impl FlatPlate {
         Ok(Self { eps, cs, cd, sun })
     }
 
+    /// The law's coefficients (a1, a2) = (eps (1 + Cs), eps (2/3) Cd), see [`flat_plate_wzdot`].
+    #[inline(always)]
+    pub fn coefficients(&self) -> (f64, f64) {
+        (self.eps * (1.0 + self.cs), self.eps * (2.0 / 3.0) * self.cd)
+    }
+
+    /// alpha = theta_sun(t) - phi, the Sun's angle from the plate normal.
+    #[inline(always)]
+    pub fn alpha(&self, t: f64, phi: f64) -> f64 {
+        self.sun.angle(t) - phi
+    }
+
     /// cos(alpha) = cos(theta_sun(t) - phi): zero where the plate is edge-on to the Sun, where
     /// the law cos(alpha)|cos(alpha)| has its kinks (integrations stop there).
     #[inline]
     pub fn terminator(&self, t: f64, phi: f64) -> f64 {
-        (self.sun.omega * t + self.sun.theta0 - phi).cos()
+        self.alpha(t, phi).cos()
     }
 
     /// wzdot from SRP and its derivative with respect to phi.
     #[inline]
     pub fn wzdot(&self, t: f64, phi: f64) -> (f64, f64) {
-        let (sa, ca) = (self.sun.omega * t + self.sun.theta0 - phi).sin_cos();
-        let v = self.eps * ((1.0 + self.cs) * ca * ca.abs() + (2.0 / 3.0) * self.cd * ca);
-        // d/dphi of cos(alpha) = sin(alpha); d/dx (x|x|) = 2|x|
-        let d = self.eps * ((1.0 + self.cs) * 2.0 * ca.abs() + (2.0 / 3.0) * self.cd) * sa;
-        (v, d)
+        let (a1, a2) = self.coefficients();
+        let (sa, ca) = self.alpha(t, phi).sin_cos();
+        flat_plate_wzdot(a1, a2, ca, sa)
     }
+}
+
+/// The flat-plate law over f64 or SIMD lanes (the scalar model and the map lanes both call
+/// this), from the coefficients (a1, a2) of [`FlatPlate::coefficients`] and (cos alpha,
+/// sin alpha):
+///   wzdot = cos(a) (a1 |cos(a)| + a2),   d wzdot / d phi = sin(a) (2 a1 |cos(a)| + a2)
+/// (d cos(alpha) / d phi = sin(alpha), d (x|x|) / dx = 2|x|).
+#[inline(always)]
+pub fn flat_plate_wzdot<L: Lane>(a1: L, a2: L, ca: L, sa: L) -> (L, L) {
+    let aca = ca.abs();
+    (ca * a1.mul_add(aca, a2), sa * (a1 + a1).mul_add(aca, a2))
 }

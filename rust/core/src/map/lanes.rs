@@ -23,8 +23,13 @@
 use wide::f64x8;
 
 use super::forcing::OrbitForcing;
-use crate::attitude::gravity_gradient_wzdot;
+use crate::attitude::{flat_plate_wzdot, gravity_gradient_wzdot, FlatPlate, Sun};
+use crate::constants::SOLAR_PRESSURE_1AU;
 use crate::integrate::tableau::{A, B8, C, ERR};
+use crate::integrate::Controller;
+
+/// The scalar driver's step-size controller with its default settings.
+const CONTROLLER: Controller = Controller::RKF78;
 
 type V = f64x8;
 /// Trajectories per lock-step group (SIMD width).
@@ -48,6 +53,11 @@ impl Case {
     /// A gravity-gradient-only trajectory.
     pub fn new(phi0: f64, wz0: f64, kz: f64) -> Self {
         Self { phi0, wz0, kz, eps: 0.0, cs: 0.0, cd: 0.0, theta_sun0: 0.0 }
+    }
+
+    /// The case's flat plate (not validated; eps = 0: none) with the Sun turning at `sun_omega`.
+    pub fn plate(&self, sun_omega: f64) -> FlatPlate {
+        FlatPlate { eps: self.eps, cs: self.cs, cd: self.cd, sun: Sun { theta0: self.theta_sun0, omega: sun_omega, pressure: SOLAR_PRESSURE_1AU } }
     }
 }
 
@@ -94,12 +104,14 @@ impl Default for LaneOptions {
 #[derive(Clone, Copy)]
 struct Params {
     kz15: V,
-    /// eps (1 + Cs), eps (2/3) Cd, cos and sin of the Sun phase at t = 0.
+    /// The plate law's coefficients (FlatPlate::coefficients), cos and sin of the Sun phase
+    /// at t = 0.
     a1: V,
     a2: V,
     c0: V,
     s0: V,
-    omega: f64,
+    /// The Sun with phase zero: its angle at the shared time, turned by each lane's phase.
+    sun: Sun,
 }
 
 #[inline(always)]
@@ -127,18 +139,17 @@ fn rhs<const D: usize, const SRP: bool>(f: &OrbitForcing, t: f64, y: &[V; D], p:
     dy[2] = -(w * sp);
     dy[3] = w * cp;
     if SRP {
-        // Sun angle theta = w t + theta0_l; alpha = theta - phi
-        let (swt, cwt) = (p.omega * t).sin_cos();
+        // Sun angle theta = w t + theta0_l: (cos, sin)(w t) turned by each lane's theta0_l;
+        // alpha = theta - phi (sin alpha, like k, is compiled away without the STM)
+        let (swt, cwt) = p.sun.angle(t).sin_cos();
         let (swt, cwt) = (V::splat(swt), V::splat(cwt));
         let ct = cwt * p.c0 - swt * p.s0;
         let st = swt * p.c0 + cwt * p.s0;
         let ca = ct.mul_add(cp, st * sp);
-        let aca = ca.abs();
-        dwz += ca * p.a1.mul_add(aca, p.a2);
-        if D == 8 {
-            let sa = st.mul_add(cp, -(ct * sp));
-            k += sa * (p.a1 + p.a1).mul_add(aca, p.a2);
-        }
+        let sa = st.mul_add(cp, -(ct * sp));
+        let (v, d) = flat_plate_wzdot(p.a1, p.a2, ca, sa);
+        dwz += v;
+        k += d;
     }
     dy[1] = dwz;
     if D == 8 {
@@ -212,15 +223,16 @@ fn integrate_group<const D: usize, const SRP: bool>(f: &OrbitForcing, t_final: f
         y[4] = V::ONE;
         y[7] = V::ONE;
     }
+    let plates: [FlatPlate; LANES] = std::array::from_fn(|l| pick(l).plate(opts.sun_omega));
     let p = Params {
         kz15: V::new(std::array::from_fn(|l| 1.5 * pick(l).kz)),
-        a1: V::new(std::array::from_fn(|l| pick(l).eps * (1.0 + pick(l).cs))),
-        a2: V::new(std::array::from_fn(|l| pick(l).eps * (2.0 / 3.0) * pick(l).cd)),
-        c0: V::new(std::array::from_fn(|l| pick(l).theta_sun0.cos())),
-        s0: V::new(std::array::from_fn(|l| pick(l).theta_sun0.sin())),
-        omega: opts.sun_omega,
+        a1: V::new(std::array::from_fn(|l| plates[l].coefficients().0)),
+        a2: V::new(std::array::from_fn(|l| plates[l].coefficients().1)),
+        c0: V::new(std::array::from_fn(|l| plates[l].sun.theta0.cos())),
+        s0: V::new(std::array::from_fn(|l| plates[l].sun.theta0.sin())),
+        sun: Sun { theta0: 0.0, ..plates[0].sun },
     };
-    let plate: [bool; LANES] = std::array::from_fn(|l| pick(l).eps != 0.0);
+    let plate: [bool; LANES] = std::array::from_fn(|l| plates[l].eps != 0.0);
     let (rtol, atol) = (V::splat(opts.rtol), V::splat(opts.atol));
     let mut ynew = [V::ZERO; D];
     let mut yc = [V::ZERO; D];
@@ -228,7 +240,7 @@ fn integrate_group<const D: usize, const SRP: bool>(f: &OrbitForcing, t_final: f
     let (mut accepted, mut rejected) = (0u32, 0u32);
     let mut after_reject = false;
     let mut status = LaneStatus::Ok;
-    let g = |l: usize, tt: f64, phi: f64| (opts.sun_omega * tt + pick(l).theta_sun0 - phi).cos();
+    let g = |l: usize, tt: f64, phi: f64| plates[l].terminator(tt, phi);
     while t < t_final {
         if accepted + rejected >= opts.max_steps {
             status = LaneStatus::MaxSteps;
@@ -242,8 +254,7 @@ fn integrate_group<const D: usize, const SRP: bool>(f: &OrbitForcing, t_final: f
         if !(emax <= 1.0) || !finite {
             rejected += 1;
             after_reject = true;
-            let fac = if emax.is_finite() { (0.8 / emax.sqrt().sqrt().sqrt()).clamp(0.2, 1.0) } else { 0.2 };
-            h = heff * fac;
+            h = heff * CONTROLLER.factor_rejected(emax);
             if h <= 1e-14 * t_final.max(1.0) {
                 status = LaneStatus::Failed;
                 break;
@@ -300,8 +311,7 @@ fn integrate_group<const D: usize, const SRP: bool>(f: &OrbitForcing, t_final: f
         accepted += 1;
         y = ynew;
         t = if last { t_final } else { t + heff };
-        let fac_max = if after_reject { 1.0 } else { 5.0 };
-        let fac = if emax == 0.0 { fac_max } else { (0.8 / emax.sqrt().sqrt().sqrt()).clamp(0.2, fac_max) };
+        let fac = CONTROLLER.factor_accepted(emax, after_reject);
         after_reject = false;
         h = h.max(heff) * fac;
     }
