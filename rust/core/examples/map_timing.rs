@@ -33,6 +33,7 @@ fn main() {
     let d = 1.0 - MU - x0;
     let o = correct_planar_symmetric(MU, x0, (MU / d).sqrt() + d, 1e-12, 30, &Options::with_tolerances(1e-13, 1e-13)).unwrap();
     let f = OrbitForcing::new(MU, &o.state0, o.period, [true, true], 1e-13).unwrap();
+    println!("orbit: x0 = {:.17e}, ydot0 = {:.17e}, period = {:.17e}; forcing table error {:.3e}", o.state0[0], o.state0[4], o.period, f.max_error);
     let n = 2000;
     let grid: Vec<Case> = (0..n).map(|i| Case::new(0.0, -3.0 + 5.0 * i as f64 / (n - 1) as f64, 0.8)).collect();
     let srp: Vec<Case> = grid.iter().map(|c| Case { eps: 0.05, cs: 0.4, cd: 0.1, theta_sun0: 0.7, ..*c }).collect();

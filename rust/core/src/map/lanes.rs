@@ -342,3 +342,65 @@ pub fn integrate_cases<const D: usize, const SRP: bool>(f: &OrbitForcing, t_fina
     }
     out
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::attitude::PlanarForced;
+    use crate::integrate::{Options, System};
+    use crate::periodic::correct_planar_symmetric;
+
+    /// The lanes' right-hand side (gravity gradient and flat plate through the shared generic
+    /// laws, cos 2phi and sin 2phi from the (cos phi, sin phi) states, the Sun turned per lane)
+    /// equals the scalar planar model's (`PlanarForced` on the same forcing table, with each
+    /// case's `FlatPlate`), 2x2 STM included, to 1e-14 relative to the size of the terms
+    /// (1 + 3 |Kz| max(|S|, |C|) + 3 |eps|, times max |STM entry|).
+    #[test]
+    fn lane_rhs_equals_scalar_model() {
+        let mu = 0.01215;
+        let (x0, d) = (0.7, 1.0 - mu - 0.7);
+        let o = correct_planar_symmetric(mu, x0, (mu / d).sqrt() + d, 1e-12, 30, &Options::with_tolerances(1e-13, 1e-13)).unwrap();
+        let f = OrbitForcing::new(mu, &o.state0, o.period, [true, true], 1e-13).unwrap();
+        let cases: [Case; LANES] = std::array::from_fn(|l| {
+            let x = l as f64;
+            Case { phi0: -2.9 + 0.8 * x, wz0: -2.0 + 0.6 * x, kz: 0.9 - 0.25 * x, eps: [0.0, 0.05, 0.3, -0.2][l % 4], cs: 0.1 * (l % 3) as f64, cd: 0.2, theta_sun0: 0.9 * x - 3.0 }
+        });
+        let opts = LaneOptions::default();
+        let plates: [FlatPlate; LANES] = std::array::from_fn(|l| cases[l].plate(opts.sun_omega));
+        let p = Params {
+            kz15: V::new(std::array::from_fn(|l| 1.5 * cases[l].kz)),
+            a1: V::new(std::array::from_fn(|l| plates[l].coefficients().0)),
+            a2: V::new(std::array::from_fn(|l| plates[l].coefficients().1)),
+            c0: V::new(std::array::from_fn(|l| plates[l].sun.theta0.cos())),
+            s0: V::new(std::array::from_fn(|l| plates[l].sun.theta0.sin())),
+            sun: Sun { theta0: 0.0, ..plates[0].sun },
+        };
+        let stm = [0.7, -1.3, 2.1, 0.4];
+        for t in [0.0, 0.37 * o.period, 0.81 * o.period, 3.3 * o.period] {
+            let mut y = [V::ZERO; 8];
+            y[0] = V::new(cases.map(|c| c.phi0));
+            y[1] = V::new(cases.map(|c| c.wz0));
+            y[2] = V::new(cases.map(|c| c.phi0.cos()));
+            y[3] = V::new(cases.map(|c| c.phi0.sin()));
+            for i in 0..4 {
+                y[4 + i] = V::splat(stm[i]);
+            }
+            let mut dy = [V::ZERO; 8];
+            rhs::<8, true>(&f, t, &y, &p, &mut dy);
+            let (s, c) = f.sc(t);
+            for (l, case) in cases.iter().enumerate() {
+                let scalar = PlanarForced { kz: case.kz, forcing: &f, srp: if case.eps != 0.0 { Some(plates[l]) } else { None } };
+                let mut ds = [0.0; 6];
+                scalar.derivative(t, &[case.phi0, case.wz0, stm[0], stm[1], stm[2], stm[3]], &mut ds);
+                let scale = 1.0 + 3.0 * case.kz.abs() * s.abs().max(c.abs()) + 3.0 * case.eps.abs();
+                let lanes = [lane(&dy[0], l), lane(&dy[1], l), lane(&dy[4], l), lane(&dy[5], l), lane(&dy[6], l), lane(&dy[7], l)];
+                for i in 0..6 {
+                    assert!((lanes[i] - ds[i]).abs() <= 1e-14 * scale * 3.0, "lane {l}, t {t}, component {i}: {} vs {}", lanes[i], ds[i]);
+                }
+                // the (cos phi, sin phi) states turn at phidot
+                assert_eq!(lane(&dy[2], l), -(ds[0] * case.phi0.sin()));
+                assert_eq!(lane(&dy[3], l), ds[0] * case.phi0.cos());
+            }
+        }
+    }
+}
