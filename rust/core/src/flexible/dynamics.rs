@@ -52,11 +52,17 @@ pub struct BodyField {
     pub p: f64,
 }
 
+/// e^{-2 i phi}: turns a synodic tidal field into body axes (w = W e^{-2 i phi}).
+#[inline(always)]
+pub(crate) fn to_body_axes(phi: f64) -> Complex<f64> {
+    let (s2, c2) = (2.0 * phi).sin_cos();
+    Complex::new(c2, -s2)
+}
+
 impl BodyField {
     #[inline(always)]
     pub fn new(w_synodic: Complex<f64>, p: f64, phi: f64) -> Self {
-        let (s2, c2) = (2.0 * phi).sin_cos();
-        Self { w: w_synodic * Complex::new(c2, -s2), p }
+        Self { w: w_synodic * to_body_axes(phi), p }
     }
     /// T_B r.
     #[inline(always)]

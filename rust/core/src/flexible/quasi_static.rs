@@ -30,7 +30,7 @@
 use nalgebra::Complex;
 
 use super::body::FlexibleBody;
-use super::dynamics::{tidal_field, tidal_field_derivatives, BodyField};
+use super::dynamics::{tidal_field, tidal_field_derivatives, to_body_axes, BodyField};
 use crate::cr3bp::Cr3bp;
 use crate::integrate::System;
 
@@ -50,8 +50,7 @@ pub struct QuasiStaticPoint {
 /// axes: (w, w', w'', wz', wz'', wz''').
 #[inline]
 fn chain(body: &FlexibleBody, wsyn: [Complex<f64>; 3], phi: f64, wz: f64) -> ([Complex<f64>; 3], [f64; 3]) {
-    let (s2, c2) = (2.0 * phi).sin_cos();
-    let e = Complex::new(c2, -s2);
+    let e = to_body_axes(phi);
     let i = Complex::new(0.0, 1.0);
     let p1 = wz - 1.0;
     let w0 = wsyn[0] * e;

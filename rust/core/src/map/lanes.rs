@@ -114,6 +114,22 @@ struct Params {
     sun: Sun,
 }
 
+impl Params {
+    /// The lanes' parameters and their cases' plates.
+    fn new(pick: impl Fn(usize) -> Case, sun_omega: f64) -> (Self, [FlatPlate; LANES]) {
+        let plates: [FlatPlate; LANES] = std::array::from_fn(|l| pick(l).plate(sun_omega));
+        let p = Params {
+            kz15: V::new(std::array::from_fn(|l| 1.5 * pick(l).kz)),
+            a1: V::new(std::array::from_fn(|l| plates[l].coefficients().0)),
+            a2: V::new(std::array::from_fn(|l| plates[l].coefficients().1)),
+            c0: V::new(std::array::from_fn(|l| plates[l].sun.theta0.cos())),
+            s0: V::new(std::array::from_fn(|l| plates[l].sun.theta0.sin())),
+            sun: Sun { theta0: 0.0, ..plates[0].sun },
+        };
+        (p, plates)
+    }
+}
+
 #[inline(always)]
 fn lincomb<const D: usize, const M: usize>(out: &mut [V; D], y: &[V; D], h: V, coef: [f64; M], ks: [&[V; D]; M]) {
     for i in 0..D {
@@ -223,15 +239,7 @@ fn integrate_group<const D: usize, const SRP: bool>(f: &OrbitForcing, t_final: f
         y[4] = V::ONE;
         y[7] = V::ONE;
     }
-    let plates: [FlatPlate; LANES] = std::array::from_fn(|l| pick(l).plate(opts.sun_omega));
-    let p = Params {
-        kz15: V::new(std::array::from_fn(|l| 1.5 * pick(l).kz)),
-        a1: V::new(std::array::from_fn(|l| plates[l].coefficients().0)),
-        a2: V::new(std::array::from_fn(|l| plates[l].coefficients().1)),
-        c0: V::new(std::array::from_fn(|l| plates[l].sun.theta0.cos())),
-        s0: V::new(std::array::from_fn(|l| plates[l].sun.theta0.sin())),
-        sun: Sun { theta0: 0.0, ..plates[0].sun },
-    };
+    let (p, plates) = Params::new(pick, opts.sun_omega);
     let plate: [bool; LANES] = std::array::from_fn(|l| plates[l].eps != 0.0);
     let (rtol, atol) = (V::splat(opts.rtol), V::splat(opts.atol));
     let mut ynew = [V::ZERO; D];
@@ -365,16 +373,7 @@ mod tests {
             let x = l as f64;
             Case { phi0: -2.9 + 0.8 * x, wz0: -2.0 + 0.6 * x, kz: 0.9 - 0.25 * x, eps: [0.0, 0.05, 0.3, -0.2][l % 4], cs: 0.1 * (l % 3) as f64, cd: 0.2, theta_sun0: 0.9 * x - 3.0 }
         });
-        let opts = LaneOptions::default();
-        let plates: [FlatPlate; LANES] = std::array::from_fn(|l| cases[l].plate(opts.sun_omega));
-        let p = Params {
-            kz15: V::new(std::array::from_fn(|l| 1.5 * cases[l].kz)),
-            a1: V::new(std::array::from_fn(|l| plates[l].coefficients().0)),
-            a2: V::new(std::array::from_fn(|l| plates[l].coefficients().1)),
-            c0: V::new(std::array::from_fn(|l| plates[l].sun.theta0.cos())),
-            s0: V::new(std::array::from_fn(|l| plates[l].sun.theta0.sin())),
-            sun: Sun { theta0: 0.0, ..plates[0].sun },
-        };
+        let (p, plates) = Params::new(|l| cases[l], LaneOptions::default().sun_omega);
         let stm = [0.7, -1.3, 2.1, 0.4];
         for t in [0.0, 0.37 * o.period, 0.81 * o.period, 3.3 * o.period] {
             let mut y = [V::ZERO; 8];
