@@ -31,7 +31,7 @@ use nalgebra::Complex;
 
 use super::body::FlexibleBody;
 use super::dynamics::{tidal_field, tidal_field_derivatives, to_body_axes, BodyField};
-use crate::cr3bp::Cr3bp;
+use crate::attitude::planar::orbit_derivative;
 use crate::integrate::System;
 
 /// The closed-form deflections and their derivatives at one point of a rigid solution.
@@ -129,10 +129,7 @@ impl System<[f64; 10]> for QuasiStaticAlongOrbit<'_> {
     #[inline]
     fn derivative(&self, t: f64, y: &[f64; 10], dy: &mut [f64; 10]) {
         let mut d = [0.0; 6];
-        if !self.held {
-            let s: [f64; 6] = std::array::from_fn(|i| y[i]);
-            Cr3bp { mu: self.mu }.derivative(t, &s, &mut d);
-        }
+        orbit_derivative(self.mu, self.held, t, y, &mut d);
         dy[..6].copy_from_slice(&d);
         let (phi, wz) = (y[6], y[7]);
         let wsyn = if self.held {

@@ -19,6 +19,10 @@
 //! itself is integrated (phidot = wz - 1) and gives the unwrapped phi(T). The flat-plate SRP
 //! law (PHYSICS.md sec. 6) is C1 only: a step never spans a lane's Sun-terminator crossing
 //! (cos(theta_sun - phi) = 0); the step is cut there (Illinois iterations on its length).
+//!
+//! Nothing of the physics or the step control is written here: the lanes call the laws the
+//! scalar planar model calls ([`gravity_gradient_wzdot`], [`flat_plate_wzdot`], [`Sun::angle`],
+//! generic over the lane type) and step with the scalar driver's [`Controller`] and tableau.
 
 use wide::f64x8;
 
