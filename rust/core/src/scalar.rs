@@ -1,7 +1,7 @@
 //! The scalar types equations are written over, so that each equation is written once:
 //!
 //! - [`Real`]: f64 and forward-mode dual numbers [`Dual`] carrying N partial derivatives, so one
-//!   generic right-hand side gives both the values (f64) and the exact Jacobian (Dual<N>) used
+//!   generic right-hand side gives both the values (f64) and the exact Jacobian (`Dual<N>`) used
 //!   by the variational equations (the CR3BP acceleration, the 3-D attitude model);
 //! - [`Lane`]: f64 and the SIMD vector `wide::f64x8`, so the scalar planar model and the map
 //!   engine's lanes evaluate the same torque laws (gravity gradient, flat-plate SRP).
