@@ -6,13 +6,22 @@ import numpy as np
 import numpy.typing as npt
 
 __version__: str
+#: Physical constants of the core (librate_core::constants).
+N_SUN: float
+OMEGA_SUN: float
+SOLAR_PRESSURE_1AU: float
+SUN_SYNODIC_PERIOD: float
 __all__ = [
     "ConvergenceError",
     "CorrectionBatch",
     "IntegrationError",
     "LibrateError",
+    "N_SUN",
+    "OMEGA_SUN",
     "OrbitForcing",
     "PlanarVerification",
+    "SOLAR_PRESSURE_1AU",
+    "SUN_SYNODIC_PERIOD",
     "SweepResult",
     "__version__",
     "attitude_correct",
@@ -38,7 +47,6 @@ __all__ = [
     "rigid_body_kz",
     "stability",
     "symmetric_correct",
-    "symmetric_evaluate",
     "system_preset",
     "system_validate",
 ]
@@ -96,7 +104,6 @@ def preset_names() -> list[str]: ...
 def symmetric_correct(
     mu: float, p: list[float], *, spatial: bool, constraint: str, values: list[float], tol: float, max_iter: int, t_max: float, rtol: float, atol: float
 ) -> dict[str, Any]: ...
-def symmetric_evaluate(mu: float, p: list[float], *, spatial: bool, t_max: float, rtol: float, atol: float) -> dict[str, Any]: ...
 def stability(m: _F64, planar: bool) -> tuple[npt.NDArray[np.complex128], npt.NDArray[np.complex128]]: ...
 def multiple_shooting(
     mu: float, patches: _F64, period: float, *, condition: str, value: float, tol: float, max_iter: int, rtol: float, atol: float
