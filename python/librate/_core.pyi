@@ -19,12 +19,14 @@ __all__ = [
     "N_SUN",
     "OMEGA_SUN",
     "OrbitForcing",
+    "PlanarFamily",
     "PlanarVerification",
     "SOLAR_PRESSURE_1AU",
     "SUN_SYNODIC_PERIOD",
     "SweepResult",
     "__version__",
     "attitude_correct",
+    "attitude_correct_across",
     "attitude_propagate",
     "attitude_torques",
     "facets_force_torque",
@@ -198,6 +200,20 @@ def attitude_correct(
     max_wz_step: float = 0.5, max_angle_step: float = 0.5, threads: int | None = None, chunk: int = 64,
     parameter: str | None = None, condition: tuple[float, float, float, float] | None = None,
     parameter_step: float = 1e-6, max_parameter_step: float = 0.5,
+) -> CorrectionBatch: ...
+
+@final
+class PlanarFamily:
+    def __init__(self, mu: float, x0: list[float], vy0: list[float]) -> None: ...
+    @property
+    def range(self) -> tuple[float, float]: ...
+    def orbit_at(self, x0: float) -> tuple[list[float], float]: ...
+
+def attitude_correct_across(
+    family: PlanarFamily, wz0: _F64, kz: _F64, turns: _F64, x0: _F64, *,
+    condition: tuple[float, float, float], phi0: float = 0.0, tol: float = 1e-12, max_iter: int = 40, rtol: float = 1e-13,
+    atol: float = 1e-13, max_steps: int = 200000, max_wz_step: float = 0.5, parameter_step: float = 1e-6,
+    max_parameter_step: float = 0.05, threads: int | None = None,
 ) -> CorrectionBatch: ...
 
 @final

@@ -364,3 +364,36 @@ fn val_bordered_correction_is_the_continuation_corrector() {
     let r = correct_bordered(&f, 0.5 * t, Closure::Half, Free::Phi0, &out, &[Candidate::new(0.0, p.wz0, 0.8, -1.0)], &opts).unwrap()[0];
     assert!(!r.converged());
 }
+
+/// The correction across a planar orbit family (the orbit's x0 freed). References: (1) with x0
+/// fixed at a value between members it equals the plain half-period correction on the DRO
+/// corrected directly at that x0 (1e-10: both orbits corrected to 1e-12); (2) its x0 column
+/// d g / d x0 gives the family's slope d wz0 / d x0 = -g_x0 / g_wz, against central differences
+/// of plain corrections at x0 +- 1e-4 (1e-5 relative: truncation and the orbits' correction
+/// noise); (3) x0 outside the members' range fails cleanly.
+#[test]
+fn val_correction_across_the_orbit_family() {
+    use librate_core::periodic::{correct_across_family, PlanarFamily};
+    let members: Vec<([f64; 6], f64)> = [0.80, 0.83, 0.86, 0.89].iter().map(|&x| dro_x0(x)).collect();
+    let x0s: Vec<f64> = members.iter().map(|m| m.0[0]).collect();
+    let vy0s: Vec<f64> = members.iter().map(|m| m.0[4]).collect();
+    let fam = PlanarFamily::new(MU, &x0s, &vy0s).unwrap();
+    let opts = CorrectorOptions::default();
+    let plain = |x0: f64| {
+        let (s0, t) = dro_x0(x0);
+        correct_planar_attitudes(&table(&s0, t), 0.5 * t, Closure::Half, Free::Phi0, &[Candidate::new(0.0, 1.8, 0.8, 0.0)], &opts).unwrap()[0]
+    };
+    let p = plain(0.85);
+    assert!(p.converged());
+    let fixed = Bordered { parameter: Parameter::OrbitX0, ..Bordered::fixed(Parameter::Kz, 0.85) };
+    let c = correct_across_family(&fam, &fixed, &[Candidate::new(0.0, p.wz0 + 0.01, 0.8, 0.0).with_x0(0.84)], &opts);
+    let c = c.unwrap()[0];
+    assert!(c.converged(), "{:?}", c.reason);
+    assert!((c.parameter - 0.85).abs() < 1e-14 && (c.wz0 - p.wz0).abs() < 1e-10, "{} vs {}", c.wz0, p.wz0);
+    let slope = -c.jacobian[0][2] / c.jacobian[0][1];
+    let fd = (plain(0.8501).wz0 - plain(0.8499).wz0) / 2e-4;
+    assert!((slope - fd).abs() <= 1e-5 * fd.abs().max(1.0), "{slope} vs {fd}");
+    let out = Bordered { b: 0.95, ..fixed };
+    let r = correct_across_family(&fam, &out, &[Candidate::new(0.0, p.wz0, 0.8, 0.0).with_x0(0.85)], &opts).unwrap()[0];
+    assert!(!r.converged());
+}

@@ -2,7 +2,10 @@
 
 use librate_core::attitude::{FlatPlate, Sun};
 use librate_core::map::{self, Case, LaneOptions};
-use librate_core::periodic::{correct_bordered, correct_planar_attitudes, verify_planar_attitudes, Bordered, Candidate, Closure, CorrectorOptions, Free, Parameter, PlanarStart};
+use librate_core::periodic::{
+    correct_across_family, correct_bordered, correct_planar_attitudes, verify_planar_attitudes, Bordered, Candidate, Closure, CorrectorOptions, Free, Parameter, PlanarFamily,
+    PlanarStart,
+};
 use numpy::{IntoPyArray, PyArrayMethods, PyReadonlyArray1};
 use pyo3::exceptions::{PyKeyError, PyValueError};
 use pyo3::prelude::*;
@@ -341,6 +344,11 @@ fn attitude_correct<'py>(
             Some(b) => correct_bordered(f, t_final, closure, free, b, &cands, &opts),
         })
         .map_err(to_py)?;
+    batch_from(py, &out)
+}
+
+fn batch_from(py: Python<'_>, out: &[librate_core::periodic::Correction]) -> PyResult<PyCorrectionBatch> {
+    let n = out.len();
     let col = |g: &dyn Fn(&librate_core::periodic::Correction) -> f64| out.iter().map(g).collect::<Vec<f64>>();
     Ok(PyCorrectionBatch {
         phi0: col(&|c| c.phi0).into_pyarray(py).into_any().unbind(),
@@ -355,6 +363,69 @@ fn attitude_correct<'py>(
         parameter: col(&|c| c.parameter).into_pyarray(py).into_any().unbind(),
         jacobian: out.iter().flat_map(|c| c.jacobian.into_iter().flatten()).collect::<Vec<f64>>().into_pyarray(py).reshape([n, 2, 3])?.into_any().unbind(),
     })
+}
+
+/// A planar symmetric orbit family (members' x0 and vy0) from which the orbit through any x0 in
+/// range is corrected and tabulated on demand (cached): the data of `attitude_correct_across`.
+#[pyclass(frozen, name = "PlanarFamily", module = "librate._core")]
+pub struct PyPlanarFamily {
+    inner: PlanarFamily,
+}
+
+#[pymethods]
+impl PyPlanarFamily {
+    #[new]
+    fn new(mu: f64, x0: Vec<f64>, vy0: Vec<f64>) -> PyResult<Self> {
+        Ok(Self { inner: PlanarFamily::new(mu, &x0, &vy0).map_err(to_py)? })
+    }
+    /// The members' x0 range (lo, hi).
+    #[getter]
+    fn range(&self) -> (f64, f64) {
+        self.inner.range()
+    }
+    /// (state0, period) of the family's orbit through x0 (corrected, cached).
+    fn orbit_at(&self, py: Python<'_>, x0: f64) -> PyResult<([f64; 6], f64)> {
+        let o = py.detach(|| self.inner.orbit_at(x0)).map_err(to_py)?;
+        Ok((o.0.state0, o.0.period))
+    }
+}
+
+/// The half-period correction with the orbit's x0 freed across a planar family, closed by the
+/// linear condition a_wz0 wz0 + a_x0 x0 = b (librate_core::periodic::correct_across_family).
+#[pyfunction]
+#[pyo3(signature = (family, wz0, kz, turns, x0, *, condition, phi0=0.0, tol=1e-12, max_iter=40, rtol=1e-13, atol=1e-13, max_steps=200_000,
+    max_wz_step=0.5, parameter_step=1e-6, max_parameter_step=0.05, threads=None))]
+#[allow(clippy::too_many_arguments)]
+fn attitude_correct_across<'py>(
+    py: Python<'py>,
+    family: PyRef<'py, PyPlanarFamily>,
+    wz0: PyReadonlyArray1<'py, f64>,
+    kz: PyReadonlyArray1<'py, f64>,
+    turns: PyReadonlyArray1<'py, f64>,
+    x0: PyReadonlyArray1<'py, f64>,
+    condition: (f64, f64, f64),
+    phi0: f64,
+    tol: f64,
+    max_iter: usize,
+    rtol: f64,
+    atol: f64,
+    max_steps: u32,
+    max_wz_step: f64,
+    parameter_step: f64,
+    max_parameter_step: f64,
+    threads: Option<usize>,
+) -> PyResult<PyCorrectionBatch> {
+    let (w, k, tu, x) = (wz0.as_array(), kz.as_array(), turns.as_array(), x0.as_array());
+    let n = w.len();
+    if k.len() != n || tu.len() != n || x.len() != n {
+        return Err(PyValueError::new_err(format!("invalid argument: wz0, kz, turns and x0 must have one length, got {}, {}, {}, {}", n, k.len(), tu.len(), x.len())));
+    }
+    let cands: Vec<Candidate> = (0..n).map(|i| Candidate::new(phi0, w[i], k[i], tu[i]).with_x0(x[i])).collect();
+    let bordered = Bordered { parameter: Parameter::OrbitX0, a: [0.0, condition.0, condition.1], b: condition.2, step: parameter_step, max_step: max_parameter_step };
+    let opts = CorrectorOptions { tol, max_iter, rtol, atol, max_steps, max_wz_step, threads, ..CorrectorOptions::default() };
+    let fam = &family.inner;
+    let out = py.detach(|| correct_across_family(fam, &bordered, &cands, &opts)).map_err(to_py)?;
+    batch_from(py, &out)
 }
 
 /// The outcome of `planar_verify`: arrays over the items.
@@ -444,6 +515,8 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyPlanarVerification>()?;
     m.add_function(wrap_pyfunction!(map_sweep, m)?)?;
     m.add_function(wrap_pyfunction!(attitude_correct, m)?)?;
+    m.add_class::<PyPlanarFamily>()?;
+    m.add_function(wrap_pyfunction!(attitude_correct_across, m)?)?;
     m.add_function(wrap_pyfunction!(planar_verify, m)?)?;
     Ok(())
 }

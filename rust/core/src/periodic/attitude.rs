@@ -33,6 +33,10 @@
 use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
 
+use std::collections::HashMap;
+use std::sync::{Arc, Mutex};
+
+use super::symmetric::{Constraint, SymmetricOrbit, SymmetricShooting, Var};
 use crate::attitude::{propagate_planar, FlatPlate, OMEGA_SUN};
 use crate::cr3bp::check_mu;
 use crate::error::{check_finite, check_positive, invalid, Error, Result};
@@ -99,12 +103,20 @@ impl StopReason {
 pub struct Candidate {
     pub case: Case,
     pub turns: f64,
+    /// The starting orbit's x0 for [`correct_across_family`] (NaN otherwise).
+    pub x0: f64,
 }
 
 impl Candidate {
     /// A gravity-gradient-only candidate.
     pub fn new(phi0: f64, wz0: f64, kz: f64, turns: f64) -> Self {
-        Self { case: Case::new(phi0, wz0, kz), turns }
+        Self { case: Case::new(phi0, wz0, kz), turns, x0: f64::NAN }
+    }
+
+    /// The same candidate started on the orbit of the family member at `x0`
+    /// ([`correct_across_family`]).
+    pub fn with_x0(self, x0: f64) -> Self {
+        Self { x0, ..self }
     }
 
     /// The same candidate with a flat plate (SRP amplitude `eps`, coefficients, Sun phase).
@@ -120,6 +132,9 @@ pub enum Parameter {
     Kz,
     /// The flat-plate SRP amplitude eps.
     Eps,
+    /// The x0 of a member of a planar symmetric orbit family ([`correct_across_family`]): each
+    /// value is its own orbit, corrected and tabulated on demand.
+    OrbitX0,
 }
 
 /// A bordered correction, the corrector of pseudo-arclength (or natural-parameter)
@@ -297,16 +312,14 @@ impl Form {
         }
     }
 
-    fn parameter_of(&self, c: &Case) -> f64 {
-        match self.bordered.map(|b| b.parameter) {
-            Some(Parameter::Eps) => c.eps,
-            _ => c.kz,
-        }
-    }
-
     fn initial(&self, c: &Candidate) -> [f64; 3] {
         let angle = if self.closure == Closure::Full && self.free == Free::SunPhase { c.case.theta_sun0 } else { c.case.phi0 };
-        [angle, c.case.wz0, self.parameter_of(&c.case)]
+        let p = match self.bordered.map(|b| b.parameter) {
+            Some(Parameter::Eps) => c.case.eps,
+            Some(Parameter::OrbitX0) => c.x0,
+            _ => c.case.kz,
+        };
+        [angle, c.case.wz0, p]
     }
 
     /// The trajectory of the point x; None when the parameter leaves its range.
@@ -322,7 +335,7 @@ impl Form {
             Some(Parameter::Kz) if !(-1.0..=1.0).contains(&x[PARAM]) => return None,
             Some(Parameter::Kz) => k.kz = x[PARAM],
             Some(Parameter::Eps) => k.eps = x[PARAM],
-            None => {}
+            Some(Parameter::OrbitX0) | None => {}
         }
         Some(k)
     }
@@ -332,25 +345,27 @@ impl Form {
         let b = self.bordered.expect("bordered");
         match b.parameter {
             Parameter::Kz => ((p + b.step).min(1.0), (p - b.step).max(-1.0)),
-            Parameter::Eps => (p + b.step, p - b.step),
+            Parameter::Eps | Parameter::OrbitX0 => (p + b.step, p - b.step),
         }
     }
 
-    /// Push the point's trajectories; false when it cannot be integrated (parameter out of range).
-    fn push_cases(&self, c: &Candidate, x: [f64; 3], out: &mut Vec<Case>) -> bool {
+    /// Push the point's trajectories with the parameter value each one runs at (the orbit's x0
+    /// for [`Parameter::OrbitX0`]); false when it cannot be integrated (parameter out of range).
+    fn push_cases(&self, c: &Candidate, x: [f64; 3], out: &mut Vec<(Case, f64)>) -> bool {
         let Some(k) = self.case_at(c, x) else { return false };
-        out.push(k);
+        out.push((k, x[PARAM]));
         if self.closure == Closure::Full && self.free == Free::SunPhase {
             for th in [x[ANGLE] + self.h, x[ANGLE] - self.h] {
-                out.push(Case { theta_sun0: th, ..k });
+                out.push((Case { theta_sun0: th, ..k }, x[PARAM]));
             }
         }
         if let Some(b) = self.bordered {
             let (pp, pm) = self.parameter_pair(x[PARAM]);
             for v in [pp, pm] {
                 out.push(match b.parameter {
-                    Parameter::Kz => Case { kz: v, ..k },
-                    Parameter::Eps => Case { eps: v, ..k },
+                    Parameter::Kz => (Case { kz: v, ..k }, v),
+                    Parameter::Eps => (Case { eps: v, ..k }, v),
+                    Parameter::OrbitX0 => (k, v),
                 });
             }
         }
@@ -567,8 +582,7 @@ fn is_multiple(t: f64, unit: f64) -> bool {
     k >= 1.0 && (t - k * unit).abs() <= 1e-9 * t
 }
 
-fn validate(forcing: &OrbitForcing, t_final: f64, closure: Closure, free: Free, candidates: &[Candidate], opts: &CorrectorOptions) -> Result<()> {
-    check_positive("t_final", t_final)?;
+fn validate_options(opts: &CorrectorOptions) -> Result<()> {
     check_positive("tol", opts.tol)?;
     check_positive("rtol", opts.rtol)?;
     check_positive("atol", opts.atol)?;
@@ -593,6 +607,12 @@ fn validate(forcing: &OrbitForcing, t_final: f64, closure: Closure, free: Free, 
     if opts.threads == Some(0) {
         return Err(invalid("threads", "must be >= 1 (or None for all cores)"));
     }
+    Ok(())
+}
+
+fn validate(forcing: &OrbitForcing, t_final: f64, closure: Closure, free: Free, candidates: &[Candidate], opts: &CorrectorOptions) -> Result<()> {
+    check_positive("t_final", t_final)?;
+    validate_options(opts)?;
     match closure {
         Closure::Half => {
             if free != Free::Phi0 {
@@ -615,6 +635,10 @@ fn validate(forcing: &OrbitForcing, t_final: f64, closure: Closure, free: Free, 
             }
         }
     }
+    validate_candidates(closure, free, candidates)
+}
+
+fn validate_candidates(closure: Closure, free: Free, candidates: &[Candidate]) -> Result<()> {
     for (i, c) in candidates.iter().enumerate() {
         let k = &c.case;
         if !(k.phi0.is_finite() && k.wz0.is_finite()) {
@@ -664,7 +688,9 @@ pub fn correct_planar_attitudes(
     candidates: &[Candidate],
     opts: &CorrectorOptions,
 ) -> Result<Vec<Correction>> {
-    run(forcing, t_final, Form { closure, free, h: opts.phase_step, bordered: None }, candidates, opts)
+    validate(forcing, t_final, closure, free, candidates, opts)?;
+    let form = Form { closure, free, h: opts.phase_step, bordered: None };
+    run(form, candidates, opts, &on_table(forcing, t_final, opts))
 }
 
 /// The bordered correction of continuation: as [`correct_planar_attitudes`], with the
@@ -682,6 +708,16 @@ pub fn correct_bordered(
     candidates: &[Candidate],
     opts: &CorrectorOptions,
 ) -> Result<Vec<Correction>> {
+    validate_bordered(bordered, closure)?;
+    if bordered.parameter == Parameter::OrbitX0 {
+        return Err(invalid("parameter", "the orbit's x0 is freed by correct_across_family"));
+    }
+    validate(forcing, t_final, closure, free, candidates, opts)?;
+    let form = Form { closure, free, h: opts.phase_step, bordered: Some(*bordered) };
+    run(form, candidates, opts, &on_table(forcing, t_final, opts))
+}
+
+fn validate_bordered(bordered: &Bordered, closure: Closure) -> Result<()> {
     check_finite("a", &bordered.a)?;
     if !bordered.b.is_finite() {
         return Err(invalid("b", format!("must be finite, got {}", bordered.b)));
@@ -697,34 +733,48 @@ pub fn correct_bordered(
     if bordered.parameter == Parameter::Eps && closure == Closure::Half {
         return Err(invalid("parameter", "eps breaks the mirror symmetry: continue in eps with Closure::Full"));
     }
-    run(forcing, t_final, Form { closure, free, h: opts.phase_step, bordered: Some(*bordered) }, candidates, opts)
+    Ok(())
 }
 
-fn run(forcing: &OrbitForcing, t_final: f64, form: Form, candidates: &[Candidate], opts: &CorrectorOptions) -> Result<Vec<Correction>> {
-    validate(forcing, t_final, form.closure, form.free, candidates, opts)?;
+/// Integrates a batch of trajectories: (cases, the parameter value of each, full period?) ->
+/// outcomes in order.
+type Integrate<'a> = dyn Fn(&[Case], &[f64], bool) -> Result<Vec<Outcome>> + Sync + 'a;
+
+/// All trajectories on one orbit's forcing table, in one sweep (over `t_final`, or twice it for
+/// the half closure's full-period monodromy).
+fn on_table<'a>(forcing: &'a OrbitForcing, t_final: f64, opts: &CorrectorOptions) -> impl Fn(&[Case], &[f64], bool) -> Result<Vec<Outcome>> + Sync + 'a {
     let lane = LaneOptions { rtol: opts.rtol, atol: opts.atol, max_steps: opts.max_steps, sun_omega: opts.sun_omega };
+    let chunk = opts.chunk;
+    move |cases: &[Case], _: &[f64], full: bool| map::sweep(forcing, if full { 2.0 * t_final } else { t_final }, cases, &lane, true, chunk, None)
+}
+
+const FAILED: Outcome = Outcome { phi_t: f64::NAN, wz_t: f64::NAN, stm: [f64::NAN; 4], accepted: 0, rejected: 0, status: LaneStatus::Failed };
+
+/// The one Newton driver of every form: all pending points of all candidates integrated in one
+/// call of `integrate` per iteration, a line search per candidate.
+fn run(form: Form, candidates: &[Candidate], opts: &CorrectorOptions, integrate: &Integrate<'_>) -> Result<Vec<Correction>> {
     let per = form.cases_per_point();
     let mut tracks: Vec<Track> = candidates
         .iter()
         .map(|c| Track { cand: *c, start: form.initial(c), cur: None, dir: [0.0; 3], scale: 1.0, rank_deficient: false, phase: Phase::Start, iterations: 0 })
         .collect();
     with_threads(opts.threads, || -> Result<Vec<Correction>> {
-        let mut cases = Vec::with_capacity(per * tracks.len());
+        let mut batch: Vec<(Case, f64)> = Vec::with_capacity(per * tracks.len());
         let mut active: Vec<(usize, [f64; 3], Option<usize>)> = Vec::with_capacity(tracks.len());
         loop {
-            cases.clear();
+            batch.clear();
             active.clear();
             for (i, t) in tracks.iter().enumerate() {
                 if let Some(x) = t.pending() {
-                    let at = cases.len();
-                    let pushed = form.push_cases(&t.cand, x, &mut cases);
+                    let at = batch.len();
+                    let pushed = form.push_cases(&t.cand, x, &mut batch);
                     active.push((i, x, pushed.then_some(at)));
                 }
             }
             if active.is_empty() {
                 break;
             }
-            let out = if cases.is_empty() { Vec::new() } else { map::sweep(forcing, t_final, &cases, &lane, true, opts.chunk, None)? };
+            let out = integrate_batch(integrate, &batch, false)?;
             for &(i, x, at) in &active {
                 let o = at.map_or(&out[0..0], |k| &out[k..k + per]);
                 tracks[i].advance(&form, x, o, opts);
@@ -732,17 +782,124 @@ fn run(forcing: &OrbitForcing, t_final: f64, form: Form, candidates: &[Candidate
         }
         let mut mono: Vec<[f64; 4]> = tracks.iter().map(|t| t.cur.map_or([f64::NAN; 4], |p| p.stm)).collect();
         if form.closure == Closure::Half {
-            // The full-period monodromy: one more sweep over K T at the final points.
-            let full: Vec<(usize, Case)> =
-                (0..tracks.len()).filter_map(|i| tracks[i].cur.and_then(|p| form.case_at(&tracks[i].cand, p.x)).map(|k| (i, k))).collect();
-            let cases: Vec<Case> = full.iter().map(|&(_, k)| k).collect();
-            let out = if cases.is_empty() { Vec::new() } else { map::sweep(forcing, 2.0 * t_final, &cases, &lane, true, opts.chunk, None)? };
+            // The full-period monodromy: one more batch over K T at the final points.
+            let full: Vec<(usize, (Case, f64))> =
+                (0..tracks.len()).filter_map(|i| tracks[i].cur.and_then(|p| form.case_at(&tracks[i].cand, p.x).map(|k| (i, (k, p.x[PARAM]))))).collect();
+            let cases: Vec<(Case, f64)> = full.iter().map(|&(_, k)| k).collect();
+            let out = integrate_batch(integrate, &cases, true)?;
             for (&(i, _), o) in full.iter().zip(&out) {
                 mono[i] = if o.status == LaneStatus::Ok { o.stm } else { [f64::NAN; 4] };
             }
         }
         Ok(tracks.iter().zip(mono).map(|(t, m)| t.result(&form, m)).collect())
     })?
+}
+
+fn integrate_batch(integrate: &Integrate<'_>, batch: &[(Case, f64)], full: bool) -> Result<Vec<Outcome>> {
+    if batch.is_empty() {
+        return Ok(Vec::new());
+    }
+    let cases: Vec<Case> = batch.iter().map(|b| b.0).collect();
+    let values: Vec<f64> = batch.iter().map(|b| b.1).collect();
+    integrate(&cases, &values, full)
+}
+
+/// Members of a planar x-z-symmetric orbit family (DROs, planar Lyapunov orbits), as the
+/// guesses from which the orbit through any x0 in their range is corrected on demand (half-period
+/// single shooting with x0 fixed, the ydot0 guess interpolated between members), with its
+/// forcing table; both kept in a cache (the continuation comes back to the same x0 when it
+/// locates folds). Thread-safe.
+pub struct PlanarFamily {
+    mu: f64,
+    x0: Vec<f64>,
+    vy0: Vec<f64>,
+    cache: Mutex<HashMap<u64, Arc<(SymmetricOrbit, OrbitForcing)>>>,
+}
+
+impl PlanarFamily {
+    /// `x0`, `vy0`: the members' initial states (any order; at least two, distinct x0).
+    pub fn new(mu: f64, x0: &[f64], vy0: &[f64]) -> Result<Self> {
+        check_mu(mu)?;
+        if x0.len() != vy0.len() || x0.len() < 2 {
+            return Err(invalid("x0", format!("need at least two members with x0 and vy0 of one length, got {} and {}", x0.len(), vy0.len())));
+        }
+        check_finite("x0", x0)?;
+        check_finite("vy0", vy0)?;
+        let mut idx: Vec<usize> = (0..x0.len()).collect();
+        idx.sort_by(|&a, &b| x0[a].total_cmp(&x0[b]));
+        let (xs, vs): (Vec<f64>, Vec<f64>) = idx.iter().map(|&i| (x0[i], vy0[i])).unzip();
+        if xs.windows(2).any(|w| w[0] == w[1]) {
+            return Err(invalid("x0", "members must have distinct x0"));
+        }
+        Ok(Self { mu, x0: xs, vy0: vs, cache: Mutex::new(HashMap::new()) })
+    }
+
+    /// The members' x0 range.
+    pub fn range(&self) -> (f64, f64) {
+        (self.x0[0], self.x0[self.x0.len() - 1])
+    }
+
+    /// The orbit through (x0, 0, 0) of the family and its forcing table.
+    pub fn orbit_at(&self, x0: f64) -> Result<Arc<(SymmetricOrbit, OrbitForcing)>> {
+        let (lo, hi) = self.range();
+        if !(x0.is_finite() && lo <= x0 && x0 <= hi) {
+            return Err(invalid("x0", format!("must be within the family's members, [{lo}, {hi}], got {x0}")));
+        }
+        if let Some(o) = self.cache.lock().map_err(|_| invalid("family", "cache poisoned"))?.get(&x0.to_bits()) {
+            return Ok(o.clone());
+        }
+        let j = self.x0.partition_point(|&v| v < x0).clamp(1, self.x0.len() - 1);
+        let w = (x0 - self.x0[j - 1]) / (self.x0[j] - self.x0[j - 1]);
+        let guess = self.vy0[j - 1] + w * (self.vy0[j] - self.vy0[j - 1]);
+        let mut sh = SymmetricShooting::new(self.mu, false, Options::with_tolerances(1e-13, 1e-13));
+        sh.tol = 1e-12;
+        let orbit = sh.correct([x0, 0.0, guess], Constraint::Fix(Var::X0, x0))?;
+        let forcing = OrbitForcing::new(self.mu, &orbit.state0, orbit.period, [true, true], 1e-12)?;
+        let out = Arc::new((orbit, forcing));
+        let mut c = self.cache.lock().map_err(|_| invalid("family", "cache poisoned"))?;
+        if c.len() > 4096 {
+            c.clear();
+        }
+        c.insert(x0.to_bits(), out.clone());
+        Ok(out)
+    }
+}
+
+/// The bordered half-period correction across a planar orbit family: unknowns (wz0, x0) of
+/// the symmetric motion phi(T(x0)/2) = phi0 + pi turns (K = 1), the orbit's x0 freed and closed
+/// by the linear condition a[1] wz0 + a[2] x0 = b (a[0] must be 0); d g / d x0 by central
+/// differences over the orbits at x0 +- `bordered.step` (each corrected and tabulated; the
+/// three orbits of a point in parallel). Returns [`Correction`]s as [`correct_bordered`]
+/// (`parameter` = x0; the monodromy over the orbit's full period).
+pub fn correct_across_family(family: &PlanarFamily, bordered: &Bordered, candidates: &[Candidate], opts: &CorrectorOptions) -> Result<Vec<Correction>> {
+    if bordered.parameter != Parameter::OrbitX0 {
+        return Err(invalid("parameter", "correct_across_family frees the orbit's x0 (Parameter::OrbitX0)"));
+    }
+    validate_bordered(bordered, Closure::Half)?;
+    validate_options(opts)?;
+    validate_candidates(Closure::Half, Free::Phi0, candidates)?;
+    let form = Form { closure: Closure::Half, free: Free::Phi0, h: opts.phase_step, bordered: Some(*bordered) };
+    let lane = LaneOptions { rtol: opts.rtol, atol: opts.atol, max_steps: opts.max_steps, sun_omega: opts.sun_omega };
+    let integrate = |cases: &[Case], values: &[f64], full: bool| -> Result<Vec<Outcome>> {
+        // distinct orbits, in parallel; then each orbit's trajectories in one sweep
+        let mut distinct: Vec<f64> = values.to_vec();
+        distinct.sort_by(f64::total_cmp);
+        distinct.dedup();
+        let orbits: Vec<Option<Arc<(SymmetricOrbit, OrbitForcing)>>> = distinct.par_iter().map(|&x| family.orbit_at(x).ok()).collect();
+        let mut out = vec![FAILED; cases.len()];
+        for (x, orbit) in distinct.iter().zip(&orbits) {
+            let Some(o) = orbit else { continue };
+            let idx: Vec<usize> = (0..cases.len()).filter(|&i| values[i] == *x).collect();
+            let group: Vec<Case> = idx.iter().map(|&i| cases[i]).collect();
+            let t = if full { o.0.period } else { 0.5 * o.0.period };
+            let r = map::sweep(&o.1, t, &group, &lane, true, opts.chunk, None)?;
+            for (&i, v) in idx.iter().zip(r) {
+                out[i] = v;
+            }
+        }
+        Ok(out)
+    };
+    run(form, candidates, opts, &integrate)
 }
 
 /// One trajectory to re-propagate with [`verify_planar_attitudes`].

@@ -12,6 +12,7 @@ pub use multiple::{correct_multiple_shooting, MemberCondition, ShotOrbit};
 pub use stability::{broucke_indices, monodromy, Stability};
 pub use symmetric::{correct_planar_symmetric, Constraint, Evaluation, SymmetricOrbit, SymmetricShooting, Var};
 pub use attitude::{
-    correct_bordered, correct_planar_attitudes, verify_planar_attitudes, Bordered, Candidate, Closure, Correction, CorrectorOptions, Free, Parameter, PlanarEnd,
+    correct_across_family, correct_bordered, correct_planar_attitudes, verify_planar_attitudes, Bordered, Candidate, Closure, Correction, CorrectorOptions, Free, Parameter,
+    PlanarEnd, PlanarFamily,
     PlanarStart, StopReason,
 };
