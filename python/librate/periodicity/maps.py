@@ -16,13 +16,12 @@ from collections.abc import Callable
 import numpy as np
 
 from .._core import __version__
-from .._errors import ConvergenceError
 from ..orbits.families import OrbitFamily
 from ..orbits.periodic import PeriodicOrbit
-from .solutions import MAP_ATOL, MAP_RTOL, AttitudeSolution, candidates, check_orbit, check_srp, orbit_forcing, periodic_attitude, sweep
+from .solutions import MAP_ATOL, MAP_RTOL, AttitudeSolution, candidates, check_orbit, check_srp, is_symmetric, orbit_forcing, refine, sweep
 
 __all__ = ["periodicity_map", "zero_contours", "orbits_of", "map_grid", "map_coords", "map_dataset", "solutions_from_row",
-           "map_solutions_dataset"]
+           "solutions_from_rows", "map_solutions_dataset"]
 
 
 def orbits_of(orbits) -> tuple[list[PeriodicOrbit], OrbitFamily | None]:
@@ -98,8 +97,7 @@ def periodicity_map(
             dwz[i], dphi[i], phi_t[i] = (r[k].reshape(nk, nw) for k in ("dwz", "dphi", "phi_t"))
             status[i] = r["status"].reshape(nk, nw)
             if solve:
-                for j, k in enumerate(kzs):
-                    sols += [(i, s) for s in solutions_from_row(o, float(k), phi0, wz, phi_t[i, j], n_periods, srp)]
+                sols += [(i, s) for s in solutions_from_rows(o, kzs, phi0, wz, phi_t[i], n_periods, srp)]
             done[i] = True
             if progress is not None:
                 progress(i + 1, no)
@@ -205,22 +203,28 @@ def _stack_srp(maps, plates):
     return out
 
 
+def solutions_from_rows(orbit, kzs, phi0, wz, phi_t_rows, n_periods, srp=None) -> list[AttitudeSolution]:
+    """The solutions of one orbit's rows (one per Kz): the candidates where phi(KT) - phi0 crosses
+    a multiple of pi, all refined in ONE call of the Rust corrector (the half-period form where
+    the orbit and phi0 are symmetric and there is no SRP, else the full-period form with phi0
+    free) and verified in one more; kept inside the row's rate window."""
+    kzs = np.atleast_1d(np.asarray(kzs, dtype=float))
+    rows = np.atleast_2d(phi_t_rows)
+    cands, kk = [], []
+    for j, k in enumerate(kzs):
+        c = candidates(rows[j], phi0, wz, math.pi)
+        cands += c
+        kk += [float(k)] * len(c)
+    symmetric = is_symmetric(orbit, phi0) and (srp is None or srp.eps == 0.0)
+    sols = refine(orbit, np.array(kk), phi0, cands, n_periods=n_periods, srp=srp, closure="half" if symmetric else "full",
+                  window=(float(wz[0]), float(wz[-1])))
+    return sorted(sols, key=lambda s: (s.kz, s.wz0))
+
+
 def solutions_from_row(orbit, kz, phi0, wz, phi_t_row, n_periods, srp=None) -> list[AttitudeSolution]:
-    """Candidates from one full-period row (phi(T) - phi0 through multiples of pi), refined."""
-    out: list[AttitudeSolution] = []
-    for k, w in candidates(phi_t_row, phi0, wz, math.pi):
-        kind = "periodic" if k % 2 == 0 else "half-turn"
-        n = k // 2
-        try:
-            sol = periodic_attitude(orbit, kz=kz, n=n, phi0=phi0, wz0=w, kind=kind, n_periods=n_periods, srp=srp)
-        except ConvergenceError:
-            continue
-        if not (wz[0] <= sol.wz0 <= wz[-1]) or sol.residual > 1e-8:
-            continue
-        if any(s.n == sol.n and s.kind == sol.kind and abs(s.wz0 - sol.wz0) < 1e-8 for s in out):
-            continue
-        out.append(sol)
-    return out
+    """Candidates from one full-period row (phi(T) - phi0 through multiples of pi), refined
+    (:func:`solutions_from_rows` with one Kz)."""
+    return solutions_from_rows(orbit, [kz], phi0, wz, [phi_t_row], n_periods, srp)
 
 
 def map_solutions_dataset(sols):
@@ -235,7 +239,9 @@ def map_solutions_dataset(sols):
             "sol_wz0": ("solution", np.array([x.wz0 for x in s], dtype=float), {"units": "1/TU"}),
             "sol_phidot0": ("solution", np.array([x.phidot0 for x in s], dtype=float), {"units": "1/TU"}),
             "sol_phi0": ("solution", np.array([x.phi0 for x in s], dtype=float), {"units": "rad"}),
-            "sol_n": ("solution", np.array([x.n for x in s], dtype=np.int64)),
+            "sol_n": ("solution", np.array([x.n for x in s], dtype=float), {"long_name": "net body turns per orbit period"}),
+            "sol_n_total": ("solution", np.array([x.n_total for x in s], dtype=np.int64),
+                            {"long_name": "net body turns over the n_periods orbit periods"}),
             "sol_kind": ("solution", np.array([x.kind for x in s], dtype="<U9")),
             "sol_residual": ("solution", np.array([x.residual for x in s], dtype=float)),
             "sol_trace": ("solution", np.array([x.trace for x in s], dtype=float)),
