@@ -224,8 +224,9 @@ def verified(orbit: PeriodicOrbit, *, kz, n_total, kind, phi0, wz0, n_periods: i
     """AttitudeSolutions for converged corrections: every one re-propagated independently in one
     batched Rust call (scalar model, orbit integrated alongside, rtol = atol = 1e-14, in
     parallel); ``plates``: one FlatPlate (or None) per solution."""
-    kz, n_total, phi0, wz0 = (np.atleast_1d(np.asarray(v, dtype=float)) for v in (kz, n_total, phi0, wz0))
-    kind = np.broadcast_to(np.asarray(kind), kz.shape)
+    kz, n_total, phi0, wz0, kind = (np.ascontiguousarray(np.atleast_1d(v).ravel())
+                                    for v in np.broadcast_arrays(np.asarray(kz, dtype=float), np.asarray(n_total, dtype=float),
+                                                                 np.asarray(phi0, dtype=float), np.asarray(wz0, dtype=float), np.asarray(kind)))
     m = kz.size
     if m == 0:
         return []
@@ -249,7 +250,7 @@ def verified(orbit: PeriodicOrbit, *, kz, n_total, kind, phi0, wz0, n_periods: i
 
 
 def _plate(srp, theta):
-    return FlatPlate(srp.eps, srp.cs, srp.cd, Sun(theta0=float(theta), omega=srp.sun.omega, pressure=srp.sun.pressure))
+    return FlatPlate(srp.eps, srp.cs, srp.cd, Sun(theta0=float(theta), pressure=srp.sun.pressure))
 
 
 def _failure(what: str, batch, i: int = 0, tol: float = 1e-12) -> ConvergenceError:
@@ -376,12 +377,12 @@ class KzBranch:
         if not b.converged[0]:
             raise CorrectionFailed(f"Kz branch: {b.reason[0]}")
         g = b.jacobian[0, 0]
-        return Point(np.array([b.parameter[0], b.wz0[0]]), {"g_kz": float(g[2]), "g_wz": float(g[1]), "trace": float(np.trace(b.monodromy[0])),
+        return Point(np.array([b.parameter[0], b.wz0[0]]), {"g_p": float(g[2]), "g_wz": float(g[1]), "trace": float(np.trace(b.monodromy[0])),
                                                             "iterations": int(b.iterations[0])}, int(b.iterations[0]))
 
     def tangent(self, pt):
         d = pt.data
-        return np.array([d["g_wz"], -d["g_kz"]])
+        return np.array([d["g_wz"], -d["g_p"]])
 
     def tests(self, pt):
         tr = pt.data["trace"]

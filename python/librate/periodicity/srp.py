@@ -7,27 +7,28 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from .._checks import as_count, as_number
 from .._core import __version__
-from .._errors import ConvergenceError
 from ..attitude.srp import FacetBody, FlatPlate, Sun, force_torque
 from ..constants import OMEGA_SUN, SOLAR_PRESSURE_1AU, SUN_SYNODIC_PERIOD
 from ..orbits.periodic import PeriodicOrbit
 from ..orbits.system import check_system
+from ..solving.continuation import Constraint, CorrectionFailed, Point, StepRules, arclength
 from .solutions import (
     AttitudeSolution,
     check_kinds,
     check_kz,
     check_orbit,
     check_srp,
+    correct,
     find_periodic_attitudes,
     orbit_forcing,
-    periodic_attitude,
     sweep,
+    verified,
 )
 
 __all__ = ["SrpContinuation", "continue_srp", "srp_map", "sun_pointing_accelerations", "sun_resonance", "sun_angle", "FOLD_TRACE_TOL"]
@@ -51,82 +52,102 @@ def sun_angle(theta_sun0: float, t) -> np.ndarray:
 class SrpContinuation:
     """Solutions continued in the flat-plate SRP amplitude ``eps`` from a starting solution.
     ``reached``: the target eps was reached; otherwise ``fold`` gives where the branch turns
-    back ({"eps", "trace"}: the 2x2 monodromy's trace passes 2 there, where Phi - I is singular)
-    or ``end_reason`` why the continuation stopped. No point of another branch is ever returned."""
+    back ({"eps", "trace", "located"}: the eps of the turning point located to 1e-8, where the
+    2x2 monodromy's trace passes 2 and Phi - I is singular) or ``end_reason`` why the
+    continuation stopped. ``marked``: (eps, solution) at the requested ``marks``.
+    ``bifurcations``: where the trace passes 2 with eps still advancing (a branch point: the
+    plate with the Sun phase a multiple of pi/K keeps a mirror symmetry, and asymmetric branches
+    split off there) or passes -2 (period doubling), each {"test", "eps", "located"}. No point of
+    another branch is ever returned."""
 
     solutions: list[AttitudeSolution]
     eps: np.ndarray
     reached: bool
     fold: dict | None
     end_reason: str
+    marked: list[tuple[float, AttitudeSolution]] = field(default_factory=list)
+    bifurcations: list[dict] = field(default_factory=list)
 
 
-def continue_srp(solution: AttitudeSolution, srp, *, steps: int = 10, min_step: float = 1e-7) -> SrpContinuation:
+class EpsBranch:
+    """Periodic motions with a flat plate continued in its amplitude eps, for the continuation
+    driver: x = (eps, phi0, wz0), the full-period closure over the K periods (SRP breaks the
+    mirror symmetry: phi0 is corrected with wz0), corrected by the Rust corrector with eps
+    freed and the driver's linear condition."""
+
+    parameter_index = 0
+    scale = np.ones(3)
+
+    def __init__(self, orbit, kz, n_total, kind, n_periods, plate: FlatPlate):
+        self.orbit, self.kz, self.n_total, self.kind, self.n_periods, self.plate = orbit, kz, n_total, kind, n_periods, plate
+
+    def correct(self, guess, c):
+        a_e, a_p, a_w = c.a
+        b = correct(self.orbit, kz=self.kz, n_total=self.n_total, kind=self.kind, phi0=float(guess[1]), wz0=float(guess[2]),
+                    n_periods=self.n_periods, srp=self.plate, eps=float(guess[0]), closure="full", free="phi0",
+                    bordered=("eps", (a_p, a_w, a_e, c.b)))
+        if not b.converged[0]:
+            raise CorrectionFailed(f"eps branch: {b.reason[0]}")
+        j = b.jacobian[0]  # columns (angle, wz0, eps)
+        return Point(np.array([b.parameter[0], b.phi0[0], b.wz0[0]]), {"j": j[:, [2, 0, 1]], "trace": float(np.trace(b.monodromy[0]))},
+                     int(b.iterations[0]))
+
+    def tangent(self, pt):
+        j = pt.data["j"]
+        return np.cross(j[0], j[1])
+
+    def tests(self, pt):
+        # trace 2 where the branch does not turn back: a symmetry-breaking (pitchfork) branch
+        # point; trace -2: period doubling
+        tr = pt.data["trace"]
+        return {"trace = 2 (branch point)": tr - 2.0, "trace = -2 (period doubling)": tr + 2.0}
+
+
+def continue_srp(solution: AttitudeSolution, srp, *, steps: int = 10, min_step: float = 1e-7, marks=()) -> SrpContinuation:
     """Continue ``solution`` (gravity-only, or with SRP) to the plate ``srp`` (its eps is the
-    target; cs, cd and the Sun phase are kept along the way) by natural continuation in eps:
-    linear extrapolation of (phi0, wz0), Newton in (phi0, wz0) with [Phi(KT) - I], steps halved on
-    failure or on a jump (the corrector landing farther than a quarter of the predicted step from
-    the prediction), and the fold detected where the monodromy's trace crosses 2
-    (det(Phi - I) = 2 - trace changes sign) or where the step collapses next to trace 2."""
+    target; cs, cd and the Sun phase are kept along the way) by pseudo-arclength continuation in
+    (eps, phi0, wz0) (:mod:`librate.solving.continuation`, first step |target - eps0| / ``steps``,
+    smallest ``min_step``), every point corrected by the Rust corrector with eps freed. A fold
+    before the target (the branch turning back in eps; the monodromy trace passes 2 there) is
+    located to 1e-8 in eps and ends the continuation. ``marks``: eps values at which the branch
+    is also corrected exactly (``marked``)."""
     srp = check_srp(srp)
     if srp is None:
         raise ValueError("invalid argument `srp`: the target plate is required")
     if not isinstance(solution, AttitudeSolution):
         raise ValueError("invalid argument `solution`: must be a librate.AttitudeSolution")
-    if not (isinstance(steps, int) and steps >= 1):
-        raise ValueError(f"invalid argument `steps`: must be an integer >= 1, got {steps!r}")
+    steps = as_count(steps, "steps", 1)
+    min_step = as_number(min_step, "min_step", positive=True)
     e0 = 0.0 if solution.srp is None else float(solution.srp.eps)
     target = float(srp.eps)
-    sols, eps = [solution], [e0]
-    h_nominal = (target - e0) / steps
-    h = h_nominal / 16.0  # a small first step: there is no trend yet to guard against jumps
+    if target == e0:
+        return SrpContinuation([solution], np.array([e0]), True, None, "reached the target eps", [(m, solution) for m in marks if m == e0])
+    problem = EpsBranch(solution.orbit, solution.kz, solution.n_total, solution.kind, solution.n_periods, srp)
+    first = problem.correct(np.array([e0, solution.phi0, solution.wz0]), Constraint.fix(3, 0, e0))
+    h = abs(target - e0) / steps
+    rules = StepRules(ds=h, ds_min=min(min_step, h), ds_max=max(h, min(4 * h, 0.25)))
+    br = arclength(problem, first, direction=1 if target > e0 else -1, target=target, stop_at_fold=True, marks=tuple(float(m) for m in marks),
+                   rules=rules, max_points=10_000, name="eps")
+    pts = br.points[1:]
+    o = solution.orbit
+    sols = [solution] + verified(o, kz=solution.kz, n_total=solution.n_total, kind=solution.kind, phi0=[p.x[1] for p in pts],
+                                 wz0=[p.x[2] for p in pts], n_periods=solution.n_periods, plates=[srp.with_eps(float(p.x[0])) for p in pts],
+                                 iterations=[p.iterations for p in pts])
+    marked = []
+    if br.marked:
+        ms = verified(o, kz=solution.kz, n_total=solution.n_total, kind=solution.kind, phi0=[p.x[1] for p in br.marked],
+                      wz0=[p.x[2] for p in br.marked], n_periods=solution.n_periods, plates=[srp.with_eps(float(p.x[0])) for p in br.marked],
+                      iterations=[p.iterations for p in br.marked])
+        marked = [(float(p.x[0]), s) for p, s in zip(br.marked, ms)]
     fold = None
-    reason = "reached the target eps"
-    while eps[-1] != target:
-        e = target if abs(target - eps[-1]) <= abs(h) * (1 + 1e-9) else eps[-1] + h
-        a = sols[-1]
-        if len(sols) >= 2:
-            b = sols[-2]
-            r = (e - eps[-1]) / (eps[-1] - eps[-2])
-            guess = (a.phi0 + r * (a.phi0 - b.phi0), a.wz0 + r * (a.wz0 - b.wz0))
-        else:
-            guess = (a.phi0, a.wz0)
-        ok = True
-        try:
-            s = periodic_attitude(a.orbit, kz=a.kz, n=a.n, kind=a.kind, phi0=guess[0], wz0=guess[1], n_periods=a.n_periods,
-                                  srp=srp.with_eps(e), method="newton")
-        except ConvergenceError:
-            ok = False
-        if ok:
-            # On a smooth branch the corrector lands within a small fraction of the predicted
-            # step (the predictor's error is second order in the step); a landing farther off is
-            # another branch, or the fold coming up: shorten the step instead.
-            jump = math.hypot(s.wz0 - guess[1], s.phi0 - guess[0])
-            if len(sols) >= 2:
-                ok = jump <= 0.25 * math.hypot(guess[1] - a.wz0, guess[0] - a.phi0) + 1e-9
-            else:
-                ok = jump <= 1e-2
-            ok = ok and s.residual <= 1e-8
-        crossing = ok and (2.0 - a.trace) * (2.0 - s.trace) < 0
-        if ok and not crossing:
-            sols.append(s)
-            eps.append(e)
-            h = float(np.sign(h_nominal) * min(abs(h) * 1.5, abs(h_nominal)))
-            continue
-        if abs(h) * 0.5 < min_step:
-            if crossing:
-                w = (2.0 - a.trace) / (s.trace - a.trace)
-                fold = {"eps": eps[-1] + w * (e - eps[-1]), "trace": 2.0}
-                reason = f"fold: the monodromy trace crosses 2 at eps = {fold['eps']:.8g} (Phi - I singular)"
-            else:
-                fold = {"eps": eps[-1], "trace": a.trace}
-                reason = f"fold or end of the branch near eps = {eps[-1]:.8g} (trace {a.trace:.6g}; step below {min_step:g})"
-            break
-        h *= 0.5  # failure, jump, or a trace crossing to pin down: shorten the step
-    return SrpContinuation(sols, np.array(eps), eps[-1] == target, fold, reason)
+    if br.folds:
+        f = br.folds[0]
+        fold = {"eps": f.parameter, "trace": f.point.data["trace"], "located": bool(f.located)}
+    reason = "reached the target eps" if br.reached else br.end_reason
+    bifs = [{"test": b.name, "eps": b.parameter, "located": bool(b.located)} for b in br.bifurcations]
+    return SrpContinuation(sols, np.array([e0] + [float(p.x[0]) for p in pts]), br.reached, fold, reason, marked, bifs)
 
 
-# --- the (eps, rate) map and Sun pointing -----------------------------------------------------------
 def srp_map(
     orbit: PeriodicOrbit,
     *,
@@ -208,22 +229,19 @@ def srp_map(
         window = (float(wz[0]), float(wz[-1]))
 
         def follow(start, e_start, values, origin):
-            """Continue ``start`` (at e_start) through the grid ``values`` in order; one branch."""
+            """Continue ``start`` (at e_start) through the grid ``values`` in order (one
+            pseudo-arclength run to the last value, corrected exactly at each grid value on the
+            way); one branch, ending at the grid's end or at a located fold."""
             b = len(branches)
-            path.append((b, e_start, start.wz0, start.phi0, start.trace))
-            end = (math.nan, math.nan, False, "reached the end of the eps grid")
-            cur = start
-            for e in values:
-                c = continue_srp(cur, plate.with_eps(float(e)), steps=steps)
-                path.extend((b, float(ei), si.wz0, si.phi0, si.trace) for ei, si in zip(c.eps[1:], c.solutions[1:]))
-                if not c.reached:
-                    last = c.solutions[-1]
-                    fold = c.fold is not None and abs(float(c.fold.get("trace", math.nan)) - 2.0) < FOLD_TRACE_TOL
-                    end = (float(c.fold["eps"]) if fold else float(c.eps[-1]), last.wz0, fold, c.end_reason)
-                    break
-                cur = c.solutions[-1]
-                sols.append((b, float(e), cur))
-            branches.append((start.n, start.kind, origin, e_start) + end)
+            c = continue_srp(start, plate.with_eps(float(values[-1])), steps=steps * len(values), marks=[float(e) for e in values])
+            path.extend((b, float(ei), si.wz0, si.phi0, si.trace) for ei, si in zip(c.eps, c.solutions))
+            sols.extend((b, e, si) for e, si in c.marked)
+            if c.reached:
+                end = (math.nan, math.nan, False, "reached the end of the eps grid")
+            else:
+                fold = c.fold is not None and bool(c.fold.get("located"))
+                end = (float(c.fold["eps"]) if fold else float(c.eps[-1]), c.solutions[-1].wz0, fold, c.end_reason)
+            branches.append((start.n_total, start.kind, origin, e_start) + end)
 
         pos, neg = es[es > 0], es[es < 0][::-1]
         for s0 in find_periodic_attitudes(orbit, kz=kz, wz0_range=window, phi0=phi0, kinds=kinds, n_periods=n_periods):
@@ -244,7 +262,7 @@ def srp_map(
                 found += find_periodic_attitudes(orbit, kz=kz, wz0_range=window, phi0=phi0 + seed, kinds=kinds,
                                                  n_periods=n_periods, srp=plate.with_eps(e_end))
             for s1 in sorted(found, key=lambda x: x.wz0):
-                if any(k.n == s1.n and k.kind == s1.kind and abs(k.wz0 - s1.wz0) < 1e-7
+                if any(k.n_total == s1.n_total and k.kind == s1.kind and abs(k.wz0 - s1.wz0) < 1e-7
                        and abs(math.remainder(k.phi0 - s1.phi0, 2 * math.pi)) < 1e-7 for k in known):
                     continue
                 sols.append((len(branches), e_end, s1))
@@ -264,7 +282,8 @@ def srp_map(
             "sol_phidot0": ("solution", sol_arr(lambda b, e, s: s.phidot0), {"units": "1/TU"}),
             "sol_phi0": ("solution", sol_arr(lambda b, e, s: math.remainder(s.phi0, 2 * math.pi)), {"units": "rad",
                          "long_name": "phi0 wrapped to [-pi, pi]"}),
-            "sol_n": ("solution", sol_arr(lambda b, e, s: s.n, np.int64)),
+            "sol_n": ("solution", sol_arr(lambda b, e, s: s.n), {"long_name": "net body turns per orbit period"}),
+            "sol_n_total": ("solution", sol_arr(lambda b, e, s: s.n_total, np.int64), {"long_name": "net body turns over the n_periods periods"}),
             "sol_kind": ("solution", sol_arr(lambda b, e, s: s.kind, "<U9")),
             "sol_trace": ("solution", sol_arr(lambda b, e, s: s.trace)),
             "sol_stable": ("solution", sol_arr(lambda b, e, s: s.stable, bool)),
@@ -274,7 +293,8 @@ def srp_map(
             "path_wz0": ("path", np.array([p[2] for p in path], dtype=float), {"units": "1/TU"}),
             "path_phi0": ("path", np.array([math.remainder(p[3], 2 * math.pi) for p in path], dtype=float), {"units": "rad"}),
             "path_trace": ("path", np.array([p[4] for p in path], dtype=float)),
-            "branch_n": ("branch", np.array([x[0] for x in branches], dtype=np.int64)),
+            "branch_n": ("branch", np.array([x[0] / n_periods for x in branches], dtype=float), {"long_name": "net body turns per orbit period"}),
+            "branch_n_total": ("branch", np.array([x[0] for x in branches], dtype=np.int64)),
             "branch_kind": ("branch", np.array([x[1] for x in branches], dtype="<U9")),
             "branch_origin": ("branch", np.array([x[2] for x in branches], dtype="<U7")),
             "branch_start_eps": ("branch", np.array([x[3] for x in branches], dtype=float)),
