@@ -1386,7 +1386,7 @@ def plot_srp_map(
         pb = np.asarray(ds["path_branch"].values)
         drawn_end = {"fold": False, "branch-end": False}
         for b in range(ds.sizes.get("branch", 0)):
-            kind, nn = str(ds["branch_kind"].values[b]), int(ds["branch_n"].values[b])
+            kind, nn = str(ds["branch_kind"].values[b]), float(ds["branch_n"].values[b])
             if kind not in kinds:
                 continue
             sel = pb == b
@@ -1394,7 +1394,7 @@ def plot_srp_map(
             (h,) = a.plot(ds["path_eps"].values[sel], ds["path_wz0"].values[sel] - offset, color=_n_color(nn),
                           linewidth=1.3 if far else 1.0, alpha=0.85, linestyle=":" if far else "--" if kind == "half-turn" else "-",
                           zorder=4)
-            h.set_gid(f"branch-{kind}-N{nn:+d}")
+            h.set_gid(f"branch-{kind}-N{nn:+g}")
             ee = float(ds["branch_end_eps"].values[b])
             if math.isfinite(ee):
                 fold = bool(ds["branch_fold"].values[b])
