@@ -13,7 +13,8 @@ from .._errors import ConvergenceError
 from ..orbits.families import OrbitFamily
 from ..orbits.periodic import PeriodicOrbit
 from ..solving.continuation import Constraint, CorrectionFailed, Point, StepRules, arclength
-from .solutions import KINDS, SOLVE_ATOL, SOLVE_RTOL, KzBranch, check_kz, check_orbit, is_symmetric, periodic_attitude, turns_of
+from .branches import KzBranch, periodic_attitude
+from .solutions import KINDS, SOLVE_ATOL, SOLVE_RTOL, check_kz, check_orbit, is_symmetric, turns_of
 
 __all__ = ["AttitudeFamily", "attitude_family"]
 

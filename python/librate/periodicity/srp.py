@@ -7,7 +7,6 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -17,18 +16,14 @@ from ..attitude.srp import FacetBody, FlatPlate, Sun, force_torque
 from ..constants import OMEGA_SUN, SOLAR_PRESSURE_1AU, SUN_SYNODIC_PERIOD
 from ..orbits.periodic import PeriodicOrbit
 from ..orbits.system import check_system
-from ..solving.continuation import Constraint, CorrectionFailed, Point, StepRules, arclength
+from .branches import SrpContinuation, continue_srp
 from .solutions import (
-    AttitudeSolution,
     check_kinds,
     check_kz,
     check_orbit,
-    check_srp,
-    correct,
     find_periodic_attitudes,
     orbit_forcing,
     sweep,
-    verified,
 )
 
 __all__ = ["SrpContinuation", "continue_srp", "srp_map", "sun_pointing_accelerations", "sun_resonance", "sun_angle", "FOLD_TRACE_TOL"]
@@ -46,106 +41,6 @@ def sun_resonance(orbit: PeriodicOrbit, tol: float = 1e-6) -> int | None:
 def sun_angle(theta_sun0: float, t) -> np.ndarray:
     """The Sun's angle from the synodic X axis at times t (TU), unwrapped (rad), from its phase at t = 0."""
     return OMEGA_SUN * np.asarray(t, dtype=float) + theta_sun0
-
-
-@dataclass
-class SrpContinuation:
-    """Solutions continued in the flat-plate SRP amplitude ``eps`` from a starting solution.
-    ``reached``: the target eps was reached; otherwise ``fold`` gives where the branch turns
-    back ({"eps", "trace", "located"}: the eps of the turning point located to 1e-8, where the
-    2x2 monodromy's trace passes 2 and Phi - I is singular) or ``end_reason`` why the
-    continuation stopped. ``marked``: (eps, solution) at the requested ``marks``.
-    ``bifurcations``: where the trace passes 2 with eps still advancing (a branch point: the
-    plate with the Sun phase a multiple of pi/K keeps a mirror symmetry, and asymmetric branches
-    split off there) or passes -2 (period doubling), each {"test", "eps", "located"}. No point of
-    another branch is ever returned."""
-
-    solutions: list[AttitudeSolution]
-    eps: np.ndarray
-    reached: bool
-    fold: dict | None
-    end_reason: str
-    marked: list[tuple[float, AttitudeSolution]] = field(default_factory=list)
-    bifurcations: list[dict] = field(default_factory=list)
-
-
-class EpsBranch:
-    """Periodic motions with a flat plate continued in its amplitude eps, for the continuation
-    driver: x = (eps, phi0, wz0), the full-period closure over the K periods (SRP breaks the
-    mirror symmetry: phi0 is corrected with wz0), corrected by the Rust corrector with eps
-    freed and the driver's linear condition."""
-
-    parameter_index = 0
-    scale = np.ones(3)
-
-    def __init__(self, orbit, kz, n_total, kind, n_periods, plate: FlatPlate):
-        self.orbit, self.kz, self.n_total, self.kind, self.n_periods, self.plate = orbit, kz, n_total, kind, n_periods, plate
-
-    def correct(self, guess, c):
-        a_e, a_p, a_w = c.a
-        b = correct(self.orbit, kz=self.kz, n_total=self.n_total, kind=self.kind, phi0=float(guess[1]), wz0=float(guess[2]),
-                    n_periods=self.n_periods, srp=self.plate, eps=float(guess[0]), closure="full", free="phi0",
-                    bordered=("eps", (a_p, a_w, a_e, c.b)))
-        if not b.converged[0]:
-            raise CorrectionFailed(f"eps branch: {b.reason[0]}")
-        j = b.jacobian[0]  # columns (angle, wz0, eps)
-        return Point(np.array([b.parameter[0], b.phi0[0], b.wz0[0]]), {"j": j[:, [2, 0, 1]], "trace": float(np.trace(b.monodromy[0]))},
-                     int(b.iterations[0]))
-
-    def tangent(self, pt):
-        j = pt.data["j"]
-        return np.cross(j[0], j[1])
-
-    def tests(self, pt):
-        # trace 2 where the branch does not turn back: a symmetry-breaking (pitchfork) branch
-        # point; trace -2: period doubling
-        tr = pt.data["trace"]
-        return {"trace = 2 (branch point)": tr - 2.0, "trace = -2 (period doubling)": tr + 2.0}
-
-
-def continue_srp(solution: AttitudeSolution, srp, *, steps: int = 10, min_step: float = 1e-7, marks=()) -> SrpContinuation:
-    """Continue ``solution`` (gravity-only, or with SRP) to the plate ``srp`` (its eps is the
-    target; cs, cd and the Sun phase are kept along the way) by pseudo-arclength continuation in
-    (eps, phi0, wz0) (:mod:`librate.solving.continuation`, first step |target - eps0| / ``steps``,
-    smallest ``min_step``), every point corrected by the Rust corrector with eps freed. A fold
-    before the target (the branch turning back in eps; the monodromy trace passes 2 there) is
-    located to 1e-8 in eps and ends the continuation. ``marks``: eps values at which the branch
-    is also corrected exactly (``marked``)."""
-    srp = check_srp(srp)
-    if srp is None:
-        raise ValueError("invalid argument `srp`: the target plate is required")
-    if not isinstance(solution, AttitudeSolution):
-        raise ValueError("invalid argument `solution`: must be a librate.AttitudeSolution")
-    steps = as_count(steps, "steps", 1)
-    min_step = as_number(min_step, "min_step", positive=True)
-    e0 = 0.0 if solution.srp is None else float(solution.srp.eps)
-    target = float(srp.eps)
-    if target == e0:
-        return SrpContinuation([solution], np.array([e0]), True, None, "reached the target eps", [(m, solution) for m in marks if m == e0])
-    problem = EpsBranch(solution.orbit, solution.kz, solution.n_total, solution.kind, solution.n_periods, srp)
-    first = problem.correct(np.array([e0, solution.phi0, solution.wz0]), Constraint.fix(3, 0, e0))
-    h = abs(target - e0) / steps
-    rules = StepRules(ds=h, ds_min=min(min_step, h), ds_max=max(h, min(4 * h, 0.25)))
-    br = arclength(problem, first, direction=1 if target > e0 else -1, target=target, stop_at_fold=True, marks=tuple(float(m) for m in marks),
-                   rules=rules, max_points=10_000, name="eps")
-    pts = br.points[1:]
-    o = solution.orbit
-    sols = [solution] + verified(o, kz=solution.kz, n_total=solution.n_total, kind=solution.kind, phi0=[p.x[1] for p in pts],
-                                 wz0=[p.x[2] for p in pts], n_periods=solution.n_periods, plates=[srp.with_eps(float(p.x[0])) for p in pts],
-                                 iterations=[p.iterations for p in pts])
-    marked = []
-    if br.marked:
-        ms = verified(o, kz=solution.kz, n_total=solution.n_total, kind=solution.kind, phi0=[p.x[1] for p in br.marked],
-                      wz0=[p.x[2] for p in br.marked], n_periods=solution.n_periods, plates=[srp.with_eps(float(p.x[0])) for p in br.marked],
-                      iterations=[p.iterations for p in br.marked])
-        marked = [(float(p.x[0]), s) for p, s in zip(br.marked, ms)]
-    fold = None
-    if br.folds:
-        f = br.folds[0]
-        fold = {"eps": f.parameter, "trace": f.point.data["trace"], "located": bool(f.located)}
-    reason = "reached the target eps" if br.reached else br.end_reason
-    bifs = [{"test": b.name, "eps": b.parameter, "located": bool(b.located)} for b in br.bifurcations]
-    return SrpContinuation(sols, np.array([e0] + [float(p.x[0]) for p in pts]), br.reached, fold, reason, marked, bifs)
 
 
 def srp_map(
