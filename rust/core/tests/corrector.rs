@@ -393,6 +393,12 @@ fn val_correction_across_the_orbit_family() {
     let slope = -c.jacobian[0][2] / c.jacobian[0][1];
     let fd = (plain(0.8501).wz0 - plain(0.8499).wz0) / 2e-4;
     assert!((slope - fd).abs() <= 1e-5 * fd.abs().max(1.0), "{slope} vs {fd}");
+    // at the end of the family's range the x0 derivative is one-sided (issue 11: a probe past the
+    // family's end made the first member unusable)
+    let end = Bordered { b: 0.89, ..fixed };
+    let e = correct_across_family(&fam, &end, &[Candidate::new(0.0, p.wz0, 0.8, 0.0).with_x0(0.88)], &opts).unwrap()[0];
+    let pe = plain(0.89);
+    assert!(e.converged() && (e.wz0 - pe.wz0).abs() < 1e-10, "{:?} {} {}", e.reason, e.wz0, pe.wz0);
     let out = Bordered { b: 0.95, ..fixed };
     let r = correct_across_family(&fam, &out, &[Candidate::new(0.0, p.wz0, 0.8, 0.0).with_x0(0.85)], &opts).unwrap()[0];
     assert!(!r.converged());

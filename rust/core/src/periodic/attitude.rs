@@ -282,6 +282,8 @@ struct Form {
     free: Free,
     h: f64,
     bordered: Option<Bordered>,
+    /// The freed parameter's range (Kz: [-1, 1]; the orbit's x0: the family's members).
+    bounds: (f64, f64),
 }
 
 const ANGLE: usize = 0;
@@ -331,8 +333,10 @@ impl Form {
                 Free::SunPhase => k.theta_sun0 = x[ANGLE],
             }
         }
+        if self.bordered.is_some() && !(self.bounds.0 <= x[PARAM] && x[PARAM] <= self.bounds.1) {
+            return None;
+        }
         match self.bordered.map(|b| b.parameter) {
-            Some(Parameter::Kz) if !(-1.0..=1.0).contains(&x[PARAM]) => return None,
             Some(Parameter::Kz) => k.kz = x[PARAM],
             Some(Parameter::Eps) => k.eps = x[PARAM],
             Some(Parameter::OrbitX0) | None => {}
@@ -340,13 +344,10 @@ impl Form {
         Some(k)
     }
 
-    /// The parameter values of the central difference (one-sided at the ends of Kz's range).
+    /// The parameter values of the central difference (one-sided at the ends of its range).
     fn parameter_pair(&self, p: f64) -> (f64, f64) {
-        let b = self.bordered.expect("bordered");
-        match b.parameter {
-            Parameter::Kz => ((p + b.step).min(1.0), (p - b.step).max(-1.0)),
-            Parameter::Eps | Parameter::OrbitX0 => (p + b.step, p - b.step),
-        }
+        let step = self.bordered.map_or(1e-6, |b| b.step);
+        ((p + step).min(self.bounds.1), (p - step).max(self.bounds.0))
     }
 
     /// Push the point's trajectories with the parameter value each one runs at (the orbit's x0
@@ -689,7 +690,7 @@ pub fn correct_planar_attitudes(
     opts: &CorrectorOptions,
 ) -> Result<Vec<Correction>> {
     validate(forcing, t_final, closure, free, candidates, opts)?;
-    let form = Form { closure, free, h: opts.phase_step, bordered: None };
+    let form = Form { closure, free, h: opts.phase_step, bordered: None, bounds: (f64::NEG_INFINITY, f64::INFINITY) };
     run(form, candidates, opts, &on_table(forcing, t_final, opts))
 }
 
@@ -713,7 +714,8 @@ pub fn correct_bordered(
         return Err(invalid("parameter", "the orbit's x0 is freed by correct_across_family"));
     }
     validate(forcing, t_final, closure, free, candidates, opts)?;
-    let form = Form { closure, free, h: opts.phase_step, bordered: Some(*bordered) };
+    let bounds = if bordered.parameter == Parameter::Kz { (-1.0, 1.0) } else { (f64::NEG_INFINITY, f64::INFINITY) };
+    let form = Form { closure, free, h: opts.phase_step, bordered: Some(*bordered), bounds };
     run(form, candidates, opts, &on_table(forcing, t_final, opts))
 }
 
@@ -878,7 +880,7 @@ pub fn correct_across_family(family: &PlanarFamily, bordered: &Bordered, candida
     validate_bordered(bordered, Closure::Half)?;
     validate_options(opts)?;
     validate_candidates(Closure::Half, Free::Phi0, candidates)?;
-    let form = Form { closure: Closure::Half, free: Free::Phi0, h: opts.phase_step, bordered: Some(*bordered) };
+    let form = Form { closure: Closure::Half, free: Free::Phi0, h: opts.phase_step, bordered: Some(*bordered), bounds: family.range() };
     let lane = LaneOptions { rtol: opts.rtol, atol: opts.atol, max_steps: opts.max_steps, sun_omega: opts.sun_omega };
     let integrate = |cases: &[Case], values: &[f64], full: bool| -> Result<Vec<Outcome>> {
         // distinct orbits, in parallel; then each orbit's trajectories in one sweep
