@@ -32,7 +32,8 @@ from .solutions import (
     verified,
 )
 
-__all__ = ["periodic_attitude", "KzBranch", "kz_branch", "EpsBranch", "SrpContinuation", "continue_srp"]
+__all__ = ["periodic_attitude", "KzBranch", "kz_branch", "EpsBranch", "SrpContinuation", "continue_srp", "eps_branch", "branch_solutions",
+           "branch_fold"]
 
 
 def _plate(srp, theta):
@@ -249,14 +250,10 @@ class EpsBranch:
         return {"trace = 2 (branch point)": tr - 2.0, "trace = -2 (period doubling)": tr + 2.0}
 
 
-def continue_srp(solution: AttitudeSolution, srp, *, steps: int = 10, min_step: float = 1e-7, marks=()) -> SrpContinuation:
-    """Continue ``solution`` (gravity-only, or with SRP) to the plate ``srp`` (its eps is the
-    target; cs, cd and the Sun phase are kept along the way) by pseudo-arclength continuation in
-    (eps, phi0, wz0) (:mod:`librate.solving.continuation`, first step |target - eps0| / ``steps``,
-    smallest ``min_step``), every point corrected by the Rust corrector with eps freed. A fold
-    before the target (the branch turning back in eps; the monodromy trace passes 2 there) is
-    located to 1e-8 in eps and ends the continuation. ``marks``: eps values at which the branch
-    is also corrected exactly (``marked``)."""
+def eps_branch(solution: AttitudeSolution, srp, *, steps: int = 10, min_step: float = 1e-7, marks=()):
+    """The driver's Branch of :func:`continue_srp` (points and marks corrected, not yet
+    re-propagated: each point's ``data`` holds its Jacobian and monodromy trace); None when the
+    target is the starting eps."""
     srp = check_srp(srp)
     if srp is None:
         raise ValueError("invalid argument `srp`: the target plate is required")
@@ -267,30 +264,48 @@ def continue_srp(solution: AttitudeSolution, srp, *, steps: int = 10, min_step: 
     e0 = 0.0 if solution.srp is None else float(solution.srp.eps)
     target = float(srp.eps)
     if target == e0:
-        return SrpContinuation([solution], np.array([e0]), True, None, "reached the target eps", [(m, solution) for m in marks if m == e0])
+        return None
     problem = EpsBranch(solution.orbit, solution.kz, solution.n_total, solution.kind, solution.n_periods, srp)
-    first = problem.correct(np.array([e0, solution.phi0, solution.wz0]), Constraint.fix(3, 0, e0))
+    try:
+        first = problem.correct(np.array([e0, solution.phi0, solution.wz0]), Constraint.fix(3, 0, e0))
+    except CorrectionFailed as e:
+        raise ConvergenceError(f"continue_srp: the starting solution does not correct at eps = {e0}: {e}") from None
     h = abs(target - e0) / steps
     rules = StepRules(ds=h, ds_min=min(min_step, h), ds_max=max(h, min(4 * h, 0.25)))
-    br = arclength(problem, first, direction=1 if target > e0 else -1, target=target, stop_at_fold=True, marks=tuple(float(m) for m in marks),
-                   rules=rules, max_points=10_000, name="eps")
+    return arclength(problem, first, direction=1 if target > e0 else -1, target=target, stop_at_fold=True,
+                     marks=tuple(float(m) for m in marks), rules=rules, max_points=10_000, name="eps")
+
+
+def branch_solutions(solution: AttitudeSolution, srp, points) -> list[AttitudeSolution]:
+    """AttitudeSolutions of eps-branch points (x = (eps, phi0, wz0)), re-propagated in one batch."""
+    return verified(solution.orbit, kz=solution.kz, n_total=solution.n_total, kind=solution.kind, phi0=[p.x[1] for p in points],
+                    wz0=[p.x[2] for p in points], n_periods=solution.n_periods, plates=[srp.with_eps(float(p.x[0])) for p in points],
+                    iterations=[p.iterations for p in points])
+
+
+def branch_fold(br) -> dict | None:
+    """The first fold of a Branch as {"eps", "trace", "located"}."""
+    if not br.folds:
+        return None
+    f = br.folds[0]
+    return {"eps": f.parameter, "trace": f.point.data["trace"], "located": bool(f.located)}
+
+
+def continue_srp(solution: AttitudeSolution, srp, *, steps: int = 10, min_step: float = 1e-7, marks=()) -> SrpContinuation:
+    """Continue ``solution`` (gravity-only, or with SRP) to the plate ``srp`` (its eps is the
+    target; cs, cd and the Sun phase are kept along the way) by pseudo-arclength continuation in
+    (eps, phi0, wz0) (:mod:`librate.solving.continuation`, first step |target - eps0| / ``steps``,
+    smallest ``min_step``), every point corrected by the Rust corrector with eps freed and
+    re-propagated independently. A fold before the target (the branch turning back in eps; the
+    monodromy trace passes 2 there) is located to 1e-8 in eps and ends the continuation, on
+    the fold. ``marks``: eps values at which the branch is also corrected exactly (``marked``)."""
+    br = eps_branch(solution, srp, steps=steps, min_step=min_step, marks=marks)
+    e0 = 0.0 if solution.srp is None else float(solution.srp.eps)
+    if br is None:
+        return SrpContinuation([solution], np.array([e0]), True, None, "reached the target eps", [(m, solution) for m in marks if m == e0])
     pts = br.points[1:]
-    o = solution.orbit
-    sols = [solution] + verified(o, kz=solution.kz, n_total=solution.n_total, kind=solution.kind, phi0=[p.x[1] for p in pts],
-                                 wz0=[p.x[2] for p in pts], n_periods=solution.n_periods, plates=[srp.with_eps(float(p.x[0])) for p in pts],
-                                 iterations=[p.iterations for p in pts])
-    marked = []
-    if br.marked:
-        ms = verified(o, kz=solution.kz, n_total=solution.n_total, kind=solution.kind, phi0=[p.x[1] for p in br.marked],
-                      wz0=[p.x[2] for p in br.marked], n_periods=solution.n_periods, plates=[srp.with_eps(float(p.x[0])) for p in br.marked],
-                      iterations=[p.iterations for p in br.marked])
-        marked = [(float(p.x[0]), s) for p, s in zip(br.marked, ms)]
-    fold = None
-    if br.folds:
-        f = br.folds[0]
-        fold = {"eps": f.parameter, "trace": f.point.data["trace"], "located": bool(f.located)}
+    sols = [solution] + branch_solutions(solution, srp, pts)
+    marked = list(zip([float(p.x[0]) for p in br.marked], branch_solutions(solution, srp, br.marked))) if br.marked else []
     reason = "reached the target eps" if br.reached else br.end_reason
     bifs = [{"test": b.name, "eps": b.parameter, "located": bool(b.located)} for b in br.bifurcations]
-    return SrpContinuation(sols, np.array([e0] + [float(p.x[0]) for p in pts]), br.reached, fold, reason, marked, bifs)
-
-
+    return SrpContinuation(sols, np.array([e0] + [float(p.x[0]) for p in pts]), br.reached, branch_fold(br), reason, marked, bifs)

@@ -21,7 +21,7 @@ from ..orbits.periodic import PeriodicOrbit
 from .solutions import MAP_ATOL, MAP_RTOL, AttitudeSolution, candidates, check_orbit, check_srp, is_symmetric, orbit_forcing, refine, sweep
 
 __all__ = ["periodicity_map", "zero_contours", "orbits_of", "map_grid", "map_coords", "map_dataset", "solutions_from_row",
-           "solutions_from_rows", "map_solutions_dataset"]
+           "solutions_from_rows", "map_solutions_dataset", "solution_variables"]
 
 
 def orbits_of(orbits) -> tuple[list[PeriodicOrbit], OrbitFamily | None]:
@@ -105,10 +105,8 @@ def periodicity_map(
         complete = False
         warnings.warn(f"periodicity_map interrupted: {int(done.sum())} of {no} orbits finished and kept", stacklevel=2)
     grid = {"dwz": dwz, "dphi": dphi, "phi_T": phi_t, "status": status}
-    ds = map_dataset(olist, family, kzs, wz, grid, done, phi0=phi0, n_periods=n_periods, rtol=rtol, atol=atol, srp=srp, complete=complete)
-    if solve:
-        ds = ds.merge(map_solutions_dataset(sols))
-    return ds
+    return map_dataset(olist, family, kzs, wz, grid, done, phi0=phi0, n_periods=n_periods, rtol=rtol, atol=atol, srp=srp, complete=complete,
+                       solutions=sols if solve else None)
 
 
 
@@ -138,14 +136,16 @@ def map_coords(olist, kzs, wz) -> dict:
     }
 
 
-def map_dataset(olist, family, kzs, wz, grid, done, *, phi0, n_periods, rtol, atol, srp, complete, attrs=None):
+def map_dataset(olist, family, kzs, wz, grid, done, *, phi0, n_periods, rtol, atol, srp, complete, attrs=None, solutions=None):
     """The map's Dataset: residual grids over (orbit, kz, wz0), coordinates with units and the
-    parameters as attributes (shared by periodicity_map and run_map)."""
+    parameters as attributes (shared by periodicity_map and run_map); ``solutions``: (orbit
+    index, AttitudeSolution) pairs, the ``sol_*`` variables along ``solution``."""
     import xarray as xr
 
     dims = ("orbit", "kz", "wz0")
     return xr.Dataset(
         {
+            **(solution_variables(solutions) if solutions is not None else {}),
             "dwz": (dims, grid["dwz"], {"units": "1/TU", "long_name": "wz(T) - wz(0)"}),
             "dphi": (dims, grid["dphi"], {"units": "rad", "long_name": "phi(T) - phi0 wrapped to (-pi, pi]"}),
             "phi_T": (dims, grid["phi_T"], {"units": "rad", "long_name": "phi(T), unwrapped"}),
@@ -227,27 +227,31 @@ def solutions_from_row(orbit, kz, phi0, wz, phi_t_row, n_periods, srp=None) -> l
     return solutions_from_rows(orbit, [kz], phi0, wz, [phi_t_row], n_periods, srp)
 
 
+def solution_variables(sols) -> dict:
+    """The ``sol_*`` variables (name -> (dimension, values[, attributes])) of (orbit index,
+    AttitudeSolution) pairs."""
+    idx = np.array([i for i, _ in sols], dtype=np.int64)
+    s = [x for _, x in sols]
+    return {
+        "sol_orbit": ("solution", idx),
+        "sol_kz": ("solution", np.array([x.kz for x in s], dtype=float)),
+        "sol_wz0": ("solution", np.array([x.wz0 for x in s], dtype=float), {"units": "1/TU"}),
+        "sol_phidot0": ("solution", np.array([x.phidot0 for x in s], dtype=float), {"units": "1/TU"}),
+        "sol_phi0": ("solution", np.array([x.phi0 for x in s], dtype=float), {"units": "rad"}),
+        "sol_n": ("solution", np.array([x.n for x in s], dtype=float), {"long_name": "net body turns per orbit period"}),
+        "sol_n_total": ("solution", np.array([x.n_total for x in s], dtype=np.int64),
+                        {"long_name": "net body turns over the n_periods orbit periods"}),
+        "sol_kind": ("solution", np.array([x.kind for x in s], dtype="<U9")),
+        "sol_residual": ("solution", np.array([x.residual for x in s], dtype=float)),
+        "sol_trace": ("solution", np.array([x.trace for x in s], dtype=float)),
+        "sol_stable": ("solution", np.array([x.stable for x in s], dtype=bool)),
+    }
+
+
 def map_solutions_dataset(sols):
     import xarray as xr
 
-    idx = np.array([i for i, _ in sols], dtype=np.int64)
-    s = [x for _, x in sols]
-    return xr.Dataset(
-        {
-            "sol_orbit": ("solution", idx),
-            "sol_kz": ("solution", np.array([x.kz for x in s], dtype=float)),
-            "sol_wz0": ("solution", np.array([x.wz0 for x in s], dtype=float), {"units": "1/TU"}),
-            "sol_phidot0": ("solution", np.array([x.phidot0 for x in s], dtype=float), {"units": "1/TU"}),
-            "sol_phi0": ("solution", np.array([x.phi0 for x in s], dtype=float), {"units": "rad"}),
-            "sol_n": ("solution", np.array([x.n for x in s], dtype=float), {"long_name": "net body turns per orbit period"}),
-            "sol_n_total": ("solution", np.array([x.n_total for x in s], dtype=np.int64),
-                            {"long_name": "net body turns over the n_periods orbit periods"}),
-            "sol_kind": ("solution", np.array([x.kind for x in s], dtype="<U9")),
-            "sol_residual": ("solution", np.array([x.residual for x in s], dtype=float)),
-            "sol_trace": ("solution", np.array([x.trace for x in s], dtype=float)),
-            "sol_stable": ("solution", np.array([x.stable for x in s], dtype=bool)),
-        }
-    )
+    return xr.Dataset(solution_variables(sols))
 
 
 def zero_contours(ds, var: str = "dwz", kz_index: int = 0) -> np.ndarray:

@@ -193,7 +193,7 @@ def turns_of(n_total, kind) -> np.ndarray:
 
 
 def correct(orbit: PeriodicOrbit, *, kz, n_total, kind, phi0, wz0, n_periods: int = 1, srp=None, closure: str = "half",
-            free: str = "phi0", theta_sun0=None, eps=None, tol: float = 1e-12, max_iter: int = 40, bordered=None):
+            free: str = "phi0", theta_sun0=None, eps=None, tol: float = 1e-12, max_iter: int = 40, bordered=None, monodromy: bool = True):
     """One call of the Rust corrector for a batch of candidates on ``orbit`` (arrays broadcast
     together: kz, n_total, kind, phi0, wz0, and theta_sun0 / eps overriding the plate's):
     ``closure`` "half" (symmetric, over K T / 2) or "full" (over K T); ``free`` "phi0" or
@@ -214,7 +214,7 @@ def correct(orbit: PeriodicOrbit, *, kz, n_total, kind, phi0, wz0, n_periods: in
         kw = dict(parameter=bordered[0], condition=tuple(float(v) for v in bordered[1]))
     return _core.attitude_correct(orbit_forcing(orbit), p, w, k, turns_of(nt, kd), t_final=0.5 * T if closure == "half" else T,
                                   closure=closure, free=free, tol=float(tol), max_iter=int(max_iter), rtol=SOLVE_RTOL, atol=SOLVE_ATOL,
-                                  **extra, **kw)
+                                  monodromy=monodromy, **extra, **kw)
 
 
 def verified(orbit: PeriodicOrbit, *, kz, n_total, kind, phi0, wz0, n_periods: int = 1, plates=None, iterations=None) -> list[AttitudeSolution]:
@@ -254,20 +254,18 @@ def _grid_for(T: float, lo: float, hi: float, n_grid: int | None) -> np.ndarray:
 
 
 def candidates(phi_t, phi0, wz, level):
-    """wz0 brackets where (phi(t) - phi0) / level crosses an integer; returns (k, wz_interp)."""
-    u = (phi_t - phi0) / level
+    """wz0 brackets where (phi(t) - phi0) / level crosses an integer; returns (k, wz_interp) in
+    order of the grid (linear interpolation)."""
+    u = (np.asarray(phi_t, dtype=float) - phi0) / level
+    wz = np.asarray(wz, dtype=float)
+    a, b = u[:-1], u[1:]
+    ok = np.isfinite(a) & np.isfinite(b) & (a != b)
+    lo = np.ceil(np.minimum(a, b))
+    hi = np.floor(np.maximum(a, b))
     out = []
-    ok = np.isfinite(u)
-    for i in range(len(u) - 1):
-        if not (ok[i] and ok[i + 1]):
-            continue
-        a, b = u[i], u[i + 1]
-        lo, hi = (a, b) if a <= b else (b, a)
-        for k in range(math.ceil(lo), math.floor(hi) + 1):
-            if a == b:
-                continue
-            w = wz[i] + (k - a) / (b - a) * (wz[i + 1] - wz[i])
-            out.append((k, w))
+    for i in np.flatnonzero(ok & (hi >= lo)):
+        for k in range(int(lo[i]), int(hi[i]) + 1):
+            out.append((k, float(wz[i] + (k - a[i]) / (b[i] - a[i]) * (wz[i + 1] - wz[i]))))
     return out
 
 
@@ -285,7 +283,7 @@ def refine(orbit, kz, phi0, cands, *, n_periods, srp, closure, window, kinds=KIN
     kind = np.where(ks % 2 == 0, "periodic", "half-turn")
     kzs = np.array([c[2] for c in cands])
     b = correct(orbit, kz=kzs, n_total=n_total, kind=kind, phi0=phi0, wz0=np.array([c[1] for c in cands]), n_periods=n_periods, srp=srp,
-                closure=closure)
+                closure=closure, monodromy=False)  # the verification brings the monodromy
     lo, hi = window
     ok = np.flatnonzero(b.converged & (b.wz0 >= lo) & (b.wz0 <= hi))
     sols = verified(orbit, kz=kzs[ok], n_total=n_total[ok], kind=kind[ok], phi0=b.phi0[ok], wz0=b.wz0[ok], n_periods=n_periods,

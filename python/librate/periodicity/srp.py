@@ -1,5 +1,5 @@
 """Solar radiation pressure on periodic attitude motions (thesis ch. 4, PHYSICS.md sec. 6):
-continuation of a solution in the flat-plate amplitude eps (:func:`continue_srp`), the
+the flat-plate amplitude eps continued by :func:`librate.continue_srp`, the
 (eps, rate) periodicity map with its solution branches (:func:`srp_map`) and the accelerations on
 a Sun-pointing body (:func:`sun_pointing_accelerations`)."""
 
@@ -16,7 +16,7 @@ from ..attitude.srp import FacetBody, FlatPlate, Sun, force_torque
 from ..constants import OMEGA_SUN, SOLAR_PRESSURE_1AU, SUN_SYNODIC_PERIOD
 from ..orbits.periodic import PeriodicOrbit
 from ..orbits.system import check_system
-from .branches import SrpContinuation, continue_srp
+from .branches import branch_fold, branch_solutions, eps_branch
 from .solutions import (
     check_kinds,
     check_kz,
@@ -26,10 +26,8 @@ from .solutions import (
     sweep,
 )
 
-__all__ = ["SrpContinuation", "continue_srp", "srp_map", "sun_pointing_accelerations", "sun_resonance", "sun_angle", "FOLD_TRACE_TOL"]
+__all__ = ["srp_map", "sun_pointing_accelerations", "sun_resonance", "sun_angle"]
 
-#: A continuation that stops with the monodromy trace this close to 2 stopped at a fold.
-FOLD_TRACE_TOL = 0.05
 
 
 def sun_resonance(orbit: PeriodicOrbit, tol: float = 1e-6) -> int | None:
@@ -126,16 +124,20 @@ def srp_map(
         def follow(start, e_start, values, origin):
             """Continue ``start`` (at e_start) through the grid ``values`` in order (one
             pseudo-arclength run to the last value, corrected exactly at each grid value on the
-            way); one branch, ending at the grid's end or at a located fold."""
+            way; only those re-propagated); one branch, ending at the grid's end or at a
+            located fold."""
             b = len(branches)
-            c = continue_srp(start, plate.with_eps(float(values[-1])), steps=steps * len(values), marks=[float(e) for e in values])
-            path.extend((b, float(ei), si.wz0, si.phi0, si.trace) for ei, si in zip(c.eps, c.solutions))
-            sols.extend((b, e, si) for e, si in c.marked)
-            if c.reached:
+            target = plate.with_eps(float(values[-1]))
+            br = eps_branch(start, target, steps=steps * len(values), marks=[float(e) for e in values])
+            path.extend((b, float(p.x[0]), float(p.x[2]), float(p.x[1]), float(p.data["trace"])) for p in br.points)
+            sols.extend((b, float(p.x[0]), si) for p, si in zip(br.marked, branch_solutions(start, target, br.marked)))
+            if br.reached:
                 end = (math.nan, math.nan, False, "reached the end of the eps grid")
             else:
-                fold = c.fold is not None and bool(c.fold.get("located"))
-                end = (float(c.fold["eps"]) if fold else float(c.eps[-1]), c.solutions[-1].wz0, fold, c.end_reason)
+                f = branch_fold(br)
+                fold = f is not None and f["located"]
+                last = br.points[-1]
+                end = (float(f["eps"]) if fold else float(last.x[0]), float(last.x[2]), fold, br.end_reason)
             branches.append((start.n_total, start.kind, origin, e_start) + end)
 
         pos, neg = es[es > 0], es[es < 0][::-1]

@@ -277,7 +277,7 @@ impl PyCorrectionBatch {
 #[pyfunction]
 #[pyo3(signature = (forcing, phi0, wz0, kz, turns, *, t_final, closure, free="phi0", eps=None, cs=None, cd=None, theta_sun0=None,
     tol=1e-12, max_iter=40, rtol=1e-13, atol=1e-13, max_steps=200_000, max_wz_step=0.5, max_angle_step=0.5, threads=None, chunk=64,
-    parameter=None, condition=None, parameter_step=1e-6, max_parameter_step=0.5))]
+    parameter=None, condition=None, parameter_step=1e-6, max_parameter_step=0.5, monodromy=true))]
 #[allow(clippy::too_many_arguments)]
 fn attitude_correct<'py>(
     py: Python<'py>,
@@ -306,6 +306,7 @@ fn attitude_correct<'py>(
     condition: Option<(f64, f64, f64, f64)>,
     parameter_step: f64,
     max_parameter_step: f64,
+    monodromy: bool,
 ) -> PyResult<PyCorrectionBatch> {
     let bordered = match (parameter, condition) {
         (None, None) => None,
@@ -336,7 +337,7 @@ fn attitude_correct<'py>(
     }
     let (e, s, d, th) = (per_case(&eps, "eps", n)?, per_case(&cs, "cs", n)?, per_case(&cd, "cd", n)?, per_case(&theta_sun0, "theta_sun0", n)?);
     let cands: Vec<Candidate> = (0..n).map(|i| Candidate::new(p[i], w[i], k[i], tu[i]).with_plate(e[i], s[i], d[i], th[i])).collect();
-    let opts = CorrectorOptions { tol, max_iter, rtol, atol, max_steps, max_wz_step, max_angle_step, threads, chunk, ..CorrectorOptions::default() };
+    let opts = CorrectorOptions { tol, max_iter, rtol, atol, max_steps, max_wz_step, max_angle_step, threads, chunk, monodromy, ..CorrectorOptions::default() };
     let f = &forcing.inner;
     let out = py
         .detach(|| match &bordered {

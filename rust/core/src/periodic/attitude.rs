@@ -185,6 +185,10 @@ pub struct CorrectorOptions {
     /// Worker threads (None: all cores) and cases per task of the sweeps.
     pub threads: Option<usize>,
     pub chunk: usize,
+    /// Compute the full-period monodromy of half-closure corrections (one more sweep over the
+    /// full period); when false their `monodromy` is NaN (e.g. when every solution is
+    /// re-propagated independently with its STM anyway).
+    pub monodromy: bool,
 }
 
 impl Default for CorrectorOptions {
@@ -202,6 +206,7 @@ impl Default for CorrectorOptions {
             sun_omega: OMEGA_SUN,
             threads: None,
             chunk: 64,
+            monodromy: true,
         }
     }
 }
@@ -783,7 +788,9 @@ fn run(form: Form, candidates: &[Candidate], opts: &CorrectorOptions, integrate:
             }
         }
         let mut mono: Vec<[f64; 4]> = tracks.iter().map(|t| t.cur.map_or([f64::NAN; 4], |p| p.stm)).collect();
-        if form.closure == Closure::Half {
+        if form.closure == Closure::Half && !opts.monodromy {
+            mono.fill([f64::NAN; 4]);
+        } else if form.closure == Closure::Half {
             // The full-period monodromy: one more batch over K T at the final points.
             let full: Vec<(usize, (Case, f64))> =
                 (0..tracks.len()).filter_map(|i| tracks[i].cur.and_then(|p| form.case_at(&tracks[i].cand, p.x).map(|k| (i, (k, p.x[PARAM]))))).collect();
