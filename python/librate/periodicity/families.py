@@ -89,9 +89,9 @@ def attitude_family(
     start: float | None = None,
     wz0: float | None = None,
     parameter_range: tuple[float, float] | None = None,
-    ds: float = 0.02,
+    ds: float = 0.05,
     ds_min: float = 1e-6,
-    ds_max: float = 0.05,
+    ds_max: float = 0.25,
     max_points: int = 400,
     direction: int = -1,
 ) -> AttitudeFamily:

@@ -72,12 +72,15 @@ impl OrbitForcing {
             let (mut fit_t, mut check_t): (Vec<f64>, Vec<f64>) = (times[..n_fit].to_vec(), times[n_fit..].to_vec());
             fit_t.sort_by(f64::total_cmp);
             check_t.sort_by(f64::total_cmp);
-            let sample = |ts: &[f64]| -> Result<Vec<(f64, f64)>> {
-                let tr = propagate(mu, state0, 0.0, period, &opts, false, Output::At(ts), &[])?;
-                Ok(tr.states.chunks_exact(6).map(|s| forcing_sc(mu, s, primaries)).collect())
-            };
-            let fit = sample(&fit_t)?;
-            let check = sample(&check_t)?;
+            // one integration samples both sets (merged in time order, then split)
+            let mut all: Vec<(f64, bool)> = fit_t.iter().map(|&t| (t, true)).chain(check_t.iter().map(|&t| (t, false))).collect();
+            all.sort_by(|a, b| a.0.total_cmp(&b.0));
+            let ts: Vec<f64> = all.iter().map(|a| a.0).collect();
+            let tr = propagate(mu, state0, 0.0, period, &opts, false, Output::At(&ts), &[])?;
+            let (mut fit, mut check) = (Vec::with_capacity(fit_t.len()), Vec::with_capacity(check_t.len()));
+            for (s, a) in tr.states.chunks_exact(6).zip(&all) {
+                if a.1 { fit.push(forcing_sc(mu, s, primaries)) } else { check.push(forcing_sc(mu, s, primaries)) }
+            }
             let mut coef = vec![0.0; segments * NC * 2];
             for s in 0..segments {
                 // fit_t is sorted: segment s holds samples s*NC .. (s+1)*NC in increasing time,
