@@ -199,7 +199,7 @@ def attitude_correct(
     tol: float = 1e-12, max_iter: int = 40, rtol: float = 1e-13, atol: float = 1e-13, max_steps: int = 200000,
     max_wz_step: float = 0.5, max_angle_step: float = 0.5, threads: int | None = None, chunk: int = 64,
     parameter: str | None = None, condition: tuple[float, float, float, float] | None = None,
-    parameter_step: float = 1e-6, max_parameter_step: float = 0.5, monodromy: bool = True,
+    parameter_step: float = 1e-6, max_parameter_step: float = 0.5, monodromy: bool = True, max_halvings: int = 10,
 ) -> CorrectionBatch: ...
 
 @final
@@ -213,7 +213,7 @@ def attitude_correct_across(
     family: PlanarFamily, wz0: _F64, kz: _F64, turns: _F64, x0: _F64, *,
     condition: tuple[float, float, float], phi0: float = 0.0, tol: float = 1e-12, max_iter: int = 40, rtol: float = 1e-13,
     atol: float = 1e-13, max_steps: int = 200000, max_wz_step: float = 0.5, parameter_step: float = 1e-6,
-    max_parameter_step: float = 0.05, threads: int | None = None,
+    max_parameter_step: float = 0.05, threads: int | None = None, max_halvings: int = 10,
 ) -> CorrectionBatch: ...
 
 @final

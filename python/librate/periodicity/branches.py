@@ -20,6 +20,8 @@ from ..orbits.periodic import PeriodicOrbit
 from ..solving.continuation import Constraint, CorrectionFailed, Point, StepRules, arclength
 from .solutions import (
     KINDS,
+    STEP_MAX_HALVINGS,
+    STEP_MAX_ITER,
     AttitudeSolution,
     check_kz,
     check_orbit,
@@ -158,7 +160,8 @@ class KzBranch:
     def correct(self, guess, c):
         a_k, a_w = c.a
         b = correct(self.orbit, kz=float(np.clip(guess[0], -1.0, 1.0)), n_total=self.n_total, kind=self.kind, phi0=self.phi0, wz0=float(guess[1]),
-                    n_periods=self.n_periods, closure="half", tol=self.tol, max_iter=self.max_iter, bordered=("kz", (0.0, a_w, a_k, c.b)))
+                    n_periods=self.n_periods, closure="half", tol=self.tol, max_iter=min(self.max_iter, STEP_MAX_ITER),
+                    max_halvings=STEP_MAX_HALVINGS, bordered=("kz", (0.0, a_w, a_k, c.b)))
         if not b.converged[0]:
             raise CorrectionFailed(f"Kz branch: {b.reason[0]}")
         g = b.jacobian[0, 0]
@@ -232,7 +235,7 @@ class EpsBranch:
         a_e, a_p, a_w = c.a
         b = correct(self.orbit, kz=self.kz, n_total=self.n_total, kind=self.kind, phi0=float(guess[1]), wz0=float(guess[2]),
                     n_periods=self.n_periods, srp=self.plate, eps=float(guess[0]), closure="full", free="phi0",
-                    bordered=("eps", (a_p, a_w, a_e, c.b)))
+                    max_iter=STEP_MAX_ITER, max_halvings=STEP_MAX_HALVINGS, bordered=("eps", (a_p, a_w, a_e, c.b)))
         if not b.converged[0]:
             raise CorrectionFailed(f"eps branch: {b.reason[0]}")
         j = b.jacobian[0]  # columns (angle, wz0, eps)
@@ -242,6 +245,19 @@ class EpsBranch:
     def tangent(self, pt):
         j = pt.data["j"]
         return np.cross(j[0], j[1])
+
+    def correct_batch(self, guesses, constraints):
+        """Points at fixed eps (the continuation's marks), all corrected in one call: the plain
+        full-period correction in (phi0, wz0) at each one's eps."""
+        g = np.array(guesses, dtype=float)
+        for c in constraints:
+            if c.fixed_index != 0:
+                raise ValueError("EpsBranch.correct_batch: only conditions fixing eps")
+        b = correct(self.orbit, kz=self.kz, n_total=self.n_total, kind=self.kind, phi0=g[:, 1], wz0=g[:, 2], n_periods=self.n_periods,
+                    srp=self.plate, eps=np.array([c.b for c in constraints]), closure="full", free="phi0", monodromy=False,
+                    max_iter=STEP_MAX_ITER, max_halvings=STEP_MAX_HALVINGS)
+        return [Point(np.array([c.b, b.phi0[i], b.wz0[i]]), None, int(b.iterations[i])) if b.converged[i] else None
+                for i, c in enumerate(constraints)]
 
     def tests(self, pt):
         # trace 2 where the branch does not turn back: a symmetry-breaking (pitchfork) branch

@@ -14,7 +14,7 @@ from ..orbits.families import OrbitFamily
 from ..orbits.periodic import PeriodicOrbit
 from ..solving.continuation import Constraint, CorrectionFailed, Point, StepRules, arclength
 from .branches import KzBranch, periodic_attitude
-from .solutions import KINDS, SOLVE_ATOL, SOLVE_RTOL, check_kz, check_orbit, is_symmetric, turns_of
+from .solutions import KINDS, SOLVE_ATOL, SOLVE_RTOL, STEP_MAX_HALVINGS, STEP_MAX_ITER, check_kz, check_orbit, is_symmetric, turns_of
 
 __all__ = ["AttitudeFamily", "attitude_family"]
 
@@ -68,7 +68,7 @@ class OrbitFamilyBranch:
         a_x, a_w = c.a
         b = _core.attitude_correct_across(self.table, np.array([float(guess[1])]), np.array([self.kz]), np.array([self.turns]),
                                           np.array([float(np.clip(guess[0], self.lo, self.hi))]), condition=(a_w, a_x, c.b),
-                                          rtol=SOLVE_RTOL, atol=SOLVE_ATOL)
+                                          rtol=SOLVE_RTOL, atol=SOLVE_ATOL, max_iter=STEP_MAX_ITER, max_halvings=STEP_MAX_HALVINGS)
         if not b.converged[0]:
             raise CorrectionFailed(f"orbit-family branch: {b.reason[0]}")
         g = b.jacobian[0, 0]

@@ -29,10 +29,15 @@ from ..orbits.periodic import PeriodicOrbit
 
 __all__ = ["AttitudeSolution", "find_periodic_attitudes", "orbit_forcing", "clear_forcing_cache", "sweep", "candidates",
            "check_orbit", "check_kz", "check_kinds", "KINDS", "check_srp", "is_symmetric", "MAP_RTOL", "MAP_ATOL", "correct", "verified", "refine",
-           "turns_of", "n_total_of", "per_period", "SOLVE_RTOL", "SOLVE_ATOL"]
+           "turns_of", "n_total_of", "per_period", "SOLVE_RTOL", "SOLVE_ATOL", "STEP_MAX_ITER",
+           "STEP_MAX_HALVINGS"]
 
 MAP_RTOL = 1e-12
 MAP_ATOL = 1e-12
+#: A continuation step's corrector: a good prediction converges in a few Newton steps; one that
+#: does not is a step too long (the driver halves it), not worth forty iterations.
+STEP_MAX_ITER = 10
+STEP_MAX_HALVINGS = 4
 #: Integration tolerances of the corrector's trajectories.
 SOLVE_RTOL = 1e-13
 SOLVE_ATOL = 1e-13
@@ -193,7 +198,8 @@ def turns_of(n_total, kind) -> np.ndarray:
 
 
 def correct(orbit: PeriodicOrbit, *, kz, n_total, kind, phi0, wz0, n_periods: int = 1, srp=None, closure: str = "half",
-            free: str = "phi0", theta_sun0=None, eps=None, tol: float = 1e-12, max_iter: int = 40, bordered=None, monodromy: bool = True):
+            free: str = "phi0", theta_sun0=None, eps=None, tol: float = 1e-12, max_iter: int = 40, bordered=None, monodromy: bool = True,
+            max_halvings: int = 10):
     """One call of the Rust corrector for a batch of candidates on ``orbit`` (arrays broadcast
     together: kz, n_total, kind, phi0, wz0, and theta_sun0 / eps overriding the plate's):
     ``closure`` "half" (symmetric, over K T / 2) or "full" (over K T); ``free`` "phi0" or
@@ -214,7 +220,7 @@ def correct(orbit: PeriodicOrbit, *, kz, n_total, kind, phi0, wz0, n_periods: in
         kw = dict(parameter=bordered[0], condition=tuple(float(v) for v in bordered[1]))
     return _core.attitude_correct(orbit_forcing(orbit), p, w, k, turns_of(nt, kd), t_final=0.5 * T if closure == "half" else T,
                                   closure=closure, free=free, tol=float(tol), max_iter=int(max_iter), rtol=SOLVE_RTOL, atol=SOLVE_ATOL,
-                                  monodromy=monodromy, **extra, **kw)
+                                  monodromy=monodromy, max_halvings=int(max_halvings), **extra, **kw)
 
 
 def verified(orbit: PeriodicOrbit, *, kz, n_total, kind, phi0, wz0, n_periods: int = 1, plates=None, iterations=None) -> list[AttitudeSolution]:

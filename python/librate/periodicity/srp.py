@@ -6,7 +6,9 @@ a Sun-pointing body (:func:`sun_pointing_accelerations`)."""
 from __future__ import annotations
 
 import math
+import os
 from collections.abc import Sequence
+from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
@@ -121,16 +123,17 @@ def srp_map(
     if solve:
         window = (float(wz[0]), float(wz[-1]))
 
-        def follow(start, e_start, values, origin):
+        def trace(job):
             """Continue ``start`` (at e_start) through the grid ``values`` in order (one
             pseudo-arclength run to the last value, corrected exactly at each grid value on the
             way; only those re-propagated); one branch, ending at the grid's end or at a
-            located fold."""
-            b = len(branches)
+            located fold. Independent of every other branch: branches run on worker threads
+            (the corrector releases the GIL) and are assembled in order."""
+            start, e_start, values, origin = job
             target = plate.with_eps(float(values[-1]))
-            br = eps_branch(start, target, steps=steps * len(values), marks=[float(e) for e in values])
-            path.extend((b, float(p.x[0]), float(p.x[2]), float(p.x[1]), float(p.data["trace"])) for p in br.points)
-            sols.extend((b, float(p.x[0]), si) for p, si in zip(br.marked, branch_solutions(start, target, br.marked)))
+            br = eps_branch(start, target, steps=steps, marks=[float(e) for e in values])
+            pts = [(float(p.x[0]), float(p.x[2]), float(p.x[1]), float(p.data["trace"])) for p in br.points]
+            marked = [(float(p.x[0]), si) for p, si in zip(br.marked, branch_solutions(start, target, br.marked))]
             if br.reached:
                 end = (math.nan, math.nan, False, "reached the end of the eps grid")
             else:
@@ -138,15 +141,30 @@ def srp_map(
                 fold = f is not None and f["located"]
                 last = br.points[-1]
                 end = (float(f["eps"]) if fold else float(last.x[0]), float(last.x[2]), fold, br.end_reason)
-            branches.append((start.n_total, start.kind, origin, e_start) + end)
+            return pts, marked, (start.n_total, start.kind, origin, e_start) + end
+
+        def run(jobs, lead):
+            """Trace the branches of ``jobs`` in parallel; record them in order, each after its
+            ``lead`` solutions ((eps, solution) recorded at the branch's index first)."""
+            with ThreadPoolExecutor(max_workers=max(1, min(len(jobs), os.cpu_count() or 1))) as pool:
+                done = list(pool.map(trace, jobs))
+            for (pts, marked, info), first in zip(done, lead):
+                b = len(branches)
+                sols.extend((b, e, s_) for e, s_ in first)
+                path.extend((b, *pt) for pt in pts)
+                sols.extend((b, e, s_) for e, s_ in marked)
+                branches.append(info)
 
         pos, neg = es[es > 0], es[es < 0][::-1]
+        jobs, lead = [], []
         for s0 in find_periodic_attitudes(orbit, kz=kz, wz0_range=window, phi0=phi0, kinds=kinds, n_periods=n_periods):
-            if 0.0 in es:
-                sols.append((len(branches), 0.0, s0))
+            first = [(0.0, s0)] if 0.0 in es else []
             for side in (pos, neg):
                 if side.size:
-                    follow(s0, 0.0, side, "gravity")
+                    jobs.append((s0, 0.0, side, "gravity"))
+                    lead.append(first)
+                    first = []
+        run(jobs, lead)
         # Solutions at the grid's far ends (SRP-dominated ones too), continued back towards eps = 0
         # unless a branch from eps = 0 already reached them.
         zero = np.array([0.0] if 0.0 in es else [])
@@ -158,13 +176,15 @@ def srp_map(
             for seed in (0.0, 0.5 * math.pi, math.pi, -0.5 * math.pi):  # phi0 is free: scan from four initial attitudes
                 found += find_periodic_attitudes(orbit, kz=kz, wz0_range=window, phi0=phi0 + seed, kinds=kinds,
                                                  n_periods=n_periods, srp=plate.with_eps(e_end))
+            jobs, lead = [], []
             for s1 in sorted(found, key=lambda x: x.wz0):
                 if any(k.n_total == s1.n_total and k.kind == s1.kind and abs(k.wz0 - s1.wz0) < 1e-7
                        and abs(math.remainder(k.phi0 - s1.phi0, 2 * math.pi)) < 1e-7 for k in known):
                     continue
-                sols.append((len(branches), e_end, s1))
                 known.append(s1)
-                follow(s1, e_end, inward, "end")
+                jobs.append((s1, e_end, inward, "end"))
+                lead.append([(e_end, s1)])
+            run(jobs, lead)
         path.sort(key=lambda p: (p[0], p[1]))
     sol_arr = lambda f, dt=float: np.array([f(b, e, s) for b, e, s in sols], dtype=dt)  # noqa: E731
     ds = xr.Dataset(

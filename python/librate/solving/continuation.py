@@ -132,7 +132,9 @@ class ContinuationProblem(Protocol):
     CorrectionFailed (or any LibrateError) on failure. ``tangent(point)``: the (unnormalised)
     null vector of the equations' Jacobian at the point (None: the driver uses secants).
     Optional: ``guard(points, new, ratio)`` returns a reason to reject ``new`` (a jump) or None;
-    ``tests(point)`` returns named bifurcation test functions.
+    ``tests(point)`` returns named bifurcation test functions; ``correct_batch(guesses,
+    constraints)`` corrects many independent points at once (a list of Point or None), used for
+    the marks of :func:`arclength`.
     """
 
     parameter_index: int
@@ -335,6 +337,25 @@ def arclength(
         t = -t
     points = [first]
     branch = Branch(points)
+    pending_marks: list = []  # (guess, condition, step, point if already on the mark)
+
+    def finish() -> Branch:
+        """Correct the marks met on the way, in one batch when the problem can
+        (``correct_batch``), and keep those that land near their guess."""
+        todo = [i for i, pm in enumerate(pending_marks) if pm[3] is None]
+        got: dict[int, Point | None] = {}
+        batch = getattr(problem, "correct_batch", None)
+        if todo and batch is not None:
+            for i, pt in zip(todo, batch([pending_marks[i][0] for i in todo], [pending_marks[i][1] for i in todo])):
+                got[i] = pt if pt is not None and np.all(np.isfinite(pt.x)) else None
+        else:
+            for i in todo:
+                got[i] = _try(problem, pending_marks[i][0], pending_marks[i][1])
+        for i, (guess, _, step, on) in enumerate(pending_marks):
+            pm = on if on is not None else got.get(i)
+            if pm is not None and _norm(problem, pm.x - guess) <= rules.jump * step + 1e-12:
+                branch.marked.append(pm)
+        return branch
     tests_prev = _tests(problem, first)
     ds = rules.ds
     sx = problem.scale
@@ -374,11 +395,11 @@ def arclength(
                     points.append(landed)
                     branch.reached = edge[2]
                     branch.end_reason = f"{edge[1]}: {name} = {edge[0]:.12g}"
-                    return branch
+                    return finish()
                 ds *= 0.5
                 if ds < rules.ds_min:
                     branch.end_reason = f"step floor: could not land on {name} = {edge[0]:.12g} from {base.x[k]:.12g} (step below {rules.ds_min:g})"
-                    return branch
+                    return finish()
                 continue
             new = at(base, t, ds)
             status = "fail"
@@ -403,7 +424,7 @@ def arclength(
             ds *= 0.5
             if ds < rules.ds_min:
                 branch.end_reason = f"step floor: arclength step below {rules.ds_min:g} at {name} = {base.x[k]:.12g} after {len(points)} points"
-                return branch
+                return finish()
         assert t_new is not None and new is not None
         # a fold: the parameter component of the tangent changes sign
         if t[k] * t_new[k] < 0:
@@ -413,7 +434,7 @@ def arclength(
                 if fold.located:
                     points.append(fold.point)  # the branch ends on its turning point
                 branch.end_reason = f"fold at {name} = {fold.parameter:.12g}" + ("" if fold.located else f" (not located: within {fold.tolerance:.2g})")
-                return branch
+                return finish()
         tests_new = _tests(problem, new)
         for test, v in tests_new.items():
             u = tests_prev.get(test)
@@ -425,19 +446,17 @@ def arclength(
                 w = (m - base.x[k]) / (new.x[k] - base.x[k])
                 guess = base.x + w * (new.x - base.x)
                 guess[k] = m
-                pm = new if new.x[k] == m else _try(problem, guess, Constraint.fix(n, k, m))
-                if pm is not None and _norm(problem, pm.x - guess) <= rules.jump * ds + 1e-12:
-                    branch.marked.append(pm)
+                pending_marks.append((guess, Constraint.fix(n, k, m), ds, new if new.x[k] == m else None))
         points.append(new)
         t = t_new
         why = stop(new) if stop else None
         if why:
             branch.end_reason = why
-            return branch
+            return finish()
         if new.iterations <= rules.easy_iterations:
             ds = min(ds * rules.growth, rules.ds_max)
     branch.end_reason = f"completed: max_points = {max_points} reached"
-    return branch
+    return finish()
 
 
 def _illinois(f, a: float, fa: float, b: float, fb: float, done: Callable[[float, float], bool], max_iter: int = 60):

@@ -277,7 +277,7 @@ impl PyCorrectionBatch {
 #[pyfunction]
 #[pyo3(signature = (forcing, phi0, wz0, kz, turns, *, t_final, closure, free="phi0", eps=None, cs=None, cd=None, theta_sun0=None,
     tol=1e-12, max_iter=40, rtol=1e-13, atol=1e-13, max_steps=200_000, max_wz_step=0.5, max_angle_step=0.5, threads=None, chunk=64,
-    parameter=None, condition=None, parameter_step=1e-6, max_parameter_step=0.5, monodromy=true))]
+    parameter=None, condition=None, parameter_step=1e-6, max_parameter_step=0.5, monodromy=true, max_halvings=10))]
 #[allow(clippy::too_many_arguments)]
 fn attitude_correct<'py>(
     py: Python<'py>,
@@ -307,6 +307,7 @@ fn attitude_correct<'py>(
     parameter_step: f64,
     max_parameter_step: f64,
     monodromy: bool,
+    max_halvings: u32,
 ) -> PyResult<PyCorrectionBatch> {
     let bordered = match (parameter, condition) {
         (None, None) => None,
@@ -337,7 +338,7 @@ fn attitude_correct<'py>(
     }
     let (e, s, d, th) = (per_case(&eps, "eps", n)?, per_case(&cs, "cs", n)?, per_case(&cd, "cd", n)?, per_case(&theta_sun0, "theta_sun0", n)?);
     let cands: Vec<Candidate> = (0..n).map(|i| Candidate::new(p[i], w[i], k[i], tu[i]).with_plate(e[i], s[i], d[i], th[i])).collect();
-    let opts = CorrectorOptions { tol, max_iter, rtol, atol, max_steps, max_wz_step, max_angle_step, threads, chunk, monodromy, ..CorrectorOptions::default() };
+    let opts = CorrectorOptions { tol, max_iter, rtol, atol, max_steps, max_wz_step, max_angle_step, threads, chunk, monodromy, max_halvings, ..CorrectorOptions::default() };
     let f = &forcing.inner;
     let out = py
         .detach(|| match &bordered {
@@ -395,7 +396,7 @@ impl PyPlanarFamily {
 /// linear condition a_wz0 wz0 + a_x0 x0 = b (librate_core::periodic::correct_across_family).
 #[pyfunction]
 #[pyo3(signature = (family, wz0, kz, turns, x0, *, condition, phi0=0.0, tol=1e-12, max_iter=40, rtol=1e-13, atol=1e-13, max_steps=200_000,
-    max_wz_step=0.5, parameter_step=1e-6, max_parameter_step=0.05, threads=None))]
+    max_wz_step=0.5, parameter_step=1e-6, max_parameter_step=0.05, threads=None, max_halvings=10))]
 #[allow(clippy::too_many_arguments)]
 fn attitude_correct_across<'py>(
     py: Python<'py>,
@@ -415,6 +416,7 @@ fn attitude_correct_across<'py>(
     parameter_step: f64,
     max_parameter_step: f64,
     threads: Option<usize>,
+    max_halvings: u32,
 ) -> PyResult<PyCorrectionBatch> {
     let (w, k, tu, x) = (wz0.as_array(), kz.as_array(), turns.as_array(), x0.as_array());
     let n = w.len();
@@ -423,7 +425,7 @@ fn attitude_correct_across<'py>(
     }
     let cands: Vec<Candidate> = (0..n).map(|i| Candidate::new(phi0, w[i], k[i], tu[i]).with_x0(x[i])).collect();
     let bordered = Bordered { parameter: Parameter::OrbitX0, a: [0.0, condition.0, condition.1], b: condition.2, step: parameter_step, max_step: max_parameter_step };
-    let opts = CorrectorOptions { tol, max_iter, rtol, atol, max_steps, max_wz_step, threads, ..CorrectorOptions::default() };
+    let opts = CorrectorOptions { tol, max_iter, rtol, atol, max_steps, max_wz_step, threads, max_halvings, ..CorrectorOptions::default() };
     let fam = &family.inner;
     let out = py.detach(|| correct_across_family(fam, &bordered, &cands, &opts)).map_err(to_py)?;
     batch_from(py, &out)
