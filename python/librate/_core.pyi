@@ -30,6 +30,7 @@ __all__ = [
     "attitude_propagate",
     "attitude_torques",
     "facets_force_torque",
+    "flat_plate_wzdot",
     "flexible_body_check",
     "flexible_energies",
     "flexible_propagate",
@@ -41,6 +42,7 @@ __all__ = [
     "lagrange_points",
     "map_sweep",
     "multiple_shooting",
+    "planar_gravity_gradient",
     "planar_propagate",
     "planar_verify",
     "preset_names",
@@ -48,6 +50,7 @@ __all__ = [
     "propagate_many",
     "rigid_body_kz",
     "stability",
+    "sun_angle",
     "symmetric_correct",
     "system_preset",
     "system_validate",
@@ -254,3 +257,7 @@ def flexible_energies(
 def flexible_rates(
     mu: float, body_arg: _FlexBody, primaries: list[bool], orbit: list[float], phi: float, wz: float, q: list[float], qdot: list[float]
 ) -> tuple[float, list[float]]: ...
+
+def planar_gravity_gradient(kz: float, s: _F64, c: _F64, phi: _F64) -> _F64: ...
+def flat_plate_wzdot(eps: float, cs: float, cd: float, theta_sun0: float, t: _F64, phi: _F64) -> _F64: ...
+def sun_angle(theta_sun0: float, t: _F64) -> _F64: ...

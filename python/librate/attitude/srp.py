@@ -41,9 +41,14 @@ class Sun:
         """Rate of the Sun direction in the synodic frame, 1/TU (clockwise)."""
         return OMEGA_SUN
 
+    def angle(self, t) -> np.ndarray:
+        """The Sun's angle from the synodic X axis at times t (TU), unwrapped (rad)."""
+        t = np.asarray(t, dtype=float)
+        return _core.sun_angle(float(self.theta0), np.ascontiguousarray(t.ravel())).reshape(t.shape)
+
     def direction(self, t) -> np.ndarray:
         """Unit vector(s) from the spacecraft to the Sun in synodic components, (3,) or (n, 3)."""
-        a = self.omega * np.asarray(t, dtype=float) + self.theta0
+        a = self.angle(t)
         return np.stack([np.cos(a), np.sin(a), np.zeros_like(a)], axis=-1)
 
 
@@ -172,10 +177,12 @@ class FlatPlate:
         return FlatPlate(float(eps), self.cs, self.cd, self.sun)
 
     def wzdot(self, t, phi) -> np.ndarray:
-        """The SRP angular acceleration (1/TU^2) at times t and attitudes phi."""
-        a = self.sun.omega * np.asarray(t, dtype=float) + self.sun.theta0 - np.asarray(phi, dtype=float)
-        c = np.cos(a)
-        return self.eps * ((1 + self.cs) * c * np.abs(c) + (2.0 / 3.0) * self.cd * c)
+        """The SRP angular acceleration (1/TU^2) at times t and attitudes phi (broadcast), by the
+        core's plate law."""
+        t, phi = np.broadcast_arrays(np.asarray(t, dtype=float), np.asarray(phi, dtype=float))
+        out = _core.flat_plate_wzdot(float(self.eps), float(self.cs), float(self.cd), float(self.sun.theta0),
+                                     np.ascontiguousarray(t.ravel()), np.ascontiguousarray(phi.ravel()))
+        return out.reshape(t.shape)
 
     def _plate(self):
         return (float(self.eps), float(self.cs), float(self.cd), float(self.sun.theta0), float(self.sun.omega))

@@ -12,10 +12,11 @@ from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
+from .. import _core
 from .._checks import as_count, as_number
 from .._core import __version__
 from ..attitude.srp import FacetBody, FlatPlate, Sun, force_torque
-from ..constants import OMEGA_SUN, SOLAR_PRESSURE_1AU, SUN_SYNODIC_PERIOD
+from ..constants import SOLAR_PRESSURE_1AU, SUN_SYNODIC_PERIOD
 from ..orbits.periodic import PeriodicOrbit
 from ..orbits.system import check_system
 from .branches import branch_fold, branch_solutions, eps_branch
@@ -40,7 +41,7 @@ def sun_resonance(orbit: PeriodicOrbit, tol: float = 1e-6) -> int | None:
 
 def sun_angle(theta_sun0: float, t) -> np.ndarray:
     """The Sun's angle from the synodic X axis at times t (TU), unwrapped (rad), from its phase at t = 0."""
-    return OMEGA_SUN * np.asarray(t, dtype=float) + theta_sun0
+    return Sun(theta0=float(theta_sun0)).angle(t)
 
 
 def srp_map(
@@ -290,7 +291,8 @@ def sun_pointing_accelerations(system, body_or_plate, t, *, orbit: PeriodicOrbit
     phi = sun_angle(sun_.theta0, t) + offset
     s_, c_ = orbit_forcing(orbit).sc(np.ascontiguousarray(t.ravel()))
     s_, c_ = np.asarray(s_).reshape(t.shape), np.asarray(c_).reshape(t.shape)
-    gg = 1.5 * kz * (s_ * np.cos(2 * phi) - c_ * np.sin(2 * phi))
+    gg = _core.planar_gravity_gradient(kz, np.ascontiguousarray(s_.ravel()), np.ascontiguousarray(c_.ravel()),
+                                       np.ascontiguousarray(np.broadcast_to(phi, t.shape).ravel())).reshape(t.shape)
     if isinstance(body_or_plate, FlatPlate):
         srp = np.asarray(body_or_plate.wzdot(t, phi), dtype=float)
     else:

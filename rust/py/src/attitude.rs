@@ -159,7 +159,56 @@ fn rigid_body_kz(ix: f64, iy: f64, iz: f64) -> PyResult<f64> {
     RigidBody::new(ix, iy, iz).map(|b| b.kz()).map_err(to_py)
 }
 
+/// The planar gravity-gradient angular acceleration 1.5 Kz [S cos 2phi - C sin 2phi] (1/TU^2) for
+/// forcing samples (S, C) at attitudes phi (arrays of one length).
+#[pyfunction]
+fn planar_gravity_gradient<'py>(
+    py: Python<'py>,
+    kz: f64,
+    s: PyReadonlyArray1<'py, f64>,
+    c: PyReadonlyArray1<'py, f64>,
+    phi: PyReadonlyArray1<'py, f64>,
+) -> PyResult<Bound<'py, PyAny>> {
+    let (s, c, phi) = (s.as_array(), c.as_array(), phi.as_array());
+    if s.len() != phi.len() || c.len() != phi.len() {
+        return Err(PyValueError::new_err(format!("invalid argument: s, c and phi must have one length, got {}, {}, {}", s.len(), c.len(), phi.len())));
+    }
+    let out: Vec<f64> = (0..phi.len()).map(|i| attitude::planar_gravity_gradient(kz, s[i], c[i], phi[i]).0).collect();
+    Ok(out.into_pyarray(py).into_any())
+}
+
+/// The flat-plate SRP angular acceleration (1/TU^2) at times t and attitudes phi (arrays of one
+/// length) for the plate (eps, cs, cd) and the Sun's phase theta_sun0.
+#[pyfunction]
+fn flat_plate_wzdot<'py>(
+    py: Python<'py>,
+    eps: f64,
+    cs: f64,
+    cd: f64,
+    theta_sun0: f64,
+    t: PyReadonlyArray1<'py, f64>,
+    phi: PyReadonlyArray1<'py, f64>,
+) -> PyResult<Bound<'py, PyAny>> {
+    let plate = FlatPlate::new(eps, cs, cd, Sun { theta0: theta_sun0, ..Sun::default() }).map_err(to_py)?;
+    let (t, phi) = (t.as_array(), phi.as_array());
+    if t.len() != phi.len() {
+        return Err(PyValueError::new_err(format!("invalid argument: t and phi must have one length, got {} and {}", t.len(), phi.len())));
+    }
+    let out: Vec<f64> = (0..t.len()).map(|i| plate.wzdot(t[i], phi[i]).0).collect();
+    Ok(out.into_pyarray(py).into_any())
+}
+
+/// The Sun's angle from the synodic X axis (rad, unwrapped) at times t (TU), from its phase.
+#[pyfunction]
+fn sun_angle<'py>(py: Python<'py>, theta_sun0: f64, t: PyReadonlyArray1<'py, f64>) -> Bound<'py, PyAny> {
+    let sun = Sun { theta0: theta_sun0, ..Sun::default() };
+    t.as_array().iter().map(|&ti| sun.angle(ti)).collect::<Vec<f64>>().into_pyarray(py).into_any()
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(planar_gravity_gradient, m)?)?;
+    m.add_function(wrap_pyfunction!(flat_plate_wzdot, m)?)?;
+    m.add_function(wrap_pyfunction!(sun_angle, m)?)?;
     m.add_function(wrap_pyfunction!(attitude_propagate, m)?)?;
     m.add_function(wrap_pyfunction!(planar_propagate, m)?)?;
     m.add_function(wrap_pyfunction!(rigid_body_kz, m)?)?;

@@ -51,6 +51,14 @@ pub fn gravity_gradient_wzdot<L: Lane>(kz15: L, s: L, c: L, c2: L, s2: L) -> (L,
     (kz15 * (s * c2 - c * s2), -(kz15 + kz15) * (s * s2 + c * c2))
 }
 
+/// The planar gravity-gradient angular acceleration (1.5 Kz [S cos 2phi - C sin 2phi]) at the
+/// attitude phi from the orbit's forcing (S, C), and its derivative with respect to phi.
+#[inline]
+pub fn planar_gravity_gradient(kz: f64, s: f64, c: f64, phi: f64) -> (f64, f64) {
+    let (s2, c2) = (2.0 * phi).sin_cos();
+    gravity_gradient_wzdot(1.5 * kz, s, c, c2, s2)
+}
+
 /// The orbit part (first six components) of a state's derivative: the CR3BP, or zero for a
 /// body held at its initial position (as at the Lagrange points).
 #[inline(always)]
@@ -73,8 +81,7 @@ pub trait Forcing: Sync {
 /// (phidot, wzdot) and the STM coefficient d(wzdot)/d(phi) from S, C (and the flat-plate SRP).
 #[inline(always)]
 fn attitude_rhs(kz: f64, s: f64, c: f64, t: f64, phi: f64, wz: f64, srp: &Option<FlatPlate>) -> (f64, f64, f64) {
-    let (s2, c2) = (2.0 * phi).sin_cos();
-    let (mut dwz, mut k) = gravity_gradient_wzdot(1.5 * kz, s, c, c2, s2);
+    let (mut dwz, mut k) = planar_gravity_gradient(kz, s, c, phi);
     if let Some(p) = srp {
         let (v, d) = p.wzdot(t, phi);
         dwz += v;
