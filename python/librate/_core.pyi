@@ -32,6 +32,7 @@ __all__ = [
     "facets_force_torque",
     "flat_plate_wzdot",
     "flexible_body_check",
+    "flexible_correct_periodic",
     "flexible_energies",
     "flexible_propagate",
     "flexible_quasi_static",
@@ -261,3 +262,7 @@ def flexible_rates(
 def planar_gravity_gradient(kz: float, s: _F64, c: _F64, phi: _F64) -> _F64: ...
 def flat_plate_wzdot(eps: float, cs: float, cd: float, theta_sun0: float, t: _F64, phi: _F64) -> _F64: ...
 def sun_angle(theta_sun0: float, t: _F64) -> _F64: ...
+def flexible_correct_periodic(
+    mu: float, body_arg: Any, primaries: list[bool], orbit0: list[float], period: float, x0: list[float], turns: float,
+    scale: list[float], *, options: Any, tol: float, max_iter: int, threads: int | None = None,
+) -> tuple[_F64, float, int, str, _F64]: ...

@@ -33,10 +33,11 @@ class FlexiblePeriodic:
 
     Full model (``method="full"``): ``full_drift`` from a re-propagation of the coupled model over
     one period, ``full_max_dphi``, ``full_max_dwz``; when re-solved, the periodic solution of the
-    coupled model (``phi0``, ``wz0``, ``q0`` (m), ``qdot0`` (m/TU)) by Newton on all 2 + 2n initial
-    values with a finite-difference Jacobian, its ``residual`` (scaled: rad, rad/TU and q relative
-    to the quasi-static amplitude), ``iterations``, ``multipliers`` (eigenvalues of the coupled
-    monodromy) and ``full_shift`` = (phi0 - phi0_rigid, wz0 - wz0_rigid).
+    coupled model (``phi0``, ``wz0``, ``q0`` (m), ``qdot0`` (m/TU)) by the Rust corrector (globalised
+    Newton on all 2 + 2n initial values, finite-difference Jacobian integrated in parallel), its
+    ``residual`` (scaled: rad, rad/TU and q relative to the quasi-static amplitude),
+    ``iterations``, why it stopped (``reason``, "converged" or the failure), ``multipliers``
+    (eigenvalues of the coupled monodromy) and ``full_shift`` = (phi0 - phi0_rigid, wz0 - wz0_rigid).
     """
 
     solution: object
@@ -56,6 +57,7 @@ class FlexiblePeriodic:
     residual: float | None = None
     iterations: int | None = None
     multipliers: np.ndarray | None = None
+    reason: str | None = None
 
     @property
     def full_shift(self) -> np.ndarray | None:
@@ -138,44 +140,16 @@ def flexible_periodic(
     if not resolve:
         return FlexiblePeriodic(**out)
 
-    # Newton on all 2 + 2n initial values, residuals scaled by the quasi-static amplitudes.
+    # One call of the Rust corrector: globalised Newton on all 2 + 2n initial values, residuals
+    # scaled by the quasi-static amplitudes, the Jacobian's columns integrated in parallel.
     omega = body.frequencies_nd(sys_)
     qscale = np.maximum(np.max(np.abs(qs.q), axis=0), 1e-12)
     scale = np.concatenate([[1.0, 1.0], qscale, qscale * omega])
-    target = np.zeros(2 + 2 * n)
-    target[0] = 2 * math.pi * turns
-
-    def residual(x):
-        y = flow(x)
-        yf = np.concatenate([[y["phi"][-1], y["wz"][-1]], y["q"][-1], y["qdot"][-1]])
-        return (yf - x - target) / scale, yf
-
-    res, _ = residual(x)
-    it = 0
-    jac = None
-    for it in range(1, max_iter + 1):
-        jac = np.empty((2 + 2 * n, 2 + 2 * n))
-        for i in range(2 + 2 * n):
-            h = 1e-6 * scale[i]
-            xp, xm = x.copy(), x.copy()
-            xp[i] += h
-            xm[i] -= h
-            jac[:, i] = (residual(xp)[0] - residual(xm)[0]) / (2 * h) * scale[i]
-        dx = np.linalg.lstsq(jac, -res, rcond=None)[0] * scale
-        step = 1.0
-        for _ in range(8):
-            trial = x + step * dx
-            r_trial, _ = residual(trial)
-            if np.max(np.abs(r_trial)) < np.max(np.abs(res)):
-                break
-            step *= 0.5
-        x, res = trial, r_trial
-        if np.max(np.abs(res)) < tol:
-            break
-    # monodromy of the coupled model: d y(T) / d x = jacobian of the residual + identity (unscaled)
-    mono = (jac * scale[:, None] / scale[None, :]) + np.eye(2 + 2 * n) if jac is not None else None
-    out.update(phi0=float(x[0]), wz0=float(x[1]), q0=x[2:2 + n].copy(), qdot0=x[2 + n:].copy(), residual=float(np.max(np.abs(res))),
-               iterations=it, multipliers=np.linalg.eigvals(mono) if mono is not None else None)
+    x, res, it, reason, mono = _core.flexible_correct_periodic(sys_.mu, arg, [True, True], s0, T, [float(v) for v in x], float(turns),
+                                                               [float(v) for v in scale], options=opts, tol=float(tol), max_iter=int(max_iter))
+    x = np.asarray(x)
+    out.update(phi0=float(x[0]), wz0=float(x[1]), q0=x[2:2 + n].copy(), qdot0=x[2 + n:].copy(), residual=float(res),
+               iterations=int(it), multipliers=np.linalg.eigvals(mono) if np.all(np.isfinite(mono)) else None, reason=reason)
     return FlexiblePeriodic(**out)
 
 

@@ -177,7 +177,38 @@ fn flexible_rates(mu: f64, body_arg: BodyArg, primaries: [bool; 2], orbit: [f64;
     Ok(flexible::flexible_rates(mu, &b, primaries, &orbit, phi, wz, &q, &qdot))
 }
 
+/// Correct (phi0, wz0, q0, qdot0) to a periodic motion of the coupled flexible model over one
+/// orbit period (librate_core::flexible::correct_flexible_periodic): returns (x, scaled residual
+/// max-norm, iterations, stop reason, monodromy (m, m)).
+#[pyfunction]
+#[pyo3(signature = (mu, body_arg, primaries, orbit0, period, x0, turns, scale, *, options, tol, max_iter, threads=None))]
+#[allow(clippy::too_many_arguments, clippy::type_complexity)]
+fn flexible_correct_periodic<'py>(
+    py: Python<'py>,
+    mu: f64,
+    body_arg: BodyArg,
+    primaries: [bool; 2],
+    orbit0: [f64; 6],
+    period: f64,
+    x0: Vec<f64>,
+    turns: f64,
+    scale: Vec<f64>,
+    options: OptionsArg,
+    tol: f64,
+    max_iter: usize,
+    threads: Option<usize>,
+) -> PyResult<(Bound<'py, PyAny>, f64, usize, &'static str, Bound<'py, PyAny>)> {
+    let b = body(body_arg)?;
+    let opts = Options::from(options);
+    let r = py
+        .detach(|| flexible::correct_flexible_periodic(mu, &b, primaries, &orbit0, period, &x0, turns, &scale, &opts, tol, max_iter, threads))
+        .map_err(to_py)?;
+    let m = r.x.len();
+    Ok((r.x.into_pyarray(py).into_any(), r.residual, r.iterations, r.reason.as_str(), r.monodromy.into_pyarray(py).reshape([m, m])?.into_any()))
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(flexible_correct_periodic, m)?)?;
     m.add_function(wrap_pyfunction!(flexible_body_check, m)?)?;
     m.add_function(wrap_pyfunction!(flexible_propagate, m)?)?;
     m.add_function(wrap_pyfunction!(flexible_quasi_static, m)?)?;

@@ -129,10 +129,12 @@
 
 pub mod body;
 pub mod dynamics;
+pub mod periodic;
 pub mod propagate;
 pub mod quasi_static;
 
 pub use body::{Appendage, FlexibleBody, GEOMETRY_TOL};
+pub use periodic::{correct_flexible_periodic, FlexiblePeriodic};
 pub use dynamics::{tidal_field, tidal_field_derivatives, BodyField, Energies, FlexibleAlongOrbit};
 pub use propagate::{evaluate_energies, flexible_rates, propagate_flexible, propagate_quasi_static, quasi_static_point, FlexibleTrajectory, QuasiStaticTrajectory};
 pub use quasi_static::{QuasiStaticAlongOrbit, QuasiStaticPoint};
