@@ -289,7 +289,9 @@ def refine(orbit, kz, phi0, cands, *, n_periods, srp, closure, window, kinds=KIN
     kind = np.where(ks % 2 == 0, "periodic", "half-turn")
     kzs = np.array([c[2] for c in cands])
     b = correct(orbit, kz=kzs, n_total=n_total, kind=kind, phi0=phi0, wz0=np.array([c[1] for c in cands]), n_periods=n_periods, srp=srp,
-                closure=closure, monodromy=False)  # the verification brings the monodromy
+                closure=closure, monodromy=False,  # the verification brings the monodromy
+                # a map candidate is a close guess: one that needs more is no solution nearby
+                max_iter=STEP_MAX_ITER, max_halvings=3)
     lo, hi = window
     ok = np.flatnonzero(b.converged & (b.wz0 >= lo) & (b.wz0 <= hi))
     sols = verified(orbit, kz=kzs[ok], n_total=n_total[ok], kind=kind[ok], phi0=b.phi0[ok], wz0=b.wz0[ok], n_periods=n_periods,
