@@ -217,7 +217,7 @@ def solutions_from_rows(orbit, kzs, phi0, wz, phi_t_rows, n_periods, srp=None) -
         kk += [float(k)] * len(c)
     symmetric = is_symmetric(orbit, phi0) and (srp is None or srp.eps == 0.0)
     sols = refine(orbit, np.array(kk), phi0, cands, n_periods=n_periods, srp=srp, closure="half" if symmetric else "full",
-                  window=(float(wz[0]), float(wz[-1])))
+                  window=(float(wz[0]), float(wz[-1])), quick=symmetric)
     return sorted(sols, key=lambda s: (s.kz, s.wz0))
 
 

@@ -275,11 +275,13 @@ def candidates(phi_t, phi0, wz, level):
     return out
 
 
-def refine(orbit, kz, phi0, cands, *, n_periods, srp, closure, window, kinds=KINDS) -> list[AttitudeSolution]:
+def refine(orbit, kz, phi0, cands, *, n_periods, srp, closure, window, kinds=KINDS, quick=False) -> list[AttitudeSolution]:
     """Refine (k, wz0) candidates (k = 2 turns over the K periods, odd k a half turn) in ONE
     corrector call and verify the converged ones in one more; keep those inside ``window``
     with an independent residual below 1e-8, one per (turns, kind, wz0 to 1e-8), sorted by wz0.
-    ``kz`` may be one value or one per candidate."""
+    ``kz`` may be one value or one per candidate. ``quick``: the candidates are close guesses
+    of the half-period closure (a fine map's crossings), and one that needs more than a few
+    Newton steps has no solution nearby: the corrector gives up early."""
     cands = [(k, w, kk) for (k, w), kk in zip(cands, np.broadcast_to(np.asarray(kz, dtype=float), (len(cands),)))
              if ("periodic" if k % 2 == 0 else "half-turn") in kinds]
     if not cands:
@@ -290,8 +292,7 @@ def refine(orbit, kz, phi0, cands, *, n_periods, srp, closure, window, kinds=KIN
     kzs = np.array([c[2] for c in cands])
     b = correct(orbit, kz=kzs, n_total=n_total, kind=kind, phi0=phi0, wz0=np.array([c[1] for c in cands]), n_periods=n_periods, srp=srp,
                 closure=closure, monodromy=False,  # the verification brings the monodromy
-                # a map candidate is a close guess: one that needs more is no solution nearby
-                max_iter=STEP_MAX_ITER, max_halvings=3)
+                **({"max_iter": STEP_MAX_ITER, "max_halvings": 3} if quick else {}))
     lo, hi = window
     ok = np.flatnonzero(b.converged & (b.wz0 >= lo) & (b.wz0 <= hi))
     sols = verified(orbit, kz=kzs[ok], n_total=n_total[ok], kind=kind[ok], phi0=b.phi0[ok], wz0=b.wz0[ok], n_periods=n_periods,
