@@ -230,7 +230,7 @@ fn val_flexible_periodic_corrector() {
     let (s0, t) = dro(0.8);
     let body = station(300.0, 400.0, 0.0);
     let f = OrbitForcing::new(MU, &s0, t, [true, true], 1e-13).unwrap();
-    let rigid = correct_planar_attitudes(&f, 0.5 * t, Closure::Half, Free::Phi0, &[Candidate::new(0.0, 1.0 + 2.0 * std::f64::consts::PI * -1.0 / t, body.kz(), -1.0)],
+    let rigid = correct_planar_attitudes(&f, 0.5 * t, Closure::Half, Free::Phi0, &[Candidate::new(0.0, 1.0 - 2.0 * std::f64::consts::PI / t, body.kz(), -1.0)],
                                          &CorrectorOptions::default()).unwrap()[0];
     assert!(rigid.converged());
     let n = body.n();
