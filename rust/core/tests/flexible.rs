@@ -235,7 +235,7 @@ fn val_flexible_periodic_corrector() {
     assert!(rigid.converged());
     let n = body.n();
     let mut x0 = vec![rigid.phi0 - body.principal_angle(), rigid.wz0];
-    x0.extend(std::iter::repeat(0.0).take(2 * n));
+    x0.extend(std::iter::repeat_n(0.0, 2 * n));
     let scale: Vec<f64> = (0..2 + 2 * n).map(|i| if i < 2 { 1.0 } else { 1e-3 }).collect();
     let r = correct_flexible_periodic(MU, &body, [true, true], &s0, t, &x0, -1.0, &scale, &tight(), 1e-10, 20, None).unwrap();
     assert_eq!(r.reason, StopReason::Converged, "{:?} residual {}", r.reason, r.residual);
