@@ -294,17 +294,14 @@ def refine(orbit, kz, phi0, cands, *, n_periods, srp, closure, window, kinds=KIN
                 closure=closure, monodromy=False,  # the verification brings the monodromy
                 **({"max_iter": STEP_MAX_ITER, "max_halvings": 3} if quick else {}))
     lo, hi = window
-    ok = np.flatnonzero(b.converged & (b.wz0 >= lo) & (b.wz0 <= hi))
+    conv = sorted(np.flatnonzero(b.converged & (b.wz0 >= lo) & (b.wz0 <= hi)), key=lambda i: (kzs[i], b.wz0[i]))
+    ok: list[int] = []  # one per solution: candidates that converged onto the same one are verified once
+    for i in conv:
+        if not any(kzs[j] == kzs[i] and n_total[j] == n_total[i] and kind[j] == kind[i] and abs(b.wz0[j] - b.wz0[i]) < 1e-8 for j in ok):
+            ok.append(int(i))
     sols = verified(orbit, kz=kzs[ok], n_total=n_total[ok], kind=kind[ok], phi0=b.phi0[ok], wz0=b.wz0[ok], n_periods=n_periods,
-                    plates=None if srp is None else [srp] * ok.size, iterations=b.iterations[ok])
-    out: list[AttitudeSolution] = []
-    for s in sorted(sols, key=lambda s: (s.kz, s.wz0)):
-        if s.residual > 1e-8:
-            continue
-        if any(o.kz == s.kz and o.n_total == s.n_total and o.kind == s.kind and abs(o.wz0 - s.wz0) < 1e-8 for o in out):
-            continue
-        out.append(s)
-    return out
+                    plates=None if srp is None else [srp] * len(ok), iterations=b.iterations[ok])
+    return [s for s in sols if s.residual <= 1e-8]
 
 
 def find_periodic_attitudes(
