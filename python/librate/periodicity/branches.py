@@ -288,7 +288,7 @@ def eps_branch(solution: AttitudeSolution, srp, *, steps: int = 10, min_step: fl
         raise ConvergenceError(f"continue_srp: the starting solution does not correct at eps = {e0}: {e}") from None
     h = abs(target - e0) / steps
     rules = StepRules(ds=h, ds_min=min(min_step, h), ds_max=max(h, min(4 * h, 0.25)))
-    return arclength(problem, first, direction=1 if target > e0 else -1, target=target, stop_at_fold=True,
+    return arclength(problem, first, direction=1 if target > e0 else -1, target=target, stop_at_fold=True, locate_bifurcations=False,
                      marks=tuple(float(m) for m in marks), rules=rules, max_points=10_000, name="eps")
 
 

@@ -303,6 +303,7 @@ def arclength(
     locate: bool = True,
     fold_tol: float = 1e-8,
     stop_at_fold: bool = False,
+    locate_bifurcations: bool = True,
     marks: Sequence[float] = (),
     name: str = "parameter",
     stop: Callable[[Point], str | None] | None = None,
@@ -315,7 +316,10 @@ def arclength(
     it (``Branch.reached``). Folds are located to ``fold_tol`` in the parameter and bifurcations
     (sign changes of ``problem.tests``) to the same tolerance when ``locate``; a fold is passed
     and the branch followed on, back in the parameter, unless ``stop_at_fold`` (then the branch
-    ends at the located fold: its last point is the turning point, within ``fold_tol``). ``marks``: parameter values at which
+    ends at the located fold: its last point is the turning point, within ``fold_tol``).
+    ``locate_bifurcations=False`` reports them at the linear interpolation of the test function
+    (cheaper; branch points cannot be located more finely by a corrector anyway, the extended
+    Jacobian being singular there). ``marks``: parameter values at which
     the branch is also corrected exactly, each time a step crosses one (``Branch.marked``; a
     branch that folds back over a value marks it again).
     """
@@ -439,7 +443,11 @@ def arclength(
         for test, v in tests_new.items():
             u = tests_prev.get(test)
             if u is not None and math.isfinite(u) and math.isfinite(v) and u * v < 0:
-                branch.bifurcations.append(_locate_sign(problem, test, base, t, ds, u, v, new, at, fold_tol) if locate else Bifurcation(test, float(new.x[k]), new, False))
+                if locate and locate_bifurcations:
+                    branch.bifurcations.append(_locate_sign(problem, test, base, t, ds, u, v, new, at, fold_tol))
+                else:  # the linear interpolation of the test function between the two points
+                    w = u / (u - v)
+                    branch.bifurcations.append(Bifurcation(test, float(base.x[k] + w * (new.x[k] - base.x[k])), new, False))
         tests_prev = tests_new
         for m in marks:
             if (base.x[k] - m) * (new.x[k] - m) < 0 or new.x[k] == m:
