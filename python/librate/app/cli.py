@@ -36,6 +36,7 @@ def main() -> None:
       librate solve study.toml         periodic attitude motions of each orbit, as a table
       librate map study.toml           the attitude periodicity map (thesis Fig. 24)
       librate plot librate-out/map.zarr   re-draw figures from a saved result
+      librate verify librate-out/map.zarr checksums: name any damaged chunk or row
       librate demo                     the DRO map at Kz = 0.8 with no study file
 
     Units: nondimensional CR3BP units (LU = distance between the primaries, TU = 1 / mean
@@ -466,6 +467,30 @@ def plot(result_path, quiet) -> None:
     written = _figures(res, p.parent, names, quiet)
     if not written:
         raise click.ClickException("no figure could be drawn (see the messages above)")
+
+
+@main.command(context_settings=_CONTEXT)
+@click.argument("result_path", type=click.Path(exists=True))
+def verify(result_path) -> None:
+    """Check a saved result for damage, without recomputing it.
+
+    \b
+    RESULT_PATH: a map store written by `librate map` (map.zarr): every row of dwz, dphi,
+    phi_T and status is read and compared with the checksum written beside its `done` flag;
+    rows not computed yet, missing, truncated or garbled chunks, and damaged coordinates or
+    solutions are named. Other results (family, solutions, map.nc): every variable is read and
+    compared with its stored checksum. Exit status 0 when intact, 1 when damaged or
+    incomplete (re-running the same `librate map` recomputes the damaged rows).
+    """
+    from .results import verify_result
+
+    try:
+        ok, report = verify_result(result_path)
+    except (ValueError, FileNotFoundError) as err:
+        raise click.ClickException(str(err)) from None
+    click.echo(report)
+    if not ok:
+        sys.exit(1)
 
 
 def _figures(result, folder: Path, names, quiet: bool) -> list[Path]:
