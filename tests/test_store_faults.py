@@ -367,3 +367,16 @@ def test_incomplete_store_is_reported_not_damaged(tmp_path, fam, write_counts):
     assert not rep.ok and rep.not_done and not rep.damaged, rep.describe()
     assert "rows not computed yet" in rep.describe()
 
+
+
+def test_plot_refuses_a_damaged_store_by_name(tmp_path, good_store):
+    """Issue 12 #3: a garbage chunk surfaced in `librate plot` only as "error during blosc
+    decompression: -1" with asyncio traceback noise; now the damage is named, no traceback."""
+    from click.testing import CliRunner
+    from librate.app.cli import main
+
+    out = _copy(good_store, tmp_path)
+    _damage(out / "dwz" / "0.0.0", "garbage", 3)
+    r = CliRunner().invoke(main, ["plot", str(out)])
+    assert r.exit_code == 1 and "chunk dwz/0.0.0" in r.output and "row 0" in r.output, r.output
+    assert "Traceback" not in r.output and "asyncio" not in r.output

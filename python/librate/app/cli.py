@@ -452,6 +452,7 @@ def plot(result_path, quiet) -> None:
 
     try:
         p = resolve_result_path(result_path)
+        _refuse_damaged_store(p)
         res = open_result(p)
     except (ValueError, FileNotFoundError) as err:
         raise click.ClickException(str(err)) from None
@@ -467,6 +468,17 @@ def plot(result_path, quiet) -> None:
     written = _figures(res, p.parent, names, quiet)
     if not written:
         raise click.ClickException("no figure could be drawn (see the messages above)")
+
+
+def _refuse_damaged_store(p: Path) -> None:
+    """A map store with damaged rows or arrays is refused by name (an incomplete one is drawn)."""
+    from .store import verify_map_store
+
+    if not (p / ".zgroup").is_file():
+        return
+    rep = verify_map_store(p)
+    if rep.damaged or (rep.problems and "not a librate map store (no librate_store marker" not in rep.problems[0]):
+        raise ValueError(rep.describe())
 
 
 @main.command(context_settings=_CONTEXT)
