@@ -124,7 +124,8 @@ def verify_result(path: str | Path) -> tuple[bool, str]:
     missing, truncated or garbled chunk is named) and compared with the digests stored in
     its ``librate_checksums`` attribute when it has them. Returns ``(ok, report)``: the report
     names every damaged row or variable."""
-    from .store import array_digest, verify_map_store
+    from .._integrity import array_digest, missing_zarr_chunks
+    from .store import verify_map_store
 
     p = resolve_result_path(path)
     if _is_zarr(p):
@@ -157,7 +158,7 @@ def verify_result(path: str | Path) -> tuple[bool, str]:
                 problems.append(f"variable {name} is unreadable ({type(err).__name__}: {str(err).splitlines()[0] if str(err) else ''})")
                 continue
             if _is_zarr(p):
-                chunks_missing = _missing_chunks(p, str(name))
+                chunks_missing = missing_zarr_chunks(p, str(name))
                 if chunks_missing:
                     problems.append(f"variable {name}: chunk(s) {', '.join(chunks_missing)} missing")
             if sums is not None and name in sums and array_digest(values) != sums[name]:
@@ -184,24 +185,6 @@ def _stored_checksums(ds) -> dict | None:
     except ValueError:
         return None
     return sums if isinstance(sums, dict) else None
-
-
-def _missing_chunks(p: Path, name: str) -> list[str]:
-    """The chunk files a Zarr v2 array of the store ``p`` should have and has not."""
-    import json
-
-    try:
-        meta = json.loads((p / name / ".zarray").read_text())
-        shape, chunks, sep = meta["shape"], meta["chunks"], meta.get("dimension_separator", ".")
-    except (OSError, ValueError, KeyError):
-        return []
-    import itertools
-
-    if any(n == 0 for n in shape):
-        return []
-    counts = [-(-n // c) for n, c in zip(shape, chunks)]
-    keys = [sep.join(map(str, idx)) for idx in itertools.product(*[range(c) for c in counts])] if counts else ["0"]
-    return [f"{name}/{k}" for k in keys if not (p / name / k).is_file()]
 
 
 def _check_target(p: Path) -> None:
@@ -253,12 +236,10 @@ def save_dataset(ds, path: str | Path) -> Path:
 def _with_checksums(ds):
     """``ds`` with the digests of every variable in its ``librate_checksums`` attribute (JSON),
     which :func:`verify_result` and :meth:`OrbitFamily.load` check."""
-    import json
-
-    from .store import array_digest
+    from .._integrity import CHECKSUM_ATTR, dataset_checksums
 
     ds = ds.copy()
-    ds.attrs["librate_checksums"] = json.dumps({str(k): array_digest(np.asarray(ds[k].values)) for k in ds.variables})
+    ds.attrs[CHECKSUM_ATTR] = dataset_checksums(ds)
     return ds
 
 

@@ -22,9 +22,10 @@ from pathlib import Path
 
 import numpy as np
 
+from .._integrity import array_digest
 from ..periodicity.maps import map_coords, map_dataset, map_grid, map_solutions_dataset, orbits_of, solutions_from_row
 from ..periodicity.solutions import MAP_ATOL, MAP_RTOL, check_orbit, check_srp, orbit_forcing, sweep
-from .store import ROW_VARS, array_digest, check_rows, open_map_group, read_array, row_checksum, writer_lock
+from .store import ROW_VARS, check_rows, open_map_group, read_array, row_checksum, writer_lock
 
 __all__ = ["run_map"]
 

@@ -33,6 +33,8 @@ from pathlib import Path
 
 import numpy as np
 
+from .._integrity import array_digest
+
 __all__ = [
     "ROW_VARS",
     "StoreBusyError",
@@ -98,20 +100,6 @@ def _digest(values) -> int:
 def row_checksum(row: dict) -> np.ndarray:
     """The (4,) uint64 digests of one row's ``ROW_VARS`` (as they are stored)."""
     return np.array([_digest(np.asarray(row[k], dtype=np.uint8 if k == "status" else np.float64)) for k in ROW_VARS], dtype=np.uint64)
-
-
-def array_digest(values) -> str:
-    """A hex digest of an array's shape and values, independent of how a file format stores
-    them (numbers as float64, text as UTF-8): for coordinates, solutions and saved results."""
-    a = np.asarray(values)
-    h = hashlib.blake2b(digest_size=16)
-    h.update(repr(a.shape).encode())
-    if a.dtype.kind in "biuf":
-        f = np.ascontiguousarray(a, dtype=np.float64)
-        h.update(np.where(np.isnan(f), np.nan, f).tobytes())  # one NaN, whatever its payload
-    else:
-        h.update("\0".join(x.decode() if isinstance(x, bytes) else str(x) for x in a.ravel().tolist()).encode())
-    return h.hexdigest()
 
 
 @contextlib.contextmanager

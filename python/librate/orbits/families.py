@@ -214,34 +214,133 @@ class OrbitFamily:
         return ds
 
     def save(self, path) -> None:
-        """Write to netCDF (``.nc``) or Zarr (``.zarr``)."""
-        path = str(path)
+        """Write to netCDF (``.nc``) or Zarr (``.zarr``), with a digest of every variable
+        (attribute ``librate_checksums``) that :meth:`load` checks.
+
+        All or nothing: written to a temporary sibling, then renamed. An existing ``path`` is
+        replaced only when it is a librate family file; anything else there (a foreign file,
+        a folder with other files) is refused with ``FileExistsError``, never overwritten."""
+        import os
+        import shutil
+        from pathlib import Path
+
+        from .._integrity import CHECKSUM_ATTR, dataset_checksums
+
+        p = Path(path)
+        if p.suffix not in (".zarr", ".nc"):
+            raise ValueError(f"invalid argument `path`: must end in .nc (netCDF) or .zarr (Zarr), got {str(path)!r}")
+        if (p.exists() or p.is_symlink()) and not (p.is_dir() and not any(p.iterdir())):
+            try:
+                OrbitFamily.load(p)
+            except (ValueError, OSError) as err:
+                raise FileExistsError(f"{str(p)!r} exists and is not a valid librate family file ({err}): refusing to overwrite it; "
+                                      "remove it or choose another path") from None
         ds = self.to_dataset()
-        if path.endswith(".zarr"):
-            ds.to_zarr(path, mode="w", zarr_format=2, consolidated=True)
-        elif path.endswith(".nc"):
-            ds.to_netcdf(path, engine="scipy")
-        else:
-            raise ValueError(f"invalid argument `path`: must end in .nc (netCDF) or .zarr (Zarr), got {path!r}")
+        ds.attrs[CHECKSUM_ATTR] = dataset_checksums(ds)
+        p.parent.mkdir(parents=True, exist_ok=True)
+        tmp = p.with_name(f".{p.name}.tmp-{os.getpid()}")
+
+        def remove(q):
+            if q.is_dir() and not q.is_symlink():
+                shutil.rmtree(q)
+            elif q.exists() or q.is_symlink():
+                q.unlink()
+
+        remove(tmp)
+        try:
+            if p.suffix == ".zarr":
+                ds.to_zarr(tmp, mode="w-", zarr_format=2, consolidated=True)
+            else:
+                ds.to_netcdf(tmp, engine="scipy")
+            remove(p)
+            os.replace(tmp, p)
+        finally:
+            remove(tmp)
 
     @classmethod
     def load(cls, path) -> OrbitFamily:
-        """Read a family written by :meth:`save`; the numbers are identical."""
+        """Read a family written by :meth:`save`; the numbers are identical.
+
+        Raises ``FileNotFoundError``, or ``ValueError`` saying why ``path`` is not a (valid)
+        librate family file: unreadable (empty, truncated, garbage, not netCDF or Zarr), another
+        kind of file (no family variables or attributes), or damaged (a missing chunk, or a
+        variable that does not match its stored checksum)."""
         import ast
+        import json
+        from pathlib import Path
 
         import xarray as xr
 
-        path = str(path)
-        ds = xr.open_zarr(path) if path.endswith(".zarr") else xr.open_dataset(path, engine="scipy")
+        from .._integrity import CHECKSUM_ATTR, array_digest, missing_zarr_chunks
+
+        p = Path(path)
+        name = str(path)
+        if not p.exists():
+            raise FileNotFoundError(f"no librate family file at {name!r}")
+        if p.suffix not in (".zarr", ".nc"):
+            raise ValueError(f"{name!r} is not a librate family file: the name must end in .nc (netCDF) or .zarr (Zarr)")
+        not_family = f"{name!r} is not a librate family file"
+        try:
+            if p.suffix == ".zarr":
+                if not p.is_dir():
+                    raise ValueError("a .zarr family must be a folder")
+                ds = xr.open_zarr(p, consolidated=None, chunks=None)
+            else:
+                if not p.is_file():
+                    raise ValueError("a .nc family must be a file")
+                if p.stat().st_size == 0:
+                    raise ValueError("the file is empty")
+                ds = xr.open_dataset(p, engine="scipy")
+        except Exception as err:  # noqa: BLE001 - whatever the reader says, it is not a family file
+            raise ValueError(f"{not_family}: it cannot be read as {'Zarr' if p.suffix == '.zarr' else 'netCDF 3'} "
+                             f"({type(err).__name__}: {str(err).strip().splitlines()[0] if str(err).strip() else 'no details'})") from None
         with ds:
             a = ds.attrs
-            system = System(mu=float(a["mu"]), lu_km=float(a["lu_km"]), tu_s=float(a["tu_s"]), r1_km=float(a["r1_km"]), r2_km=float(a["r2_km"]), name=str(a["system_name"]))
+            kind = a.get("librate_result")
+            if kind is not None and kind != "family":
+                raise ValueError(f"{not_family}: it is a librate {kind} result")
+            need_vars = ("state0", "state_half", "period", "jacobi", "eigenvalues_real", "eigenvalues_imag", "stability_real", "stability_imag")
+            need_attrs = ("mu", "lu_km", "tu_s", "r1_km", "r2_km", "system_name", "kind", "spatial", "end_reason", "bifurcations", "parameters")
+            miss = [v for v in need_vars if v not in ds.variables] + [f"attribute {k}" for k in need_attrs if k not in a]
+            if miss:
+                raise ValueError(f"{not_family}: missing {', '.join(miss)}")
+            if p.suffix == ".zarr":
+                gone = [c for v in ds.variables for c in missing_zarr_chunks(p, str(v))]
+                if gone:
+                    raise ValueError(f"{name!r} is a damaged librate family file: chunk(s) {', '.join(gone)} missing")
+            try:
+                values = {v: np.asarray(ds[v].values) for v in ds.variables}
+            except Exception as err:  # noqa: BLE001 - a garbled chunk: named, never a decompressor traceback
+                raise ValueError(f"{name!r} is a damaged librate family file: a variable cannot be read ({type(err).__name__}: {err})") from None
+            sums = a.get(CHECKSUM_ATTR)
+            if isinstance(sums, str):
+                try:
+                    sums = json.loads(sums)
+                except ValueError:
+                    raise ValueError(f"{name!r} is a damaged librate family file: attribute {CHECKSUM_ATTR} is not valid JSON") from None
+                bad = [v for v, want in sums.items() if v in values and array_digest(values[v]) != want]
+                if bad:
+                    raise ValueError(f"{name!r} is a damaged librate family file: {', '.join(bad)} do(es) not match the stored checksum(s)")
+            n = values["period"].shape[0] if values["period"].ndim == 1 else -1
+            shapes = {"state0": (n, 6), "state_half": (n, 6), "period": (n,), "jacobi": (n,), "eigenvalues_real": (n, 6), "eigenvalues_imag": (n, 6),
+                      "stability_real": (n, 2), "stability_imag": (n, 2)}
+            wrong = [f"{v} {values[v].shape} (expected {s})" for v, s in shapes.items() if values[v].shape != s]
+            if wrong:
+                raise ValueError(f"{not_family}: inconsistent shapes: {'; '.join(wrong)}")
+            try:
+                system = System(mu=float(a["mu"]), lu_km=float(a["lu_km"]), tu_s=float(a["tu_s"]), r1_km=float(a["r1_km"]), r2_km=float(a["r2_km"]),
+                                name=str(a["system_name"]))
+                spatial = bool(int(a["spatial"]))
+                bif = ast.literal_eval(str(a["bifurcations"]))
+                params = ast.literal_eval(str(a["parameters"]))
+            except (ValueError, TypeError, SyntaxError, LibrateError) as err:
+                raise ValueError(f"{not_family}: invalid attributes ({type(err).__name__}: {err})") from None
             return cls(
-                system, str(a["kind"]), bool(int(a["spatial"])),
-                ds["state0"].values.copy(), ds["state_half"].values.copy(), ds["period"].values.copy(), ds["jacobi"].values.copy(),
-                ds["eigenvalues_real"].values + 1j * ds["eigenvalues_imag"].values,
-                ds["stability_real"].values + 1j * ds["stability_imag"].values,
-                str(a["end_reason"]), ast.literal_eval(str(a["bifurcations"])), ast.literal_eval(str(a["parameters"])),
+                system, str(a["kind"]), spatial,
+                values["state0"].copy(), values["state_half"].copy(), values["period"].copy(), values["jacobi"].copy(),
+                values["eigenvalues_real"] + 1j * values["eigenvalues_imag"],
+                values["stability_real"] + 1j * values["stability_imag"],
+                str(a["end_reason"]), bif, params,
             )
 
 
