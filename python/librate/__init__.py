@@ -8,7 +8,7 @@ All quantities are nondimensional (CR3BP units) unless a name says otherwise
 import warnings as _warnings
 
 from ._core import __version__
-from ._errors import ConvergenceError, IntegrationError, LibrateError
+from ._errors import CollisionError, ConvergenceError, IntegrationError, LibrateError
 from .app import Study, StudyError, open_result, run_map
 from .attitude import (
     Appendage,
@@ -69,6 +69,7 @@ __all__ = [
     "__version__",
     "LibrateError",
     "IntegrationError",
+    "CollisionError",
     "ConvergenceError",
     "System",
     "Event",

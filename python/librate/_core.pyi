@@ -7,6 +7,7 @@ import numpy.typing as npt
 
 __version__: str
 __all__ = [
+    "CollisionError",
     "ConvergenceError",
     "IntegrationError",
     "LibrateError",
@@ -45,6 +46,11 @@ class IntegrationError(LibrateError):
     steps: int
     kind: str
 
+class CollisionError(IntegrationError):
+    primary: int
+    distance: float
+    radius: float
+
 class ConvergenceError(LibrateError):
     iterations: int
     residual: float
@@ -72,6 +78,7 @@ def propagate(
     stm: bool,
     t_eval: _F64 | None,
     events: list[tuple[str, list[float], int, bool]],
+    collision: tuple[float, float] | None = None,
 ) -> dict[str, Any]: ...
 def propagate_many(
     mu: float,
@@ -82,6 +89,7 @@ def propagate_many(
     options: _Options,
     stm: bool,
     threads: int | None,
+    collision: tuple[float, float] | None = None,
 ) -> dict[str, Any]: ...
 def jacobi(mu: float, states: _F64) -> _F64: ...
 def lagrange_points(mu: float) -> _F64: ...

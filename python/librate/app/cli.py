@@ -154,7 +154,7 @@ def dros(system_name: str, x0_values: tuple[float, ...]) -> None:
     for x0 in xs:
         t_start = time.perf_counter()
         orbit = correct_dro(system, x0, guess)
-        one = propagate(system, orbit.state0, orbit.period, rtol=1e-13, atol=1e-13, t_eval=[orbit.period])
+        one = propagate(system, orbit.state0, orbit.period, rtol=1e-13, atol=1e-13, t_eval=[orbit.period], collision="point")
         closure = float(np.max(np.abs(one.y[-1] - orbit.state0)))
         elapsed = time.perf_counter() - t_start
         click.echo(

@@ -65,7 +65,7 @@ class PeriodicOrbit:
         """Monodromy matrix Phi(T, 0) (6, 6)."""
         from .propagation import propagate
 
-        return propagate(self.system, self.state0, self.period, stm=True, rtol=SHOOT_RTOL, atol=SHOOT_ATOL).stm
+        return propagate(self.system, self.state0, self.period, stm=True, rtol=SHOOT_RTOL, atol=SHOOT_ATOL, collision="point").stm
 
     @cached_property
     def _stability(self):
@@ -88,9 +88,12 @@ class PeriodicOrbit:
 
     def propagate(self, n_periods: float = 1.0, **kwargs):
         """Propagate the orbit over ``n_periods`` periods (keyword arguments go to
-        :func:`librate.propagate`; default tolerances 1e-13)."""
+        :func:`librate.propagate`; default tolerances 1e-13). The orbit is a solution of the
+        point-mass model, so by default only the singular point counts as a collision
+        (``collision="point"``); pass ``collision="radius"`` to stop at a primary's surface."""
         from .propagation import propagate
 
+        kwargs.setdefault("collision", "point")
         kwargs.setdefault("rtol", SHOOT_RTOL)
         kwargs.setdefault("atol", SHOOT_ATOL)
         return propagate(self.system, self.state0, n_periods * self.period, **kwargs)
