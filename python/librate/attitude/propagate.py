@@ -19,7 +19,7 @@ from .. import _core
 from .._checks import as_state, as_time_span
 from ..orbits.propagation import Stats, integration_options
 from ..orbits.system import System, resolve_system
-from .body import EULER_SEQUENCES, TORQUES, RigidBody
+from .body import EULER_SEQUENCES, RigidBody, torque_names
 from .flexible import FlexibleBody, FlexibleResponse, enabled_primaries, flexible_attitude, initial_deflection
 from .srp import FacetBody, FlatPlate, Sun
 
@@ -142,10 +142,7 @@ def propagate_attitude(
     t0, tf = as_time_span(t_span)
     if not isinstance(body, (RigidBody, FlexibleBody)):
         raise ValueError(f"invalid argument `body`: must be a librate.RigidBody or librate.FlexibleBody, got {body!r}")
-    names = tuple(torques)
-    for n in names:
-        if n not in TORQUES:
-            raise ValueError(f"invalid argument `torques`: unknown torque {n!r}; known: {', '.join(TORQUES)}")
+    names = torque_names(torques)
     if srp is not None and not (planar and isinstance(srp, FlatPlate)):
         raise ValueError("invalid argument `srp`: a librate.FlatPlate, for planar runs (3-D runs use a FacetBody with torques including 'srp')")
     if planar and "srp" in names:
@@ -179,6 +176,9 @@ def propagate_attitude(
         w = np.stack([zero, zero, wz], axis=1)
         return AttitudeTrajectory(sys_, body, names, True, r["t"], r["orbit"], q, w, phi, wz, r["stm"], Stats(*r["stats"]))
 
+    if isinstance(body, RigidBody) and body.is_rod:
+        raise ValueError(f"invalid argument `body`: a body with a zero principal moment (Kz = {body.kz:g}, a thin rod) has no 3-D attitude "
+                         "dynamics; use planar=True (the planar model depends only on Kz)")
     q0, w0 = _quaternion_and_rate(attitude)
     inertia_nd = None
     if orbit == "coupled":

@@ -58,7 +58,7 @@ class OrbitFamily:
         state0 = np.array([m.state0 for m in members])
         half = np.array([m._evaluation["crossing"] for m in members])
         period = np.array([m.period for m in members])
-        batch = propagate_many(system, state0, period, stm=True, rtol=SHOOT_RTOL, atol=SHOOT_ATOL, on_error="mask")
+        batch = propagate_many(system, state0, period, stm=True, rtol=SHOOT_RTOL, atol=SHOOT_ATOL, on_error="mask", collision="point")
         eig = np.full((len(members), 6), np.nan + 0j)
         nu = np.full((len(members), 2), np.nan + 0j)
         for i in range(len(members)):
@@ -147,10 +147,20 @@ class OrbitFamily:
             if d[-1] == 0:
                 brackets.append((states[-1], len(d) - 1))
         if not brackets:
-            q = {"x0": self.state0[:, 0], "z0": self.state0[:, 2], "period": self.period, "jacobi": self.jacobi}[name]
+            # the ranges searched: for halos, z0 at the half-period crossing too (the other
+            # side of the x-y plane), so the accepted values may form two intervals
+            user = next(iter(given))
+            spans = []
+            for st, what in zip(sets, ("initial states", "half-period crossings")):
+                q = {"x0": st[:, 0], "z0": st[:, 2], "period": self.period, "jacobi": self.jacobi}[name]
+                if user == "period_days":
+                    q = self.system.period_days(q)
+                spans.append(f"[{np.min(q):.10g}, {np.max(q):.10g}]" + (f" ({what})" if len(sets) > 1 and name in ("x0", "z0") else ""))
+                if name not in ("x0", "z0"):
+                    break
             raise ValueError(
-                f"invalid argument `{name}`: {value!r} is outside the {self.kind} family's range "
-                f"[{np.min(q):.10g}, {np.max(q):.10g}] (family end: {self.end_reason})"
+                f"invalid argument `{user}`: {float(given[user])!r} is outside the {self.kind} family's range "
+                f"{' or '.join(spans)} (family end: {self.end_reason})"
             )
         if not 0 <= which < len(brackets):
             raise ValueError(f"invalid argument `which`: the value is bracketed {len(brackets)} time(s); which must be in 0..{len(brackets) - 1}")
@@ -430,7 +440,7 @@ def _correct_dro_at(sys_, x0, ydot0, tol, max_iter, rtol, atol) -> PeriodicOrbit
     return correct_symmetric(sys_, (x0, 0.0, ydot0), fix="x0", family="dro", tol=tol, max_iter=max_iter, rtol=rtol, atol=atol)
 
 
-def dro_family(system: System | str = "earth-moon", x0=None, *, check_geometry: bool = True) -> OrbitFamily:
+def dro_family(system: System | str = "earth-moon", x0=None, *, check_geometry: bool = True, allow_partial: bool = False) -> OrbitFamily:
     """The planar DRO family by natural-parameter continuation in x0 (thesis eq. 20-22).
 
     ``x0``: the members wanted (any order along the family; default the whole family from
@@ -438,6 +448,11 @@ def dro_family(system: System | str = "earth-moon", x0=None, *, check_geometry: 
     silent jumps (Jacobi constant and period continuity, winding numbers about both primaries)
     and halved when needed; the run ends cleanly, with ``end_reason``, at a collision with the
     Earth's surface or a step floor, keeping every member found.
+
+    When ``x0`` is given, every requested member must be reached: otherwise
+    :class:`librate.LibrateError` lists the missing x0 values and why the continuation ended
+    (attributes ``missing``, ``found`` and ``end_reason``), unless ``allow_partial=True``, which
+    returns the members found (``parameters["missing_x0"]`` lists the others).
     """
     sys_ = resolve_system(system)
     mu = sys_.mu
@@ -453,7 +468,18 @@ def dro_family(system: System | str = "earth-moon", x0=None, *, check_geometry: 
             raise LibrateError(f"could not reach the first requested DRO at x0 = {xs[0]}: {lead.end_reason}")
         first = lead.members[-1]
     res = continue_natural(sys_, first, "x0", xs, family="dro", check_geometry=check_geometry, stop=stop)
-    return OrbitFamily.from_members(sys_, "dro", False, res.members, res.end_reason, {"rejected_jumps": res.rejected_jumps})
+    params: dict = {"rejected_jumps": res.rejected_jumps}
+    if x0 is not None:
+        got = np.array([m.x0 for m in res.members])
+        missing = [float(x) for x in xs if not np.any(np.abs(got - x) <= 1e-12 * max(1.0, abs(x)))]
+        if missing:
+            if not allow_partial:
+                err = LibrateError(f"dro_family: {len(missing)} of the {xs.size} requested members were not reached, x0 = {missing} "
+                                   f"(the continuation ended: {res.end_reason}); {len(res.members)} found; pass allow_partial=True to keep them")
+                err.missing, err.found, err.end_reason = missing, [float(v) for v in got], res.end_reason
+                raise err
+            params["missing_x0"] = missing
+    return OrbitFamily.from_members(sys_, "dro", False, res.members, res.end_reason, params)
 
 
 @functools.lru_cache(maxsize=8)

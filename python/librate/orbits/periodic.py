@@ -9,6 +9,7 @@ from functools import cached_property
 import numpy as np
 
 from .. import _core
+from .._checks import as_count, as_number
 from .system import System, resolve_system
 
 __all__ = ["PeriodicOrbit", "correct_symmetric", "correct_periodic"]
@@ -122,7 +123,12 @@ def correct_symmetric(
     or a target ``jacobi`` constant. Raises :class:`librate.ConvergenceError` on failure.
     """
     sys_ = resolve_system(system)
-    g = np.asarray(guess, dtype=np.float64).ravel()
+    as_number(tol, "tol", positive=True)
+    as_count(max_iter, "max_iter", 1)
+    try:
+        g = np.asarray(guess, dtype=np.float64).ravel()
+    except (TypeError, ValueError):
+        raise ValueError(f"invalid argument `guess`: must be finite (x0, z0, vy0) or a (6,) state, got {guess!r}") from None
     if g.shape == (6,):
         g = g[[0, 2, 4]]
     if g.shape != (3,) or not np.all(np.isfinite(g)):
@@ -177,13 +183,17 @@ def correct_periodic(
     The least-squares Newton step absorbs the conserved Jacobi constant's redundant equation.
     """
     sys_ = resolve_system(system)
-    patches = np.ascontiguousarray(np.atleast_2d(np.asarray(states, dtype=np.float64)))
+    as_number(tol, "tol", positive=True)
+    as_count(max_iter, "max_iter", 1)
+    try:
+        patches = np.ascontiguousarray(np.atleast_2d(np.asarray(states, dtype=np.float64)))
+    except (TypeError, ValueError):
+        raise ValueError(f"invalid argument `states`: must be (6,) or (n, 6) finite numbers, got {states!r}") from None
     if patches.ndim != 2 or patches.shape[1] != 6:
         raise ValueError(f"invalid argument `states`: must be (6,) or (n, 6), got shape {np.shape(states)}")
     if not np.all(np.isfinite(patches)):
         raise ValueError("invalid argument `states`: must be finite")
-    if not (math.isfinite(period) and period > 0):
-        raise ValueError(f"invalid argument `period`: must be finite and > 0, got {period!r}")
+    as_number(period, "period", positive=True)
     if fixed_period and jacobi is not None:
         raise ValueError("invalid argument: give `jacobi` or `fixed_period=True`, not both")
     if fixed_period:
