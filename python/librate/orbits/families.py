@@ -16,6 +16,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .. import _core
+from .._checks import as_count, as_real
 from .._errors import ConvergenceError, LibrateError
 from ..constants import SUN_SYNODIC_PERIOD
 from .continuation import continue_arclength, continue_natural, geometry
@@ -129,8 +130,7 @@ class OrbitFamily:
         if len(given) != 1:
             raise ValueError("invalid argument: give exactly one of x0, z0, period, period_days, jacobi")
         (name, value), = given.items()
-        if not math.isfinite(value):
-            raise ValueError(f"invalid argument `{name}`: must be finite, got {value!r}")
+        value = as_real(value, name)
         if name == "period_days":
             name, value = "period", self.system.from_days(value)
         if name == "z0" and not self.spatial:
@@ -406,15 +406,15 @@ def correct_dro(
     """
     sys_ = resolve_system(system)
     mu = sys_.mu
-    if not (isinstance(x0, (int, float, np.integer, np.floating)) and math.isfinite(x0) and -mu < x0 < 1.0 - mu):
+    if not (isinstance(x0, (int, float, np.integer, np.floating)) and not isinstance(x0, (bool, np.bool_)) and math.isfinite(x0) and -mu < x0 < 1.0 - mu):
         raise ValueError(f"invalid argument `x0`: a DRO starts between the primaries, -mu < x0 < 1 - mu = ({-mu}, {1 - mu}), got {x0!r}")
     x0 = float(x0)
-    if ydot0 is not None and not (math.isfinite(ydot0) and ydot0 > 0):
-        raise ValueError(f"invalid argument `ydot0`: must be finite and > 0 (retrograde about the Moon), got {ydot0!r}")
-    if not isinstance(max_iter, (int, np.integer)) or isinstance(max_iter, bool) or max_iter < 1:
-        raise ValueError(f"invalid argument `max_iter`: must be an integer >= 1, got {max_iter!r}")
-    if not (math.isfinite(tol) and tol > 0):
-        raise ValueError(f"invalid argument `tol`: must be a finite number > 0, got {tol!r}")
+    if ydot0 is not None:
+        ydot0 = as_real(ydot0, "ydot0", positive=True)
+    as_count(max_iter, "max_iter", 1)
+    as_real(tol, "tol", positive=True)
+    as_real(rtol, "rtol", positive=True)
+    as_real(atol, "atol", positive=True)
     d = 1.0 - mu - x0
     if ydot0 is None and d > 0.2:
         start = _correct_dro_at(sys_, 0.95, None, tol, max_iter, rtol, atol)
@@ -502,6 +502,7 @@ def dro(system: System | str = "earth-moon", *, x0: float | None = None, period:
     whole family (computed once per system and cached)."""
     sys_ = resolve_system(system)
     name, value = _one_target(dict(x0=x0, period=period, period_days=period_days, jacobi=jacobi))
+    value = as_real(value, name)
     if name == "x0":
         if not (math.isfinite(value) and -sys_.mu < value < 1 - sys_.mu):
             raise ValueError(f"invalid argument `x0`: DROs start between the primaries, -mu < x0 < 1 - mu; got {value!r}")
@@ -512,7 +513,7 @@ def dro(system: System | str = "earth-moon", *, x0: float | None = None, period:
 
 # --- Lyapunov and halo orbits -----------------------------------------------------------------
 def _check_point(point) -> int:
-    if point not in (1, 2):
+    if isinstance(point, (bool, np.bool_)) or point not in (1, 2):
         raise ValueError(f"invalid argument `point`: must be 1 (L1) or 2 (L2), got {point!r}")
     return int(point)
 
@@ -560,7 +561,7 @@ def lyapunov(system: System | str = "earth-moon", point: int = 1, *, x0: float |
 
 
 def _check_branch(branch) -> float:
-    if branch not in ("north", "south"):
+    if not isinstance(branch, str) or branch not in ("north", "south"):
         raise ValueError(f"invalid argument `branch`: must be 'north' or 'south', got {branch!r}")
     return 1.0 if branch == "north" else -1.0
 

@@ -9,7 +9,7 @@ from functools import cached_property
 import numpy as np
 
 from .. import _core
-from .._checks import as_count, as_number
+from .._checks import as_count, as_number, as_real
 from .system import System, resolve_system
 
 __all__ = ["PeriodicOrbit", "correct_symmetric", "correct_periodic"]
@@ -125,6 +125,12 @@ def correct_symmetric(
     sys_ = resolve_system(system)
     as_number(tol, "tol", positive=True)
     as_count(max_iter, "max_iter", 1)
+    for name, v in (("t_max", t_max), ("rtol", rtol), ("atol", atol)):
+        as_real(v, name, positive=True)
+    if period is not None:
+        period = as_real(period, "period", positive=True)
+    if jacobi is not None:
+        jacobi = as_real(jacobi, "jacobi")
     try:
         g = np.asarray(guess, dtype=np.float64).ravel()
     except (TypeError, ValueError):
@@ -185,6 +191,10 @@ def correct_periodic(
     sys_ = resolve_system(system)
     as_number(tol, "tol", positive=True)
     as_count(max_iter, "max_iter", 1)
+    for name, v in (("rtol", rtol), ("atol", atol)):
+        as_real(v, name, positive=True)
+    if jacobi is not None:
+        jacobi = as_real(jacobi, "jacobi")
     try:
         patches = np.ascontiguousarray(np.atleast_2d(np.asarray(states, dtype=np.float64)))
     except (TypeError, ValueError):

@@ -10,7 +10,7 @@ from typing import Literal
 import numpy as np
 
 from .. import _core
-from .._checks import as_direction, as_state, as_states, as_time_span
+from .._checks import as_count, as_direction, as_float_array, as_real, as_state, as_states, as_time_span
 from .._errors import CollisionError
 from .system import System, resolve_system
 
@@ -163,17 +163,17 @@ def _primary_name(system: System, k: int) -> str:
 
 
 def integration_options(rtol, atol, h0, h_min, h_max, max_steps, safety, fixed_step) -> dict:
-    if not isinstance(max_steps, (int, np.integer)) or max_steps < 1:
-        raise ValueError(f"invalid argument `max_steps`: must be an integer >= 1, got {max_steps!r}")
+    """The integrator settings, each checked for its type here (the core checks the ranges);
+    every error names the parameter."""
     return dict(
-        rtol=float(rtol),
-        atol=float(atol),
-        h0=None if h0 is None else float(h0),
-        h_min=float(h_min),
-        h_max=float(h_max),
-        max_steps=int(max_steps),
-        safety=float(safety),
-        fixed_step=None if fixed_step is None else float(fixed_step),
+        rtol=as_real(rtol, "rtol", positive=True),
+        atol=as_real(atol, "atol", positive=True),
+        h0=None if h0 is None else as_real(h0, "h0", positive=True),
+        h_min=as_real(h_min, "h_min", nonnegative=True),
+        h_max=as_real(h_max, "h_max", positive=True, allow_inf=True),
+        max_steps=as_count(max_steps, "max_steps", 1),
+        safety=as_real(safety, "safety", positive=True),
+        fixed_step=None if fixed_step is None else as_real(fixed_step, "fixed_step", positive=True),
     )
 
 
@@ -228,7 +228,7 @@ def propagate(
     for e in evs:
         if not isinstance(e, Event):
             raise ValueError(f"invalid argument `events`: must be librate.Event objects, got {e!r}")
-    te = None if t_eval is None else np.ascontiguousarray(t_eval, dtype=np.float64).ravel()
+    te = None if t_eval is None else as_float_array(t_eval, "t_eval").ravel()
     radii = collision_radii(sys_, collision)
     r = _core.propagate(
         sys_.mu, s, t0, tf, stm=bool(stm), t_eval=te, events=[e._spec(sys_) for e in evs],
@@ -297,12 +297,15 @@ def propagate_many(
     if not np.all(np.isfinite(arr)) and on_error == "raise":
         bad = int(np.argwhere(~np.isfinite(arr))[0][0])
         raise ValueError(f"invalid argument `states`: row {bad} is not finite")
-    tf = np.ascontiguousarray(np.atleast_1d(np.asarray(t_final, dtype=np.float64)).ravel())
+    tf = np.ascontiguousarray(np.atleast_1d(as_float_array(t_final, "t_final")).ravel())
+    if not np.all(np.isfinite(tf)):
+        raise ValueError(f"invalid argument `t_final`: must be finite, got {t_final!r}")
+    t0 = as_real(t0, "t0")
     if tf.size not in (1, arr.shape[0]):
         raise ValueError(f"invalid argument `t_final`: must be one time or one per state ({arr.shape[0]}), got {tf.size}")
     if on_error not in ("raise", "mask"):
         raise ValueError(f"invalid argument `on_error`: must be 'raise' or 'mask', got {on_error!r}")
-    if threads is not None and (not isinstance(threads, (int, np.integer)) or threads < 1):
+    if threads is not None and (isinstance(threads, (bool, np.bool_)) or not isinstance(threads, (int, np.integer)) or threads < 1):
         raise ValueError(f"invalid argument `threads`: must be an integer >= 1 or None (all cores), got {threads!r}")
     radii = collision_radii(sys_, collision)
     r = _core.propagate_many(
