@@ -21,7 +21,7 @@ em = librate.System.preset("earth-moon")
 orbit = librate.dro_family(em).resonant(2, "sun")
 print(f"1:2 Sun-resonant DRO: x0 = {orbit.x0:.6f} LU, T = {orbit.period_days:.3f} d")
 
-gravity = librate.periodic_attitude(orbit, kz=0.8, n=-2, n_periods=2)
+gravity = librate.periodic_attitude(orbit, kz=0.8, n=-1, n_periods=2)
 print(f"gravity gradient only: wz0 = {gravity.wz0:.8f} 1/TU, phi0 = {gravity.phi0:.3g} rad, residual {gravity.residual:.1e}")
 
 plate = librate.FlatPlate(0.02, cs=0.4)

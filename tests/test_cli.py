@@ -250,7 +250,7 @@ def test_srp_study_solve_and_map(run, tmp_path, no_runner):
     assert ds.sizes["solution"] >= 1 and set(ds["sol_n_periods"].values.tolist()) == {2}
     # the gravity-gradient N = -2 motion continued to eps = 0.02 (examples/03) is among them
     orbit = librate.dro_family("earth-moon").resonant(2, "sun")
-    ref = librate.continue_srp(librate.periodic_attitude(orbit, kz=0.8, n=-2, n_periods=2), librate.FlatPlate(0.02, cs=0.4)).solutions[-1]
+    ref = librate.continue_srp(librate.periodic_attitude(orbit, kz=0.8, n=-1, n_periods=2), librate.FlatPlate(0.02, cs=0.4)).solutions[-1]
     assert np.min(np.abs(ds["sol_wz0"].values - ref.wz0)) < 1e-9
     assert f"{ref.wz0:>13.8f}" in res.output
     run("map", "srp.toml", "--quiet")

@@ -690,14 +690,14 @@ def test_srp_map_solutions_and_plot_fig35(eps_map, sun12_orbit, tmp_path):
     rng = np.random.default_rng(3)
     for i in rng.choice(ds.sizes["solution"], 4, replace=False):
         plate = librate.FlatPlate(float(ds.sol_eps.values[i]), cs=0.4, cd=0.1)
-        phi0, wz0, n = float(ds.sol_phi0.values[i]), float(ds.sol_wz0.values[i]), int(ds.sol_n.values[i])
+        phi0, wz0, n = float(ds.sol_phi0.values[i]), float(ds.sol_wz0.values[i]), int(ds.sol_n_total.values[i])
         T = 2 * sun12_orbit.period
         tr = librate.propagate_attitude(sun12_orbit.system, sun12_orbit.state0, (phi0, wz0), librate.RigidBody.from_kz(0.6), T,
                                         planar=True, srp=plate, rtol=1e-13, atol=1e-13, t_eval=[T])
         assert abs(tr.phi[-1] - phi0 - 2 * math.pi * n) < 1e-9 and abs(tr.wz[-1] - wz0) < 1e-9
     for b in range(ds.sizes["branch"]):
         sel = ds.path_branch.values == b
-        lines = gid(ax, f"branch-{ds.branch_kind.values[b]}-N{int(ds.branch_n.values[b]):+d}")
+        lines = gid(ax, f"branch-{ds.branch_kind.values[b]}-N{float(ds.branch_n.values[b]):+g}")
         assert any(len(h.get_xdata()) == sel.sum() and np.array_equal(h.get_xdata(), ds.path_eps.values[sel])
                    and np.array_equal(h.get_ydata(), ds.path_wz0.values[sel] - 1.0) for h in lines)
     folds = gid(ax, "fold")

@@ -19,7 +19,7 @@ def sun12(em):
 
 @pytest.fixture(scope="module")
 def gravity_solution(sun12):
-    return librate.periodic_attitude(sun12, kz=0.8, n=-2, n_periods=2)
+    return librate.periodic_attitude(sun12, kz=0.8, n=-1, n_periods=2)
 
 
 def test_plate_model_equals_the_facet_model_in_3d(em, sun12):
@@ -49,7 +49,7 @@ def test_srp_solutions_tend_to_the_gravity_solution(sun12, gravity_solution):
     g = gravity_solution
     dist = []
     for eps in (4e-3, 2e-3, 1e-3):
-        s = librate.periodic_attitude(sun12, kz=0.8, n=-2, n_periods=2, srp=librate.FlatPlate(eps, cs=0.4, cd=0.1),
+        s = librate.periodic_attitude(sun12, kz=0.8, n=-1, n_periods=2, srp=librate.FlatPlate(eps, cs=0.4, cd=0.1),
                                       phi0=g.phi0, wz0=g.wz0, method="newton")
         dist.append(math.hypot(s.wz0 - g.wz0, s.phi0 - g.phi0))
     assert dist[0] / dist[1] == pytest.approx(2, rel=0.02) and dist[1] / dist[2] == pytest.approx(2, rel=0.02)
@@ -75,15 +75,25 @@ def test_srp_solution_repeats_over_k_revolutions_in_the_facet_model(em, sun12, g
 
 
 def test_continuation_reports_the_fold(gravity_solution):
-    """Continuing to a large eps, the branch folds: the fold is reported with the trace at 2
-    (Phi - I singular), and no solution past it (from another branch) is returned."""
+    """Continuing to a large eps, the branch folds: the turning point in eps is located (1e-8),
+    the monodromy trace is 2 there (Phi - I singular, 1e-3), and no solution past it (from
+    another branch) is returned. On the way the trace passes 2 once WITHOUT a turning point,
+    near eps = 0.52: with the Sun phase 0 the plate keeps the mirror symmetry, and that point is
+    a symmetry-breaking branch point (the continuation before issue 11 took it for the fold).
+    Reference: every returned solution re-propagated independently (1e-9), eps increasing up
+    to the fold, the fold's eps the largest reached, and a direct correction at eps just below
+    the fold from the last point converging onto the branch."""
     c = librate.continue_srp(gravity_solution, librate.FlatPlate(1.0, cs=0.4, cd=0.1))
-    assert not c.reached and c.fold is not None and "fold" in c.end_reason
+    assert not c.reached and c.fold is not None and c.fold["located"] and "fold" in c.end_reason
     assert 0 < c.fold["eps"] < 1.0 and abs(c.fold["trace"] - 2.0) < 1e-3
-    assert np.all(np.diff(c.eps) >= 0) and c.eps[-1] <= c.fold["eps"] + 1e-12
-    assert abs(c.solutions[-1].trace - 2.0) < 1e-3  # the last point sits next to the fold
-    traces = np.array([s.trace for s in c.solutions])
-    assert np.all(traces > 2.0)  # all on the starting side: never a point of the other branch
+    assert np.all(np.diff(c.eps) > 0) and abs(c.eps[-1] - c.fold["eps"]) < 1e-8  # the last point is the fold
+    assert all(s.residual < 1e-9 for s in c.solutions)
+    branch_points = [b for b in c.bifurcations if b["test"].startswith("trace = 2")]
+    assert len(branch_points) == 1 and 0.5 < branch_points[0]["eps"] < 0.55 < c.fold["eps"]
+    last = c.solutions[-1]
+    near = librate.periodic_attitude(gravity_solution.orbit, kz=0.8, n=-1, n_periods=2, phi0=last.phi0, wz0=last.wz0,
+                                     srp=librate.FlatPlate(c.fold["eps"] - 1e-4, cs=0.4, cd=0.1))
+    assert near.residual < 1e-9 and abs(near.wz0 - last.wz0) < 0.05
     # Regression: on the unstable N = 0 branch at Kz = 0.6 the continuation used to jump to
     # another branch at eps = 0.43 and run on to 0.66; the branch folds at eps = 0.3775.
     orbit = gravity_solution.orbit
@@ -146,13 +156,13 @@ def test_free_sun_phase_finds_the_symmetric_phases(sun12, gravity_solution):
     multiple of pi/K for this plate). Freeing the Sun phase from 0.3 converges to such a phase
     (K = 2: a multiple of pi/2, to 1e-9), and the solution repeats (1e-9)."""
     plate = librate.FlatPlate(0.05, cs=0.4, cd=0.1, sun=librate.Sun(theta0=0.3))
-    s = librate.periodic_attitude(sun12, kz=0.8, n=-2, n_periods=2, srp=plate, wz0=gravity_solution.wz0, free="theta_sun0")
+    s = librate.periodic_attitude(sun12, kz=0.8, n=-1, n_periods=2, srp=plate, wz0=gravity_solution.wz0, free="theta_sun0")
     assert s.phi0 == 0.0 and s.residual < 1e-9
     k = s.srp.sun.theta0 / (math.pi / 2)
     assert abs(k - round(k)) < 1e-9
     # the old spelling free="sun_phase" still works, with a DeprecationWarning
     with pytest.warns(DeprecationWarning, match="theta_sun0"), pytest.raises(ValueError, match="needs srp"):
-        librate.periodic_attitude(sun12, kz=0.8, n=-2, n_periods=2, free="sun_phase")
+        librate.periodic_attitude(sun12, kz=0.8, n=-1, n_periods=2, free="sun_phase")
 
 
 def test_map_over_several_plates(sun12):

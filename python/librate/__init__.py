@@ -63,10 +63,16 @@ from .periodicity import (
     frequency_scan,
     periodic_attitude,
     periodicity_map,
+    srp_map,
+    sun_pointing_accelerations,
+    zero_contours,
 )
 
 __all__ = [
     "__version__",
+    "srp_map",
+    "sun_pointing_accelerations",
+    "zero_contours",
     "LibrateError",
     "IntegrationError",
     "CollisionError",

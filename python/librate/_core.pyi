@@ -6,13 +6,28 @@ import numpy as np
 import numpy.typing as npt
 
 __version__: str
+#: Physical constants of the core (librate_core::constants).
+N_SUN: float
+OMEGA_SUN: float
+SOLAR_PRESSURE_1AU: float
+SUN_SYNODIC_PERIOD: float
 __all__ = [
     "CollisionError",
     "ConvergenceError",
+    "CorrectionBatch",
     "IntegrationError",
     "LibrateError",
+    "N_SUN",
+    "OMEGA_SUN",
     "OrbitForcing",
+    "PlanarFamily",
+    "PlanarVerification",
+    "SOLAR_PRESSURE_1AU",
+    "SUN_SYNODIC_PERIOD",
+    "SweepResult",
     "__version__",
+    "attitude_correct",
+    "attitude_correct_across",
     "attitude_propagate",
     "attitude_torques",
     "facets_force_torque",
@@ -28,13 +43,13 @@ __all__ = [
     "map_sweep",
     "multiple_shooting",
     "planar_propagate",
+    "planar_verify",
     "preset_names",
     "propagate",
     "propagate_many",
     "rigid_body_kz",
     "stability",
     "symmetric_correct",
-    "symmetric_evaluate",
     "system_preset",
     "system_validate",
 ]
@@ -99,7 +114,6 @@ def preset_names() -> list[str]: ...
 def symmetric_correct(
     mu: float, p: list[float], *, spatial: bool, constraint: str, values: list[float], tol: float, max_iter: int, t_max: float, rtol: float, atol: float
 ) -> dict[str, Any]: ...
-def symmetric_evaluate(mu: float, p: list[float], *, spatial: bool, t_max: float, rtol: float, atol: float) -> dict[str, Any]: ...
 def stability(m: _F64, planar: bool) -> tuple[npt.NDArray[np.complex128], npt.NDArray[np.complex128]]: ...
 def multiple_shooting(
     mu: float, patches: _F64, period: float, *, condition: str, value: float, tol: float, max_iter: int, rtol: float, atol: float
@@ -134,11 +148,99 @@ class OrbitForcing:
     def max_error(self) -> float: ...
     def sc(self, t: _F64) -> tuple[_F64, _F64]: ...
 
+@final
+class SweepResult:
+    @property
+    def phi_t(self) -> _F64: ...
+    @property
+    def wz_t(self) -> _F64: ...
+    @property
+    def dwz(self) -> _F64: ...
+    @property
+    def dphi(self) -> _F64: ...
+    @property
+    def stm(self) -> _F64 | None: ...
+    @property
+    def status(self) -> npt.NDArray[np.uint8]: ...
+    @property
+    def steps(self) -> npt.NDArray[np.uint32]: ...
+    def __getitem__(self, name: str, /) -> Any: ...
+    def keys(self) -> list[str]: ...
+    def __len__(self) -> int: ...
+
 def map_sweep(
     forcing: OrbitForcing, t_final: float, phi0: _F64, wz0: _F64, kz: _F64, *,
     rtol: float, atol: float, max_steps: int, stm: bool, chunk: int, threads: int | None,
     eps: _F64 | None = None, cs: _F64 | None = None, cd: _F64 | None = None, theta_sun0: _F64 | None = None,
-) -> dict[str, Any]: ...
+) -> SweepResult: ...
+
+@final
+class CorrectionBatch:
+    @property
+    def phi0(self) -> _F64: ...
+    @property
+    def wz0(self) -> _F64: ...
+    @property
+    def theta_sun0(self) -> _F64: ...
+    @property
+    def residual(self) -> _F64: ...
+    @property
+    def residual_norm(self) -> _F64: ...
+    @property
+    def iterations(self) -> npt.NDArray[np.int64]: ...
+    @property
+    def converged(self) -> npt.NDArray[np.bool_]: ...
+    @property
+    def reason(self) -> list[str]: ...
+    @property
+    def monodromy(self) -> _F64: ...
+    @property
+    def parameter(self) -> _F64: ...
+    @property
+    def jacobian(self) -> _F64: ...
+    def __len__(self) -> int: ...
+
+def attitude_correct(
+    forcing: OrbitForcing, phi0: _F64, wz0: _F64, kz: _F64, turns: _F64, *,
+    t_final: float, closure: str, free: str = "phi0",
+    eps: _F64 | None = None, cs: _F64 | None = None, cd: _F64 | None = None, theta_sun0: _F64 | None = None,
+    tol: float = 1e-12, max_iter: int = 40, rtol: float = 1e-13, atol: float = 1e-13, max_steps: int = 200000,
+    max_wz_step: float = 0.5, max_angle_step: float = 0.5, threads: int | None = None, chunk: int = 64,
+    parameter: str | None = None, condition: tuple[float, float, float, float] | None = None,
+    parameter_step: float = 1e-6, max_parameter_step: float = 0.5, monodromy: bool = True,
+) -> CorrectionBatch: ...
+
+@final
+class PlanarFamily:
+    def __new__(cls, mu: float, x0: list[float], vy0: list[float]) -> PlanarFamily: ...
+    @property
+    def range(self) -> tuple[float, float]: ...
+    def orbit_at(self, x0: float) -> tuple[list[float], float]: ...
+
+def attitude_correct_across(
+    family: PlanarFamily, wz0: _F64, kz: _F64, turns: _F64, x0: _F64, *,
+    condition: tuple[float, float, float], phi0: float = 0.0, tol: float = 1e-12, max_iter: int = 40, rtol: float = 1e-13,
+    atol: float = 1e-13, max_steps: int = 200000, max_wz_step: float = 0.5, parameter_step: float = 1e-6,
+    max_parameter_step: float = 0.05, threads: int | None = None,
+) -> CorrectionBatch: ...
+
+@final
+class PlanarVerification:
+    @property
+    def phi_t(self) -> _F64: ...
+    @property
+    def wz_t(self) -> _F64: ...
+    @property
+    def stm(self) -> _F64: ...
+    @property
+    def error(self) -> list[str | None]: ...
+    def __len__(self) -> int: ...
+
+def planar_verify(
+    mu: float, orbit_state0: list[float], t_final: float, kz: _F64, phi0: _F64, wz0: _F64, *,
+    eps: _F64 | None = None, cs: _F64 | None = None, cd: _F64 | None = None, theta_sun0: _F64 | None = None,
+    primaries: list[bool] = ..., threads: int | None = None,
+) -> PlanarVerification: ...
 
 _FlexBody = tuple[float, list[float], list[tuple[float, list[float], list[float], float, float]]]
 

@@ -113,7 +113,7 @@ def demo(system_name: str, kz: float, n_orbits: int, n_rates: int, out_dir: str)
         if abs(n) > 3:
             continue
         pd = ds.sol_phidot0.values[sel]
-        click.echo(f"{n:>4} {kind:>10} {int(sel.sum()):>6} {int(ds.sol_stable.values[sel].sum()):>7} {pd.min():>11.4f} .. {pd.max():<10.4f} {ds.sol_residual.values[sel].max():>13.1e}")
+        click.echo(f"{n:>4g} {kind:>10} {int(sel.sum()):>6} {int(ds.sol_stable.values[sel].sum()):>7} {pd.min():>11.4f} .. {pd.max():<10.4f} {ds.sol_residual.values[sel].max():>13.1e}")
     out = pathlib.Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     path = out / f"dro_map_kz{kz:g}.nc"
@@ -366,7 +366,7 @@ def solve(study, sets, out_dir, quiet) -> None:
         click.echo(f"{'orbit':>5} {'x0 [LU]':>9} {'T [d]':>8} {'Kz':>6} {'N':>4} {'kind':>9} {'wz0 [1/TU]':>13} {'phidot0':>13} {'phi0':>9} {'trace':>10} {'stable':>6} {'residual':>9}")
         for j in range(n):
             r = {k: ds[f"sol_{k}"].values[j] for k in ("orbit", "x0", "period_days", "kz", "n", "kind", "wz0", "phidot0", "phi0", "trace", "stable", "residual")}
-            click.echo(f"{r['orbit']:>5d} {r['x0']:>9.5f} {r['period_days']:>8.4f} {r['kz']:>6.3g} {r['n']:>4d} {r['kind']:>9} {r['wz0']:>13.8f} "
+            click.echo(f"{r['orbit']:>5d} {r['x0']:>9.5f} {r['period_days']:>8.4f} {r['kz']:>6.3g} {r['n']:>4g} {r['kind']:>9} {r['wz0']:>13.8f} "
                        f"{r['phidot0']:>13.8f} {r['phi0']:>9.5f} {r['trace']:>10.4g} {'yes' if r['stable'] else 'no':>6} {r['residual']:>9.1e}")
     click.echo(f"written: {path}")
     _figures(ds, path.parent, st.figures(("solutions",)), quiet)
@@ -427,7 +427,7 @@ def _solution_summary(ds) -> None:
     click.echo(f"{'N':>4} {'kind':>10} {'count':>6} {'stable':>7} {'phidot0 range [1/TU]':>24} {'max residual':>13}")
     for n, kind in sorted(set(zip(n_.tolist(), kind_.tolist())), key=lambda x: (x[1], -x[0])):
         sel = (n_ == n) & (kind_ == kind)
-        click.echo(f"{n:>4} {kind:>10} {int(sel.sum()):>6} {int(stable[sel].sum()):>7} {pd[sel].min():>11.4f} .. {pd[sel].max():<10.4f} {res[sel].max():>13.1e}")
+        click.echo(f"{n:>4g} {kind:>10} {int(sel.sum()):>6} {int(stable[sel].sum()):>7} {pd[sel].min():>11.4f} .. {pd[sel].max():<10.4f} {res[sel].max():>13.1e}")
 
 
 @main.command(context_settings=_CONTEXT)
@@ -567,7 +567,7 @@ def _solutions_scatter(ds):
     x, y = ds["sol_x0"].values, ds["sol_phidot0"].values
     for k in sorted(set(n.tolist())):
         sel = n == k
-        sc = ax.scatter(x[sel & stable], y[sel & stable], s=18, label=f"N = {k}")
+        sc = ax.scatter(x[sel & stable], y[sel & stable], s=18, label=f"N = {k:g}")
         ax.scatter(x[sel & ~stable], y[sel & ~stable], s=18, facecolors="none", edgecolors=sc.get_facecolor())
     ax.set_xlabel("$x_0$ (LU)")
     ax.set_ylabel(r"$\dot\phi(0)$ (1/TU)")

@@ -275,9 +275,9 @@ def solutions_dataset(rows, orbits, kz, attrs: dict | None = None):
     s = [x for _, x in rows]
     ds["sol_n_periods"] = ("solution", np.array([x.n_periods for x in s], dtype=np.int64))
     ds["sol_kz"].attrs["long_name"] = "(Iy - Ix) / Iz"
-    ds["sol_n"].attrs["long_name"] = "net body turns per orbit relative to the synodic frame"
+    ds["sol_n"].attrs["long_name"] = "net body turns per orbit period relative to the synodic frame"
     ds["sol_trace"].attrs["long_name"] = "trace of the 2x2 attitude monodromy (stable when |trace| < 2)"
-    ds["sol_residual"].attrs["long_name"] = "max(|Dphi|, |Dwz|) after one period, independent re-propagation"
+    ds["sol_residual"].attrs["long_name"] = "max(|Dphi|, |Dwz|) after the n_periods periods, independent re-propagation"
     sys_ = olist[0].system if olist else None
     ds.attrs.update({
         "title": "librate periodic attitude solutions",

@@ -23,7 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from .._integrity import array_digest
-from ..periodicity.maps import map_coords, map_dataset, map_grid, map_solutions_dataset, orbits_of, solutions_from_row
+from ..periodicity.maps import map_coords, map_dataset, map_grid, map_solutions_dataset, orbits_of, solutions_from_rows
 from ..periodicity.solutions import MAP_ATOL, MAP_RTOL, check_orbit, check_srp, orbit_forcing, sweep
 from .store import ROW_VARS, check_rows, open_map_group, read_array, row_checksum, writer_lock
 
@@ -279,8 +279,8 @@ def _run(olist, family, kzs, wz, coords, fp, args, out, resume, scheduler, progr
     if solve:
         sols = []
         for i, o in enumerate(olist):
-            for j, k in enumerate(kzs):
-                sols += [(i, s) for s in solutions_from_row(o, float(k), float(phi0), wz, grid["phi_T"][i, j], int(n_periods), srp)]
+            # one batch per orbit, as periodicity_map does (the same lock-step companions: the same bits)
+            sols += [(i, s) for s in solutions_from_rows(o, kzs, float(phi0), wz, grid["phi_T"][i], int(n_periods), srp)]
         ds = ds.merge(map_solutions_dataset(sols))
     if store is not None:
         _finalise(store, Path(out), ds, fp, coords)

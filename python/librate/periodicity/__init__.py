@@ -2,6 +2,7 @@
 solar radiation pressure continuation and maps, and the effect of flexibility on periodic
 motion."""
 
+from .branches import SrpContinuation, continue_srp, periodic_attitude
 from .families import AttitudeFamily, attitude_family
 from .flexible import FlexiblePeriodic, FrequencyScan, flexible_periodic, frequency_scan
 from .maps import periodicity_map, zero_contours
@@ -12,10 +13,9 @@ from .solutions import (
     clear_forcing_cache,
     find_periodic_attitudes,
     orbit_forcing,
-    periodic_attitude,
     sweep,
 )
-from .srp import SrpContinuation, continue_srp, srp_map, sun_pointing_accelerations
+from .srp import srp_map, sun_pointing_accelerations
 
 __all__ = [
     "AttitudeSolution",

@@ -109,7 +109,7 @@ def flexible_periodic(
         method = "full" if float(np.max(body.frequencies_nd(sys_))) * T <= 2e4 else "quasi-static"
     phi0 = solution.phi0 - body.principal_angle
     wz0 = solution.wz0
-    turns = solution.n + (0.5 if solution.kind == "half-turn" else 0.0)
+    turns = solution.n_total + (0.5 if solution.kind == "half-turn" else 0.0)
     te = np.linspace(0.0, T, 401)
     qs = quasi_static(sys_, orbit.state0, (phi0, wz0), body, T, t_eval=te, rtol=rtol, atol=atol, max_steps=max_steps)
     drift = np.array([qs.dphi[-1], qs.dwz[-1]])

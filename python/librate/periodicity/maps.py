@@ -16,13 +16,12 @@ from collections.abc import Callable
 import numpy as np
 
 from .._core import __version__
-from .._errors import ConvergenceError
 from ..orbits.families import OrbitFamily
 from ..orbits.periodic import PeriodicOrbit
-from .solutions import MAP_ATOL, MAP_RTOL, AttitudeSolution, candidates, check_orbit, check_srp, orbit_forcing, periodic_attitude, sweep
+from .solutions import MAP_ATOL, MAP_RTOL, AttitudeSolution, candidates, check_orbit, check_srp, is_symmetric, orbit_forcing, refine, sweep
 
 __all__ = ["periodicity_map", "zero_contours", "orbits_of", "map_grid", "map_coords", "map_dataset", "solutions_from_row",
-           "map_solutions_dataset"]
+           "solutions_from_rows", "map_solutions_dataset", "solution_variables"]
 
 
 def orbits_of(orbits) -> tuple[list[PeriodicOrbit], OrbitFamily | None]:
@@ -98,8 +97,7 @@ def periodicity_map(
             dwz[i], dphi[i], phi_t[i] = (r[k].reshape(nk, nw) for k in ("dwz", "dphi", "phi_t"))
             status[i] = r["status"].reshape(nk, nw)
             if solve:
-                for j, k in enumerate(kzs):
-                    sols += [(i, s) for s in solutions_from_row(o, float(k), phi0, wz, phi_t[i, j], n_periods, srp)]
+                sols += [(i, s) for s in solutions_from_rows(o, kzs, phi0, wz, phi_t[i], n_periods, srp)]
             done[i] = True
             if progress is not None:
                 progress(i + 1, no)
@@ -107,10 +105,8 @@ def periodicity_map(
         complete = False
         warnings.warn(f"periodicity_map interrupted: {int(done.sum())} of {no} orbits finished and kept", stacklevel=2)
     grid = {"dwz": dwz, "dphi": dphi, "phi_T": phi_t, "status": status}
-    ds = map_dataset(olist, family, kzs, wz, grid, done, phi0=phi0, n_periods=n_periods, rtol=rtol, atol=atol, srp=srp, complete=complete)
-    if solve:
-        ds = ds.merge(map_solutions_dataset(sols))
-    return ds
+    return map_dataset(olist, family, kzs, wz, grid, done, phi0=phi0, n_periods=n_periods, rtol=rtol, atol=atol, srp=srp, complete=complete,
+                       solutions=sols if solve else None)
 
 
 
@@ -140,14 +136,16 @@ def map_coords(olist, kzs, wz) -> dict:
     }
 
 
-def map_dataset(olist, family, kzs, wz, grid, done, *, phi0, n_periods, rtol, atol, srp, complete, attrs=None):
+def map_dataset(olist, family, kzs, wz, grid, done, *, phi0, n_periods, rtol, atol, srp, complete, attrs=None, solutions=None):
     """The map's Dataset: residual grids over (orbit, kz, wz0), coordinates with units and the
-    parameters as attributes (shared by periodicity_map and run_map)."""
+    parameters as attributes (shared by periodicity_map and run_map); ``solutions``: (orbit
+    index, AttitudeSolution) pairs, the ``sol_*`` variables along ``solution``."""
     import xarray as xr
 
     dims = ("orbit", "kz", "wz0")
     return xr.Dataset(
         {
+            **(solution_variables(solutions) if solutions is not None else {}),
             "dwz": (dims, grid["dwz"], {"units": "1/TU", "long_name": "wz(T) - wz(0)"}),
             "dphi": (dims, grid["dphi"], {"units": "rad", "long_name": "phi(T) - phi0 wrapped to (-pi, pi]"}),
             "phi_T": (dims, grid["phi_T"], {"units": "rad", "long_name": "phi(T), unwrapped"}),
@@ -205,43 +203,55 @@ def _stack_srp(maps, plates):
     return out
 
 
+def solutions_from_rows(orbit, kzs, phi0, wz, phi_t_rows, n_periods, srp=None) -> list[AttitudeSolution]:
+    """The solutions of one orbit's rows (one per Kz): the candidates where phi(KT) - phi0 crosses
+    a multiple of pi, all refined in ONE call of the Rust corrector (the half-period form where
+    the orbit and phi0 are symmetric and there is no SRP, else the full-period form with phi0
+    free) and verified in one more; kept inside the row's rate window."""
+    kzs = np.atleast_1d(np.asarray(kzs, dtype=float))
+    rows = np.atleast_2d(phi_t_rows)
+    cands, kk = [], []
+    for j, k in enumerate(kzs):
+        c = candidates(rows[j], phi0, wz, math.pi)
+        cands += c
+        kk += [float(k)] * len(c)
+    symmetric = is_symmetric(orbit, phi0) and (srp is None or srp.eps == 0.0)
+    sols = refine(orbit, np.array(kk), phi0, cands, n_periods=n_periods, srp=srp, closure="half" if symmetric else "full",
+                  window=(float(wz[0]), float(wz[-1])))
+    return sorted(sols, key=lambda s: (s.kz, s.wz0))
+
+
 def solutions_from_row(orbit, kz, phi0, wz, phi_t_row, n_periods, srp=None) -> list[AttitudeSolution]:
-    """Candidates from one full-period row (phi(T) - phi0 through multiples of pi), refined."""
-    out: list[AttitudeSolution] = []
-    for k, w in candidates(phi_t_row, phi0, wz, math.pi):
-        kind = "periodic" if k % 2 == 0 else "half-turn"
-        n = k // 2
-        try:
-            sol = periodic_attitude(orbit, kz=kz, n=n, phi0=phi0, wz0=w, kind=kind, n_periods=n_periods, srp=srp)
-        except ConvergenceError:
-            continue
-        if not (wz[0] <= sol.wz0 <= wz[-1]) or sol.residual > 1e-8:
-            continue
-        if any(s.n == sol.n and s.kind == sol.kind and abs(s.wz0 - sol.wz0) < 1e-8 for s in out):
-            continue
-        out.append(sol)
-    return out
+    """Candidates from one full-period row (phi(T) - phi0 through multiples of pi), refined
+    (:func:`solutions_from_rows` with one Kz)."""
+    return solutions_from_rows(orbit, [kz], phi0, wz, [phi_t_row], n_periods, srp)
+
+
+def solution_variables(sols) -> dict:
+    """The ``sol_*`` variables (name -> (dimension, values[, attributes])) of (orbit index,
+    AttitudeSolution) pairs."""
+    idx = np.array([i for i, _ in sols], dtype=np.int64)
+    s = [x for _, x in sols]
+    return {
+        "sol_orbit": ("solution", idx),
+        "sol_kz": ("solution", np.array([x.kz for x in s], dtype=float)),
+        "sol_wz0": ("solution", np.array([x.wz0 for x in s], dtype=float), {"units": "1/TU"}),
+        "sol_phidot0": ("solution", np.array([x.phidot0 for x in s], dtype=float), {"units": "1/TU"}),
+        "sol_phi0": ("solution", np.array([x.phi0 for x in s], dtype=float), {"units": "rad"}),
+        "sol_n": ("solution", np.array([x.n for x in s], dtype=float), {"long_name": "net body turns per orbit period"}),
+        "sol_n_total": ("solution", np.array([x.n_total for x in s], dtype=np.int64),
+                        {"long_name": "net body turns over the n_periods orbit periods"}),
+        "sol_kind": ("solution", np.array([x.kind for x in s], dtype="<U9")),
+        "sol_residual": ("solution", np.array([x.residual for x in s], dtype=float)),
+        "sol_trace": ("solution", np.array([x.trace for x in s], dtype=float)),
+        "sol_stable": ("solution", np.array([x.stable for x in s], dtype=bool)),
+    }
 
 
 def map_solutions_dataset(sols):
     import xarray as xr
 
-    idx = np.array([i for i, _ in sols], dtype=np.int64)
-    s = [x for _, x in sols]
-    return xr.Dataset(
-        {
-            "sol_orbit": ("solution", idx),
-            "sol_kz": ("solution", np.array([x.kz for x in s], dtype=float)),
-            "sol_wz0": ("solution", np.array([x.wz0 for x in s], dtype=float), {"units": "1/TU"}),
-            "sol_phidot0": ("solution", np.array([x.phidot0 for x in s], dtype=float), {"units": "1/TU"}),
-            "sol_phi0": ("solution", np.array([x.phi0 for x in s], dtype=float), {"units": "rad"}),
-            "sol_n": ("solution", np.array([x.n for x in s], dtype=np.int64)),
-            "sol_kind": ("solution", np.array([x.kind for x in s], dtype="<U9")),
-            "sol_residual": ("solution", np.array([x.residual for x in s], dtype=float)),
-            "sol_trace": ("solution", np.array([x.trace for x in s], dtype=float)),
-            "sol_stable": ("solution", np.array([x.stable for x in s], dtype=bool)),
-        }
-    )
+    return xr.Dataset(solution_variables(sols))
 
 
 def zero_contours(ds, var: str = "dwz", kz_index: int = 0) -> np.ndarray:

@@ -15,24 +15,27 @@ independently (scalar model, orbit integrated alongside, tight tolerance).
 from __future__ import annotations
 
 import math
-import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from .. import _core
-from .._errors import ConvergenceError
+from .._checks import as_count, as_number
 from ..attitude.body import RigidBody
 from ..attitude.propagate import propagate_attitude
-from ..attitude.srp import FlatPlate, Sun
+from ..attitude.srp import FlatPlate
 from ..orbits.periodic import PeriodicOrbit
 
-__all__ = ["AttitudeSolution", "periodic_attitude", "find_periodic_attitudes", "orbit_forcing", "clear_forcing_cache", "sweep", "candidates",
-           "check_orbit", "check_kz", "check_kinds", "KINDS", "check_srp", "is_symmetric", "MAP_RTOL", "MAP_ATOL"]
+__all__ = ["AttitudeSolution", "find_periodic_attitudes", "orbit_forcing", "clear_forcing_cache", "sweep", "candidates",
+           "check_orbit", "check_kz", "check_kinds", "KINDS", "check_srp", "is_symmetric", "MAP_RTOL", "MAP_ATOL", "correct", "verified", "refine",
+           "turns_of", "n_total_of", "per_period", "SOLVE_RTOL", "SOLVE_ATOL"]
 
 MAP_RTOL = 1e-12
 MAP_ATOL = 1e-12
+#: Integration tolerances of the corrector's trajectories.
+SOLVE_RTOL = 1e-13
+SOLVE_ATOL = 1e-13
 _FORCINGS: dict = {}
 
 
@@ -99,19 +102,38 @@ def is_symmetric(orbit: PeriodicOrbit, phi0: float) -> bool:
     return on_axis and abs(k - round(k)) < 1e-15
 
 
+def n_total_of(n, n_periods: int) -> int:
+    """Net turns over the K = ``n_periods`` periods from ``n`` turns per orbit period (n K must
+    be a whole number)."""
+    if isinstance(n, bool) or not isinstance(n, (int, float, np.integer, np.floating)) or not math.isfinite(n):
+        raise ValueError(f"invalid argument `n`: must be a number of turns per orbit period, got {n!r}")
+    total = n * n_periods
+    if abs(total - round(total)) > 1e-9:
+        raise ValueError(f"invalid argument `n`: n x n_periods must be a whole number of turns over the {n_periods} periods, got n = {n!r}")
+    return int(round(total))
+
+
+def per_period(n_total: int, n_periods: int) -> int | float:
+    return n_total // n_periods if n_total % n_periods == 0 else n_total / n_periods
+
+
 @dataclass(frozen=True)
 class AttitudeSolution:
-    """A periodic (or half-turn) planar attitude motion along an orbit.
+    """A periodic (or half-turn) planar attitude motion along an orbit, over K = ``n_periods``
+    orbit periods.
 
-    ``n``: net body turns per orbit relative to the synodic frame (for "half-turn" solutions
-    phi(T) = phi0 + 2 pi n + pi). ``residual``: max(|Dphi|, |Dwz|) after one period from an
-    independent re-propagation. ``monodromy``: the 2x2 d(phi, wz)(T)/d(phi0, wz0); the motion is
-    linearly stable when |trace| < 2 (multipliers on the unit circle).
+    ``n_total``: net body turns relative to the synodic frame over the K periods, so that
+    phi(KT) = phi0 + 2 pi n_total (+ pi for "half-turn" solutions); ``n`` = n_total / K: turns
+    per orbit period (a whole number when K divides n_total). ``residual``: max(|Dphi|, |Dwz|)
+    after the K periods from an independent re-propagation (scalar model, orbit integrated
+    alongside, rtol = atol = 1e-14). ``monodromy``: the 2x2 d(phi, wz)(KT)/d(phi0, wz0); the
+    motion is linearly stable when |trace| < 2 (multipliers on the unit circle).
+    ``iterations``: the corrector's accepted Newton steps.
     """
 
     orbit: PeriodicOrbit
     kz: float
-    n: int
+    n_total: int
     kind: str
     phi0: float
     wz0: float
@@ -121,6 +143,11 @@ class AttitudeSolution:
     iterations: int = 0
     srp: object = None
     n_periods: int = 1
+
+    @property
+    def n(self) -> int | float:
+        """Net turns per orbit period, n_total / n_periods."""
+        return per_period(self.n_total, self.n_periods)
 
     @property
     def phidot0(self) -> float:
@@ -151,43 +178,6 @@ class AttitudeSolution:
                                   n_periods * self.orbit.period, planar=True, srp=self.srp, **kwargs)
 
 
-def _solve_sun_phase(orbit, kz, n, kind, phi0, w, srp, n_periods, turns, tol, max_iter):
-    """Newton on (Sun phase, wz0) with phi0 fixed."""
-    forcing = orbit_forcing(orbit)
-    T = n_periods * orbit.period
-    th = float(srp.sun.theta0)
-
-    def plate(theta):
-        return FlatPlate(srp.eps, srp.cs, srp.cd, Sun(theta0=theta, pressure=srp.sun.pressure))
-
-    def F(theta, wz, stm=False):
-        r = sweep(forcing, T, phi0, wz, kz, stm=stm, rtol=1e-13, atol=1e-13, srp=plate(theta))
-        return np.array([r["phi_t"][0] - phi0 - 2 * math.pi * turns, r["wz_t"][0] - wz]), r
-
-    res = math.inf
-    for it in range(1, max_iter + 1):
-        f, r = F(th, w, stm=True)
-        res = float(np.max(np.abs(f)))
-        if res < tol:
-            break
-        h = 1e-6
-        dth = (F(th + h, w)[0] - F(th - h, w)[0]) / (2 * h)
-        m = r["stm"][0]
-        jac = np.array([[dth[0], m[0, 1]], [dth[1], m[1, 1] - 1.0]])
-        try:
-            d = np.linalg.solve(jac, -f)
-        except np.linalg.LinAlgError:
-            raise ConvergenceError(f"periodic attitude (Sun phase free): singular Jacobian at wz0 = {w}") from None
-        scale = min(1.0, 0.5 / max(abs(d[0]), abs(d[1]), 1e-300))
-        th += float(d[0]) * scale
-        w += float(d[1]) * scale
-    else:
-        raise ConvergenceError(f"periodic attitude (Sun phase free, N = {n}) did not converge after {max_iter} iterations (residual {res:.3e})")
-    found = plate(math.remainder(th, 2 * math.pi))
-    dphi, dwz, mono = _verify(orbit, kz, phi0, w, turns, n_periods, found)
-    return AttitudeSolution(orbit, kz, int(n), kind, phi0, w, float(dphi), float(dwz), mono, it, found, int(n_periods))
-
-
 def check_srp(srp):
     if srp is None:
         return None
@@ -196,116 +186,64 @@ def check_srp(srp):
     return srp
 
 
-def _verify(orbit, kz, phi0, wz0, turns, n_periods, srp=None):
-    """Independent re-propagation (scalar planar model with the orbit integrated alongside, at
-    rtol = atol = 1e-14): residuals and the 2x2 monodromy."""
+def turns_of(n_total, kind) -> np.ndarray:
+    """Turns of the closure condition: n_total, plus a half for half-turn motions."""
+    kinds = np.asarray(kind)
+    return np.asarray(n_total, dtype=float) + np.where(kinds == "half-turn", 0.5, 0.0)
+
+
+def correct(orbit: PeriodicOrbit, *, kz, n_total, kind, phi0, wz0, n_periods: int = 1, srp=None, closure: str = "half",
+            free: str = "phi0", theta_sun0=None, eps=None, tol: float = 1e-12, max_iter: int = 40, bordered=None, monodromy: bool = True):
+    """One call of the Rust corrector for a batch of candidates on ``orbit`` (arrays broadcast
+    together: kz, n_total, kind, phi0, wz0, and theta_sun0 / eps overriding the plate's):
+    ``closure`` "half" (symmetric, over K T / 2) or "full" (over K T); ``free`` "phi0" or
+    "sun_phase"; ``bordered``: (parameter "kz" or "eps", condition (a_angle, a_wz0, a_parameter,
+    b)) for the continuation driver. Returns the core's CorrectionBatch."""
+    cols = np.broadcast_arrays(np.asarray(kz, dtype=float), np.asarray(n_total, dtype=float), np.asarray(kind), np.asarray(phi0, dtype=float),
+                               np.asarray(wz0, dtype=float), np.asarray(0.0 if eps is None else eps, dtype=float),
+                               np.asarray(0.0 if theta_sun0 is None else theta_sun0, dtype=float))
+    k, nt, kd, p, w, e, th = (np.ascontiguousarray(c).ravel() for c in cols)
+    extra = {}
+    if srp is not None:
+        extra = dict(eps=np.ascontiguousarray(np.full(k.size, srp.eps) if eps is None else e),
+                     cs=np.full(k.size, float(srp.cs)), cd=np.full(k.size, float(srp.cd)),
+                     theta_sun0=np.ascontiguousarray(np.full(k.size, float(srp.sun.theta0)) if theta_sun0 is None else th))
     T = n_periods * orbit.period
-    tr = propagate_attitude(orbit.system, orbit.state0, (phi0, wz0), RigidBody.from_kz(kz), T, planar=True, stm=True,
-                            rtol=1e-14, atol=1e-14, t_eval=[T], srp=srp)
-    dphi = tr.phi[-1] - phi0 - 2 * math.pi * turns
-    dwz = tr.wz[-1] - wz0
-    return dphi, dwz, tr.stm
+    kw = {}
+    if bordered is not None:
+        kw = dict(parameter=bordered[0], condition=tuple(float(v) for v in bordered[1]))
+    return _core.attitude_correct(orbit_forcing(orbit), p, w, k, turns_of(nt, kd), t_final=0.5 * T if closure == "half" else T,
+                                  closure=closure, free=free, tol=float(tol), max_iter=int(max_iter), rtol=SOLVE_RTOL, atol=SOLVE_ATOL,
+                                  monodromy=monodromy, **extra, **kw)
 
 
-def periodic_attitude(
-    orbit: PeriodicOrbit,
-    *,
-    kz: float,
-    n: int,
-    phi0: float = 0.0,
-    wz0: float | None = None,
-    kind: str = "periodic",
-    method: str = "auto",
-    n_periods: int = 1,
-    srp=None,
-    free: str = "phi0",
-    tol: float = 1e-12,
-    max_iter: int = 40,
-) -> AttitudeSolution:
-    """The periodic attitude motion with ``n`` net turns per orbit (``kind="half-turn"``: a half
-    turn more) along ``orbit``, for the body with ``kz``.
-
-    ``method``: "half" solves phi(KT/2) = phi0 + pi * turns for wz0 (a scalar Newton with the
-    STM; exact for x-symmetric orbits with phi0 a multiple of pi/2 and no SRP; K = ``n_periods``),
-    "newton" corrects
-    (phi0, wz0) together with the full-period Newton step [Phi(T) - I] d = -F (PHYSICS.md: the
-    correct form of thesis eq. 53), "auto" picks "half" when it applies. With SRP the mirror
-    symmetry is broken (PHYSICS.md sec. 6): ``free="phi0"`` (default) corrects (phi0, wz0);
-    ``free="theta_sun0"`` keeps phi0 and corrects (Sun phase theta_sun0, wz0) instead (the returned
-    solution's ``srp.sun.theta0`` is the phase found; d/d(phase) by central differences; the old
-    spelling ``free="sun_phase"`` still works, with a DeprecationWarning). ``wz0``: the guess
-    (default: the torque-free solution 1 + 2 pi turns / T). Raises ConvergenceError.
-    """
-    orbit = check_orbit(orbit)
-    kz = check_kz(kz)
-    if not isinstance(n, (int, np.integer)):
-        raise ValueError(f"invalid argument `n`: must be an integer, got {n!r}")
-    if kind not in ("periodic", "half-turn"):
-        raise ValueError(f"invalid argument `kind`: must be 'periodic' or 'half-turn', got {kind!r}")
-    if method not in ("auto", "half", "newton"):
-        raise ValueError(f"invalid argument `method`: must be 'auto', 'half' or 'newton', got {method!r}")
-    if not isinstance(n_periods, (int, np.integer)) or n_periods < 1:
-        raise ValueError(f"invalid argument `n_periods`: must be an integer >= 1, got {n_periods!r}")
-    if not math.isfinite(phi0):
-        raise ValueError(f"invalid argument `phi0`: must be finite, got {phi0!r}")
-    turns = n + (0.5 if kind == "half-turn" else 0.0)
+def verified(orbit: PeriodicOrbit, *, kz, n_total, kind, phi0, wz0, n_periods: int = 1, plates=None, iterations=None) -> list[AttitudeSolution]:
+    """AttitudeSolutions for converged corrections: every one re-propagated independently in one
+    batched Rust call (scalar model, orbit integrated alongside, rtol = atol = 1e-14, in
+    parallel); ``plates``: one FlatPlate (or None) per solution."""
+    kz, n_total, phi0, wz0, kind = (np.ascontiguousarray(np.atleast_1d(v).ravel())
+                                    for v in np.broadcast_arrays(np.asarray(kz, dtype=float), np.asarray(n_total, dtype=float),
+                                                                 np.asarray(phi0, dtype=float), np.asarray(wz0, dtype=float), np.asarray(kind)))
+    m = kz.size
+    if m == 0:
+        return []
+    plates = [None] * m if plates is None else list(plates)
+    extra = {}
+    if any(pl is not None for pl in plates):
+        extra = dict(eps=np.array([pl.eps if pl else 0.0 for pl in plates]), cs=np.array([pl.cs if pl else 0.0 for pl in plates]),
+                     cd=np.array([pl.cd if pl else 0.0 for pl in plates]), theta_sun0=np.array([pl.sun.theta0 if pl else 0.0 for pl in plates]))
     T = n_periods * orbit.period
-    w = 1.0 + 2 * math.pi * turns / T if wz0 is None else float(wz0)
-    if not math.isfinite(w):
-        raise ValueError(f"invalid argument `wz0`: must be finite, got {wz0!r}")
-    srp = check_srp(srp)
-    if free == "sun_phase":
-        warnings.warn("periodic_attitude(free='sun_phase') is deprecated; use free='theta_sun0'", DeprecationWarning, stacklevel=2)
-        free = "theta_sun0"
-    if free not in ("phi0", "theta_sun0"):
-        raise ValueError(f"invalid argument `free`: must be 'phi0' or 'theta_sun0', got {free!r}")
-    if free == "theta_sun0":
-        if srp is None:
-            raise ValueError("invalid argument `free`: 'theta_sun0' needs srp")
-        return _solve_sun_phase(orbit, kz, n, kind, float(phi0), w, srp, n_periods, turns, tol, max_iter)
-    symmetric = is_symmetric(orbit, phi0) and (srp is None or srp.eps == 0.0)
-    if method == "auto":
-        method = "half" if symmetric else "newton"
-    if method == "half" and not symmetric:
-        raise ValueError("invalid argument `method`: 'half' needs an x-symmetric orbit started on the x axis, phi0 a multiple of pi/2 and no SRP")
-    forcing = orbit_forcing(orbit)
-    p = float(phi0)
-    it = 0
-    res = math.inf
-    for it in range(1, max_iter + 1):
-        if method == "half":
-            r = sweep(forcing, 0.5 * T, p, w, kz, stm=True, rtol=1e-13, atol=1e-13, srp=srp)
-            g = r["phi_t"][0] - p - math.pi * turns
-            d = r["stm"][0, 0, 1]
-            res = abs(g)
-            if res < tol:
-                break
-            if d == 0 or not math.isfinite(d):
-                raise ConvergenceError(f"periodic attitude (half period): zero derivative at wz0 = {w}")
-            step = -g / d
-            w += float(np.clip(step, -0.5, 0.5))
-        else:
-            r = sweep(forcing, T, p, w, kz, stm=True, rtol=1e-13, atol=1e-13, srp=srp)
-            F = np.array([r["phi_t"][0] - p - 2 * math.pi * turns, r["wz_t"][0] - w])
-            res = float(np.max(np.abs(F)))
-            if res < tol:
-                break
-            J = r["stm"][0] - np.eye(2)
-            try:
-                dx = np.linalg.solve(J, -F)
-            except np.linalg.LinAlgError:
-                raise ConvergenceError(f"periodic attitude: Phi(T) - I is singular at wz0 = {w} (trace 2: a fold)") from None
-            scale = min(1.0, 0.5 / max(abs(dx[1]), 1e-300))
-            p += float(dx[0]) * scale
-            w += float(dx[1]) * scale
-        if not (math.isfinite(w) and math.isfinite(p)):
-            break
-    else:
-        raise ConvergenceError(f"periodic attitude (N = {n}, {kind}) did not converge after {max_iter} iterations (residual {res:.3e}, tolerance {tol:.1e})")
-    if not math.isfinite(res) or res >= tol:
-        raise ConvergenceError(f"periodic attitude (N = {n}, {kind}) diverged (residual {res:.3e})")
-    dphi, dwz, m = _verify(orbit, kz, p, w, turns, n_periods, srp)
-    return AttitudeSolution(orbit, kz, int(n), kind, p, w, float(dphi), float(dwz), m, it, srp, int(n_periods))
+    v = _core.planar_verify(orbit.system.mu, [float(x) for x in orbit.state0], T, np.ascontiguousarray(kz), np.ascontiguousarray(phi0),
+                            np.ascontiguousarray(wz0), **extra)
+    turns = turns_of(n_total, kind)
+    its = np.zeros(m, dtype=int) if iterations is None else np.asarray(iterations)
+    out = []
+    for i in range(m):
+        dphi = float(v.phi_t[i] - phi0[i] - 2 * math.pi * turns[i])
+        dwz = float(v.wz_t[i] - wz0[i])
+        out.append(AttitudeSolution(orbit, float(kz[i]), int(n_total[i]), str(kind[i]), float(phi0[i]), float(wz0[i]), dphi, dwz,
+                                    np.array(v.stm[i]), int(its[i]), plates[i], int(n_periods)))
+    return out
 
 
 def _grid_for(T: float, lo: float, hi: float, n_grid: int | None) -> np.ndarray:
@@ -316,20 +254,47 @@ def _grid_for(T: float, lo: float, hi: float, n_grid: int | None) -> np.ndarray:
 
 
 def candidates(phi_t, phi0, wz, level):
-    """wz0 brackets where (phi(t) - phi0) / level crosses an integer; returns (k, wz_interp)."""
-    u = (phi_t - phi0) / level
+    """wz0 brackets where (phi(t) - phi0) / level crosses an integer; returns (k, wz_interp) in
+    order of the grid (linear interpolation)."""
+    u = (np.asarray(phi_t, dtype=float) - phi0) / level
+    wz = np.asarray(wz, dtype=float)
+    a, b = u[:-1], u[1:]
+    ok = np.isfinite(a) & np.isfinite(b) & (a != b)
+    lo = np.ceil(np.minimum(a, b))
+    hi = np.floor(np.maximum(a, b))
     out = []
-    ok = np.isfinite(u)
-    for i in range(len(u) - 1):
-        if not (ok[i] and ok[i + 1]):
+    for i in np.flatnonzero(ok & (hi >= lo)):
+        for k in range(int(lo[i]), int(hi[i]) + 1):
+            out.append((k, float(wz[i] + (k - a[i]) / (b[i] - a[i]) * (wz[i + 1] - wz[i]))))
+    return out
+
+
+def refine(orbit, kz, phi0, cands, *, n_periods, srp, closure, window, kinds=KINDS) -> list[AttitudeSolution]:
+    """Refine (k, wz0) candidates (k = 2 turns over the K periods, odd k a half turn) in ONE
+    corrector call and verify the converged ones in one more; keep those inside ``window``
+    with an independent residual below 1e-8, one per (turns, kind, wz0 to 1e-8), sorted by wz0.
+    ``kz`` may be one value or one per candidate."""
+    cands = [(k, w, kk) for (k, w), kk in zip(cands, np.broadcast_to(np.asarray(kz, dtype=float), (len(cands),)))
+             if ("periodic" if k % 2 == 0 else "half-turn") in kinds]
+    if not cands:
+        return []
+    ks = np.array([c[0] for c in cands])
+    n_total = ks // 2
+    kind = np.where(ks % 2 == 0, "periodic", "half-turn")
+    kzs = np.array([c[2] for c in cands])
+    b = correct(orbit, kz=kzs, n_total=n_total, kind=kind, phi0=phi0, wz0=np.array([c[1] for c in cands]), n_periods=n_periods, srp=srp,
+                closure=closure, monodromy=False)  # the verification brings the monodromy
+    lo, hi = window
+    ok = np.flatnonzero(b.converged & (b.wz0 >= lo) & (b.wz0 <= hi))
+    sols = verified(orbit, kz=kzs[ok], n_total=n_total[ok], kind=kind[ok], phi0=b.phi0[ok], wz0=b.wz0[ok], n_periods=n_periods,
+                    plates=None if srp is None else [srp] * ok.size, iterations=b.iterations[ok])
+    out: list[AttitudeSolution] = []
+    for s in sorted(sols, key=lambda s: (s.kz, s.wz0)):
+        if s.residual > 1e-8:
             continue
-        a, b = u[i], u[i + 1]
-        lo, hi = (a, b) if a <= b else (b, a)
-        for k in range(math.ceil(lo), math.floor(hi) + 1):
-            if a == b:
-                continue
-            w = wz[i] + (k - a) / (b - a) * (wz[i + 1] - wz[i])
-            out.append((k, w))
+        if any(o.kz == s.kz and o.n_total == s.n_total and o.kind == s.kind and abs(o.wz0 - s.wz0) < 1e-8 for o in out):
+            continue
+        out.append(s)
     return out
 
 
@@ -339,7 +304,7 @@ def find_periodic_attitudes(
     kz: float,
     wz0_range: tuple[float, float],
     phi0: float = 0.0,
-    kinds: Sequence[str] = ("periodic", "half-turn"),
+    kinds: Sequence[str] = KINDS,
     n_grid: int | None = None,
     n_periods: int = 1,
     srp=None,
@@ -348,8 +313,8 @@ def find_periodic_attitudes(
 
     A grid scan by the engine brackets the candidates (crossings of phi(T/2) - phi0 through
     multiples of pi/2 for symmetric cases, of phi(T) - phi0 through multiples of pi otherwise);
-    each is refined by :func:`periodic_attitude` and kept when it converges inside the window.
-    Sorted by wz0.
+    all are refined together by one call of the Rust corrector and kept when they converge
+    inside the window (each re-propagated independently). Sorted by wz0.
     """
     orbit = check_orbit(orbit)
     kz = check_kz(kz)
@@ -359,30 +324,18 @@ def find_periodic_attitudes(
         raise ValueError(f"invalid argument `wz0_range`: must be (lo, hi), got {wz0_range!r}") from None
     if not (math.isfinite(lo) and math.isfinite(hi) and lo < hi):
         raise ValueError(f"invalid argument `wz0_range`: must be finite with lo < hi, got {wz0_range!r}")
-    for k in kinds:
-        if k not in ("periodic", "half-turn"):
-            raise ValueError(f"invalid argument `kinds`: must be 'periodic' and/or 'half-turn', got {k!r}")
+    kinds = check_kinds(kinds)
+    n_periods = as_count(n_periods, "n_periods", 1)
+    if n_grid is not None:
+        n_grid = as_count(n_grid, "n_grid", 2)
+    phi0 = as_number(phi0, "phi0")
     srp = check_srp(srp)
     T = n_periods * orbit.period
     wz = _grid_for(T, lo, hi, n_grid)
     symmetric = is_symmetric(orbit, phi0) and (srp is None or srp.eps == 0.0)
-    forcing = orbit_forcing(orbit)
     t_scan, level = (0.5 * T, 0.5 * math.pi) if symmetric else (T, math.pi)
-    r = sweep(forcing, t_scan, phi0, wz, kz, srp=srp)
-    found: list[AttitudeSolution] = []
-    for k, w in candidates(r["phi_t"], phi0, wz, level):
-        # symmetric: phi(T/2) - phi0 = k pi/2 -> turns = k/2; else phi(T) - phi0 = k pi -> turns = k/2
-        kind = "periodic" if k % 2 == 0 else "half-turn"
-        if kind not in kinds:
-            continue
-        n = k // 2
-        try:
-            sol = periodic_attitude(orbit, kz=kz, n=n, phi0=phi0, wz0=w, kind=kind, n_periods=n_periods, srp=srp)
-        except ConvergenceError:
-            continue
-        if not (lo <= sol.wz0 <= hi) or sol.residual > 1e-8:
-            continue
-        if any(s.n == sol.n and s.kind == sol.kind and abs(s.wz0 - sol.wz0) < 1e-8 for s in found):
-            continue
-        found.append(sol)
+    r = sweep(orbit_forcing(orbit), t_scan, phi0, wz, kz, srp=srp)
+    # symmetric: phi(T/2) - phi0 = k pi/2 -> turns = k/2; else phi(T) - phi0 = k pi -> turns = k/2
+    found = refine(orbit, kz, phi0, candidates(r["phi_t"], phi0, wz, level), n_periods=n_periods, srp=srp,
+                   closure="half" if symmetric else "full", window=(lo, hi), kinds=kinds)
     return sorted(found, key=lambda s: s.wz0)

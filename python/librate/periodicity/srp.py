@@ -1,5 +1,5 @@
 """Solar radiation pressure on periodic attitude motions (thesis ch. 4, PHYSICS.md sec. 6):
-continuation of a solution in the flat-plate amplitude eps (:func:`continue_srp`), the
+the flat-plate amplitude eps continued by :func:`librate.continue_srp`, the
 (eps, rate) periodicity map with its solution branches (:func:`srp_map`) and the accelerations on
 a Sun-pointing body (:func:`sun_pointing_accelerations`)."""
 
@@ -7,33 +7,27 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
 
 import numpy as np
 
 from .._checks import as_count, as_number
 from .._core import __version__
-from .._errors import ConvergenceError
 from ..attitude.srp import FacetBody, FlatPlate, Sun, force_torque
 from ..constants import OMEGA_SUN, SOLAR_PRESSURE_1AU, SUN_SYNODIC_PERIOD
 from ..orbits.periodic import PeriodicOrbit
 from ..orbits.system import check_system
+from .branches import branch_fold, branch_solutions, eps_branch
 from .solutions import (
-    AttitudeSolution,
     check_kinds,
     check_kz,
     check_orbit,
-    check_srp,
     find_periodic_attitudes,
     orbit_forcing,
-    periodic_attitude,
     sweep,
 )
 
-__all__ = ["SrpContinuation", "continue_srp", "srp_map", "sun_pointing_accelerations", "sun_resonance", "sun_angle", "FOLD_TRACE_TOL"]
+__all__ = ["srp_map", "sun_pointing_accelerations", "sun_resonance", "sun_angle"]
 
-#: A continuation that stops with the monodromy trace this close to 2 stopped at a fold.
-FOLD_TRACE_TOL = 0.05
 
 
 def sun_resonance(orbit: PeriodicOrbit, tol: float = 1e-6) -> int | None:
@@ -47,86 +41,6 @@ def sun_angle(theta_sun0: float, t) -> np.ndarray:
     return OMEGA_SUN * np.asarray(t, dtype=float) + theta_sun0
 
 
-@dataclass
-class SrpContinuation:
-    """Solutions continued in the flat-plate SRP amplitude ``eps`` from a starting solution.
-    ``reached``: the target eps was reached; otherwise ``fold`` gives where the branch turns
-    back ({"eps", "trace"}: the 2x2 monodromy's trace passes 2 there, where Phi - I is singular)
-    or ``end_reason`` why the continuation stopped. No point of another branch is ever returned."""
-
-    solutions: list[AttitudeSolution]
-    eps: np.ndarray
-    reached: bool
-    fold: dict | None
-    end_reason: str
-
-
-def continue_srp(solution: AttitudeSolution, srp, *, steps: int = 10, min_step: float = 1e-7) -> SrpContinuation:
-    """Continue ``solution`` (gravity-only, or with SRP) to the plate ``srp`` (its eps is the
-    target; cs, cd and the Sun phase are kept along the way) by natural continuation in eps:
-    linear extrapolation of (phi0, wz0), Newton in (phi0, wz0) with [Phi(KT) - I], steps halved on
-    failure or on a jump (the corrector landing farther than a quarter of the predicted step from
-    the prediction), and the fold detected where the monodromy's trace crosses 2
-    (det(Phi - I) = 2 - trace changes sign) or where the step collapses next to trace 2."""
-    srp = check_srp(srp)
-    if srp is None:
-        raise ValueError("invalid argument `srp`: the target plate is required")
-    if not isinstance(solution, AttitudeSolution):
-        raise ValueError("invalid argument `solution`: must be a librate.AttitudeSolution")
-    if not (isinstance(steps, int) and steps >= 1):
-        raise ValueError(f"invalid argument `steps`: must be an integer >= 1, got {steps!r}")
-    e0 = 0.0 if solution.srp is None else float(solution.srp.eps)
-    target = float(srp.eps)
-    sols, eps = [solution], [e0]
-    h_nominal = (target - e0) / steps
-    h = h_nominal / 16.0  # a small first step: there is no trend yet to guard against jumps
-    fold = None
-    reason = "reached the target eps"
-    while eps[-1] != target:
-        e = target if abs(target - eps[-1]) <= abs(h) * (1 + 1e-9) else eps[-1] + h
-        a = sols[-1]
-        if len(sols) >= 2:
-            b = sols[-2]
-            r = (e - eps[-1]) / (eps[-1] - eps[-2])
-            guess = (a.phi0 + r * (a.phi0 - b.phi0), a.wz0 + r * (a.wz0 - b.wz0))
-        else:
-            guess = (a.phi0, a.wz0)
-        ok = True
-        try:
-            s = periodic_attitude(a.orbit, kz=a.kz, n=a.n, kind=a.kind, phi0=guess[0], wz0=guess[1], n_periods=a.n_periods,
-                                  srp=srp.with_eps(e), method="newton")
-        except ConvergenceError:
-            ok = False
-        if ok:
-            # On a smooth branch the corrector lands within a small fraction of the predicted
-            # step (the predictor's error is second order in the step); a landing farther off is
-            # another branch, or the fold coming up: shorten the step instead.
-            jump = math.hypot(s.wz0 - guess[1], s.phi0 - guess[0])
-            if len(sols) >= 2:
-                ok = jump <= 0.25 * math.hypot(guess[1] - a.wz0, guess[0] - a.phi0) + 1e-9
-            else:
-                ok = jump <= 1e-2
-            ok = ok and s.residual <= 1e-8
-        crossing = ok and (2.0 - a.trace) * (2.0 - s.trace) < 0
-        if ok and not crossing:
-            sols.append(s)
-            eps.append(e)
-            h = float(np.sign(h_nominal) * min(abs(h) * 1.5, abs(h_nominal)))
-            continue
-        if abs(h) * 0.5 < min_step:
-            if crossing:
-                w = (2.0 - a.trace) / (s.trace - a.trace)
-                fold = {"eps": eps[-1] + w * (e - eps[-1]), "trace": 2.0}
-                reason = f"fold: the monodromy trace crosses 2 at eps = {fold['eps']:.8g} (Phi - I singular)"
-            else:
-                fold = {"eps": eps[-1], "trace": a.trace}
-                reason = f"fold or end of the branch near eps = {eps[-1]:.8g} (trace {a.trace:.6g}; step below {min_step:g})"
-            break
-        h *= 0.5  # failure, jump, or a trace crossing to pin down: shorten the step
-    return SrpContinuation(sols, np.array(eps), eps[-1] == target, fold, reason)
-
-
-# --- the (eps, rate) map and Sun pointing -----------------------------------------------------------
 def srp_map(
     orbit: PeriodicOrbit,
     *,
@@ -208,22 +122,23 @@ def srp_map(
         window = (float(wz[0]), float(wz[-1]))
 
         def follow(start, e_start, values, origin):
-            """Continue ``start`` (at e_start) through the grid ``values`` in order; one branch."""
+            """Continue ``start`` (at e_start) through the grid ``values`` in order (one
+            pseudo-arclength run to the last value, corrected exactly at each grid value on the
+            way; only those re-propagated); one branch, ending at the grid's end or at a
+            located fold."""
             b = len(branches)
-            path.append((b, e_start, start.wz0, start.phi0, start.trace))
-            end = (math.nan, math.nan, False, "reached the end of the eps grid")
-            cur = start
-            for e in values:
-                c = continue_srp(cur, plate.with_eps(float(e)), steps=steps)
-                path.extend((b, float(ei), si.wz0, si.phi0, si.trace) for ei, si in zip(c.eps[1:], c.solutions[1:]))
-                if not c.reached:
-                    last = c.solutions[-1]
-                    fold = c.fold is not None and abs(float(c.fold.get("trace", math.nan)) - 2.0) < FOLD_TRACE_TOL
-                    end = (float(c.fold["eps"]) if fold else float(c.eps[-1]), last.wz0, fold, c.end_reason)
-                    break
-                cur = c.solutions[-1]
-                sols.append((b, float(e), cur))
-            branches.append((start.n, start.kind, origin, e_start) + end)
+            target = plate.with_eps(float(values[-1]))
+            br = eps_branch(start, target, steps=steps * len(values), marks=[float(e) for e in values])
+            path.extend((b, float(p.x[0]), float(p.x[2]), float(p.x[1]), float(p.data["trace"])) for p in br.points)
+            sols.extend((b, float(p.x[0]), si) for p, si in zip(br.marked, branch_solutions(start, target, br.marked)))
+            if br.reached:
+                end = (math.nan, math.nan, False, "reached the end of the eps grid")
+            else:
+                f = branch_fold(br)
+                fold = f is not None and f["located"]
+                last = br.points[-1]
+                end = (float(f["eps"]) if fold else float(last.x[0]), float(last.x[2]), fold, br.end_reason)
+            branches.append((start.n_total, start.kind, origin, e_start) + end)
 
         pos, neg = es[es > 0], es[es < 0][::-1]
         for s0 in find_periodic_attitudes(orbit, kz=kz, wz0_range=window, phi0=phi0, kinds=kinds, n_periods=n_periods):
@@ -244,7 +159,7 @@ def srp_map(
                 found += find_periodic_attitudes(orbit, kz=kz, wz0_range=window, phi0=phi0 + seed, kinds=kinds,
                                                  n_periods=n_periods, srp=plate.with_eps(e_end))
             for s1 in sorted(found, key=lambda x: x.wz0):
-                if any(k.n == s1.n and k.kind == s1.kind and abs(k.wz0 - s1.wz0) < 1e-7
+                if any(k.n_total == s1.n_total and k.kind == s1.kind and abs(k.wz0 - s1.wz0) < 1e-7
                        and abs(math.remainder(k.phi0 - s1.phi0, 2 * math.pi)) < 1e-7 for k in known):
                     continue
                 sols.append((len(branches), e_end, s1))
@@ -264,7 +179,8 @@ def srp_map(
             "sol_phidot0": ("solution", sol_arr(lambda b, e, s: s.phidot0), {"units": "1/TU"}),
             "sol_phi0": ("solution", sol_arr(lambda b, e, s: math.remainder(s.phi0, 2 * math.pi)), {"units": "rad",
                          "long_name": "phi0 wrapped to [-pi, pi]"}),
-            "sol_n": ("solution", sol_arr(lambda b, e, s: s.n, np.int64)),
+            "sol_n": ("solution", sol_arr(lambda b, e, s: s.n), {"long_name": "net body turns per orbit period"}),
+            "sol_n_total": ("solution", sol_arr(lambda b, e, s: s.n_total, np.int64), {"long_name": "net body turns over the n_periods periods"}),
             "sol_kind": ("solution", sol_arr(lambda b, e, s: s.kind, "<U9")),
             "sol_trace": ("solution", sol_arr(lambda b, e, s: s.trace)),
             "sol_stable": ("solution", sol_arr(lambda b, e, s: s.stable, bool)),
@@ -274,7 +190,8 @@ def srp_map(
             "path_wz0": ("path", np.array([p[2] for p in path], dtype=float), {"units": "1/TU"}),
             "path_phi0": ("path", np.array([math.remainder(p[3], 2 * math.pi) for p in path], dtype=float), {"units": "rad"}),
             "path_trace": ("path", np.array([p[4] for p in path], dtype=float)),
-            "branch_n": ("branch", np.array([x[0] for x in branches], dtype=np.int64)),
+            "branch_n": ("branch", np.array([x[0] / n_periods for x in branches], dtype=float), {"long_name": "net body turns per orbit period"}),
+            "branch_n_total": ("branch", np.array([x[0] for x in branches], dtype=np.int64)),
             "branch_kind": ("branch", np.array([x[1] for x in branches], dtype="<U9")),
             "branch_origin": ("branch", np.array([x[2] for x in branches], dtype="<U7")),
             "branch_start_eps": ("branch", np.array([x[3] for x in branches], dtype=float)),

@@ -677,7 +677,7 @@ def _solution_legend(n, kind, stable) -> list:
     others = [nn for nn in ns if nn not in _N_COLORS]
     for nn in ns:
         if nn in _N_COLORS or len(others) == 1:
-            out.append(Line2D([], [], linestyle="none", marker="s", color=_n_color(nn), markersize=7, label=f"$N$ = {nn}"))
+            out.append(Line2D([], [], linestyle="none", marker="s", color=_n_color(nn), markersize=7, label=f"$N$ = {nn:g}"))
     if len(others) > 1:
         out.append(Line2D([], [], linestyle="none", marker="s", color=_N_OTHER, markersize=7,
                           label=f"other $N$ ({min(others)} ... {max(others)})"))
@@ -790,7 +790,7 @@ def plot_residuals(
             _draw_solutions(a, xs, np.zeros_like(xs), tab["n"][m], tab["kind"][m], tab["stable"][m])
             if annotate:
                 for xv, nn, k in zip(xs, tab["n"][m], tab["kind"][m]):
-                    txt = f"$N$ = {nn}" + (", half-turn" if k == "half-turn" else "")
+                    txt = f"$N$ = {nn:g}" + (", half-turn" if k == "half-turn" else "")
                     a.annotate(txt, (xv, 0.0), xytext=(0, 9), textcoords="offset points", ha="center", va="bottom",
                                fontsize=7.5, color=_n_color(nn), rotation=90)
             handles += _solution_legend(tab["n"][m], tab["kind"][m], tab["stable"][m])
@@ -997,7 +997,7 @@ def plot_solution_families(
                 continue
             color = kz_colors[jk] if separate else _n_color(nn)
             style = "-" if separate else _KZ_STYLES[jk % len(_KZ_STYLES)]
-            name = f"$K_z$ = {kz:g}" if separate else f"$N$ = {nn}{' half-turn' if kind == 'half-turn' else ''}, $K_z$ = {kz:g}"
+            name = f"$K_z$ = {kz:g}" if separate else f"$N$ = {nn:g}{' half-turn' if kind == 'half-turn' else ''}, $K_z$ = {kz:g}"
             orb, w = tab["orbit"][sel], tab["wz0"][sel]
             for b_i, br in enumerate(_branches(orb, w, max_jump)):
                 idx = sel[br]
@@ -1023,7 +1023,7 @@ def plot_solution_families(
             turns = {0: "", 1: " + 2\\pi", -1: " - 2\\pi"}.get(nn, f" {'+' if nn > 0 else '-'} {2 * abs(nn)}\\pi")
             if kind == "half-turn":
                 turns += " + \\pi"
-            a.set_title(f"$N$ = {nn}{' (half-turn)' if kind == 'half-turn' else ''}: $\\varphi(T) = \\varphi_0{turns}$", fontsize=10)
+            a.set_title(f"$N$ = {nn:g}{' (half-turn)' if kind == 'half-turn' else ''}: $\\varphi(T) = \\varphi_0{turns}$", fontsize=10)
             if not drawn:
                 a.text(0.5, 0.5, "no solutions in the map", transform=a.transAxes, ha="center", va="center", color="0.4")
     lo, hi = float(np.nanmin(xv)), float(np.nanmax(xv))
@@ -1086,7 +1086,7 @@ def plot_attitude_motion(
         tr = s.propagate(n_periods, t_eval=np.linspace(0.0, n_periods * T, m))
         color = _n_color(s.n) if by_n else cycle[i % len(cycle)]
         ls = "--" if s.kind == "half-turn" else "-"
-        label = (f"$N$ = {s.n}{' half-turn' if s.kind == 'half-turn' else ''}, "
+        label = (f"$N$ = {s.n:g}{' half-turn' if s.kind == 'half-turn' else ''}, "
                  f"$\\dot\\varphi(0)$ = {s.phidot0:.4f} ($\\omega_z(0)$ = {s.wz0:.4f}), {'stable' if s.stable else 'unstable'}")
         (h,) = a_ang.plot(tr.t / T, k * tr.phi, color=color, linestyle=ls, linewidth=1.4, label=label)
         h.set_gid("angle")
@@ -1386,7 +1386,7 @@ def plot_srp_map(
         pb = np.asarray(ds["path_branch"].values)
         drawn_end = {"fold": False, "branch-end": False}
         for b in range(ds.sizes.get("branch", 0)):
-            kind, nn = str(ds["branch_kind"].values[b]), int(ds["branch_n"].values[b])
+            kind, nn = str(ds["branch_kind"].values[b]), float(ds["branch_n"].values[b])
             if kind not in kinds:
                 continue
             sel = pb == b
@@ -1394,7 +1394,7 @@ def plot_srp_map(
             (h,) = a.plot(ds["path_eps"].values[sel], ds["path_wz0"].values[sel] - offset, color=_n_color(nn),
                           linewidth=1.3 if far else 1.0, alpha=0.85, linestyle=":" if far else "--" if kind == "half-turn" else "-",
                           zorder=4)
-            h.set_gid(f"branch-{kind}-N{nn:+d}")
+            h.set_gid(f"branch-{kind}-N{nn:+g}")
             ee = float(ds["branch_end_eps"].values[b])
             if math.isfinite(ee):
                 fold = bool(ds["branch_fold"].values[b])
@@ -1558,7 +1558,7 @@ def plot_srp_comparison(
         tr = sol.propagate(n, t_eval=t)
         eps = 0.0 if sol.srp is None else float(sol.srp.eps)
         what = "gravity only" if sol.srp is None or eps == 0.0 else f"SRP $\\varepsilon$ = {eps:.4g}"
-        label = (f"{what}: $N$ = {sol.n}, $\\varphi_0$ = {math.degrees(sol.phi0):.3f} deg, $\\dot\\varphi(0)$ = {sol.phidot0:.4f}, "
+        label = (f"{what}: $N$ = {sol.n:g}, $\\varphi_0$ = {math.degrees(sol.phi0):.3f} deg, $\\dot\\varphi(0)$ = {sol.phidot0:.4f}, "
                  f"{'stable' if sol.stable else 'unstable'}")
         (h,) = a_ang.plot(tr.t / T, kdeg * tr.phi, color=color, linestyle=ls, linewidth=1.4, label=label)
         h.set_gid(f"{key}-angle")

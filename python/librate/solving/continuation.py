@@ -313,7 +313,7 @@ def arclength(
     it (``Branch.reached``). Folds are located to ``fold_tol`` in the parameter and bifurcations
     (sign changes of ``problem.tests``) to the same tolerance when ``locate``; a fold is passed
     and the branch followed on, back in the parameter, unless ``stop_at_fold`` (then the branch
-    ends at the located fold, its points all before it). ``marks``: parameter values at which
+    ends at the located fold: its last point is the turning point, within ``fold_tol``). ``marks``: parameter values at which
     the branch is also corrected exactly, each time a step crosses one (``Branch.marked``; a
     branch that folds back over a value marks it again).
     """
@@ -347,29 +347,39 @@ def arclength(
     def at(base: Point, tb: np.ndarray, s: float) -> Point | None:
         return _try(problem, base.x + s * tb * sx, constraint(base, tb, s))
 
-    def finish_at(value: float, reason: str, reached: bool) -> Branch:
+    def land(value: float) -> Point | None:
+        """The point exactly at parameter ``value``, from the last point along the tangent."""
         last = points[-1]
         dp = t[k] * sx[k]
         guess = last.x + (value - last.x[k]) / dp * t * sx if dp != 0 else last.x.copy()
         guess[k] = value
         pt = _try(problem, guess, Constraint.fix(n, k, value))
         if pt is not None and _norm(problem, pt.x - guess) <= rules.jump * max(_norm(problem, guess - last.x), rules.ds_min) + 1e-9:
-            points.append(pt)
-            branch.reached = reached
-            branch.end_reason = reason
-        else:
-            branch.end_reason = f"stopped at {name} = {last.x[k]:.12g}: could not land on {value:.12g}"
-        return branch
+            return pt
+        return None
 
     while len(points) < max_points:
         base = points[-1]
         while True:
             pred = base.x + ds * t * sx
             p_pred = pred[k]
-            # the parameter range or the target lies within this step: land exactly on it
-            for edge, reason, reached in ((target, "reached the target parameter", True), (lo, "parameter range end", False), (hi, "parameter range end", False)):
-                if edge is not None and math.isfinite(edge) and (base.x[k] - edge) * (p_pred - edge) < 0 and base.x[k] != edge:
-                    return finish_at(edge, f"{reason}: {name} = {edge:.12g}", reached)
+            # the parameter range or the target lies within this step: land exactly on it (when
+            # that fails, the branch may turn back first: shorter steps find out)
+            edge = next(((e, r, ok) for e, r, ok in ((target, "reached the target parameter", True), (lo, "parameter range end", False),
+                                                     (hi, "parameter range end", False))
+                         if e is not None and math.isfinite(e) and (base.x[k] - e) * (p_pred - e) < 0 and base.x[k] != e), None)
+            if edge is not None:
+                landed = land(edge[0])
+                if landed is not None:
+                    points.append(landed)
+                    branch.reached = edge[2]
+                    branch.end_reason = f"{edge[1]}: {name} = {edge[0]:.12g}"
+                    return branch
+                ds *= 0.5
+                if ds < rules.ds_min:
+                    branch.end_reason = f"step floor: could not land on {name} = {edge[0]:.12g} from {base.x[k]:.12g} (step below {rules.ds_min:g})"
+                    return branch
+                continue
             new = at(base, t, ds)
             status = "fail"
             t_new = None
@@ -400,13 +410,15 @@ def arclength(
             fold = _locate_fold(problem, base, t, ds, new, t_new, at, fold_tol) if locate else Fold(float(new.x[k]), new, False, abs(new.x[k] - base.x[k]))
             branch.folds.append(fold)
             if stop_at_fold:
+                if fold.located:
+                    points.append(fold.point)  # the branch ends on its turning point
                 branch.end_reason = f"fold at {name} = {fold.parameter:.12g}" + ("" if fold.located else f" (not located: within {fold.tolerance:.2g})")
                 return branch
         tests_new = _tests(problem, new)
-        for name, v in tests_new.items():
-            u = tests_prev.get(name)
+        for test, v in tests_new.items():
+            u = tests_prev.get(test)
             if u is not None and math.isfinite(u) and math.isfinite(v) and u * v < 0:
-                branch.bifurcations.append(_locate_sign(problem, name, base, t, ds, u, v, new, at, fold_tol) if locate else Bifurcation(name, float(new.x[k]), new, False))
+                branch.bifurcations.append(_locate_sign(problem, test, base, t, ds, u, v, new, at, fold_tol) if locate else Bifurcation(test, float(new.x[k]), new, False))
         tests_prev = tests_new
         for m in marks:
             if (base.x[k] - m) * (new.x[k] - m) < 0 or new.x[k] == m:
@@ -463,35 +475,57 @@ def _illinois(f, a: float, fa: float, b: float, fb: float, done: Callable[[float
 
 
 def _locate_fold(problem, base, t, ds, new, t_new, at, tol) -> Fold:
-    """The turning point between ``base`` and ``new``: the arclength s in (0, ds) where the
-    tangent's parameter component vanishes. p(s) is quadratic about the fold, so the search
-    stops when the parameter values of the bracket's ends (and the best point) agree to tol."""
+    """The turning point between ``base`` and ``new``, searched on the hyperplanes
+    t . (y - y_base) = s, s in (0, ds): Illinois iterations on g(s) = dp/ds, the parameter's rate
+    along them (from the unit tangent at each point). Around the fold p(s) is a parabola, so p*
+    is estimated from each end of the bracket, p(a) + g(a) (s* - a) / 2 with s* the zero of g
+    interpolated linearly; located when the two estimates agree to ``tol``."""
     k = problem.parameter_index
-    cache: dict[float, tuple[float, Point]] = {0.0: (float(t[k]), base), ds: (float(t_new[k]), new)}
+    sk = float(problem.scale[k])
 
-    def f(s):
-        pt = at(base, t, s)
-        if pt is None:
-            return None
-        tt = _unit_tangent(problem, pt, t, pt.x - base.x)
-        if tt is None:
-            return None
-        cache[s] = (float(tt[k]), pt)
-        return float(tt[k]), pt
+    def rate(tt):
+        return float(tt[k]) * sk / max(float(np.dot(tt, t)), 1e-300)
 
-    def done(a, b):
-        pa, pb = cache[a][1].x[k], cache[b][1].x[k]
-        return abs(pa - pb) <= tol and abs(b - a) <= 1e-3 * ds or abs(b - a) <= 1e-14 * ds
-
-    best, ok = _illinois(f, 0.0, float(t[k]), ds, float(t_new[k]), done)
-    if best is None:
-        return Fold(float(new.x[k]), new, False, abs(new.x[k] - base.x[k]))
-    # the fold's parameter: the extremum of p over the evaluated points near it
-    pts = [v[1] for v in cache.values()]
-    sign = 1.0 if t[k] > 0 else -1.0  # p increases up to the fold
-    top = max(pts, key=lambda p: sign * p.x[k])
-    spread = max(abs(top.x[k] - cache[s][1].x[k]) for s in cache if abs(s - best[0]) <= 1e-3 * ds) if ok else math.inf
-    return Fold(float(top.x[k]), top, ok and spread <= tol, float(spread))
+    a, pa, ga = 0.0, base, rate(t)
+    b, pb, gb = ds, new, rate(t_new)
+    wa, wb = ga, gb  # the Illinois weights (the rates themselves are kept for the estimates)
+    g0 = max(abs(ga), abs(gb))
+    side = 0
+    est, err = float(new.x[k]), math.inf
+    for _ in range(80):
+        lin = a - ga * (b - a) / (gb - ga) if gb != ga else 0.5 * (a + b)
+        ea = pa.x[k] + 0.5 * ga * (lin - a)
+        eb = pb.x[k] + 0.5 * gb * (lin - b)
+        est, err = 0.5 * (ea + eb), abs(ea - eb)
+        # located: the parameter to tol, and a bracket end on the fold itself (its rate 1e-4 of
+        # the step's: quantities that vanish at the fold, det(J), vanish there to that order)
+        if err <= tol and min(abs(ga), abs(gb)) <= 1e-4 * g0:
+            return Fold(float(est), pa if abs(ga) < abs(gb) else pb, True, float(err))
+        c = a - wa * (b - a) / (wb - wa) if wb != wa else 0.5 * (a + b)
+        if not a < c < b:
+            c = 0.5 * (a + b)
+        pc = at(base, t, c)
+        tc = None if pc is None else _unit_tangent(problem, pc, t, pc.x - base.x)
+        if tc is None:
+            c = 0.5 * (a + b)
+            pc = at(base, t, c)
+            tc = None if pc is None else _unit_tangent(problem, pc, t, pc.x - base.x)
+            if tc is None:
+                break
+        gc = rate(tc)
+        if (gc > 0) == (gb > 0):
+            b, pb, gb, wb = c, pc, gc, gc
+            if side == 1:
+                wa *= 0.5
+            side = 1
+        else:
+            a, pa, ga, wa = c, pc, gc, gc
+            if side == -1:
+                wb *= 0.5
+            side = -1
+        if b - a <= 1e-15 * ds:
+            break
+    return Fold(float(est), pa if abs(ga) < abs(gb) else pb, False, float(err))
 
 
 def _locate_sign(problem, name, base, t, ds, u, v, new, at, tol) -> Bifurcation:
@@ -518,6 +552,9 @@ def _locate_sign(problem, name, base, t, ds, u, v, new, at, tol) -> Bifurcation:
         return abs(b - a) * max(abs(t[k]), 1e-16) * problem.scale[k] <= tol
 
     best, ok = _illinois(g, 0.0, u, ds, v, done)
-    if best is None:
-        return Bifurcation(name, float(new.x[k]), new, False)
+    if best is None or not ok:
+        # not located (the corrector cannot converge next to it, as at a branch point, where the
+        # extended Jacobian is singular): the linear interpolation of the test function
+        w = u / (u - v)
+        return Bifurcation(name, float(base.x[k] + w * (new.x[k] - base.x[k])), new if best is None else best[1], False)
     return Bifurcation(name, float(best[1].x[k]), best[1], ok)

@@ -1,6 +1,6 @@
 //! Solar radiation pressure against analytic plate cases and the simplified planar model.
 
-use librate_core::attitude::{Facet, FacetSrp, FlatPlate, Sun, P0};
+use librate_core::attitude::{Facet, FacetBody, FlatPlate, Sun, SOLAR_PRESSURE_1AU};
 
 fn unit(v: [f64; 3]) -> [f64; 3] {
     let n = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
@@ -9,8 +9,8 @@ fn unit(v: [f64; 3]) -> [f64; 3] {
 fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
-fn srp(facets: Vec<Facet>) -> FacetSrp {
-    FacetSrp { facets, sun: Sun::default(), tu_s: 375190.0 }
+fn srp(facets: Vec<Facet>) -> FacetBody {
+    FacetBody { facets, sun: Sun::default(), tu_s: 375190.0 }
 }
 
 /// PHYSICS.md sec. 6 / thesis Fig. 32: a fully absorbing plate feels P A cos(t) along -s; a
@@ -26,12 +26,12 @@ fn val_analytic_plate_cases() {
         let abs = srp(vec![Facet::new(area, n, [0.0; 3], 1.0, 0.0, 0.0).unwrap()]);
         let (f, _) = abs.force_torque(&s);
         for i in 0..3 {
-            assert!((f[i] + P0 * area * cos_t * s[i]).abs() < 1e-15 * P0 * area);
+            assert!((f[i] + SOLAR_PRESSURE_1AU * area * cos_t * s[i]).abs() < 1e-15 * SOLAR_PRESSURE_1AU * area);
         }
         let spec = srp(vec![Facet::new(area, n, [0.0; 3], 0.0, 1.0, 0.0).unwrap()]);
         let (f, _) = spec.force_torque(&s);
         for i in 0..3 {
-            assert!((f[i] + 2.0 * P0 * area * cos_t * cos_t * n[i]).abs() < 1e-15 * P0 * area);
+            assert!((f[i] + 2.0 * SOLAR_PRESSURE_1AU * area * cos_t * cos_t * n[i]).abs() < 1e-15 * SOLAR_PRESSURE_1AU * area);
         }
     }
     // edge-on and facing away
@@ -105,7 +105,7 @@ fn val_flat_plate_model_matches_facets() {
     let (area, d, iz, tu) = (500.0, 3.0, 2.0e8, 375190.0);
     let (cs, cd) = (0.4, 0.1);
     let ca = 1.0 - cs - cd;
-    let body = FacetSrp {
+    let body = FacetBody {
         facets: vec![
             Facet::new(area, [1.0, 0.0, 0.0], [0.0, d, 0.0], ca, cs, cd).unwrap(),
             Facet::new(area, [-1.0, 0.0, 0.0], [0.0, d, 0.0], ca, cs, cd).unwrap(),
@@ -113,13 +113,13 @@ fn val_flat_plate_model_matches_facets() {
         sun: Sun::default(),
         tu_s: tu,
     };
-    let eps = P0 * area * d * tu * tu / iz;
-    let plate = FlatPlate::new(eps, cs, cd, Sun { theta0: 0.0, omega: 0.0, pressure: P0 }).unwrap();
+    let eps = SOLAR_PRESSURE_1AU * area * d * tu * tu / iz;
+    let plate = FlatPlate::new(eps, cs, cd, Sun { theta0: 0.0, omega: 0.0, pressure: SOLAR_PRESSURE_1AU }).unwrap();
     for k in 0..36 {
         let a = k as f64 * 10.0_f64.to_radians() + 0.01;
         let (_, t) = body.force_torque(&[a.cos(), a.sin(), 0.0]);
         // planar model: alpha = theta_sun - phi with phi = 0 and theta_sun = a
-        let p = FlatPlate { sun: Sun { theta0: a, omega: 0.0, pressure: P0 }, ..plate };
+        let p = FlatPlate { sun: Sun { theta0: a, omega: 0.0, pressure: SOLAR_PRESSURE_1AU }, ..plate };
         let (w, _) = p.wzdot(0.0, 0.0);
         assert!((t[2] * tu * tu / iz - w).abs() < 1e-14 * eps, "a = {a}: {} vs {w}", t[2] * tu * tu / iz);
     }
@@ -132,12 +132,12 @@ fn val_flat_plate_model_matches_facets() {
 fn val_srp_acceleration_order_of_magnitude() {
     let mass = 1000.0;
     let area = 0.016 * mass;
-    let body = FacetSrp { facets: vec![Facet::new(area, [1.0, 0.0, 0.0], [0.0; 3], 1.0, 0.0, 0.0).unwrap()], sun: Sun::default(), tu_s: 375190.0 };
+    let body = FacetBody { facets: vec![Facet::new(area, [1.0, 0.0, 0.0], [0.0; 3], 1.0, 0.0, 0.0).unwrap()], sun: Sun::default(), tu_s: 375190.0 };
     let a_id = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
     let acc = body.acceleration(0.0, &a_id, mass, 384400e3);
     let n = acc.iter().map(|v| v * v).sum::<f64>().sqrt();
     assert!((1e-6..1e-4).contains(&n), "{n:e}");
-    assert!((n - P0 * 0.016 * 375190.0f64.powi(2) / 384400e3).abs() < 1e-18);
+    assert!((n - SOLAR_PRESSURE_1AU * 0.016 * 375190.0f64.powi(2) / 384400e3).abs() < 1e-18);
 }
 
 /// Bad parameters name themselves.

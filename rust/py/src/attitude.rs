@@ -1,6 +1,6 @@
 //! Bindings of the attitude models: convert, call the core with the GIL released, convert.
 
-use librate_core::attitude::{self, gravity_gradient_by_name, Facet, FacetSrp, FlatPlate, GravityGradient, OrbitMode, RigidBody, Sun, Torque};
+use librate_core::attitude::{self, gravity_gradient_by_name, Facet, FacetBody, FlatPlate, GravityGradient, OrbitMode, RigidBody, Sun, Torque};
 use librate_core::integrate::{Options, Output};
 use numpy::{IntoPyArray, PyArrayMethods, PyReadonlyArray1};
 use pyo3::exceptions::PyValueError;
@@ -19,21 +19,21 @@ fn output<'a>(t_eval: &'a Option<Vec<f64>>) -> Output<'a> {
 /// Facets as (area, normal[3], center[3], ca, cs, cd) tuples -> validated core facets.
 type FacetTuple = (f64, [f64; 3], [f64; 3], f64, f64, f64);
 
-fn facet_model(facets: Vec<FacetTuple>, sun: (f64, f64, f64), tu_s: f64) -> PyResult<FacetSrp> {
+fn facet_model(facets: Vec<FacetTuple>, sun: (f64, f64, f64), tu_s: f64) -> PyResult<FacetBody> {
     let facets = facets.into_iter().map(|(a, n, c, ca, cs, cd)| Facet::new(a, n, c, ca, cs, cd)).collect::<Result<Vec<_>, _>>().map_err(to_py)?;
-    Ok(FacetSrp { facets, sun: Sun { theta0: sun.0, omega: sun.1, pressure: sun.2 }, tu_s })
+    Ok(FacetBody { facets, sun: Sun { theta0: sun.0, omega: sun.1, pressure: sun.2 }, tu_s })
 }
 
 /// SRP force (N) and torque (N m) in body axes of facets for a Sun direction in body axes.
 #[pyfunction]
 fn facets_force_torque(facets: Vec<FacetTuple>, s_body: [f64; 3]) -> PyResult<([f64; 3], [f64; 3])> {
-    let m = facet_model(facets, (0.0, 0.0, librate_core::attitude::P0), 1.0)?;
+    let m = facet_model(facets, (0.0, 0.0, librate_core::constants::SOLAR_PRESSURE_1AU), 1.0)?;
     Ok(m.force_torque(&s_body))
 }
 
 /// Coupled 3-D orbit-attitude propagation.
 #[pyfunction]
-#[pyo3(signature = (mu, inertia, torques, orbit_mode, state0, t0, tf, *, options, stm, t_eval, inertia_nd=None, facets=None, sun=(0.0, librate_core::attitude::OMEGA_SUN, librate_core::attitude::P0), tu_s=1.0, srp_force=None))]
+#[pyo3(signature = (mu, inertia, torques, orbit_mode, state0, t0, tf, *, options, stm, t_eval, inertia_nd=None, facets=None, sun=(0.0, librate_core::constants::OMEGA_SUN, librate_core::constants::SOLAR_PRESSURE_1AU), tu_s=1.0, srp_force=None))]
 #[allow(clippy::too_many_arguments)]
 fn attitude_propagate<'py>(
     py: Python<'py>,
@@ -117,7 +117,7 @@ fn planar_propagate<'py>(
     let opts = Options::from(options);
     let times = t_eval.map(|a| a.as_array().to_vec());
     let srp = match plate {
-        Some((eps, cs, cd, theta0, omega)) => Some(FlatPlate::new(eps, cs, cd, Sun { theta0, omega, pressure: librate_core::attitude::P0 }).map_err(to_py)?),
+        Some((eps, cs, cd, theta0, omega)) => Some(FlatPlate::new(eps, cs, cd, Sun { theta0, omega, pressure: librate_core::constants::SOLAR_PRESSURE_1AU }).map_err(to_py)?),
         None => None,
     };
     let tr = py

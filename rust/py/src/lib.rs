@@ -359,15 +359,6 @@ fn symmetric_correct<'py>(
     Ok(d)
 }
 
-/// Residuals and sensitivities of the symmetric conditions at p = (x0, z0, vy0).
-#[pyfunction]
-#[pyo3(signature = (mu, p, *, spatial, t_max, rtol, atol))]
-fn symmetric_evaluate<'py>(py: Python<'py>, mu: f64, p: [f64; 3], spatial: bool, t_max: f64, rtol: f64, atol: f64) -> PyResult<Bound<'py, PyDict>> {
-    let sh = shooting(mu, spatial, 1e-12, 1, t_max, rtol, atol);
-    let e = py.detach(|| sh.evaluate(p)).map_err(to_py)?;
-    evaluation_dict(py, &e)
-}
-
 /// Eigenvalues (6,) and the two stability indices (2,) of a monodromy matrix, both complex.
 #[pyfunction]
 fn stability<'py>(py: Python<'py>, m: PyReadonlyArray2<'py, f64>, planar: bool) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
@@ -436,13 +427,17 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(system_validate, m)?)?;
     m.add_function(wrap_pyfunction!(preset_names, m)?)?;
     m.add_function(wrap_pyfunction!(symmetric_correct, m)?)?;
-    m.add_function(wrap_pyfunction!(symmetric_evaluate, m)?)?;
     m.add_function(wrap_pyfunction!(stability, m)?)?;
     m.add_function(wrap_pyfunction!(multiple_shooting, m)?)?;
     fourier::register(m)?;
     attitude::register(m)?;
     map::register(m)?;
     flexible::register(m)?;
+    // Physical constants, read from the core (one definition: librate_core::constants).
+    m.add("N_SUN", librate_core::constants::N_SUN)?;
+    m.add("OMEGA_SUN", librate_core::constants::OMEGA_SUN)?;
+    m.add("SOLAR_PRESSURE_1AU", librate_core::constants::SOLAR_PRESSURE_1AU)?;
+    m.add("SUN_SYNODIC_PERIOD", librate_core::constants::SUN_SYNODIC_PERIOD)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

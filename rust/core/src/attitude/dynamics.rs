@@ -39,7 +39,7 @@ pub struct Coupled<'a> {
     pub orbit: OrbitMode,
     /// Solar radiation pressure force on the orbit (facets, spacecraft mass in kg, LU in m);
     /// off (None) by default, as for the maps.
-    pub orbit_srp: Option<(&'a super::srp::FacetSrp, f64, f64)>,
+    pub orbit_srp: Option<(&'a super::srp::FacetBody, f64, f64)>,
 }
 
 /// Attitude matrix A(q)/|q|^2 (synodic -> body), scalar-last quaternion.
@@ -76,7 +76,7 @@ impl Coupled<'_> {
                 }
             }
             OrbitMode::Integrate | OrbitMode::Coupled { .. } => {
-                let mut acc = cr3bp_acc(mu, &pos, &vel);
+                let mut acc = crate::cr3bp::acceleration(mu, &pos, &vel);
                 if let OrbitMode::Coupled { inertia_nd } = self.orbit {
                     let extra = extended_body_acc(mu, &pos, &a, inertia_nd);
                     for i in 0..3 {
@@ -121,23 +121,6 @@ impl Coupled<'_> {
             dy[10 + i] = (tq[i] - gyro[i]).scale(1.0 / inertia[i]);
         }
     }
-}
-
-/// CR3BP acceleration over any scalar (same formula as `cr3bp::Cr3bp`).
-#[inline(always)]
-fn cr3bp_acc<R: Real>(mu: f64, p: &[R; 3], v: &[R; 3]) -> [R; 3] {
-    let d1 = p[0] + R::cst(mu);
-    let d2 = p[0] - R::cst(1.0 - mu);
-    let yz = p[1] * p[1] + p[2] * p[2];
-    let r1s = d1 * d1 + yz;
-    let r2s = d2 * d2 + yz;
-    let c1 = R::cst(1.0 - mu) / (r1s * r1s.sqrt());
-    let c2 = R::cst(mu) / (r2s * r2s.sqrt());
-    [
-        v[1].scale(2.0) + p[0] - c1 * d1 - c2 * d2,
-        -v[0].scale(2.0) + p[1] - (c1 + c2) * p[1],
-        -(c1 + c2) * p[2],
-    ]
 }
 
 /// Second-order extended-body acceleration of both primaries (thesis eq. 37):

@@ -12,7 +12,7 @@ pub mod torque;
 
 pub use body::RigidBody;
 pub use dynamics::{dcm, Coupled, CoupledStm, OrbitMode};
-pub use planar::{forcing_sc, Forcing, FourierForcing, PlanarAlongOrbit, PlanarForced};
-pub use propagate::{evaluate_torques, propagate_attitude, propagate_planar, propagate_planar_forced, AttitudeTrajectory, PlanarTrajectory};
-pub use srp::{Facet, FacetSrp, FlatPlate, Sun, OMEGA_SUN, P0};
+pub use planar::{forcing_sc, forcing_scp, gravity_gradient_wzdot, Forcing, PlanarAlongOrbit, PlanarForced};
+pub use propagate::{evaluate_torques, propagate_attitude, propagate_planar, AttitudeTrajectory, PlanarTrajectory};
+pub use srp::{flat_plate_wzdot, Facet, FacetBody, FlatPlate, Sun, N_SUN, OMEGA_SUN, P0, SOLAR_PRESSURE_1AU};
 pub use torque::{gravity_gradient_by_name, GravityGradient, Torque, TorqueInput};

@@ -4,19 +4,22 @@
 //!   C = sum_i mu_i cos(2 theta_i) / r_i^3 = sum_i mu_i (x_i^2 - y_i^2) / r_i^5,
 //! with (x_i, y_i) the position relative to primary i (the atan2-free form). S and C depend on
 //! the orbit only: the orbit is integrated with the attitude, held at a point, or supplied
-//! precomputed through the [`Forcing`] trait (e.g. a Fourier series of the orbit).
+//! precomputed through the [`Forcing`] trait (e.g. the map engine's Chebyshev table).
 //! Optional 2x2 attitude STM: d/dt [dphi, dwz] = [[0, 1], [-3 Kz (S sin 2phi + C cos 2phi), 0]].
 
 use super::srp::FlatPlate;
 use crate::cr3bp::Cr3bp;
-use crate::fourier::FourierOrbit;
 use crate::integrate::System;
+use crate::scalar::Lane;
 
-/// S and C at a synodic position, for the enabled primaries [larger, smaller].
+/// S, C and P = sum_i mu_i / r_i^3 at a synodic position, for the enabled primaries [larger,
+/// smaller]: the one definition of the tidal field (the flexible model's complex field is
+/// W = C + i S, `flexible::tidal_field`).
 #[inline(always)]
-pub fn forcing_sc(mu: f64, pos: &[f64], primaries: [bool; 2]) -> (f64, f64) {
+pub fn forcing_scp(mu: f64, pos: &[f64], primaries: [bool; 2]) -> (f64, f64, f64) {
     let mut s = 0.0;
     let mut c = 0.0;
+    let mut p = 0.0;
     for (k, (cx, gm)) in [(-mu, 1.0 - mu), (1.0 - mu, mu)].into_iter().enumerate() {
         if !primaries[k] {
             continue;
@@ -27,8 +30,25 @@ pub fn forcing_sc(mu: f64, pos: &[f64], primaries: [bool; 2]) -> (f64, f64) {
         let inv5 = gm / (r2 * r2 * r2.sqrt());
         s += 2.0 * x * y * inv5;
         c += (x * x - y * y) * inv5;
+        p += inv5 * r2;
     }
+    (s, c, p)
+}
+
+/// S and C at a synodic position, for the enabled primaries [larger, smaller].
+#[inline(always)]
+pub fn forcing_sc(mu: f64, pos: &[f64], primaries: [bool; 2]) -> (f64, f64) {
+    let (s, c, _) = forcing_scp(mu, pos, primaries);
     (s, c)
+}
+
+/// The planar gravity-gradient angular acceleration and its derivative in phi (thesis eq. 33),
+/// over f64 or SIMD lanes (the scalar model and the map engine both call this): with
+/// kz15 = (3/2) Kz and (c2, s2) = (cos 2phi, sin 2phi),
+///   wzdot = kz15 (S c2 - C s2),   d wzdot / d phi = -2 kz15 (S s2 + C c2).
+#[inline(always)]
+pub fn gravity_gradient_wzdot<L: Lane>(kz15: L, s: L, c: L, c2: L, s2: L) -> (L, L) {
+    (kz15 * (s * c2 - c * s2), -(kz15 + kz15) * (s * s2 + c * c2))
 }
 
 /// The orbit part (first six components) of a state's derivative: the CR3BP, or zero for a
@@ -50,24 +70,11 @@ pub trait Forcing: Sync {
     fn sc(&self, t: f64) -> (f64, f64);
 }
 
-/// S, C from a Fourier-series orbit.
-pub struct FourierForcing<'a> {
-    pub mu: f64,
-    pub orbit: &'a FourierOrbit,
-    pub primaries: [bool; 2],
-}
-
-impl Forcing for FourierForcing<'_> {
-    fn sc(&self, t: f64) -> (f64, f64) {
-        forcing_sc(self.mu, &self.orbit.position(t), self.primaries)
-    }
-}
-
 /// (phidot, wzdot) and the STM coefficient d(wzdot)/d(phi) from S, C (and the flat-plate SRP).
 #[inline(always)]
 fn attitude_rhs(kz: f64, s: f64, c: f64, t: f64, phi: f64, wz: f64, srp: &Option<FlatPlate>) -> (f64, f64, f64) {
     let (s2, c2) = (2.0 * phi).sin_cos();
-    let (mut dwz, mut k) = (1.5 * kz * (s * c2 - c * s2), -3.0 * kz * (s * s2 + c * c2));
+    let (mut dwz, mut k) = gravity_gradient_wzdot(1.5 * kz, s, c, c2, s2);
     if let Some(p) = srp {
         let (v, d) = p.wzdot(t, phi);
         dwz += v;

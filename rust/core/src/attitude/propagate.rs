@@ -2,7 +2,7 @@
 
 use super::body::RigidBody;
 use super::dynamics::{dcm, Coupled, CoupledStm, OrbitMode, DIM, STM_DIM};
-use super::planar::{Forcing, PlanarAlongOrbit, PlanarForced};
+use super::planar::PlanarAlongOrbit;
 use super::srp::FlatPlate;
 use super::torque::Torque;
 use crate::cr3bp::check_mu;
@@ -33,8 +33,8 @@ pub fn propagate_attitude(
     opts: &Options,
     with_stm: bool,
     output: Output<'_>,
-    orbit_srp: Option<(&super::srp::FacetSrp, f64, f64)>,
-    terminators: Option<&super::srp::FacetSrp>,
+    orbit_srp: Option<(&super::srp::FacetBody, f64, f64)>,
+    terminators: Option<&super::srp::FacetBody>,
 ) -> Result<AttitudeTrajectory> {
     check_mu(mu)?;
     RigidBody::new(body.ix, body.iy, body.iz)?;
@@ -79,11 +79,11 @@ pub fn propagate_attitude(
     }
 }
 
-/// Result of [`propagate_planar`] and [`propagate_planar_forced`].
+/// Result of [`propagate_planar`].
 #[derive(Debug, Clone)]
 pub struct PlanarTrajectory {
     pub t: Vec<f64>,
-    /// Row-major n x 6 (empty when the orbit was supplied precomputed).
+    /// Row-major n x 6.
     pub orbit: Vec<f64>,
     pub phi: Vec<f64>,
     pub wz: Vec<f64>,
@@ -158,45 +158,6 @@ pub fn propagate_planar(
         wz.push(row[7]);
     }
     Ok(PlanarTrajectory { t, orbit, phi, wz, stm_final: stm, stats })
-}
-
-/// Planar attitude driven by a precomputed orbit forcing S(t), C(t).
-#[allow(clippy::too_many_arguments)]
-pub fn propagate_planar_forced(
-    kz: f64,
-    forcing: &dyn Forcing,
-    phi0: f64,
-    wz0: f64,
-    t0: f64,
-    tf: f64,
-    opts: &Options,
-    with_stm: bool,
-    output: Output<'_>,
-    srp: Option<FlatPlate>,
-) -> Result<PlanarTrajectory> {
-    check_kz(kz)?;
-    check_finite("attitude", &[phi0, wz0])?;
-    let sys = PlanarForced { kz, forcing, srp };
-    let kink6 = srp.map(|p| move |t: f64, y: &[f64; 6]| p.terminator(t, y[0]));
-    let kink2 = srp.map(|p| move |t: f64, y: &[f64; 2]| p.terminator(t, y[0]));
-    let (t, rows, width, stm, stats) = if with_stm {
-        let y0 = [phi0, wz0, 1.0, 0.0, 0.0, 1.0];
-        let sol = match &kink6 {
-            Some(k) => solve_piecewise(&sys, t0, &y0, tf, opts, output, &[k as &dyn EventFn<[f64; 6]>])?,
-            None => solve(&sys, t0, &y0, tf, opts, output, &[])?,
-        };
-        let f = sol.y_final;
-        (sol.t, sol.y, 6, Some([f[2], f[3], f[4], f[5]]), sol.stats)
-    } else {
-        let sol = match &kink2 {
-            Some(k) => solve_piecewise(&sys, t0, &[phi0, wz0], tf, opts, output, &[k as &dyn EventFn<[f64; 2]>])?,
-            None => solve(&sys, t0, &[phi0, wz0], tf, opts, output, &[])?,
-        };
-        (sol.t, sol.y, 2, None, sol.stats)
-    };
-    let phi = rows.chunks_exact(width).map(|r| r[0]).collect();
-    let wz = rows.chunks_exact(width).map(|r| r[1]).collect();
-    Ok(PlanarTrajectory { t, orbit: Vec::new(), phi, wz, stm_final: stm, stats })
 }
 
 /// The total torque of `torques` (body axes) at each coupled state (rows of 13).

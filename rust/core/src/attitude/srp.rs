@@ -14,15 +14,13 @@
 //! gradient is proportional to the inertia and accepts the same units).
 
 use super::dual::Real;
+use crate::scalar::Lane;
 use super::torque::{cross, mat_vec, Torque, TorqueInput, D13};
 use crate::error::{check_finite, invalid, Result};
 
-/// Sidereal month / sidereal year: the Sun's mean motion in units of the Moon's.
-pub const N_SUN: f64 = 27.321661 / 365.25636;
-/// Rate of the Sun direction in the synodic frame (clockwise), 1/TU.
-pub const OMEGA_SUN: f64 = -(1.0 - N_SUN);
-/// Solar pressure at 1 AU, N/m^2.
-pub const P0: f64 = 4.56e-6;
+pub use crate::constants::{N_SUN, OMEGA_SUN, SOLAR_PRESSURE_1AU};
+/// Former name of [`SOLAR_PRESSURE_1AU`] (kept for existing callers).
+pub use crate::constants::SOLAR_PRESSURE_1AU as P0;
 
 /// The apparent Sun: its initial phase and the pressure.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -34,15 +32,22 @@ pub struct Sun {
 
 impl Default for Sun {
     fn default() -> Self {
-        Self { theta0: 0.0, omega: OMEGA_SUN, pressure: P0 }
+        Self { theta0: 0.0, omega: OMEGA_SUN, pressure: SOLAR_PRESSURE_1AU }
     }
 }
 
 impl Sun {
+    /// The Sun's angle from the synodic x axis, theta_sun(t) = omega t + theta0: the one place
+    /// the Sun's motion is written (direction, plate law, terminators, map lanes).
+    #[inline(always)]
+    pub fn angle(&self, t: f64) -> f64 {
+        self.omega * t + self.theta0
+    }
+
     /// Unit vector to the Sun in synodic components.
     #[inline]
     pub fn direction(&self, t: f64) -> [f64; 3] {
-        let (s, c) = (self.omega * t + self.theta0).sin_cos();
+        let (s, c) = self.angle(t).sin_cos();
         [c, s, 0.0]
     }
 }
@@ -97,16 +102,17 @@ impl Facet {
     }
 }
 
-/// A body as a list of facets: SRP force and torque (a [`Torque`] model).
+/// A body as a list of facets: SRP force and torque (a [`Torque`] model); the Rust side of
+/// the Python `librate.FacetBody`.
 #[derive(Debug, Clone, PartialEq)]
-pub struct FacetSrp {
+pub struct FacetBody {
     pub facets: Vec<Facet>,
     pub sun: Sun,
     /// TU in seconds: torques are returned in kg m^2 / TU^2.
     pub tu_s: f64,
 }
 
-impl FacetSrp {
+impl FacetBody {
     /// Total force (N) and torque (N m) in body axes for the Sun direction `s_body`.
     pub fn force_torque(&self, s_body: &[f64; 3]) -> ([f64; 3], [f64; 3]) {
         self.eval(s_body)
@@ -147,7 +153,7 @@ impl FacetSrp {
     }
 }
 
-impl Torque for FacetSrp {
+impl Torque for FacetBody {
     fn name(&self) -> &'static str {
         "srp"
     }
@@ -187,20 +193,41 @@ impl FlatPlate {
         Ok(Self { eps, cs, cd, sun })
     }
 
+    /// The law's coefficients (a1, a2) = (eps (1 + Cs), eps (2/3) Cd), see [`flat_plate_wzdot`].
+    #[inline(always)]
+    pub fn coefficients(&self) -> (f64, f64) {
+        (self.eps * (1.0 + self.cs), self.eps * (2.0 / 3.0) * self.cd)
+    }
+
+    /// alpha = theta_sun(t) - phi, the Sun's angle from the plate normal.
+    #[inline(always)]
+    pub fn alpha(&self, t: f64, phi: f64) -> f64 {
+        self.sun.angle(t) - phi
+    }
+
     /// cos(alpha) = cos(theta_sun(t) - phi): zero where the plate is edge-on to the Sun, where
     /// the law cos(alpha)|cos(alpha)| has its kinks (integrations stop there).
     #[inline]
     pub fn terminator(&self, t: f64, phi: f64) -> f64 {
-        (self.sun.omega * t + self.sun.theta0 - phi).cos()
+        self.alpha(t, phi).cos()
     }
 
     /// wzdot from SRP and its derivative with respect to phi.
     #[inline]
     pub fn wzdot(&self, t: f64, phi: f64) -> (f64, f64) {
-        let (sa, ca) = (self.sun.omega * t + self.sun.theta0 - phi).sin_cos();
-        let v = self.eps * ((1.0 + self.cs) * ca * ca.abs() + (2.0 / 3.0) * self.cd * ca);
-        // d/dphi of cos(alpha) = sin(alpha); d/dx (x|x|) = 2|x|
-        let d = self.eps * ((1.0 + self.cs) * 2.0 * ca.abs() + (2.0 / 3.0) * self.cd) * sa;
-        (v, d)
+        let (a1, a2) = self.coefficients();
+        let (sa, ca) = self.alpha(t, phi).sin_cos();
+        flat_plate_wzdot(a1, a2, ca, sa)
     }
+}
+
+/// The flat-plate law over f64 or SIMD lanes (the scalar model and the map lanes both call
+/// this), from the coefficients (a1, a2) of [`FlatPlate::coefficients`] and (cos alpha,
+/// sin alpha):
+///   wzdot = cos(a) (a1 |cos(a)| + a2),   d wzdot / d phi = sin(a) (2 a1 |cos(a)| + a2)
+/// (d cos(alpha) / d phi = sin(alpha), d (x|x|) / dx = 2|x|).
+#[inline(always)]
+pub fn flat_plate_wzdot<L: Lane>(a1: L, a2: L, ca: L, sa: L) -> (L, L) {
+    let aca = ca.abs();
+    (ca * a1.mul_add(aca, a2), sa * (a1 + a1).mul_add(aca, a2))
 }

@@ -7,6 +7,6 @@ mod dynamics;
 mod lagrange;
 mod system;
 
-pub use dynamics::{jacobi, potential, potential_gradient, potential_hessian, Cr3bp, Cr3bpStm, STM_DIM};
+pub use dynamics::{acceleration, jacobi, potential, potential_gradient, potential_hessian, Cr3bp, Cr3bpStm, STM_DIM};
 pub use lagrange::{collinear_point, lagrange_points};
 pub use system::{check_mu, SystemConstants, PRESETS};

@@ -4,37 +4,26 @@
 use nalgebra::Complex;
 
 use super::body::{cross, dot, FlexibleBody};
+use crate::attitude::forcing_scp;
 use crate::integrate::System;
 
 /// The tidal field of the enabled primaries [larger, smaller] at a synodic position:
-/// W = C + i S = sum_i mu_i zeta_i^2 / r_i^5 (zeta_i = x_i + i y_i relative to primary i, so
-/// C, S are PHYSICS.md sec. 4's) and P = sum_i mu_i / r_i^3.
+/// W = C + i S = sum_i mu_i zeta_i^2 / r_i^5 (zeta_i = x_i + i y_i relative to primary i:
+/// zeta^2 = (x^2 - y^2) + i 2 x y, so C, S are PHYSICS.md sec. 4's, computed by the planar
+/// model's [`forcing_scp`]) and P = sum_i mu_i / r_i^3.
 #[inline(always)]
 pub fn tidal_field(mu: f64, pos: &[f64], primaries: [bool; 2]) -> (Complex<f64>, f64) {
-    let mut w = Complex::new(0.0, 0.0);
-    let mut p = 0.0;
-    for (k, (cx, gm)) in [(-mu, 1.0 - mu), (1.0 - mu, mu)].into_iter().enumerate() {
-        if !primaries[k] {
-            continue;
-        }
-        let x = pos[0] - cx;
-        let y = pos[1];
-        let r2 = x * x + y * y + pos[2] * pos[2];
-        let inv3 = gm / (r2 * r2.sqrt());
-        let inv5 = inv3 / r2;
-        w += Complex::new(x * x - y * y, 2.0 * x * y) * inv5;
-        p += inv3;
-    }
-    (w, p)
+    let (s, c, p) = forcing_scp(mu, pos, primaries);
+    (Complex::new(c, s), p)
 }
 
-/// W and its first two time derivatives along a planar orbit, from the position, velocity and
-/// acceleration (synodic): W = sum mu zeta^2 f, f = r^-5, so
+/// W ([`tidal_field`]) and its first two time derivatives along a planar orbit, from the
+/// position, velocity and acceleration (synodic): W = sum mu zeta^2 f, f = r^-5, so
 /// W' = sum mu (2 zeta zeta' f + zeta^2 f'), W'' = sum mu (2 zeta'^2 f + 2 zeta zeta'' f +
 /// 4 zeta zeta' f' + zeta^2 f''), f' = -5 r^-7 s, f'' = 35 r^-9 s^2 - 5 r^-7 s', s = r.v,
 /// s' = |v|^2 + r.a.
 pub fn tidal_field_derivatives(mu: f64, pos: &[f64], vel: &[f64], acc: &[f64], primaries: [bool; 2]) -> [Complex<f64>; 3] {
-    let mut out = [Complex::new(0.0, 0.0); 3];
+    let mut out = [tidal_field(mu, pos, primaries).0, Complex::new(0.0, 0.0), Complex::new(0.0, 0.0)];
     for (k, (cx, gm)) in [(-mu, 1.0 - mu), (1.0 - mu, mu)].into_iter().enumerate() {
         if !primaries[k] {
             continue;
@@ -49,7 +38,6 @@ pub fn tidal_field_derivatives(mu: f64, pos: &[f64], vel: &[f64], acc: &[f64], p
         let sd = zd.norm_sqr() + z.re * zdd.re + z.im * zdd.im;
         let fd = -5.0 * f / r2 * s;
         let fdd = 35.0 * f / (r2 * r2) * s * s - 5.0 * f / r2 * sd;
-        out[0] += z * z * f * gm;
         out[1] += (z * zd * 2.0 * f + z * z * fd) * gm;
         out[2] += (zd * zd * 2.0 * f + z * zdd * 2.0 * f + z * zd * 4.0 * fd + z * z * fdd) * gm;
     }
@@ -64,11 +52,17 @@ pub struct BodyField {
     pub p: f64,
 }
 
+/// e^{-2 i phi}: turns a synodic tidal field into body axes (w = W e^{-2 i phi}).
+#[inline(always)]
+pub(crate) fn to_body_axes(phi: f64) -> Complex<f64> {
+    let (s2, c2) = (2.0 * phi).sin_cos();
+    Complex::new(c2, -s2)
+}
+
 impl BodyField {
     #[inline(always)]
     pub fn new(w_synodic: Complex<f64>, p: f64, phi: f64) -> Self {
-        let (s2, c2) = (2.0 * phi).sin_cos();
-        Self { w: w_synodic * Complex::new(c2, -s2), p }
+        Self { w: w_synodic * to_body_axes(phi), p }
     }
     /// T_B r.
     #[inline(always)]

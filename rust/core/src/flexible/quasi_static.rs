@@ -30,8 +30,8 @@
 use nalgebra::Complex;
 
 use super::body::FlexibleBody;
-use super::dynamics::{tidal_field, tidal_field_derivatives, BodyField};
-use crate::cr3bp::Cr3bp;
+use super::dynamics::{tidal_field, tidal_field_derivatives, to_body_axes, BodyField};
+use crate::attitude::planar::orbit_derivative;
 use crate::integrate::System;
 
 /// The closed-form deflections and their derivatives at one point of a rigid solution.
@@ -50,18 +50,15 @@ pub struct QuasiStaticPoint {
 /// axes: (w, w', w'', wz', wz'', wz''').
 #[inline]
 fn chain(body: &FlexibleBody, wsyn: [Complex<f64>; 3], phi: f64, wz: f64) -> ([Complex<f64>; 3], [f64; 3]) {
-    let kappa = 1.5 / body.inertia();
-    let z0c = body.asymmetry().conj();
-    let (s2, c2) = (2.0 * phi).sin_cos();
-    let e = Complex::new(c2, -s2);
+    let e = to_body_axes(phi);
     let i = Complex::new(0.0, 1.0);
     let p1 = wz - 1.0;
     let w0 = wsyn[0] * e;
-    let wz1 = kappa * (z0c * w0).im;
+    let wz1 = body.rigid_response(w0);
     let w1 = (wsyn[1] - i * 2.0 * p1 * wsyn[0]) * e;
-    let wz2 = kappa * (z0c * w1).im;
+    let wz2 = body.rigid_response(w1);
     let w2 = (wsyn[2] - i * 4.0 * p1 * wsyn[1] - i * 2.0 * wz1 * wsyn[0] - wsyn[0] * 4.0 * p1 * p1) * e;
-    let wz3 = kappa * (z0c * w2).im;
+    let wz3 = body.rigid_response(w2);
     ([w0, w1, w2], [wz1, wz2, wz3])
 }
 
@@ -104,7 +101,17 @@ impl FlexibleBody {
     /// wzdot of the rigid composite model (the flexible body frozen undeformed).
     #[inline]
     pub fn rigid_wzdot(&self, field: &BodyField) -> f64 {
-        1.5 * (self.asymmetry().conj() * field.w).im / self.inertia()
+        self.rigid_response(field.w)
+    }
+
+    /// (3/2) Im(conj(Z0) w) / I0: the rigid composite body's gravity-gradient angular
+    /// acceleration for the body-axes field w, i.e. the planar law
+    /// [`crate::attitude::gravity_gradient_wzdot`] for a body turned by its principal angle
+    /// (tests/flexible.rs checks the two agree); linear in w, so applied to w', w'' it gives
+    /// the rate's higher derivatives.
+    #[inline(always)]
+    fn rigid_response(&self, w: Complex<f64>) -> f64 {
+        1.5 * (self.asymmetry().conj() * w).im / self.inertia()
     }
 }
 
@@ -122,10 +129,7 @@ impl System<[f64; 10]> for QuasiStaticAlongOrbit<'_> {
     #[inline]
     fn derivative(&self, t: f64, y: &[f64; 10], dy: &mut [f64; 10]) {
         let mut d = [0.0; 6];
-        if !self.held {
-            let s: [f64; 6] = std::array::from_fn(|i| y[i]);
-            Cr3bp { mu: self.mu }.derivative(t, &s, &mut d);
-        }
+        orbit_derivative(self.mu, self.held, t, y, &mut d);
         dy[..6].copy_from_slice(&d);
         let (phi, wz) = (y[6], y[7]);
         let wsyn = if self.held {

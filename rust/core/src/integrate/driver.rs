@@ -36,9 +36,9 @@ impl Default for Options {
             h_min: 0.0,
             h_max: f64::INFINITY,
             max_steps: 1_000_000,
-            safety: 0.8,
-            fac_min: 0.2,
-            fac_max: 5.0,
+            safety: Controller::RKF78.safety,
+            fac_min: Controller::RKF78.fac_min,
+            fac_max: Controller::RKF78.fac_max,
             fixed_step: None,
         }
     }

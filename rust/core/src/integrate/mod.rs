@@ -74,16 +74,4 @@ impl Stats {
     }
 }
 
-/// Fused multiply-add `a * b + c` where the target has a hardware FMA (one rounding, faster),
-/// otherwise the plain expression (a software `fma` call would be far slower).
-#[inline(always)]
-pub(crate) fn fmadd(a: f64, b: f64, c: f64) -> f64 {
-    #[cfg(target_feature = "fma")]
-    {
-        a.mul_add(b, c)
-    }
-    #[cfg(not(target_feature = "fma"))]
-    {
-        a * b + c
-    }
-}
+pub(crate) use crate::scalar::fmadd;

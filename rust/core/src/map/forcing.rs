@@ -9,8 +9,6 @@
 //! max(|S|, |C|), or until doubling no longer halves the error (the samples' own integration
 //! noise, ~1e-13 on orbits grazing a primary) while it is below 1e-10.
 
-use wide::f64x4;
-
 use crate::attitude::{forcing_sc, Forcing};
 use crate::cr3bp::check_mu;
 use crate::error::{check_finite, check_positive, invalid, Error, Result};
@@ -147,36 +145,6 @@ impl OrbitForcing {
             b1c = tc;
         }
         (x.mul_add(b1s, c[0] - b2s), x.mul_add(b1c, c[1] - b2c))
-    }
-
-    /// S, C at four times at once (each lane its own time and segment).
-    #[inline(always)]
-    pub fn sc4(&self, t: f64x4) -> (f64x4, f64x4) {
-        let ta = t.to_array();
-        let mut seg = [0usize; 4];
-        let mut xs = [0.0; 4];
-        for l in 0..4 {
-            let (s, x) = self.locate(ta[l]);
-            seg[l] = s;
-            xs[l] = x;
-        }
-        let x = f64x4::new(xs);
-        let x2 = x + x;
-        let (mut b1s, mut b2s, mut b1c, mut b2c) = (f64x4::ZERO, f64x4::ZERO, f64x4::ZERO, f64x4::ZERO);
-        let base = seg.map(|s| s * NC * 2);
-        for k in (1..NC).rev() {
-            let cs = f64x4::new(std::array::from_fn(|l| self.coef[base[l] + 2 * k]));
-            let cc = f64x4::new(std::array::from_fn(|l| self.coef[base[l] + 2 * k + 1]));
-            let ts = x2.mul_add(b1s, cs - b2s);
-            let tc = x2.mul_add(b1c, cc - b2c);
-            b2s = b1s;
-            b1s = ts;
-            b2c = b1c;
-            b1c = tc;
-        }
-        let c0s = f64x4::new(std::array::from_fn(|l| self.coef[base[l]]));
-        let c0c = f64x4::new(std::array::from_fn(|l| self.coef[base[l] + 1]));
-        (x.mul_add(b1s, c0s - b2s), x.mul_add(b1c, c0c - b2c))
     }
 }
 

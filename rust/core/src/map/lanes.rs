@@ -19,11 +19,21 @@
 //! itself is integrated (phidot = wz - 1) and gives the unwrapped phi(T). The flat-plate SRP
 //! law (PHYSICS.md sec. 6) is C1 only: a step never spans a lane's Sun-terminator crossing
 //! (cos(theta_sun - phi) = 0); the step is cut there (Illinois iterations on its length).
+//!
+//! Nothing of the physics or the step control is written here: the lanes call the laws the
+//! scalar planar model calls ([`gravity_gradient_wzdot`], [`flat_plate_wzdot`], [`Sun::angle`],
+//! generic over the lane type) and step with the scalar driver's [`Controller`] and tableau.
 
 use wide::f64x8;
 
 use super::forcing::OrbitForcing;
+use crate::attitude::{flat_plate_wzdot, gravity_gradient_wzdot, FlatPlate, Sun};
+use crate::constants::SOLAR_PRESSURE_1AU;
 use crate::integrate::tableau::{A, B8, C, ERR};
+use crate::integrate::Controller;
+
+/// The scalar driver's step-size controller with its default settings.
+const CONTROLLER: Controller = Controller::RKF78;
 
 type V = f64x8;
 /// Trajectories per lock-step group (SIMD width).
@@ -47,6 +57,11 @@ impl Case {
     /// A gravity-gradient-only trajectory.
     pub fn new(phi0: f64, wz0: f64, kz: f64) -> Self {
         Self { phi0, wz0, kz, eps: 0.0, cs: 0.0, cd: 0.0, theta_sun0: 0.0 }
+    }
+
+    /// The case's flat plate (not validated; eps = 0: none) with the Sun turning at `sun_omega`.
+    pub fn plate(&self, sun_omega: f64) -> FlatPlate {
+        FlatPlate { eps: self.eps, cs: self.cs, cd: self.cd, sun: Sun { theta0: self.theta_sun0, omega: sun_omega, pressure: SOLAR_PRESSURE_1AU } }
     }
 }
 
@@ -85,7 +100,7 @@ pub struct LaneOptions {
 
 impl Default for LaneOptions {
     fn default() -> Self {
-        Self { rtol: 1e-12, atol: 1e-12, max_steps: 200_000, sun_omega: crate::attitude::OMEGA_SUN }
+        Self { rtol: 1e-12, atol: 1e-12, max_steps: 200_000, sun_omega: crate::constants::OMEGA_SUN }
     }
 }
 
@@ -93,12 +108,30 @@ impl Default for LaneOptions {
 #[derive(Clone, Copy)]
 struct Params {
     kz15: V,
-    /// eps (1 + Cs), eps (2/3) Cd, cos and sin of the Sun phase at t = 0.
+    /// The plate law's coefficients (FlatPlate::coefficients), cos and sin of the Sun phase
+    /// at t = 0.
     a1: V,
     a2: V,
     c0: V,
     s0: V,
-    omega: f64,
+    /// The Sun with phase zero: its angle at the shared time, turned by each lane's phase.
+    sun: Sun,
+}
+
+impl Params {
+    /// The lanes' parameters and their cases' plates.
+    fn new(pick: impl Fn(usize) -> Case, sun_omega: f64) -> (Self, [FlatPlate; LANES]) {
+        let plates: [FlatPlate; LANES] = std::array::from_fn(|l| pick(l).plate(sun_omega));
+        let p = Params {
+            kz15: V::new(std::array::from_fn(|l| 1.5 * pick(l).kz)),
+            a1: V::new(std::array::from_fn(|l| plates[l].coefficients().0)),
+            a2: V::new(std::array::from_fn(|l| plates[l].coefficients().1)),
+            c0: V::new(std::array::from_fn(|l| plates[l].sun.theta0.cos())),
+            s0: V::new(std::array::from_fn(|l| plates[l].sun.theta0.sin())),
+            sun: Sun { theta0: 0.0, ..plates[0].sun },
+        };
+        (p, plates)
+    }
 }
 
 #[inline(always)]
@@ -121,26 +154,22 @@ fn rhs<const D: usize, const SRP: bool>(f: &OrbitForcing, t: f64, y: &[V; D], p:
     let c2 = cp * cp - sp * sp;
     let s2 = (cp + cp) * sp;
     dy[0] = w;
-    let mut dwz = p.kz15 * (s * c2 - c * s2);
+    // k (d wzdot / d phi) is only used with the STM: unused, it is compiled away
+    let (mut dwz, mut k) = gravity_gradient_wzdot(p.kz15, s, c, c2, s2);
     dy[2] = -(w * sp);
     dy[3] = w * cp;
-    let mut k = V::ZERO;
-    if D == 8 {
-        k = -(p.kz15 + p.kz15) * (s * s2 + c * c2);
-    }
     if SRP {
-        // Sun angle theta = w t + theta0_l; alpha = theta - phi
-        let (swt, cwt) = (p.omega * t).sin_cos();
+        // Sun angle theta = w t + theta0_l: (cos, sin)(w t) turned by each lane's theta0_l;
+        // alpha = theta - phi (sin alpha, like k, is compiled away without the STM)
+        let (swt, cwt) = p.sun.angle(t).sin_cos();
         let (swt, cwt) = (V::splat(swt), V::splat(cwt));
         let ct = cwt * p.c0 - swt * p.s0;
         let st = swt * p.c0 + cwt * p.s0;
         let ca = ct.mul_add(cp, st * sp);
-        let aca = ca.abs();
-        dwz += ca * p.a1.mul_add(aca, p.a2);
-        if D == 8 {
-            let sa = st.mul_add(cp, -(ct * sp));
-            k += sa * (p.a1 + p.a1).mul_add(aca, p.a2);
-        }
+        let sa = st.mul_add(cp, -(ct * sp));
+        let (v, d) = flat_plate_wzdot(p.a1, p.a2, ca, sa);
+        dwz += v;
+        k += d;
     }
     dy[1] = dwz;
     if D == 8 {
@@ -214,15 +243,8 @@ fn integrate_group<const D: usize, const SRP: bool>(f: &OrbitForcing, t_final: f
         y[4] = V::ONE;
         y[7] = V::ONE;
     }
-    let p = Params {
-        kz15: V::new(std::array::from_fn(|l| 1.5 * pick(l).kz)),
-        a1: V::new(std::array::from_fn(|l| pick(l).eps * (1.0 + pick(l).cs))),
-        a2: V::new(std::array::from_fn(|l| pick(l).eps * (2.0 / 3.0) * pick(l).cd)),
-        c0: V::new(std::array::from_fn(|l| pick(l).theta_sun0.cos())),
-        s0: V::new(std::array::from_fn(|l| pick(l).theta_sun0.sin())),
-        omega: opts.sun_omega,
-    };
-    let plate: [bool; LANES] = std::array::from_fn(|l| pick(l).eps != 0.0);
+    let (p, plates) = Params::new(pick, opts.sun_omega);
+    let plate: [bool; LANES] = std::array::from_fn(|l| plates[l].eps != 0.0);
     let (rtol, atol) = (V::splat(opts.rtol), V::splat(opts.atol));
     let mut ynew = [V::ZERO; D];
     let mut yc = [V::ZERO; D];
@@ -230,7 +252,7 @@ fn integrate_group<const D: usize, const SRP: bool>(f: &OrbitForcing, t_final: f
     let (mut accepted, mut rejected) = (0u32, 0u32);
     let mut after_reject = false;
     let mut status = LaneStatus::Ok;
-    let g = |l: usize, tt: f64, phi: f64| (opts.sun_omega * tt + pick(l).theta_sun0 - phi).cos();
+    let g = |l: usize, tt: f64, phi: f64| plates[l].terminator(tt, phi);
     while t < t_final {
         if accepted + rejected >= opts.max_steps {
             status = LaneStatus::MaxSteps;
@@ -244,8 +266,7 @@ fn integrate_group<const D: usize, const SRP: bool>(f: &OrbitForcing, t_final: f
         if !(emax <= 1.0) || !finite {
             rejected += 1;
             after_reject = true;
-            let fac = if emax.is_finite() { (0.8 / emax.sqrt().sqrt().sqrt()).clamp(0.2, 1.0) } else { 0.2 };
-            h = heff * fac;
+            h = heff * CONTROLLER.factor_rejected(emax);
             if h <= 1e-14 * t_final.max(1.0) {
                 status = LaneStatus::Failed;
                 break;
@@ -302,8 +323,7 @@ fn integrate_group<const D: usize, const SRP: bool>(f: &OrbitForcing, t_final: f
         accepted += 1;
         y = ynew;
         t = if last { t_final } else { t + heff };
-        let fac_max = if after_reject { 1.0 } else { 5.0 };
-        let fac = if emax == 0.0 { fac_max } else { (0.8 / emax.sqrt().sqrt().sqrt()).clamp(0.2, fac_max) };
+        let fac = CONTROLLER.factor_accepted(emax, after_reject);
         after_reject = false;
         h = h.max(heff) * fac;
     }
@@ -333,4 +353,57 @@ pub fn integrate_cases<const D: usize, const SRP: bool>(f: &OrbitForcing, t_fina
         out.extend_from_slice(&r[..group.len()]);
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::attitude::PlanarForced;
+    use crate::integrate::{Options, System};
+    use crate::periodic::correct_planar_symmetric;
+
+    /// The lanes' right-hand side (gravity gradient and flat plate through the shared generic
+    /// laws, cos 2phi and sin 2phi from the (cos phi, sin phi) states, the Sun turned per lane)
+    /// equals the scalar planar model's (`PlanarForced` on the same forcing table, with each
+    /// case's `FlatPlate`), 2x2 STM included, to 1e-14 relative to the size of the terms
+    /// (1 + 3 |Kz| max(|S|, |C|) + 3 |eps|, times max |STM entry|).
+    #[test]
+    fn lane_rhs_equals_scalar_model() {
+        let mu = 0.01215;
+        let (x0, d) = (0.7, 1.0 - mu - 0.7);
+        let o = correct_planar_symmetric(mu, x0, (mu / d).sqrt() + d, 1e-12, 30, &Options::with_tolerances(1e-13, 1e-13)).unwrap();
+        let f = OrbitForcing::new(mu, &o.state0, o.period, [true, true], 1e-13).unwrap();
+        let cases: [Case; LANES] = std::array::from_fn(|l| {
+            let x = l as f64;
+            Case { phi0: -2.9 + 0.8 * x, wz0: -2.0 + 0.6 * x, kz: 0.9 - 0.25 * x, eps: [0.0, 0.05, 0.3, -0.2][l % 4], cs: 0.1 * (l % 3) as f64, cd: 0.2, theta_sun0: 0.9 * x - 3.0 }
+        });
+        let (p, plates) = Params::new(|l| cases[l], LaneOptions::default().sun_omega);
+        let stm = [0.7, -1.3, 2.1, 0.4];
+        for t in [0.0, 0.37 * o.period, 0.81 * o.period, 3.3 * o.period] {
+            let mut y = [V::ZERO; 8];
+            y[0] = V::new(cases.map(|c| c.phi0));
+            y[1] = V::new(cases.map(|c| c.wz0));
+            y[2] = V::new(cases.map(|c| c.phi0.cos()));
+            y[3] = V::new(cases.map(|c| c.phi0.sin()));
+            for i in 0..4 {
+                y[4 + i] = V::splat(stm[i]);
+            }
+            let mut dy = [V::ZERO; 8];
+            rhs::<8, true>(&f, t, &y, &p, &mut dy);
+            let (s, c) = f.sc(t);
+            for (l, case) in cases.iter().enumerate() {
+                let scalar = PlanarForced { kz: case.kz, forcing: &f, srp: if case.eps != 0.0 { Some(plates[l]) } else { None } };
+                let mut ds = [0.0; 6];
+                scalar.derivative(t, &[case.phi0, case.wz0, stm[0], stm[1], stm[2], stm[3]], &mut ds);
+                let scale = 1.0 + 3.0 * case.kz.abs() * s.abs().max(c.abs()) + 3.0 * case.eps.abs();
+                let lanes = [lane(&dy[0], l), lane(&dy[1], l), lane(&dy[4], l), lane(&dy[5], l), lane(&dy[6], l), lane(&dy[7], l)];
+                for i in 0..6 {
+                    assert!((lanes[i] - ds[i]).abs() <= 1e-14 * scale * 3.0, "lane {l}, t {t}, component {i}: {} vs {}", lanes[i], ds[i]);
+                }
+                // the (cos phi, sin phi) states turn at phidot
+                assert_eq!(lane(&dy[2], l), -(ds[0] * case.phi0.sin()));
+                assert_eq!(lane(&dy[3], l), ds[0] * case.phi0.cos());
+            }
+        }
+    }
 }

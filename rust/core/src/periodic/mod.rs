@@ -1,7 +1,9 @@
 //! Periodic orbits of the CR3BP (PHYSICS.md section 3): symmetric single shooting on the half
 //! period, general multiple shooting (free period, phase condition), monodromy matrices and
-//! their stability indices.
+//! their stability indices; periodic planar attitude motions along an orbit (batched corrector
+//! and independent verifier).
 
+mod attitude;
 mod multiple;
 mod stability;
 mod symmetric;
@@ -9,3 +11,8 @@ mod symmetric;
 pub use multiple::{correct_multiple_shooting, MemberCondition, ShotOrbit};
 pub use stability::{broucke_indices, monodromy, Stability};
 pub use symmetric::{correct_planar_symmetric, Constraint, Evaluation, SymmetricOrbit, SymmetricShooting, Var};
+pub use attitude::{
+    correct_across_family, correct_bordered, correct_planar_attitudes, verify_planar_attitudes, Bordered, Candidate, Closure, Correction, CorrectorOptions, Free, Parameter,
+    PlanarEnd, PlanarFamily,
+    PlanarStart, StopReason,
+};

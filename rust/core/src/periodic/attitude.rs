@@ -1,0 +1,978 @@
+//! Periodic planar attitude motions along a periodic orbit (thesis sec. 3.3, PHYSICS.md sec. 5
+//! and 6): a batched, globalised Newton corrector on the periodicity-map engine, and a batched
+//! independent verifier on the scalar model.
+//!
+//! Along an orbit of period T, the planar motion (phi0, wz0) is periodic over K revolutions
+//! when phi(KT) = phi0 + 2 pi N and wz(KT) = wz0 (N net body turns; N + 1/2 for the half-turn
+//! motions, which repeat too since the inertia is symmetric under a half turn). Three problem
+//! forms share one driver ([`correct_planar_attitudes`]):
+//!
+//! - [`Closure::Half`]: symmetric half-period shooting. On an x-symmetric orbit started on the x
+//!   axis, with phi0 a multiple of pi/2 and no SRP, the motion is symmetric and periodic when
+//!   g(wz0) = phi(KT/2) - phi0 - pi N = 0 (one unknown, g' = d phi / d wz0 from the STM).
+//! - [`Closure::Full`] with [`Free::Phi0`]: unknowns (phi0, wz0), residuals
+//!   F = (phi(KT) - phi0 - 2 pi N, wz(KT) - wz0), Jacobian Phi(KT) - I (the correct Newton form;
+//!   thesis eq. 53 omits the identity).
+//! - [`Closure::Full`] with [`Free::SunPhase`]: phi0 kept, unknowns (theta_sun0, wz0) for a flat
+//!   plate with SRP; dF/dtheta_sun0 by central differences, from two extra trajectories
+//!   integrated in the same batch as the point itself; dF/dwz0 from the STM.
+//!
+//! Every Newton iteration integrates every still-active candidate of the batch in ONE
+//! [`map::sweep`] call with the STM (SIMD lanes, all cores). Newton is globalised per candidate:
+//! the steps in wz0 and in the angle unknown are capped, and a backtracking line search (Armijo-type sufficient decrease
+//! of the residual's 2-norm, step halved up to `max_halvings` times) evaluates the trial
+//! points of all candidates together in the next sweep. Each candidate reports why it stopped
+//! ([`StopReason`]); nothing panics and a non-finite result is never labelled converged.
+//!
+//! Determinism: candidates keep their order; the sweep of each iteration is bit-identical for
+//! any thread count and chunk size, so the results are too. The lane engine integrates eight
+//! trajectories in lock step with a shared step size, however, so a candidate's last bits
+//! (~1e-14 relative, the integration tolerance's noise) can depend on its batch companions:
+//! correcting it alone, or in another batch, can differ at that level (never in the outcome).
+
+use nalgebra::{DMatrix, DVector};
+use rayon::prelude::*;
+
+use std::collections::HashMap;
+use std::sync::{Arc, Mutex};
+
+use super::symmetric::{Constraint, SymmetricOrbit, SymmetricShooting, Var};
+use crate::attitude::{propagate_planar, FlatPlate, OMEGA_SUN};
+use crate::cr3bp::check_mu;
+use crate::error::{check_finite, check_positive, invalid, Error, Result};
+use crate::integrate::{Options, Output};
+use crate::map::{self, Case, LaneOptions, LaneStatus, OrbitForcing, Outcome};
+use crate::propagation::with_threads;
+
+use std::f64::consts::{FRAC_PI_2, PI};
+
+/// How the periodicity condition is closed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Closure {
+    /// Symmetric half-period shooting: `t_final` = K T / 2, unknown wz0, residual
+    /// phi(t_final) - phi0 - pi turns. Needs an x-symmetric orbit started on the x axis,
+    /// phi0 a multiple of pi/2 and no SRP; `free` must be [`Free::Phi0`] (phi0 itself is kept).
+    Half,
+    /// Full closure over `t_final` = K T: residuals (phi - phi0 - 2 pi turns, wz - wz0).
+    Full,
+}
+
+/// The unknown corrected with wz0 in the [`Closure::Full`] form.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Free {
+    /// (phi0, wz0).
+    Phi0,
+    /// (theta_sun0, wz0) with phi0 kept: SRP candidates only (eps != 0).
+    SunPhase,
+}
+
+/// Why the corrector stopped on a candidate.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum StopReason {
+    /// Residual max-norm <= tol.
+    Converged,
+    /// `max_iter` Newton steps taken without convergence.
+    MaxIterations,
+    /// The Jacobian is zero or non-finite, or rank-deficient with no decrease along its
+    /// minimum-norm step (e.g. a fold: trace of the monodromy = 2).
+    SingularJacobian,
+    /// The line search found no sufficient decrease after `max_halvings` halvings.
+    NoDescent,
+    /// The integration failed (lane status not Ok, or non-finite results) at the starting
+    /// point, or at every trial point of the last line search.
+    IntegrationFailed,
+}
+
+impl StopReason {
+    /// "converged", "max_iterations", "singular_jacobian", "no_descent", "integration_failed".
+    pub fn as_str(&self) -> &'static str {
+        match self {
+            Self::Converged => "converged",
+            Self::MaxIterations => "max_iterations",
+            Self::SingularJacobian => "singular_jacobian",
+            Self::NoDescent => "no_descent",
+            Self::IntegrationFailed => "integration_failed",
+        }
+    }
+}
+
+/// One starting point: the trajectory's parameters (its `phi0`, `wz0`, `theta_sun0` are the
+/// initial guesses of the unknowns) and its target number of turns per `t_final` closure
+/// (N, or N + 1/2 for half-turn motions).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Candidate {
+    pub case: Case,
+    pub turns: f64,
+    /// The starting orbit's x0 for [`correct_across_family`] (NaN otherwise).
+    pub x0: f64,
+}
+
+impl Candidate {
+    /// A gravity-gradient-only candidate.
+    pub fn new(phi0: f64, wz0: f64, kz: f64, turns: f64) -> Self {
+        Self { case: Case::new(phi0, wz0, kz), turns, x0: f64::NAN }
+    }
+
+    /// The same candidate started on the orbit of the family member at `x0`
+    /// ([`correct_across_family`]).
+    pub fn with_x0(self, x0: f64) -> Self {
+        Self { x0, ..self }
+    }
+
+    /// The same candidate with a flat plate (SRP amplitude `eps`, coefficients, Sun phase).
+    pub fn with_plate(self, eps: f64, cs: f64, cd: f64, theta_sun0: f64) -> Self {
+        Self { case: Case { eps, cs, cd, theta_sun0, ..self.case }, ..self }
+    }
+}
+
+/// The parameter freed by a bordered correction (continuation in Kz or in the SRP amplitude).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Parameter {
+    /// Kz = (Iy - Ix) / Iz, kept in [-1, 1] (one-sided differences at the ends).
+    Kz,
+    /// The flat-plate SRP amplitude eps.
+    Eps,
+    /// The x0 of a member of a planar symmetric orbit family ([`correct_across_family`]): each
+    /// value is its own orbit, corrected and tabulated on demand.
+    OrbitX0,
+}
+
+/// A bordered correction, the corrector of pseudo-arclength (or natural-parameter)
+/// continuation: the parameter becomes an unknown and one linear condition closes the system,
+///   a[0] angle + a[1] wz0 + a[2] parameter = b,
+/// with "angle" the second unknown of the form (phi0, or theta_sun0; a[0] must be 0 for the
+/// half-period closure, which has no angle unknown). d F / d parameter by central differences
+/// (`step`), from two extra trajectories integrated in the same sweep as the point itself.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Bordered {
+    pub parameter: Parameter,
+    pub a: [f64; 3],
+    pub b: f64,
+    /// Central-difference step in the parameter.
+    pub step: f64,
+    /// Largest |Newton step| in the parameter (the step is scaled down, direction kept).
+    pub max_step: f64,
+}
+
+impl Bordered {
+    /// The natural-parameter condition: the parameter fixed at `value`.
+    pub fn fixed(parameter: Parameter, value: f64) -> Self {
+        Self { parameter, a: [0.0, 0.0, 1.0], b: value, step: 1e-6, max_step: 0.5 }
+    }
+}
+
+/// Settings of [`correct_planar_attitudes`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CorrectorOptions {
+    /// Convergence: residual max-norm <= tol.
+    pub tol: f64,
+    /// Most Newton steps per candidate.
+    pub max_iter: usize,
+    /// Lane integrator tolerances and step limit.
+    pub rtol: f64,
+    pub atol: f64,
+    pub max_steps: u32,
+    /// Largest |step| in wz0 (1/TU) and in the angle unknown (phi0 or theta_sun0, rad): the
+    /// Newton step is scaled down (direction kept) until both hold.
+    pub max_wz_step: f64,
+    pub max_angle_step: f64,
+    /// Step halvings of the line search before giving up ([`StopReason::NoDescent`]).
+    pub max_halvings: u32,
+    /// Central-difference step in theta_sun0 ([`Free::SunPhase`]), rad.
+    pub phase_step: f64,
+    /// Rate of the Sun direction in the synodic frame (1/TU), for SRP candidates.
+    pub sun_omega: f64,
+    /// Worker threads (None: all cores) and cases per task of the sweeps.
+    pub threads: Option<usize>,
+    pub chunk: usize,
+    /// Compute the full-period monodromy of half-closure corrections (one more sweep over the
+    /// full period); when false their `monodromy` is NaN (e.g. when every solution is
+    /// re-propagated independently with its STM anyway).
+    pub monodromy: bool,
+}
+
+impl Default for CorrectorOptions {
+    fn default() -> Self {
+        Self {
+            tol: 1e-12,
+            max_iter: 40,
+            rtol: 1e-13,
+            atol: 1e-13,
+            max_steps: 200_000,
+            max_wz_step: 0.5,
+            max_angle_step: 0.5,
+            max_halvings: 10,
+            phase_step: 1e-6,
+            sun_omega: OMEGA_SUN,
+            threads: None,
+            chunk: 64,
+            monodromy: true,
+        }
+    }
+}
+
+/// The outcome of one candidate.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Correction {
+    /// Final unknowns (the last accepted point; the start when nothing was accepted). Angles
+    /// are not wrapped (the residual is exactly the one of these values).
+    pub phi0: f64,
+    pub wz0: f64,
+    pub theta_sun0: f64,
+    /// Full: (phi(KT) - phi0 - 2 pi turns, wz(KT) - wz0). Half: (phi(KT/2) - phi0 - pi turns,
+    /// NaN). NaN when the starting point could not be integrated.
+    pub residual: [f64; 2],
+    /// Max-norm of the residual (NaN when it could not be evaluated).
+    pub residual_norm: f64,
+    /// Accepted Newton steps.
+    pub iterations: usize,
+    pub reason: StopReason,
+    /// Full-period (K T) monodromy d(phi, wz)(KT)/d(phi0, wz0), row-major, at the final point
+    /// (for Half from one extra batched sweep over 2 `t_final`); NaN when not available.
+    pub monodromy: [f64; 4],
+    /// The freed parameter's final value ([`correct_bordered`]; the candidate's Kz or eps
+    /// otherwise).
+    pub parameter: f64,
+    /// d F / d (angle, wz0, parameter) at the final point, rows F = (phi closure, wz closure)
+    /// (Half: the first row only, d g / d wz0 and d g / d parameter); NaN where not computed
+    /// (the angle column of Half, the parameter column without a bordered correction, the
+    /// second row of Half). The continuation driver takes the family's tangent from it.
+    pub jacobian: [[f64; 3]; 2],
+}
+
+impl Correction {
+    pub fn converged(&self) -> bool {
+        self.reason == StopReason::Converged
+    }
+}
+
+/// Residual, Jacobian and STM at one point of the unknowns x = (angle, wz0, parameter): the
+/// angle (phi0, or theta_sun0 for [`Free::SunPhase`]) is unused by Half, the parameter by
+/// corrections that are not bordered.
+#[derive(Debug, Clone, Copy)]
+struct Point {
+    x: [f64; 3],
+    /// Residual rows (phi closure, wz closure, linear condition); NaN for unused rows.
+    f: [f64; 3],
+    norm: f64,
+    /// Line-search merit: the 2-norm of the used rows.
+    merit: f64,
+    /// d f / d x, row-major 3x3 (unused rows and columns NaN or 0).
+    jac: [f64; 9],
+    stm: [f64; 4],
+}
+
+#[derive(Debug, Clone, Copy)]
+enum Phase {
+    Start,
+    Trial { lambda: f64, halvings: u32, any_integrated: bool },
+    Done(StopReason),
+}
+
+struct Track {
+    cand: Candidate,
+    start: [f64; 3],
+    cur: Option<Point>,
+    /// Newton direction, already scaled to the step caps; `scale` is that factor (<= 1).
+    dir: [f64; 3],
+    scale: f64,
+    rank_deficient: bool,
+    phase: Phase,
+    iterations: usize,
+}
+
+#[derive(Clone, Copy)]
+struct Form {
+    closure: Closure,
+    free: Free,
+    h: f64,
+    bordered: Option<Bordered>,
+    /// The freed parameter's range (Kz: [-1, 1]; the orbit's x0: the family's members).
+    bounds: (f64, f64),
+}
+
+const ANGLE: usize = 0;
+const WZ: usize = 1;
+const PARAM: usize = 2;
+
+impl Form {
+    fn cases_per_point(&self) -> usize {
+        1 + if self.closure == Closure::Full && self.free == Free::SunPhase { 2 } else { 0 } + if self.bordered.is_some() { 2 } else { 0 }
+    }
+
+    /// The residual rows and unknown columns in use.
+    fn rows(&self) -> &'static [usize] {
+        match (self.closure, self.bordered.is_some()) {
+            (Closure::Half, false) => &[0],
+            (Closure::Half, true) => &[0, 2],
+            (Closure::Full, false) => &[0, 1],
+            (Closure::Full, true) => &[0, 1, 2],
+        }
+    }
+
+    fn cols(&self) -> &'static [usize] {
+        match (self.closure, self.bordered.is_some()) {
+            (Closure::Half, false) => &[WZ],
+            (Closure::Half, true) => &[WZ, PARAM],
+            (Closure::Full, false) => &[ANGLE, WZ],
+            (Closure::Full, true) => &[ANGLE, WZ, PARAM],
+        }
+    }
+
+    fn initial(&self, c: &Candidate) -> [f64; 3] {
+        let angle = if self.closure == Closure::Full && self.free == Free::SunPhase { c.case.theta_sun0 } else { c.case.phi0 };
+        let p = match self.bordered.map(|b| b.parameter) {
+            Some(Parameter::Eps) => c.case.eps,
+            Some(Parameter::OrbitX0) => c.x0,
+            _ => c.case.kz,
+        };
+        [angle, c.case.wz0, p]
+    }
+
+    /// The trajectory of the point x; None when the parameter leaves its range.
+    fn case_at(&self, c: &Candidate, x: [f64; 3]) -> Option<Case> {
+        let mut k = Case { wz0: x[WZ], ..c.case };
+        if self.closure == Closure::Full {
+            match self.free {
+                Free::Phi0 => k.phi0 = x[ANGLE],
+                Free::SunPhase => k.theta_sun0 = x[ANGLE],
+            }
+        }
+        if self.bordered.is_some() && !(self.bounds.0 <= x[PARAM] && x[PARAM] <= self.bounds.1) {
+            return None;
+        }
+        match self.bordered.map(|b| b.parameter) {
+            Some(Parameter::Kz) => k.kz = x[PARAM],
+            Some(Parameter::Eps) => k.eps = x[PARAM],
+            Some(Parameter::OrbitX0) | None => {}
+        }
+        Some(k)
+    }
+
+    /// The parameter values of the central difference (one-sided at the ends of its range).
+    fn parameter_pair(&self, p: f64) -> (f64, f64) {
+        let step = self.bordered.map_or(1e-6, |b| b.step);
+        ((p + step).min(self.bounds.1), (p - step).max(self.bounds.0))
+    }
+
+    /// Push the point's trajectories with the parameter value each one runs at (the orbit's x0
+    /// for [`Parameter::OrbitX0`]); false when it cannot be integrated (parameter out of range).
+    fn push_cases(&self, c: &Candidate, x: [f64; 3], out: &mut Vec<(Case, f64)>) -> bool {
+        let Some(k) = self.case_at(c, x) else { return false };
+        out.push((k, x[PARAM]));
+        if self.closure == Closure::Full && self.free == Free::SunPhase {
+            for th in [x[ANGLE] + self.h, x[ANGLE] - self.h] {
+                out.push((Case { theta_sun0: th, ..k }, x[PARAM]));
+            }
+        }
+        if let Some(b) = self.bordered {
+            let (pp, pm) = self.parameter_pair(x[PARAM]);
+            for v in [pp, pm] {
+                out.push(match b.parameter {
+                    Parameter::Kz => (Case { kz: v, ..k }, v),
+                    Parameter::Eps => (Case { eps: v, ..k }, v),
+                    Parameter::OrbitX0 => (k, v),
+                });
+            }
+        }
+        true
+    }
+
+    /// The closure residuals (phi, wz) of one trajectory.
+    fn closure_residual(&self, c: &Candidate, x: [f64; 3], o: &Outcome) -> [f64; 2] {
+        match self.closure {
+            Closure::Half => [o.phi_t - c.case.phi0 - PI * c.turns, f64::NAN],
+            Closure::Full => {
+                let phi0 = if self.free == Free::Phi0 { x[ANGLE] } else { c.case.phi0 };
+                [o.phi_t - phi0 - 2.0 * PI * c.turns, o.wz_t - x[WZ]]
+            }
+        }
+    }
+
+    /// The point from its trajectories; None when any failed or is non-finite.
+    fn point(&self, c: &Candidate, x: [f64; 3], o: &[Outcome]) -> Option<Point> {
+        let ok = |o: &Outcome| o.status == LaneStatus::Ok && o.phi_t.is_finite() && o.wz_t.is_finite() && o.stm.iter().all(|v| v.is_finite());
+        if o.len() != self.cases_per_point() || !o.iter().all(ok) {
+            return None;
+        }
+        let m = o[0].stm;
+        let r = self.closure_residual(c, x, &o[0]);
+        let mut f = [r[0], r[1], f64::NAN];
+        let mut jac = [f64::NAN; 9];
+        match self.closure {
+            Closure::Half => {
+                jac[ANGLE] = 0.0;
+                jac[WZ] = m[1];
+            }
+            Closure::Full => {
+                if self.free == Free::Phi0 {
+                    jac[ANGLE] = m[0] - 1.0;
+                    jac[3 + ANGLE] = m[2];
+                } else {
+                    let k = 0.5 / self.h;
+                    jac[ANGLE] = (o[1].phi_t - o[2].phi_t) * k;
+                    jac[3 + ANGLE] = (o[1].wz_t - o[2].wz_t) * k;
+                }
+                jac[WZ] = m[1];
+                jac[3 + WZ] = m[3] - 1.0;
+            }
+        }
+        if let Some(b) = self.bordered {
+            let j = self.cases_per_point() - 2;
+            let (pp, pm) = self.parameter_pair(x[PARAM]);
+            let (rp, rm) = (self.closure_residual(c, x, &o[j]), self.closure_residual(c, x, &o[j + 1]));
+            jac[PARAM] = (rp[0] - rm[0]) / (pp - pm);
+            jac[3 + PARAM] = (rp[1] - rm[1]) / (pp - pm);
+            f[2] = b.a[0] * x[0] + b.a[1] * x[1] + b.a[2] * x[2] - b.b;
+            jac[6..9].copy_from_slice(&b.a);
+        }
+        let rows = self.rows();
+        let norm = rows.iter().fold(0.0f64, |a, &i| a.max(f[i].abs()));
+        let merit = rows.iter().map(|&i| f[i] * f[i]).sum::<f64>().sqrt();
+        let used = rows.iter().all(|&i| self.cols().iter().all(|&j| jac[3 * i + j].is_finite()));
+        (norm.is_finite() && merit.is_finite() && used).then_some(Point { x, f, norm, merit, jac, stm: m })
+    }
+
+    /// Newton direction at p (minimum-norm step when J is rank-deficient) and whether J was;
+    /// None when J is zero or non-finite.
+    fn direction(&self, p: &Point) -> Option<([f64; 3], bool)> {
+        let (rows, cols) = (self.rows(), self.cols());
+        let n = rows.len();
+        let j = DMatrix::from_fn(n, n, |r, c| p.jac[3 * rows[r] + cols[c]]);
+        let rhs = DVector::from_fn(n, |r, _| -p.f[rows[r]]);
+        let svd = j.try_svd(true, true, f64::EPSILON, 200)?;
+        let s1 = svd.singular_values.max();
+        let s2 = svd.singular_values.min();
+        if !(s1 > 0.0 && s1.is_finite()) {
+            return None;
+        }
+        let deficient = s2 <= RANK_TOL * s1;
+        let d = svd.solve(&rhs, RANK_TOL * s1).ok()?;
+        let mut out = [0.0; 3];
+        for (k, &c) in cols.iter().enumerate() {
+            out[c] = d[k];
+        }
+        out.iter().all(|v| v.is_finite()).then_some((out, deficient))
+    }
+}
+
+/// Singular values below this fraction of the largest are treated as zero (minimum-norm step).
+const RANK_TOL: f64 = 1e-11;
+/// Armijo constant of the sufficient-decrease test |F(x + l d)|_2 <= (1 - C l) |F(x)|_2.
+const ARMIJO: f64 = 1e-4;
+
+impl Track {
+    /// The point to integrate in the next sweep, if still active.
+    fn pending(&self) -> Option<[f64; 3]> {
+        match self.phase {
+            Phase::Start => Some(self.start),
+            Phase::Trial { lambda, .. } => {
+                let x = self.cur.as_ref()?.x;
+                Some(std::array::from_fn(|i| x[i] + lambda * self.dir[i]))
+            }
+            Phase::Done(_) => None,
+        }
+    }
+
+    fn advance(&mut self, form: &Form, x: [f64; 3], o: &[Outcome], opts: &CorrectorOptions) {
+        let p = form.point(&self.cand, x, o);
+        match self.phase {
+            Phase::Start => match p {
+                None => self.phase = Phase::Done(StopReason::IntegrationFailed),
+                Some(p) => {
+                    self.cur = Some(p);
+                    self.next_step(form, opts);
+                }
+            },
+            Phase::Trial { lambda, halvings, any_integrated } => {
+                let Some(cur) = self.cur else { return };
+                let integrated = any_integrated || p.is_some();
+                match p.filter(|p| p.merit <= (1.0 - ARMIJO * lambda * self.scale) * cur.merit) {
+                    Some(p) => {
+                        self.cur = Some(p);
+                        self.iterations += 1;
+                        self.next_step(form, opts);
+                    }
+                    None if halvings >= opts.max_halvings => {
+                        self.phase = Phase::Done(if !integrated {
+                            StopReason::IntegrationFailed
+                        } else if self.rank_deficient {
+                            StopReason::SingularJacobian
+                        } else {
+                            StopReason::NoDescent
+                        })
+                    }
+                    None => self.phase = Phase::Trial { lambda: 0.5 * lambda, halvings: halvings + 1, any_integrated: integrated },
+                }
+            }
+            Phase::Done(_) => {}
+        }
+    }
+
+    /// After accepting a point: stop, or set up the line search along the Newton direction.
+    fn next_step(&mut self, form: &Form, opts: &CorrectorOptions) {
+        let Some(p) = self.cur else { return };
+        if p.norm <= opts.tol {
+            self.phase = Phase::Done(StopReason::Converged);
+            return;
+        }
+        if self.iterations >= opts.max_iter {
+            self.phase = Phase::Done(StopReason::MaxIterations);
+            return;
+        }
+        match form.direction(&p) {
+            None => self.phase = Phase::Done(StopReason::SingularJacobian),
+            Some((d, deficient)) => {
+                let cap = |v: f64, m: f64| if v.abs() > m { m / v.abs() } else { 1.0 };
+                let mut scale = cap(d[WZ], opts.max_wz_step).min(cap(d[ANGLE], opts.max_angle_step));
+                if let Some(b) = form.bordered {
+                    scale = scale.min(cap(d[PARAM], b.max_step));
+                }
+                self.dir = d.map(|v| v * scale);
+                self.scale = scale;
+                self.rank_deficient = deficient;
+                self.phase = Phase::Trial { lambda: 1.0, halvings: 0, any_integrated: false };
+            }
+        }
+    }
+
+    fn result(&self, form: &Form, monodromy: [f64; 4]) -> Correction {
+        let reason = match self.phase {
+            Phase::Done(r) => r,
+            _ => StopReason::MaxIterations,
+        };
+        let x = self.cur.map_or(self.start, |p| p.x);
+        let c = &self.cand.case;
+        let (phi0, theta_sun0) = match (form.closure, form.free) {
+            (Closure::Half, _) => (c.phi0, c.theta_sun0),
+            (Closure::Full, Free::Phi0) => (x[ANGLE], c.theta_sun0),
+            (Closure::Full, Free::SunPhase) => (c.phi0, x[ANGLE]),
+        };
+        let jac = self.cur.map_or([f64::NAN; 9], |p| p.jac);
+        let mut jacobian = [[jac[0], jac[1], jac[2]], [jac[3], jac[4], jac[5]]];
+        if form.closure == Closure::Half {
+            jacobian[0][ANGLE] = f64::NAN;
+            jacobian[1] = [f64::NAN; 3];
+        }
+        Correction {
+            phi0,
+            wz0: x[WZ],
+            theta_sun0,
+            residual: self.cur.map_or([f64::NAN; 2], |p| [p.f[0], p.f[1]]),
+            residual_norm: self.cur.map_or(f64::NAN, |p| p.norm),
+            iterations: self.iterations,
+            reason,
+            monodromy,
+            parameter: x[PARAM],
+            jacobian,
+        }
+    }
+}
+
+/// Whether the table's S(T - t) = -S(t), C(T - t) = C(t) (an x-symmetric orbit started on the
+/// x axis), to 1e-8 of max(|S|, |C|) at 16 interior times; the largest deviation otherwise.
+fn forcing_asymmetry(f: &OrbitForcing) -> f64 {
+    (0..16)
+        .map(|k| {
+            let t = f.period * (k as f64 + 0.37) / 16.0;
+            let (s1, c1) = f.sc(t);
+            let (s2, c2) = f.sc(f.period - t);
+            (s1 + s2).abs().max((c1 - c2).abs()) / f.scale.max(f64::MIN_POSITIVE)
+        })
+        .fold(0.0, f64::max)
+}
+
+/// Whether `t` is a whole multiple (>= 1) of `unit`, to 1e-9 relative.
+fn is_multiple(t: f64, unit: f64) -> bool {
+    let k = (t / unit).round();
+    k >= 1.0 && (t - k * unit).abs() <= 1e-9 * t
+}
+
+fn validate_options(opts: &CorrectorOptions) -> Result<()> {
+    check_positive("tol", opts.tol)?;
+    check_positive("rtol", opts.rtol)?;
+    check_positive("atol", opts.atol)?;
+    check_positive("max_wz_step", opts.max_wz_step)?;
+    check_positive("max_angle_step", opts.max_angle_step)?;
+    check_positive("phase_step", opts.phase_step)?;
+    if !opts.sun_omega.is_finite() {
+        return Err(invalid("sun_omega", format!("must be finite, got {}", opts.sun_omega)));
+    }
+    if opts.max_iter == 0 {
+        return Err(invalid("max_iter", "must be >= 1"));
+    }
+    if opts.max_steps == 0 {
+        return Err(invalid("max_steps", "must be >= 1"));
+    }
+    if opts.max_halvings > 60 {
+        return Err(invalid("max_halvings", format!("must be in [0, 60], got {}", opts.max_halvings)));
+    }
+    if opts.chunk == 0 {
+        return Err(invalid("chunk", "must be >= 1"));
+    }
+    if opts.threads == Some(0) {
+        return Err(invalid("threads", "must be >= 1 (or None for all cores)"));
+    }
+    Ok(())
+}
+
+fn validate(forcing: &OrbitForcing, t_final: f64, closure: Closure, free: Free, candidates: &[Candidate], opts: &CorrectorOptions) -> Result<()> {
+    check_positive("t_final", t_final)?;
+    validate_options(opts)?;
+    match closure {
+        Closure::Half => {
+            if free != Free::Phi0 {
+                return Err(invalid("free", "the half-period closure corrects wz0 only: use Free::Phi0 (phi0 is kept), or Closure::Full for the Sun phase"));
+            }
+            if !is_multiple(t_final, 0.5 * forcing.period) {
+                return Err(invalid("t_final", format!("the half-period closure needs t_final = K T / 2 (K >= 1, T = {}), got {t_final}", forcing.period)));
+            }
+            let a = forcing_asymmetry(forcing);
+            if !(a <= 1e-8) {
+                return Err(invalid(
+                    "closure",
+                    format!("the half-period closure needs an x-symmetric orbit started on the x axis: S(T - t) = -S(t), C(T - t) = C(t) fail by {a:.2e} relative (use Closure::Full)"),
+                ));
+            }
+        }
+        Closure::Full => {
+            if !is_multiple(t_final, forcing.period) {
+                return Err(invalid("t_final", format!("the full closure needs t_final = K T (K >= 1, T = {}), got {t_final}", forcing.period)));
+            }
+        }
+    }
+    validate_candidates(closure, free, candidates)
+}
+
+fn validate_candidates(closure: Closure, free: Free, candidates: &[Candidate]) -> Result<()> {
+    for (i, c) in candidates.iter().enumerate() {
+        let k = &c.case;
+        if !(k.phi0.is_finite() && k.wz0.is_finite()) {
+            return Err(invalid("wz0", format!("candidate {i}: phi0 and wz0 must be finite, got ({}, {})", k.phi0, k.wz0)));
+        }
+        if !(k.kz.is_finite() && (-1.0..=1.0).contains(&k.kz)) {
+            return Err(invalid("kz", format!("candidate {i}: must be in [-1, 1], got {}", k.kz)));
+        }
+        if !c.turns.is_finite() {
+            return Err(invalid("turns", format!("candidate {i}: must be finite, got {}", c.turns)));
+        }
+        if !(k.eps.is_finite() && k.theta_sun0.is_finite()) {
+            return Err(invalid("eps", format!("candidate {i}: eps and theta_sun0 must be finite, got ({}, {})", k.eps, k.theta_sun0)));
+        }
+        if !(k.cs >= 0.0 && k.cd >= 0.0 && k.cs + k.cd <= 1.0 + 1e-12) {
+            return Err(invalid("cs", format!("candidate {i}: need cs, cd >= 0 and cs + cd <= 1, got ({}, {})", k.cs, k.cd)));
+        }
+        if closure == Closure::Half {
+            if k.eps != 0.0 {
+                return Err(invalid("eps", format!("candidate {i}: the half-period closure needs no SRP (eps = 0), got {} (use Closure::Full)", k.eps)));
+            }
+            let m = k.phi0 / FRAC_PI_2;
+            if (m - m.round()).abs() > 1e-12 {
+                return Err(invalid("phi0", format!("candidate {i}: the half-period closure needs phi0 a multiple of pi/2, got {} (use Closure::Full)", k.phi0)));
+            }
+        }
+        if free == Free::SunPhase && k.eps == 0.0 {
+            return Err(invalid("free", format!("candidate {i}: Free::SunPhase needs an SRP plate (eps != 0)")));
+        }
+    }
+    Ok(())
+}
+
+/// Correct many candidates at once to periodic planar attitude motions along the orbit of
+/// `forcing` (see the module documentation for the three forms). `t_final` is the closure time:
+/// K T for [`Closure::Full`], K T / 2 for [`Closure::Half`] (the monodromy is then over K T).
+///
+/// Returns one [`Correction`] per candidate, in order; `Err` only for invalid arguments (each
+/// naming the parameter and its allowed range, candidate index included). Results do not depend
+/// on `threads` or `chunk`; a candidate's last bits (~1e-14) can depend on its batch companions
+/// (lock-step lanes share their step size).
+pub fn correct_planar_attitudes(
+    forcing: &OrbitForcing,
+    t_final: f64,
+    closure: Closure,
+    free: Free,
+    candidates: &[Candidate],
+    opts: &CorrectorOptions,
+) -> Result<Vec<Correction>> {
+    validate(forcing, t_final, closure, free, candidates, opts)?;
+    let form = Form { closure, free, h: opts.phase_step, bordered: None, bounds: (f64::NEG_INFINITY, f64::INFINITY) };
+    run(form, candidates, opts, &on_table(forcing, t_final, opts))
+}
+
+/// The bordered correction of continuation: as [`correct_planar_attitudes`], with the
+/// parameter of `bordered` (Kz or eps) an unknown too and its linear condition closing the
+/// system (pseudo-arclength: the tangent's components and the step; natural: the parameter
+/// fixed). Every candidate starts from its own parameter value (its case's Kz or eps).
+/// [`Correction::parameter`] is the final value and [`Correction::jacobian`] holds d F / d
+/// parameter, from which the driver takes the family's tangent.
+pub fn correct_bordered(
+    forcing: &OrbitForcing,
+    t_final: f64,
+    closure: Closure,
+    free: Free,
+    bordered: &Bordered,
+    candidates: &[Candidate],
+    opts: &CorrectorOptions,
+) -> Result<Vec<Correction>> {
+    validate_bordered(bordered, closure)?;
+    if bordered.parameter == Parameter::OrbitX0 {
+        return Err(invalid("parameter", "the orbit's x0 is freed by correct_across_family"));
+    }
+    validate(forcing, t_final, closure, free, candidates, opts)?;
+    let bounds = if bordered.parameter == Parameter::Kz { (-1.0, 1.0) } else { (f64::NEG_INFINITY, f64::INFINITY) };
+    let form = Form { closure, free, h: opts.phase_step, bordered: Some(*bordered), bounds };
+    run(form, candidates, opts, &on_table(forcing, t_final, opts))
+}
+
+fn validate_bordered(bordered: &Bordered, closure: Closure) -> Result<()> {
+    check_finite("a", &bordered.a)?;
+    if !bordered.b.is_finite() {
+        return Err(invalid("b", format!("must be finite, got {}", bordered.b)));
+    }
+    check_positive("step", bordered.step)?;
+    check_positive("max_step", bordered.max_step)?;
+    if closure == Closure::Half && bordered.a[0] != 0.0 {
+        return Err(invalid("a", "the half-period closure has no angle unknown: a[0] must be 0"));
+    }
+    if bordered.a.iter().all(|&v| v == 0.0) {
+        return Err(invalid("a", "the linear condition needs a non-zero row"));
+    }
+    if bordered.parameter == Parameter::Eps && closure == Closure::Half {
+        return Err(invalid("parameter", "eps breaks the mirror symmetry: continue in eps with Closure::Full"));
+    }
+    Ok(())
+}
+
+/// Integrates a batch of trajectories: (cases, the parameter value of each, full period?) ->
+/// outcomes in order.
+type Integrate<'a> = dyn Fn(&[Case], &[f64], bool) -> Result<Vec<Outcome>> + Sync + 'a;
+
+/// All trajectories on one orbit's forcing table, in one sweep (over `t_final`, or twice it for
+/// the half closure's full-period monodromy).
+fn on_table<'a>(forcing: &'a OrbitForcing, t_final: f64, opts: &CorrectorOptions) -> impl Fn(&[Case], &[f64], bool) -> Result<Vec<Outcome>> + Sync + 'a {
+    let lane = LaneOptions { rtol: opts.rtol, atol: opts.atol, max_steps: opts.max_steps, sun_omega: opts.sun_omega };
+    let chunk = opts.chunk;
+    move |cases: &[Case], _: &[f64], full: bool| map::sweep(forcing, if full { 2.0 * t_final } else { t_final }, cases, &lane, true, chunk, None)
+}
+
+const FAILED: Outcome = Outcome { phi_t: f64::NAN, wz_t: f64::NAN, stm: [f64::NAN; 4], accepted: 0, rejected: 0, status: LaneStatus::Failed };
+
+/// The one Newton driver of every form: all pending points of all candidates integrated in one
+/// call of `integrate` per iteration, a line search per candidate.
+fn run(form: Form, candidates: &[Candidate], opts: &CorrectorOptions, integrate: &Integrate<'_>) -> Result<Vec<Correction>> {
+    let per = form.cases_per_point();
+    let mut tracks: Vec<Track> = candidates
+        .iter()
+        .map(|c| Track { cand: *c, start: form.initial(c), cur: None, dir: [0.0; 3], scale: 1.0, rank_deficient: false, phase: Phase::Start, iterations: 0 })
+        .collect();
+    with_threads(opts.threads, || -> Result<Vec<Correction>> {
+        let mut batch: Vec<(Case, f64)> = Vec::with_capacity(per * tracks.len());
+        let mut active: Vec<(usize, [f64; 3], Option<usize>)> = Vec::with_capacity(tracks.len());
+        loop {
+            batch.clear();
+            active.clear();
+            for (i, t) in tracks.iter().enumerate() {
+                if let Some(x) = t.pending() {
+                    let at = batch.len();
+                    let pushed = form.push_cases(&t.cand, x, &mut batch);
+                    active.push((i, x, pushed.then_some(at)));
+                }
+            }
+            if active.is_empty() {
+                break;
+            }
+            let out = integrate_batch(integrate, &batch, false)?;
+            for &(i, x, at) in &active {
+                let o = at.map_or(&out[0..0], |k| &out[k..k + per]);
+                tracks[i].advance(&form, x, o, opts);
+            }
+        }
+        let mut mono: Vec<[f64; 4]> = tracks.iter().map(|t| t.cur.map_or([f64::NAN; 4], |p| p.stm)).collect();
+        if form.closure == Closure::Half && !opts.monodromy {
+            mono.fill([f64::NAN; 4]);
+        } else if form.closure == Closure::Half {
+            // The full-period monodromy: one more batch over K T at the final points.
+            let full: Vec<(usize, (Case, f64))> =
+                (0..tracks.len()).filter_map(|i| tracks[i].cur.and_then(|p| form.case_at(&tracks[i].cand, p.x).map(|k| (i, (k, p.x[PARAM]))))).collect();
+            let cases: Vec<(Case, f64)> = full.iter().map(|&(_, k)| k).collect();
+            let out = integrate_batch(integrate, &cases, true)?;
+            for (&(i, _), o) in full.iter().zip(&out) {
+                mono[i] = if o.status == LaneStatus::Ok { o.stm } else { [f64::NAN; 4] };
+            }
+        }
+        Ok(tracks.iter().zip(mono).map(|(t, m)| t.result(&form, m)).collect())
+    })?
+}
+
+fn integrate_batch(integrate: &Integrate<'_>, batch: &[(Case, f64)], full: bool) -> Result<Vec<Outcome>> {
+    if batch.is_empty() {
+        return Ok(Vec::new());
+    }
+    let cases: Vec<Case> = batch.iter().map(|b| b.0).collect();
+    let values: Vec<f64> = batch.iter().map(|b| b.1).collect();
+    integrate(&cases, &values, full)
+}
+
+/// Members of a planar x-z-symmetric orbit family (DROs, planar Lyapunov orbits), as the
+/// guesses from which the orbit through any x0 in their range is corrected on demand (half-period
+/// single shooting with x0 fixed, the ydot0 guess interpolated between members), with its
+/// forcing table; both kept in a cache (the continuation comes back to the same x0 when it
+/// locates folds). Thread-safe.
+pub struct PlanarFamily {
+    mu: f64,
+    x0: Vec<f64>,
+    vy0: Vec<f64>,
+    cache: Mutex<HashMap<u64, Arc<(SymmetricOrbit, OrbitForcing)>>>,
+}
+
+impl PlanarFamily {
+    /// `x0`, `vy0`: the members' initial states (any order; at least two, distinct x0).
+    pub fn new(mu: f64, x0: &[f64], vy0: &[f64]) -> Result<Self> {
+        check_mu(mu)?;
+        if x0.len() != vy0.len() || x0.len() < 2 {
+            return Err(invalid("x0", format!("need at least two members with x0 and vy0 of one length, got {} and {}", x0.len(), vy0.len())));
+        }
+        check_finite("x0", x0)?;
+        check_finite("vy0", vy0)?;
+        let mut idx: Vec<usize> = (0..x0.len()).collect();
+        idx.sort_by(|&a, &b| x0[a].total_cmp(&x0[b]));
+        let (xs, vs): (Vec<f64>, Vec<f64>) = idx.iter().map(|&i| (x0[i], vy0[i])).unzip();
+        if xs.windows(2).any(|w| w[0] == w[1]) {
+            return Err(invalid("x0", "members must have distinct x0"));
+        }
+        Ok(Self { mu, x0: xs, vy0: vs, cache: Mutex::new(HashMap::new()) })
+    }
+
+    /// The members' x0 range.
+    pub fn range(&self) -> (f64, f64) {
+        (self.x0[0], self.x0[self.x0.len() - 1])
+    }
+
+    /// The orbit through (x0, 0, 0) of the family and its forcing table.
+    pub fn orbit_at(&self, x0: f64) -> Result<Arc<(SymmetricOrbit, OrbitForcing)>> {
+        let (lo, hi) = self.range();
+        if !(x0.is_finite() && lo <= x0 && x0 <= hi) {
+            return Err(invalid("x0", format!("must be within the family's members, [{lo}, {hi}], got {x0}")));
+        }
+        if let Some(o) = self.cache.lock().map_err(|_| invalid("family", "cache poisoned"))?.get(&x0.to_bits()) {
+            return Ok(o.clone());
+        }
+        let j = self.x0.partition_point(|&v| v < x0).clamp(1, self.x0.len() - 1);
+        let w = (x0 - self.x0[j - 1]) / (self.x0[j] - self.x0[j - 1]);
+        let guess = self.vy0[j - 1] + w * (self.vy0[j] - self.vy0[j - 1]);
+        let mut sh = SymmetricShooting::new(self.mu, false, Options::with_tolerances(1e-13, 1e-13));
+        sh.tol = 1e-12;
+        let orbit = sh.correct([x0, 0.0, guess], Constraint::Fix(Var::X0, x0))?;
+        let forcing = OrbitForcing::new(self.mu, &orbit.state0, orbit.period, [true, true], 1e-12)?;
+        let out = Arc::new((orbit, forcing));
+        let mut c = self.cache.lock().map_err(|_| invalid("family", "cache poisoned"))?;
+        if c.len() > 4096 {
+            c.clear();
+        }
+        c.insert(x0.to_bits(), out.clone());
+        Ok(out)
+    }
+}
+
+/// The bordered half-period correction across a planar orbit family: unknowns (wz0, x0) of
+/// the symmetric motion phi(T(x0)/2) = phi0 + pi turns (K = 1), the orbit's x0 freed and closed
+/// by the linear condition a[1] wz0 + a[2] x0 = b (a[0] must be 0); d g / d x0 by central
+/// differences over the orbits at x0 +- `bordered.step` (each corrected and tabulated; the
+/// three orbits of a point in parallel). Returns [`Correction`]s as [`correct_bordered`]
+/// (`parameter` = x0; the monodromy over the orbit's full period).
+pub fn correct_across_family(family: &PlanarFamily, bordered: &Bordered, candidates: &[Candidate], opts: &CorrectorOptions) -> Result<Vec<Correction>> {
+    if bordered.parameter != Parameter::OrbitX0 {
+        return Err(invalid("parameter", "correct_across_family frees the orbit's x0 (Parameter::OrbitX0)"));
+    }
+    validate_bordered(bordered, Closure::Half)?;
+    validate_options(opts)?;
+    validate_candidates(Closure::Half, Free::Phi0, candidates)?;
+    let form = Form { closure: Closure::Half, free: Free::Phi0, h: opts.phase_step, bordered: Some(*bordered), bounds: family.range() };
+    let lane = LaneOptions { rtol: opts.rtol, atol: opts.atol, max_steps: opts.max_steps, sun_omega: opts.sun_omega };
+    let integrate = |cases: &[Case], values: &[f64], full: bool| -> Result<Vec<Outcome>> {
+        // distinct orbits, in parallel; then each orbit's trajectories in one sweep
+        let mut distinct: Vec<f64> = values.to_vec();
+        distinct.sort_by(f64::total_cmp);
+        distinct.dedup();
+        let orbits: Vec<Option<Arc<(SymmetricOrbit, OrbitForcing)>>> = distinct.par_iter().map(|&x| family.orbit_at(x).ok()).collect();
+        let mut out = vec![FAILED; cases.len()];
+        for (x, orbit) in distinct.iter().zip(&orbits) {
+            let Some(o) = orbit else { continue };
+            let idx: Vec<usize> = (0..cases.len()).filter(|&i| values[i] == *x).collect();
+            let group: Vec<Case> = idx.iter().map(|&i| cases[i]).collect();
+            let t = if full { o.0.period } else { 0.5 * o.0.period };
+            let r = map::sweep(&o.1, t, &group, &lane, true, opts.chunk, None)?;
+            for (&i, v) in idx.iter().zip(r) {
+                out[i] = v;
+            }
+        }
+        Ok(out)
+    };
+    run(form, candidates, opts, &integrate)
+}
+
+/// One trajectory to re-propagate with [`verify_planar_attitudes`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PlanarStart {
+    pub kz: f64,
+    pub phi0: f64,
+    pub wz0: f64,
+    /// Optional flat plate (SRP); its Sun carries the phase and rate.
+    pub plate: Option<FlatPlate>,
+}
+
+/// The end of one re-propagated trajectory.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PlanarEnd {
+    pub phi_t: f64,
+    pub wz_t: f64,
+    /// d(phi, wz)(t_final) / d(phi0, wz0), row-major.
+    pub stm: [f64; 4],
+    /// The integration error of this item (then the values are NaN).
+    pub error: Option<Error>,
+}
+
+/// Independent re-propagation of many planar attitude motions along the orbit `orbit_state0`:
+/// the scalar model [`propagate_planar`] with the orbit integrated alongside (not the forcing
+/// table, not the SIMD lanes), rtol = atol = 1e-14, stopping at every terminator crossing of a
+/// plate, with the 2x2 STM. Items run in parallel on rayon (`threads`; None: all cores); each is
+/// independent of the others and of the thread count. `Err` for invalid arguments; an item whose
+/// integration fails carries its error and NaN values.
+pub fn verify_planar_attitudes(
+    mu: f64,
+    orbit_state0: &[f64; 6],
+    t_final: f64,
+    items: &[PlanarStart],
+    primaries: [bool; 2],
+    threads: Option<usize>,
+) -> Result<Vec<PlanarEnd>> {
+    check_mu(mu)?;
+    check_finite("orbit_state0", orbit_state0)?;
+    check_positive("t_final", t_final)?;
+    if orbit_state0[2] != 0.0 || orbit_state0[5] != 0.0 {
+        return Err(invalid("orbit_state0", format!("the planar model needs a planar orbit (z = zd = 0), got z = {}, zd = {}", orbit_state0[2], orbit_state0[5])));
+    }
+    if threads == Some(0) {
+        return Err(invalid("threads", "must be >= 1 (or None for all cores)"));
+    }
+    for (i, it) in items.iter().enumerate() {
+        if !(it.kz.is_finite() && (-1.0..=1.0).contains(&it.kz)) {
+            return Err(invalid("kz", format!("item {i}: must be in [-1, 1], got {}", it.kz)));
+        }
+        if !(it.phi0.is_finite() && it.wz0.is_finite()) {
+            return Err(invalid("wz0", format!("item {i}: phi0 and wz0 must be finite, got ({}, {})", it.phi0, it.wz0)));
+        }
+        if let Some(p) = &it.plate {
+            let ok = p.eps.is_finite() && p.sun.theta0.is_finite() && p.sun.omega.is_finite() && p.cs >= 0.0 && p.cd >= 0.0 && p.cs + p.cd <= 1.0 + 1e-12;
+            if !ok {
+                return Err(invalid("plate", format!("item {i}: eps, the Sun phase and rate must be finite, cs, cd >= 0 with cs + cd <= 1; got {p:?}")));
+            }
+        }
+    }
+    let opts = Options::with_tolerances(1e-14, 1e-14);
+    let one = |it: &PlanarStart| match propagate_planar(mu, it.kz, primaries, false, orbit_state0, it.phi0, it.wz0, 0.0, t_final, &opts, true, Output::Final, it.plate) {
+        Ok(r) => PlanarEnd { phi_t: r.phi.last().copied().unwrap_or(f64::NAN), wz_t: r.wz.last().copied().unwrap_or(f64::NAN), stm: r.stm_final.unwrap_or([f64::NAN; 4]), error: None },
+        Err(e) => PlanarEnd { phi_t: f64::NAN, wz_t: f64::NAN, stm: [f64::NAN; 4], error: Some(e) },
+    };
+    with_threads(threads, || items.par_iter().map(one).collect())
+}
