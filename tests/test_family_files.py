@@ -150,3 +150,24 @@ def test_load_foreign_folder_and_wrong_suffix(tmp_path):
         librate.OrbitFamily.load(f)
     with pytest.raises(FileNotFoundError):
         librate.OrbitFamily.load(tmp_path / "none.nc")
+
+
+def test_verify_names_a_damaged_saved_result(tmp_path, fam):
+    """`librate verify` / verify_result on results other than map stores: every variable is read
+    and compared with the digests written by save_dataset (a deleted chunk read as NaN before)."""
+    from click.testing import CliRunner
+    from librate.app.cli import main
+    from librate.app.results import save_family, verify_result
+
+    p = save_family(fam, tmp_path / "family.zarr", attrs={"study": "{}"})
+    assert verify_result(p)[0]
+    r = CliRunner().invoke(main, ["verify", str(p)])
+    assert r.exit_code == 0 and "ok" in r.output, r.output
+    chunk = next(x for x in sorted((p / "period").iterdir()) if not x.name.startswith("."))
+    chunk.unlink()
+    ok, report = verify_result(p)
+    assert not ok and "period/" in report and "missing" in report, report
+    r = CliRunner().invoke(main, ["verify", str(p)])
+    assert r.exit_code == 1 and "period/" in r.output, r.output
+    with pytest.raises(ValueError, match="period"):
+        librate.open_result(p, verify=True)
