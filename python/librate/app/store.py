@@ -77,10 +77,13 @@ def writer_lock(out: Path) -> Iterator[None]:
     try:
         lock.acquire()
     except Timeout:
-        try:
-            who = owner.read_text(encoding="utf-8").strip()
-        except OSError:
-            who = "a process that has not recorded its pid yet"
+        who = "a process that has not recorded its pid yet"
+        for _ in range(40):  # the holder writes its pid just after taking the lock
+            try:
+                who = owner.read_text(encoding="utf-8").strip() or who
+                break
+            except OSError:
+                time.sleep(0.05)
         raise StoreBusyError(f"{out} is being written by another librate process ({who}); "
                              "wait for it to finish or stop it, or choose another folder") from None
     try:
