@@ -356,3 +356,17 @@ def test_messages_name_parameters_with_backticks():
     """(The convention the properties check: ``invalid argument `name`: ...``.)"""
     with pytest.raises(ValueError, match=re.escape("invalid argument `rtol`")):
         librate.propagate(EM, STATE, 1.0, rtol=-1.0)
+
+
+GEOMETRY_BAD = {"area_m2": not_positive, "offset_m": not_a_number, "iz_kgm2": not_positive, "sun": st.one_of(st.integers(), st.text(min_size=1, max_size=2))}
+
+
+@pytest.mark.parametrize("name", sorted(GEOMETRY_BAD))
+@FEW
+@given(data=st.data())
+def test_flat_plate_from_geometry_invalid(name, data):
+    """Before: one message for three parameters ("need area_m2 > 0, iz_kgm2 > 0 and a finite
+    offset_m"), and a TypeError for a string."""
+    kw = {"area_m2": 100.0, "offset_m": 2.0, "iz_kgm2": 1e8}
+    kw[name] = data.draw(GEOMETRY_BAD[name], label=name)
+    raises_naming(name, lambda: librate.FlatPlate.from_geometry(EM, **kw))

@@ -10,7 +10,6 @@ t = 0.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -173,8 +172,11 @@ class FlatPlate:
     def from_geometry(cls, system, *, area_m2: float, offset_m: float, iz_kgm2: float, cs: float = 0.0, cd: float = 0.0, sun: Sun | None = None):
         """eps = P A d TU^2 / Iz from the plate's area, offset and the body's Iz (SI units)."""
         sun = sun or Sun()
-        if not (area_m2 > 0 and iz_kgm2 > 0 and math.isfinite(offset_m)):
-            raise ValueError("invalid argument: need area_m2 > 0, iz_kgm2 > 0 and a finite offset_m")
+        if not isinstance(sun, Sun):
+            raise ValueError(f"invalid argument `sun`: must be a librate.Sun, got {sun!r}")
+        area_m2 = as_real(area_m2, "area_m2", positive=True)
+        iz_kgm2 = as_real(iz_kgm2, "iz_kgm2", positive=True)
+        offset_m = as_real(offset_m, "offset_m")
         return cls(sun.pressure * area_m2 * offset_m * system.tu_s**2 / iz_kgm2, cs, cd, sun)
 
     def with_eps(self, eps: float) -> FlatPlate:
