@@ -171,7 +171,7 @@ class FlatPlate:
     @classmethod
     def from_geometry(cls, system, *, area_m2: float, offset_m: float, iz_kgm2: float, cs: float = 0.0, cd: float = 0.0, sun: Sun | None = None):
         """eps = P A d TU^2 / Iz from the plate's area, offset and the body's Iz (SI units)."""
-        sun = sun or Sun()
+        sun = Sun() if sun is None else sun
         if not isinstance(sun, Sun):
             raise ValueError(f"invalid argument `sun`: must be a librate.Sun, got {sun!r}")
         area_m2 = as_real(area_m2, "area_m2", positive=True)
