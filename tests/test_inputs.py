@@ -143,3 +143,27 @@ def test_halo_z0_message_shows_the_accepted_range(em):
     spans = [(float(a), float(b)) for a, b in re.findall(r"\[([-\d.e]+), ([-\d.e]+)\]", str(info.value))]
     assert any(a <= -0.1 <= b for a, b in spans), str(info.value)
     assert abs(librate.halo(em, 2, z0=-0.1).state_half[2] if hasattr(librate.PeriodicOrbit, "state_half") else 0) >= 0
+
+
+# --- silently ignored keywords (issue 12: srp_force or sun in planar runs, sun with a plain
+# RigidBody, step options when fixed_step is given) -------------------------------------------
+
+
+def test_ignored_attitude_keywords_are_refused(em, dro_085):
+    b = librate.RigidBody.from_kz(0.8)
+    args = (em, dro_085.state0, (0.0, 1.2), b, 1.0)
+    with pytest.raises(ValueError, match="invalid argument `srp_force`: planar runs"):
+        librate.propagate_attitude(*args, planar=True, srp_force=True)
+    with pytest.raises(ValueError, match="invalid argument `sun`: planar runs take the Sun from the plate"):
+        librate.propagate_attitude(*args, planar=True, sun=librate.Sun(0.3))
+    with pytest.raises(ValueError, match="invalid argument `sun`: only a librate.FacetBody"):
+        librate.propagate_attitude(em, dro_085.state0, ([0, 0, 0, 1], [0, 0, 1.2]), librate.RigidBody(1, 2, 2.5), 1.0, sun=librate.Sun(0.3))
+
+
+@pytest.mark.parametrize("kw", [{"h0": 1e-3}, {"h_min": 1e-9}, {"h_max": 0.1}, {"safety": 0.5}])
+def test_step_options_with_fixed_step_are_refused(em, dro_085, kw):
+    name = next(iter(kw))
+    with pytest.raises(ValueError, match=f"invalid argument `{name}`: adaptive step options do not apply with fixed_step"):
+        librate.propagate(em, dro_085.state0, 1.0, fixed_step=0.01, **kw)
+    with pytest.raises(ValueError, match=f"invalid argument `{name}`"):
+        librate.propagate_attitude(em, dro_085.state0, (0.0, 1.2), librate.RigidBody.from_kz(0.8), 1.0, planar=True, fixed_step=0.01, **kw)

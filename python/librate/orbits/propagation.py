@@ -164,7 +164,12 @@ def _primary_name(system: System, k: int) -> str:
 
 def integration_options(rtol, atol, h0, h_min, h_max, max_steps, safety, fixed_step) -> dict:
     """The integrator settings, each checked for its type here (the core checks the ranges);
-    every error names the parameter."""
+    every error names the parameter. With ``fixed_step`` the adaptive step options (h0, h_min,
+    h_max, safety) do not apply: giving any of them is an error, not silently ignored."""
+    if fixed_step is not None:
+        for name, value, default in (("h0", h0, None), ("h_min", h_min, 0.0), ("h_max", h_max, math.inf), ("safety", safety, 0.8)):
+            if value != default:
+                raise ValueError(f"invalid argument `{name}`: adaptive step options do not apply with fixed_step; got {name} = {value!r}")
     return dict(
         rtol=as_real(rtol, "rtol", positive=True),
         atol=as_real(atol, "atol", positive=True),
