@@ -8,7 +8,7 @@ All quantities are nondimensional (CR3BP units) unless a name says otherwise
 import warnings as _warnings
 
 from ._core import __version__
-from ._errors import ConvergenceError, IntegrationError, LibrateError
+from ._errors import CollisionError, ConvergenceError, IntegrationError, LibrateError
 from .app import Study, StudyError, open_result, run_map
 from .attitude import (
     Appendage,
@@ -75,6 +75,7 @@ __all__ = [
     "zero_contours",
     "LibrateError",
     "IntegrationError",
+    "CollisionError",
     "ConvergenceError",
     "System",
     "Event",

@@ -12,6 +12,7 @@ OMEGA_SUN: float
 SOLAR_PRESSURE_1AU: float
 SUN_SYNODIC_PERIOD: float
 __all__ = [
+    "CollisionError",
     "ConvergenceError",
     "CorrectionBatch",
     "IntegrationError",
@@ -64,6 +65,11 @@ class IntegrationError(LibrateError):
     steps: int
     kind: str
 
+class CollisionError(IntegrationError):
+    primary: int
+    distance: float
+    radius: float
+
 class ConvergenceError(LibrateError):
     iterations: int
     residual: float
@@ -91,6 +97,7 @@ def propagate(
     stm: bool,
     t_eval: _F64 | None,
     events: list[tuple[str, list[float], int, bool]],
+    collision: tuple[float, float] | None = None,
 ) -> dict[str, Any]: ...
 def propagate_many(
     mu: float,
@@ -101,6 +108,7 @@ def propagate_many(
     options: _Options,
     stm: bool,
     threads: int | None,
+    collision: tuple[float, float] | None = None,
 ) -> dict[str, Any]: ...
 def jacobi(mu: float, states: _F64) -> _F64: ...
 def lagrange_points(mu: float) -> _F64: ...

@@ -1,5 +1,5 @@
 """librate's exceptions, defined in the Rust extension and re-exported here."""
 
-from ._core import ConvergenceError, IntegrationError, LibrateError
+from ._core import CollisionError, ConvergenceError, IntegrationError, LibrateError
 
-__all__ = ["LibrateError", "IntegrationError", "ConvergenceError"]
+__all__ = ["LibrateError", "IntegrationError", "CollisionError", "ConvergenceError"]

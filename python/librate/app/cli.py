@@ -36,6 +36,7 @@ def main() -> None:
       librate solve study.toml         periodic attitude motions of each orbit, as a table
       librate map study.toml           the attitude periodicity map (thesis Fig. 24)
       librate plot librate-out/map.zarr   re-draw figures from a saved result
+      librate verify librate-out/map.zarr checksums: name any damaged chunk or row
       librate demo                     the DRO map at Kz = 0.8 with no study file
 
     Units: nondimensional CR3BP units (LU = distance between the primaries, TU = 1 / mean
@@ -153,7 +154,7 @@ def dros(system_name: str, x0_values: tuple[float, ...]) -> None:
     for x0 in xs:
         t_start = time.perf_counter()
         orbit = correct_dro(system, x0, guess)
-        one = propagate(system, orbit.state0, orbit.period, rtol=1e-13, atol=1e-13, t_eval=[orbit.period])
+        one = propagate(system, orbit.state0, orbit.period, rtol=1e-13, atol=1e-13, t_eval=[orbit.period], collision="point")
         closure = float(np.max(np.abs(one.y[-1] - orbit.state0)))
         elapsed = time.perf_counter() - t_start
         click.echo(
@@ -451,6 +452,7 @@ def plot(result_path, quiet) -> None:
 
     try:
         p = resolve_result_path(result_path)
+        _refuse_damaged_store(p)
         res = open_result(p)
     except (ValueError, FileNotFoundError) as err:
         raise click.ClickException(str(err)) from None
@@ -466,6 +468,41 @@ def plot(result_path, quiet) -> None:
     written = _figures(res, p.parent, names, quiet)
     if not written:
         raise click.ClickException("no figure could be drawn (see the messages above)")
+
+
+def _refuse_damaged_store(p: Path) -> None:
+    """A map store with damaged rows or arrays is refused by name (an incomplete one is drawn)."""
+    from .store import verify_map_store
+
+    if not (p / ".zgroup").is_file():
+        return
+    rep = verify_map_store(p)
+    if rep.damaged or (rep.problems and "not a librate map store (no librate_store marker" not in rep.problems[0]):
+        raise ValueError(rep.describe())
+
+
+@main.command(context_settings=_CONTEXT)
+@click.argument("result_path", type=click.Path(exists=True))
+def verify(result_path) -> None:
+    """Check a saved result for damage, without recomputing it.
+
+    \b
+    RESULT_PATH: a map store written by `librate map` (map.zarr): every row of dwz, dphi,
+    phi_T and status is read and compared with the checksum written beside its `done` flag;
+    rows not computed yet, missing, truncated or garbled chunks, and damaged coordinates or
+    solutions are named. Other results (family, solutions, map.nc): every variable is read and
+    compared with its stored checksum. Exit status 0 when intact, 1 when damaged or
+    incomplete (re-running the same `librate map` recomputes the damaged rows).
+    """
+    from .results import verify_result
+
+    try:
+        ok, report = verify_result(result_path)
+    except (ValueError, FileNotFoundError) as err:
+        raise click.ClickException(str(err)) from None
+    click.echo(report)
+    if not ok:
+        sys.exit(1)
 
 
 def _figures(result, folder: Path, names, quiet: bool) -> list[Path]:

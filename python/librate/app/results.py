@@ -19,7 +19,8 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["RESULT_KINDS", "open_result", "read_attrs", "result_kind", "run_map_to", "save_dataset", "save_family", "solutions_dataset"]
+__all__ = ["RESULT_KINDS", "open_result", "read_attrs", "result_kind", "run_map_to", "save_dataset", "save_family", "solutions_dataset",
+           "verify_result"]
 
 #: The kinds of result, as stored in the ``librate_result`` attribute.
 RESULT_KINDS = ("family", "solutions", "map")
@@ -84,17 +85,23 @@ def read_attrs(path: str | Path) -> dict:
         ds.close()
 
 
-def open_result(path: str | Path):
+def open_result(path: str | Path, *, verify: bool = False):
     """Reload a saved result without recomputing: an :class:`~librate.OrbitFamily` for a family
     (through :meth:`OrbitFamily.load`), an ``xarray.Dataset`` for a periodicity map or a table
     of periodic solutions (its ``attrs["study"]`` is the study as JSON).
 
     ``path``: a ``.zarr`` folder or a ``.nc`` file, or an output folder holding exactly one of
-    map/family/solutions. Raises ``FileNotFoundError`` or ``ValueError`` (not a librate result).
+    map/family/solutions. ``verify``: first check the result as :func:`verify_result` does
+    (every chunk against its checksum, every map row computed) and raise ``ValueError`` naming
+    the damage. Raises ``FileNotFoundError`` or ``ValueError`` (not a librate result, or damaged).
     """
     from ..orbits.families import OrbitFamily
 
     p = resolve_result_path(path)
+    if verify:
+        ok, report = verify_result(p)
+        if not ok:
+            raise ValueError(report)
     ds = _open_dataset(p)
     kind = result_kind(ds)
     if kind is None:
@@ -105,7 +112,79 @@ def open_result(path: str | Path):
         if p.suffix not in (".zarr", ".nc"):
             raise ValueError(f"{str(p)!r}: a saved family must be a .zarr folder or a .nc file")
         return OrbitFamily.load(p)
+    if "row_checksum" in ds.variables:  # the map store's integrity data, not a result
+        ds = ds.drop_vars("row_checksum")
     return ds
+
+
+def verify_result(path: str | Path) -> tuple[bool, str]:
+    """Check a saved result without recomputing it. A map store written by ``librate map``:
+    every row against its checksum and ``done`` flag, the coordinates and the solutions (see
+    :func:`librate.app.store.verify_map_store`). Other results: every variable is read (a
+    missing, truncated or garbled chunk is named) and compared with the digests stored in
+    its ``librate_checksums`` attribute when it has them. Returns ``(ok, report)``: the report
+    names every damaged row or variable."""
+    from .._integrity import array_digest, missing_zarr_chunks
+    from .store import verify_map_store
+
+    p = resolve_result_path(path)
+    if _is_zarr(p):
+        import zarr
+
+        try:
+            marker = zarr.open_group(str(p), mode="r", use_consolidated=False).attrs.get("librate_store")
+        except Exception:  # noqa: BLE001 - judged below, by reading it as a result
+            marker = None
+        if marker == "periodicity_map":
+            rep = verify_map_store(p)
+            return rep.ok, rep.describe()
+    try:
+        ds = _open_dataset(p)
+    except ValueError as err:
+        return False, str(err)
+    problems = []
+    try:
+        kind = result_kind(ds)
+        if kind is None:
+            return False, f"{str(p)!r} is not a librate result (no librate_result attribute; neither a family, a map nor solutions)"
+        sums = _stored_checksums(ds)
+        from .store import quiet_zarr
+
+        for name in ds.variables:
+            try:
+                with quiet_zarr():
+                    values = np.asarray(ds[name].values)
+            except Exception as err:  # noqa: BLE001 - named, never a traceback
+                problems.append(f"variable {name} is unreadable ({type(err).__name__}: {str(err).splitlines()[0] if str(err) else ''})")
+                continue
+            if _is_zarr(p):
+                chunks_missing = missing_zarr_chunks(p, str(name))
+                if chunks_missing:
+                    problems.append(f"variable {name}: chunk(s) {', '.join(chunks_missing)} missing")
+            if sums is not None and name in sums and array_digest(values) != sums[name]:
+                problems.append(f"variable {name} does not match its checksum")
+        if sums is None:
+            note = " (no checksums stored: written by an older librate; only readability was checked)"
+        else:
+            note = ", every variable matches its checksum"
+    finally:
+        ds.close()
+    if problems:
+        return False, f"{p}: damaged librate result\n" + "\n".join(f"  {q}" for q in problems)
+    return True, f"{p}: ok: a librate {kind} result{note}"
+
+
+def _stored_checksums(ds) -> dict | None:
+    import json
+
+    raw = ds.attrs.get("librate_checksums")
+    if not isinstance(raw, str):
+        return None
+    try:
+        sums = json.loads(raw)
+    except ValueError:
+        return None
+    return sums if isinstance(sums, dict) else None
 
 
 def _check_target(p: Path) -> None:
@@ -141,6 +220,7 @@ def save_dataset(ds, path: str | Path) -> Path:
     _check_target(p)
     tmp = p.with_name(f".{p.name}.tmp-{os.getpid()}")
     _remove(tmp)
+    ds = _with_checksums(ds)
     try:
         if p.suffix == ".zarr":
             ds.to_zarr(tmp, mode="w", zarr_format=2, consolidated=True)
@@ -151,6 +231,16 @@ def save_dataset(ds, path: str | Path) -> Path:
     finally:
         _remove(tmp)
     return p
+
+
+def _with_checksums(ds):
+    """``ds`` with the digests of every variable in its ``librate_checksums`` attribute (JSON),
+    which :func:`verify_result` and :meth:`OrbitFamily.load` check."""
+    from .._integrity import CHECKSUM_ATTR, dataset_checksums
+
+    ds = ds.copy()
+    ds.attrs[CHECKSUM_ATTR] = dataset_checksums(ds)
+    return ds
 
 
 def save_family(family, path: str | Path, attrs: dict | None = None) -> Path:

@@ -33,6 +33,8 @@ from typing import Annotated, Any, Literal
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Discriminator, Field, Tag, ValidationError, model_validator
 
+from .._errors import LibrateError
+
 if sys.version_info >= (3, 11):
     import tomllib
 else:  # pragma: no cover - Python 3.10
@@ -669,7 +671,18 @@ class Study(BaseModel):
         system = system or self.build_system()
         o = self.orbits
         if o.kind == "dro":
-            return dro_family(system, x0=_grid_values(o.x0)) if o.x0 is not None else dro_family(system)
+            if o.x0 is None:
+                return dro_family(system)
+            try:
+                return dro_family(system, x0=_grid_values(o.x0))
+            except LibrateError as err:
+                missing = getattr(err, "missing", None)
+                if not missing:
+                    raise
+                raise StudyError([_problem("orbits.x0", _grid_raw(o.x0),
+                                           f"no DRO reached at x0 = {', '.join(f'{v:g}' for v in missing)} (the continuation ended: {err.end_reason}); "
+                                           f"{len(err.found)} of the requested members were found",
+                                           "x0 values on the DRO family, between the Moon and the DRO that grazes the Earth (about 0.985 to 0.005)")]) from None
         kw = {} if o.max_members is None else {"max_members": o.max_members}
         if o.kind == "lyapunov":
             return lyapunov_family(system, o.point or 1, **kw)
@@ -907,7 +920,7 @@ def _with_crossing(o):
 
     from ..orbits.propagation import propagate
 
-    half = propagate(o.system, o.state0, 0.5 * o.period, rtol=1e-13, atol=1e-13).y[-1]
+    half = propagate(o.system, o.state0, 0.5 * o.period, rtol=1e-13, atol=1e-13, collision="point").y[-1]
     return dataclasses.replace(o, _evaluation={"crossing": half})
 
 

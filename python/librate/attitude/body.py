@@ -14,7 +14,7 @@ import numpy as np
 
 from .. import _core
 
-__all__ = ["RigidBody", "quaternion_from_euler", "TORQUES", "EULER_SEQUENCES"]
+__all__ = ["RigidBody", "quaternion_from_euler", "TORQUES", "EULER_SEQUENCES", "torque_names"]
 
 #: Torque model names accepted by ``torques=``.
 TORQUES = ("gravity_gradient", "gravity_gradient_earth", "gravity_gradient_moon", "srp")
@@ -22,11 +22,30 @@ TORQUES = ("gravity_gradient", "gravity_gradient_earth", "gravity_gradient_moon"
 EULER_SEQUENCES = {"123": "XYZ", "321": "ZYX", "313": "ZXZ"}
 
 
+def torque_names(torques) -> tuple[str, ...]:
+    """The torque names of ``torques=``: one name (a string) or a sequence of names from
+    :data:`TORQUES`; anything else is a ValueError naming ``torques``."""
+    names = (torques,) if isinstance(torques, str) else torques
+    try:
+        names = tuple(names)
+    except TypeError:
+        raise ValueError(f"invalid argument `torques`: must be a torque name or a list of names from {', '.join(TORQUES)}, got {torques!r}") from None
+    for n in names:
+        if not isinstance(n, str) or n not in TORQUES:
+            raise ValueError(f"invalid argument `torques`: unknown torque {n!r}; known: {', '.join(TORQUES)}")
+    if len(set(names)) != len(names):
+        raise ValueError(f"invalid argument `torques`: a torque is listed twice in {list(names)}")
+    return names
+
+
 @dataclass(frozen=True)
 class RigidBody:
     """Principal moments of inertia about the body axes x, y, z (kg m^2, or normalised: only
     ratios matter for gravity-gradient dynamics). ``mass_kg`` is needed only for the orbital
-    coupling term (thesis eq. 37). Validated: positive, triangle inequality."""
+    coupling term (thesis eq. 37). Validated: finite numbers >= 0 with Iz > 0, triangle
+    inequality. One zero moment is a thin rod along that axis (Ix = 0 and Iy = Iz: Kz = 1;
+    Iy = 0 and Ix = Iz: Kz = -1), valid for the planar model, which depends only on Kz; the 3-D
+    models need every moment > 0."""
 
     ix: float
     iy: float
@@ -34,16 +53,39 @@ class RigidBody:
     mass_kg: float | None = None
 
     def __post_init__(self) -> None:
-        _core.rigid_body_kz(float(self.ix), float(self.iy), float(self.iz))
-        if self.mass_kg is not None and not (math.isfinite(self.mass_kg) and self.mass_kg > 0):
-            raise ValueError(f"invalid argument `mass_kg`: must be finite and > 0, got {self.mass_kg!r}")
+        for name in ("ix", "iy", "iz"):
+            v = getattr(self, name)
+            if isinstance(v, bool) or not isinstance(v, (int, float, np.integer, np.floating)) or not math.isfinite(v) or v < 0:
+                raise ValueError(f"invalid argument `{name}`: principal moment must be a finite number >= 0, got {v!r}")
+            object.__setattr__(self, name, float(v))
+        ix, iy, iz = self.ix, self.iy, self.iz
+        if min(ix, iy, iz) > 0:
+            _core.rigid_body_kz(ix, iy, iz)  # the triangle inequality, in the core
+        else:
+            if iz <= 0:
+                raise ValueError(f"invalid argument `iz`: must be > 0 (Kz = (Iy - Ix) / Iz), got {iz!r}")
+            tol = 1e-12 * (ix + iy + iz)
+            for name, a, b, c in (("ix", ix, iy, iz), ("iy", iy, ix, iz), ("iz", iz, ix, iy)):
+                if a > b + c + tol:
+                    raise ValueError(f"invalid argument `{name}`: principal moments violate the triangle inequality: {name} = {a} "
+                                     f"exceeds the sum of the other two ({b + c}); a zero moment is a thin rod (the other two equal)")
+        m = self.mass_kg
+        if m is not None and (isinstance(m, bool) or not isinstance(m, (int, float, np.integer, np.floating)) or not (math.isfinite(m) and m > 0)):
+            raise ValueError(f"invalid argument `mass_kg`: must be a finite number > 0, got {m!r}")
 
     @classmethod
     def from_kz(cls, kz: float) -> RigidBody:
-        """A planar body with Kz = (Iy - Ix)/Iz in [-1, 1] (Iz = 1, Ix + Iy = 1)."""
-        if not (math.isfinite(kz) and -1 <= kz <= 1):
-            raise ValueError(f"invalid argument `kz`: must be in [-1, 1], got {kz!r}")
+        """A planar body with Kz = (Iy - Ix)/Iz in [-1, 1] (Iz = 1, Ix + Iy = 1). The ends are
+        thin rods: Kz = 1 gives Ix = 0, Kz = -1 gives Iy = 0 (planar model only)."""
+        if isinstance(kz, bool) or not isinstance(kz, (int, float, np.integer, np.floating)) or not (math.isfinite(kz) and -1 <= kz <= 1):
+            raise ValueError(f"invalid argument `kz`: must be a number in [-1, 1], got {kz!r}")
+        kz = float(kz)
         return cls(0.5 * (1 - kz), 0.5 * (1 + kz), 1.0)
+
+    @property
+    def is_rod(self) -> bool:
+        """A zero principal moment (Kz = +-1): only the planar model applies."""
+        return min(self.ix, self.iy, self.iz) == 0
 
     @property
     def kz(self) -> float:

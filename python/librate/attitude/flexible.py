@@ -55,7 +55,7 @@ from .. import _core
 from .._checks import as_state, as_time_span
 from ..orbits.propagation import Stats, integration_options
 from ..orbits.system import System, resolve_system
-from .body import TORQUES, RigidBody
+from .body import RigidBody, torque_names
 
 __all__ = [
     "Appendage",
@@ -537,10 +537,7 @@ def flexible_run_inputs(system, orbit_state, body, t_span, torques, orbit):
     t0, tf = as_time_span(t_span)
     if not isinstance(body, FlexibleBody):
         raise ValueError(f"invalid argument `body`: must be a librate.FlexibleBody, got {type(body).__name__}")
-    names = tuple(torques)
-    for n in names:
-        if n not in TORQUES:
-            raise ValueError(f"invalid argument `torques`: unknown torque {n!r}; known: {', '.join(TORQUES)}")
+    names = torque_names(torques)
     if orbit not in ("integrate", "held"):
         raise ValueError(f"invalid argument `orbit`: must be 'integrate' or 'held', got {orbit!r}")
     return sys_, s, t0, tf, names

@@ -16,10 +16,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import _core
-from .._checks import as_state, as_time_span
+from .._checks import as_float_array, as_state, as_time_span
 from ..orbits.propagation import Stats, integration_options
 from ..orbits.system import System, resolve_system
-from .body import EULER_SEQUENCES, TORQUES, RigidBody
+from .body import EULER_SEQUENCES, RigidBody, torque_names
 from .flexible import FlexibleBody, FlexibleResponse, enabled_primaries, flexible_attitude, initial_deflection
 from .srp import FacetBody, FlatPlate, Sun
 
@@ -142,10 +142,7 @@ def propagate_attitude(
     t0, tf = as_time_span(t_span)
     if not isinstance(body, (RigidBody, FlexibleBody)):
         raise ValueError(f"invalid argument `body`: must be a librate.RigidBody or librate.FlexibleBody, got {body!r}")
-    names = tuple(torques)
-    for n in names:
-        if n not in TORQUES:
-            raise ValueError(f"invalid argument `torques`: unknown torque {n!r}; known: {', '.join(TORQUES)}")
+    names = torque_names(torques)
     if srp is not None and not (planar and isinstance(srp, FlatPlate)):
         raise ValueError("invalid argument `srp`: a librate.FlatPlate, for planar runs (3-D runs use a FacetBody with torques including 'srp')")
     if planar and "srp" in names:
@@ -154,10 +151,19 @@ def propagate_attitude(
         raise ValueError("invalid argument `body`: the SRP torque or force needs a librate.FacetBody")
     if sun is not None and not isinstance(sun, Sun):
         raise ValueError(f"invalid argument `sun`: must be a librate.Sun, got {sun!r}")
+    if not isinstance(srp_force, (bool, np.bool_)):
+        raise ValueError(f"invalid argument `srp_force`: must be True or False, got {srp_force!r}")
+    # keywords that would be silently ignored are refused by name (issue 12)
+    if planar and srp_force:
+        raise ValueError("invalid argument `srp_force`: planar runs have no SRP force on the orbit (3-D runs with a FacetBody do)")
+    if sun is not None and (planar or isinstance(body, FlexibleBody)):
+        raise ValueError("invalid argument `sun`: planar runs take the Sun from the plate, srp=FlatPlate(..., sun=Sun(...))")
+    if sun is not None and not isinstance(body, FacetBody):
+        raise ValueError("invalid argument `sun`: only a librate.FacetBody feels the Sun (solar radiation pressure); a plain RigidBody does not")
     if orbit not in ("integrate", "held", "coupled"):
         raise ValueError(f"invalid argument `orbit`: must be 'integrate', 'held' or 'coupled', got {orbit!r}")
     opts = integration_options(rtol, atol, h0, h_min, h_max, max_steps, safety, fixed_step)
-    te = None if t_eval is None else np.ascontiguousarray(t_eval, dtype=np.float64).ravel()
+    te = None if t_eval is None else np.ascontiguousarray(as_float_array(t_eval, "t_eval"), dtype=np.float64).ravel()
     if isinstance(body, FlexibleBody):
         if srp is not None or "srp" in names or srp_force:
             raise ValueError("invalid argument `srp`: the flexible model has no solar radiation pressure yet; use a RigidBody or FacetBody")
@@ -179,6 +185,9 @@ def propagate_attitude(
         w = np.stack([zero, zero, wz], axis=1)
         return AttitudeTrajectory(sys_, body, names, True, r["t"], r["orbit"], q, w, phi, wz, r["stm"], Stats(*r["stats"]))
 
+    if isinstance(body, RigidBody) and body.is_rod:
+        raise ValueError(f"invalid argument `body`: a body with a zero principal moment (Kz = {body.kz:g}, a thin rod) has no 3-D attitude "
+                         "dynamics; use planar=True (the planar model depends only on Kz)")
     q0, w0 = _quaternion_and_rate(attitude)
     inertia_nd = None
     if orbit == "coupled":

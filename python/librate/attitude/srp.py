@@ -10,12 +10,12 @@ t = 0.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from .. import _core
+from .._checks import as_float_array, as_real
 from ..constants import OMEGA_SUN, SOLAR_PRESSURE_1AU
 from .body import RigidBody
 
@@ -31,10 +31,8 @@ class Sun:
     pressure: float = SOLAR_PRESSURE_1AU
 
     def __post_init__(self):
-        if not math.isfinite(self.theta0):
-            raise ValueError(f"invalid argument `theta0`: must be finite, got {self.theta0!r}")
-        if not (math.isfinite(self.pressure) and self.pressure >= 0):
-            raise ValueError(f"invalid argument `pressure`: must be finite and >= 0 N/m^2, got {self.pressure!r}")
+        object.__setattr__(self, "theta0", as_real(self.theta0, "theta0"))
+        object.__setattr__(self, "pressure", as_real(self.pressure, "pressure", nonnegative=True))
 
     @property
     def omega(self) -> float:
@@ -66,10 +64,19 @@ class Facet:
     cd: float = 0.0
 
     def __post_init__(self):
-        n = np.asarray(self.normal, dtype=float).ravel()
-        c = np.asarray(self.center, dtype=float).ravel()
-        if n.shape != (3,) or c.shape != (3,):
-            raise ValueError("invalid argument `normal`/`center`: each must have 3 components")
+        n = as_float_array(self.normal, "normal").ravel()
+        c = as_float_array(self.center, "center").ravel()
+        for name, v in (("normal", n), ("center", c)):
+            if v.shape != (3,) or not np.all(np.isfinite(v)):
+                raise ValueError(f"invalid argument `{name}`: must be 3 finite numbers, got {getattr(self, name)!r}")
+        if not np.any(n):
+            raise ValueError("invalid argument `normal`: must not be zero")
+        object.__setattr__(self, "area", as_real(self.area, "area", positive=True))
+        for name in ("ca", "cs", "cd"):
+            v = as_real(getattr(self, name), name)
+            if not 0 <= v <= 1:
+                raise ValueError(f"invalid argument `{name}`: must be in [0, 1], got {v!r}")
+            object.__setattr__(self, name, v)
         # validated by the core: area > 0, non-zero normal, coefficients in [0, 1] summing to one
         _core.facets_force_torque([self._tuple(n, c)], [1.0, 0.0, 0.0])
         object.__setattr__(self, "normal", tuple(float(v) for v in n / np.linalg.norm(n)))
@@ -151,11 +158,12 @@ class FlatPlate:
     sun: Sun = field(default_factory=Sun)
 
     def __post_init__(self):
-        if not math.isfinite(self.eps):
-            raise ValueError(f"invalid argument `eps`: must be finite, got {self.eps!r}")
-        for name, v in (("cs", self.cs), ("cd", self.cd)):
-            if not (math.isfinite(v) and 0 <= v <= 1):
+        object.__setattr__(self, "eps", as_real(self.eps, "eps"))
+        for name in ("cs", "cd"):
+            v = as_real(getattr(self, name), name)
+            if not 0 <= v <= 1:
                 raise ValueError(f"invalid argument `{name}`: must be in [0, 1], got {v!r}")
+            object.__setattr__(self, name, v)
         if self.cs + self.cd > 1 + 1e-12:
             raise ValueError(f"invalid argument `cs`: cs + cd must not exceed one (ca = 1 - cs - cd), got {self.cs + self.cd}")
         if not isinstance(self.sun, Sun):
@@ -168,9 +176,12 @@ class FlatPlate:
     @classmethod
     def from_geometry(cls, system, *, area_m2: float, offset_m: float, iz_kgm2: float, cs: float = 0.0, cd: float = 0.0, sun: Sun | None = None):
         """eps = P A d TU^2 / Iz from the plate's area, offset and the body's Iz (SI units)."""
-        sun = sun or Sun()
-        if not (area_m2 > 0 and iz_kgm2 > 0 and math.isfinite(offset_m)):
-            raise ValueError("invalid argument: need area_m2 > 0, iz_kgm2 > 0 and a finite offset_m")
+        sun = Sun() if sun is None else sun
+        if not isinstance(sun, Sun):
+            raise ValueError(f"invalid argument `sun`: must be a librate.Sun, got {sun!r}")
+        area_m2 = as_real(area_m2, "area_m2", positive=True)
+        iz_kgm2 = as_real(iz_kgm2, "iz_kgm2", positive=True)
+        offset_m = as_real(offset_m, "offset_m")
         return cls(sun.pressure * area_m2 * offset_m * system.tu_s**2 / iz_kgm2, cs, cd, sun)
 
     def with_eps(self, eps: float) -> FlatPlate:

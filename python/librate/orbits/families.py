@@ -16,6 +16,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .. import _core
+from .._checks import as_count, as_real
 from .._errors import ConvergenceError, LibrateError
 from ..constants import SUN_SYNODIC_PERIOD
 from .continuation import continue_arclength, continue_natural, geometry
@@ -58,7 +59,7 @@ class OrbitFamily:
         state0 = np.array([m.state0 for m in members])
         half = np.array([m._evaluation["crossing"] for m in members])
         period = np.array([m.period for m in members])
-        batch = propagate_many(system, state0, period, stm=True, rtol=SHOOT_RTOL, atol=SHOOT_ATOL, on_error="mask")
+        batch = propagate_many(system, state0, period, stm=True, rtol=SHOOT_RTOL, atol=SHOOT_ATOL, on_error="mask", collision="point")
         eig = np.full((len(members), 6), np.nan + 0j)
         nu = np.full((len(members), 2), np.nan + 0j)
         for i in range(len(members)):
@@ -129,8 +130,7 @@ class OrbitFamily:
         if len(given) != 1:
             raise ValueError("invalid argument: give exactly one of x0, z0, period, period_days, jacobi")
         (name, value), = given.items()
-        if not math.isfinite(value):
-            raise ValueError(f"invalid argument `{name}`: must be finite, got {value!r}")
+        value = as_real(value, name)
         if name == "period_days":
             name, value = "period", self.system.from_days(value)
         if name == "z0" and not self.spatial:
@@ -147,10 +147,20 @@ class OrbitFamily:
             if d[-1] == 0:
                 brackets.append((states[-1], len(d) - 1))
         if not brackets:
-            q = {"x0": self.state0[:, 0], "z0": self.state0[:, 2], "period": self.period, "jacobi": self.jacobi}[name]
+            # the ranges searched: for halos, z0 at the half-period crossing too (the other
+            # side of the x-y plane), so the accepted values may form two intervals
+            user = next(iter(given))
+            spans = []
+            for st, what in zip(sets, ("initial states", "half-period crossings")):
+                q = {"x0": st[:, 0], "z0": st[:, 2], "period": self.period, "jacobi": self.jacobi}[name]
+                if user == "period_days":
+                    q = self.system.period_days(q)
+                spans.append(f"[{np.min(q):.10g}, {np.max(q):.10g}]" + (f" ({what})" if len(sets) > 1 and name in ("x0", "z0") else ""))
+                if name not in ("x0", "z0"):
+                    break
             raise ValueError(
-                f"invalid argument `{name}`: {value!r} is outside the {self.kind} family's range "
-                f"[{np.min(q):.10g}, {np.max(q):.10g}] (family end: {self.end_reason})"
+                f"invalid argument `{user}`: {float(given[user])!r} is outside the {self.kind} family's range "
+                f"{' or '.join(spans)} (family end: {self.end_reason})"
             )
         if not 0 <= which < len(brackets):
             raise ValueError(f"invalid argument `which`: the value is bracketed {len(brackets)} time(s); which must be in 0..{len(brackets) - 1}")
@@ -214,34 +224,133 @@ class OrbitFamily:
         return ds
 
     def save(self, path) -> None:
-        """Write to netCDF (``.nc``) or Zarr (``.zarr``)."""
-        path = str(path)
+        """Write to netCDF (``.nc``) or Zarr (``.zarr``), with a digest of every variable
+        (attribute ``librate_checksums``) that :meth:`load` checks.
+
+        All or nothing: written to a temporary sibling, then renamed. An existing ``path`` is
+        replaced only when it is a librate family file; anything else there (a foreign file,
+        a folder with other files) is refused with ``FileExistsError``, never overwritten."""
+        import os
+        import shutil
+        from pathlib import Path
+
+        from .._integrity import CHECKSUM_ATTR, dataset_checksums
+
+        p = Path(path)
+        if p.suffix not in (".zarr", ".nc"):
+            raise ValueError(f"invalid argument `path`: must end in .nc (netCDF) or .zarr (Zarr), got {str(path)!r}")
+        if (p.exists() or p.is_symlink()) and not (p.is_dir() and not any(p.iterdir())):
+            try:
+                OrbitFamily.load(p)
+            except (ValueError, OSError) as err:
+                raise FileExistsError(f"{str(p)!r} exists and is not a valid librate family file ({err}): refusing to overwrite it; "
+                                      "remove it or choose another path") from None
         ds = self.to_dataset()
-        if path.endswith(".zarr"):
-            ds.to_zarr(path, mode="w", zarr_format=2, consolidated=True)
-        elif path.endswith(".nc"):
-            ds.to_netcdf(path, engine="scipy")
-        else:
-            raise ValueError(f"invalid argument `path`: must end in .nc (netCDF) or .zarr (Zarr), got {path!r}")
+        ds.attrs[CHECKSUM_ATTR] = dataset_checksums(ds)
+        p.parent.mkdir(parents=True, exist_ok=True)
+        tmp = p.with_name(f".{p.name}.tmp-{os.getpid()}")
+
+        def remove(q):
+            if q.is_dir() and not q.is_symlink():
+                shutil.rmtree(q)
+            elif q.exists() or q.is_symlink():
+                q.unlink()
+
+        remove(tmp)
+        try:
+            if p.suffix == ".zarr":
+                ds.to_zarr(tmp, mode="w-", zarr_format=2, consolidated=True)
+            else:
+                ds.to_netcdf(tmp, engine="scipy")
+            remove(p)
+            os.replace(tmp, p)
+        finally:
+            remove(tmp)
 
     @classmethod
     def load(cls, path) -> OrbitFamily:
-        """Read a family written by :meth:`save`; the numbers are identical."""
+        """Read a family written by :meth:`save`; the numbers are identical.
+
+        Raises ``FileNotFoundError``, or ``ValueError`` saying why ``path`` is not a (valid)
+        librate family file: unreadable (empty, truncated, garbage, not netCDF or Zarr), another
+        kind of file (no family variables or attributes), or damaged (a missing chunk, or a
+        variable that does not match its stored checksum)."""
         import ast
+        import json
+        from pathlib import Path
 
         import xarray as xr
 
-        path = str(path)
-        ds = xr.open_zarr(path) if path.endswith(".zarr") else xr.open_dataset(path, engine="scipy")
+        from .._integrity import CHECKSUM_ATTR, array_digest, missing_zarr_chunks
+
+        p = Path(path)
+        name = str(path)
+        if not p.exists():
+            raise FileNotFoundError(f"no librate family file at {name!r}")
+        if p.suffix not in (".zarr", ".nc"):
+            raise ValueError(f"{name!r} is not a librate family file: the name must end in .nc (netCDF) or .zarr (Zarr)")
+        not_family = f"{name!r} is not a librate family file"
+        try:
+            if p.suffix == ".zarr":
+                if not p.is_dir():
+                    raise ValueError("a .zarr family must be a folder")
+                ds = xr.open_zarr(p, consolidated=None, chunks=None)
+            else:
+                if not p.is_file():
+                    raise ValueError("a .nc family must be a file")
+                if p.stat().st_size == 0:
+                    raise ValueError("the file is empty")
+                ds = xr.open_dataset(p, engine="scipy")
+        except Exception as err:  # noqa: BLE001 - whatever the reader says, it is not a family file
+            raise ValueError(f"{not_family}: it cannot be read as {'Zarr' if p.suffix == '.zarr' else 'netCDF 3'} "
+                             f"({type(err).__name__}: {str(err).strip().splitlines()[0] if str(err).strip() else 'no details'})") from None
         with ds:
             a = ds.attrs
-            system = System(mu=float(a["mu"]), lu_km=float(a["lu_km"]), tu_s=float(a["tu_s"]), r1_km=float(a["r1_km"]), r2_km=float(a["r2_km"]), name=str(a["system_name"]))
+            kind = a.get("librate_result")
+            if kind is not None and kind != "family":
+                raise ValueError(f"{not_family}: it is a librate {kind} result")
+            need_vars = ("state0", "state_half", "period", "jacobi", "eigenvalues_real", "eigenvalues_imag", "stability_real", "stability_imag")
+            need_attrs = ("mu", "lu_km", "tu_s", "r1_km", "r2_km", "system_name", "kind", "spatial", "end_reason", "bifurcations", "parameters")
+            miss = [v for v in need_vars if v not in ds.variables] + [f"attribute {k}" for k in need_attrs if k not in a]
+            if miss:
+                raise ValueError(f"{not_family}: missing {', '.join(miss)}")
+            if p.suffix == ".zarr":
+                gone = [c for v in ds.variables for c in missing_zarr_chunks(p, str(v))]
+                if gone:
+                    raise ValueError(f"{name!r} is a damaged librate family file: chunk(s) {', '.join(gone)} missing")
+            try:
+                values = {v: np.asarray(ds[v].values) for v in ds.variables}
+            except Exception as err:  # noqa: BLE001 - a garbled chunk: named, never a decompressor traceback
+                raise ValueError(f"{name!r} is a damaged librate family file: a variable cannot be read ({type(err).__name__}: {err})") from None
+            sums = a.get(CHECKSUM_ATTR)
+            if isinstance(sums, str):
+                try:
+                    sums = json.loads(sums)
+                except ValueError:
+                    raise ValueError(f"{name!r} is a damaged librate family file: attribute {CHECKSUM_ATTR} is not valid JSON") from None
+                bad = [v for v, want in sums.items() if v in values and array_digest(values[v]) != want]
+                if bad:
+                    raise ValueError(f"{name!r} is a damaged librate family file: {', '.join(bad)} do(es) not match the stored checksum(s)")
+            n = values["period"].shape[0] if values["period"].ndim == 1 else -1
+            shapes = {"state0": (n, 6), "state_half": (n, 6), "period": (n,), "jacobi": (n,), "eigenvalues_real": (n, 6), "eigenvalues_imag": (n, 6),
+                      "stability_real": (n, 2), "stability_imag": (n, 2)}
+            wrong = [f"{v} {values[v].shape} (expected {s})" for v, s in shapes.items() if values[v].shape != s]
+            if wrong:
+                raise ValueError(f"{not_family}: inconsistent shapes: {'; '.join(wrong)}")
+            try:
+                system = System(mu=float(a["mu"]), lu_km=float(a["lu_km"]), tu_s=float(a["tu_s"]), r1_km=float(a["r1_km"]), r2_km=float(a["r2_km"]),
+                                name=str(a["system_name"]))
+                spatial = bool(int(a["spatial"]))
+                bif = ast.literal_eval(str(a["bifurcations"]))
+                params = ast.literal_eval(str(a["parameters"]))
+            except (ValueError, TypeError, SyntaxError, LibrateError) as err:
+                raise ValueError(f"{not_family}: invalid attributes ({type(err).__name__}: {err})") from None
             return cls(
-                system, str(a["kind"]), bool(int(a["spatial"])),
-                ds["state0"].values.copy(), ds["state_half"].values.copy(), ds["period"].values.copy(), ds["jacobi"].values.copy(),
-                ds["eigenvalues_real"].values + 1j * ds["eigenvalues_imag"].values,
-                ds["stability_real"].values + 1j * ds["stability_imag"].values,
-                str(a["end_reason"]), ast.literal_eval(str(a["bifurcations"])), ast.literal_eval(str(a["parameters"])),
+                system, str(a["kind"]), spatial,
+                values["state0"].copy(), values["state_half"].copy(), values["period"].copy(), values["jacobi"].copy(),
+                values["eigenvalues_real"] + 1j * values["eigenvalues_imag"],
+                values["stability_real"] + 1j * values["stability_imag"],
+                str(a["end_reason"]), bif, params,
             )
 
 
@@ -297,15 +406,15 @@ def correct_dro(
     """
     sys_ = resolve_system(system)
     mu = sys_.mu
-    if not (isinstance(x0, (int, float, np.integer, np.floating)) and math.isfinite(x0) and -mu < x0 < 1.0 - mu):
+    if not (isinstance(x0, (int, float, np.integer, np.floating)) and not isinstance(x0, (bool, np.bool_)) and math.isfinite(x0) and -mu < x0 < 1.0 - mu):
         raise ValueError(f"invalid argument `x0`: a DRO starts between the primaries, -mu < x0 < 1 - mu = ({-mu}, {1 - mu}), got {x0!r}")
     x0 = float(x0)
-    if ydot0 is not None and not (math.isfinite(ydot0) and ydot0 > 0):
-        raise ValueError(f"invalid argument `ydot0`: must be finite and > 0 (retrograde about the Moon), got {ydot0!r}")
-    if not isinstance(max_iter, (int, np.integer)) or isinstance(max_iter, bool) or max_iter < 1:
-        raise ValueError(f"invalid argument `max_iter`: must be an integer >= 1, got {max_iter!r}")
-    if not (math.isfinite(tol) and tol > 0):
-        raise ValueError(f"invalid argument `tol`: must be a finite number > 0, got {tol!r}")
+    if ydot0 is not None:
+        ydot0 = as_real(ydot0, "ydot0", positive=True)
+    as_count(max_iter, "max_iter", 1)
+    as_real(tol, "tol", positive=True)
+    as_real(rtol, "rtol", positive=True)
+    as_real(atol, "atol", positive=True)
     d = 1.0 - mu - x0
     if ydot0 is None and d > 0.2:
         start = _correct_dro_at(sys_, 0.95, None, tol, max_iter, rtol, atol)
@@ -331,7 +440,7 @@ def _correct_dro_at(sys_, x0, ydot0, tol, max_iter, rtol, atol) -> PeriodicOrbit
     return correct_symmetric(sys_, (x0, 0.0, ydot0), fix="x0", family="dro", tol=tol, max_iter=max_iter, rtol=rtol, atol=atol)
 
 
-def dro_family(system: System | str = "earth-moon", x0=None, *, check_geometry: bool = True) -> OrbitFamily:
+def dro_family(system: System | str = "earth-moon", x0=None, *, check_geometry: bool = True, allow_partial: bool = False) -> OrbitFamily:
     """The planar DRO family by natural-parameter continuation in x0 (thesis eq. 20-22).
 
     ``x0``: the members wanted (any order along the family; default the whole family from
@@ -339,6 +448,11 @@ def dro_family(system: System | str = "earth-moon", x0=None, *, check_geometry: 
     silent jumps (Jacobi constant and period continuity, winding numbers about both primaries)
     and halved when needed; the run ends cleanly, with ``end_reason``, at a collision with the
     Earth's surface or a step floor, keeping every member found.
+
+    When ``x0`` is given, every requested member must be reached: otherwise
+    :class:`librate.LibrateError` lists the missing x0 values and why the continuation ended
+    (attributes ``missing``, ``found`` and ``end_reason``), unless ``allow_partial=True``, which
+    returns the members found (``parameters["missing_x0"]`` lists the others).
     """
     sys_ = resolve_system(system)
     mu = sys_.mu
@@ -354,7 +468,18 @@ def dro_family(system: System | str = "earth-moon", x0=None, *, check_geometry: 
             raise LibrateError(f"could not reach the first requested DRO at x0 = {xs[0]}: {lead.end_reason}")
         first = lead.members[-1]
     res = continue_natural(sys_, first, "x0", xs, family="dro", check_geometry=check_geometry, stop=stop)
-    return OrbitFamily.from_members(sys_, "dro", False, res.members, res.end_reason, {"rejected_jumps": res.rejected_jumps})
+    params: dict = {"rejected_jumps": res.rejected_jumps}
+    if x0 is not None:
+        got = np.array([m.x0 for m in res.members])
+        missing = [float(x) for x in xs if not np.any(np.abs(got - x) <= 1e-12 * max(1.0, abs(x)))]
+        if missing:
+            if not allow_partial:
+                err = LibrateError(f"dro_family: {len(missing)} of the {xs.size} requested members were not reached, x0 = {missing} "
+                                   f"(the continuation ended: {res.end_reason}); {len(res.members)} found; pass allow_partial=True to keep them")
+                err.missing, err.found, err.end_reason = missing, [float(v) for v in got], res.end_reason
+                raise err
+            params["missing_x0"] = missing
+    return OrbitFamily.from_members(sys_, "dro", False, res.members, res.end_reason, params)
 
 
 @functools.lru_cache(maxsize=8)
@@ -377,6 +502,7 @@ def dro(system: System | str = "earth-moon", *, x0: float | None = None, period:
     whole family (computed once per system and cached)."""
     sys_ = resolve_system(system)
     name, value = _one_target(dict(x0=x0, period=period, period_days=period_days, jacobi=jacobi))
+    value = as_real(value, name)
     if name == "x0":
         if not (math.isfinite(value) and -sys_.mu < value < 1 - sys_.mu):
             raise ValueError(f"invalid argument `x0`: DROs start between the primaries, -mu < x0 < 1 - mu; got {value!r}")
@@ -387,7 +513,7 @@ def dro(system: System | str = "earth-moon", *, x0: float | None = None, period:
 
 # --- Lyapunov and halo orbits -----------------------------------------------------------------
 def _check_point(point) -> int:
-    if point not in (1, 2):
+    if isinstance(point, (bool, np.bool_)) or point not in (1, 2):
         raise ValueError(f"invalid argument `point`: must be 1 (L1) or 2 (L2), got {point!r}")
     return int(point)
 
@@ -435,7 +561,7 @@ def lyapunov(system: System | str = "earth-moon", point: int = 1, *, x0: float |
 
 
 def _check_branch(branch) -> float:
-    if branch not in ("north", "south"):
+    if not isinstance(branch, str) or branch not in ("north", "south"):
         raise ValueError(f"invalid argument `branch`: must be 'north' or 'south', got {branch!r}")
     return 1.0 if branch == "north" else -1.0
 

@@ -197,7 +197,7 @@ def fit_fourier(
 
     # Samples (even indices) and check points (odd indices), then t = T for the closure.
     t_all = np.arange(2 * m + 1) * (period / (2 * m))
-    tr = propagate(sys_, s0, period, t_eval=t_all, rtol=rtol, atol=atol)
+    tr = propagate(sys_, s0, period, t_eval=t_all, rtol=rtol, atol=atol, collision="point")
     y = tr.y
     scale = max(float(np.max(np.abs(y[:, :3] - y[:, :3].mean(axis=0)))), 1e-300)
     closure = float(np.max(np.abs(y[-1] - s0)))

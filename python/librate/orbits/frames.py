@@ -220,7 +220,7 @@ def mean_elements(
         raise ValueError(f"invalid argument `samples_per_period`: must be an integer >= 8, got {samples_per_period!r}")
     m, k = int(samples_per_period), int(n_periods)
     t = np.arange(m * k) * (float(period) / m)
-    tr = propagate(sys_, s0, float(period) * k, t_eval=t, rtol=rtol, atol=atol)
+    tr = propagate(sys_, s0, float(period) * k, t_eval=t, rtol=rtol, atol=atol, collision="point")
     el = osculating_elements(sys_, tr.t, tr.y, theta0=theta0)
     argp = np.unwrap(el.argp)
     a_pp = el.a_km.reshape(k, m).mean(axis=1)

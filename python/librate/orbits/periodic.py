@@ -9,6 +9,7 @@ from functools import cached_property
 import numpy as np
 
 from .. import _core
+from .._checks import as_count, as_number, as_real
 from .system import System, resolve_system
 
 __all__ = ["PeriodicOrbit", "correct_symmetric", "correct_periodic"]
@@ -65,7 +66,7 @@ class PeriodicOrbit:
         """Monodromy matrix Phi(T, 0) (6, 6)."""
         from .propagation import propagate
 
-        return propagate(self.system, self.state0, self.period, stm=True, rtol=SHOOT_RTOL, atol=SHOOT_ATOL).stm
+        return propagate(self.system, self.state0, self.period, stm=True, rtol=SHOOT_RTOL, atol=SHOOT_ATOL, collision="point").stm
 
     @cached_property
     def _stability(self):
@@ -88,9 +89,12 @@ class PeriodicOrbit:
 
     def propagate(self, n_periods: float = 1.0, **kwargs):
         """Propagate the orbit over ``n_periods`` periods (keyword arguments go to
-        :func:`librate.propagate`; default tolerances 1e-13)."""
+        :func:`librate.propagate`; default tolerances 1e-13). The orbit is a solution of the
+        point-mass model, so by default only the singular point counts as a collision
+        (``collision="point"``); pass ``collision="radius"`` to stop at a primary's surface."""
         from .propagation import propagate
 
+        kwargs.setdefault("collision", "point")
         kwargs.setdefault("rtol", SHOOT_RTOL)
         kwargs.setdefault("atol", SHOOT_ATOL)
         return propagate(self.system, self.state0, n_periods * self.period, **kwargs)
@@ -119,7 +123,18 @@ def correct_symmetric(
     or a target ``jacobi`` constant. Raises :class:`librate.ConvergenceError` on failure.
     """
     sys_ = resolve_system(system)
-    g = np.asarray(guess, dtype=np.float64).ravel()
+    as_number(tol, "tol", positive=True)
+    as_count(max_iter, "max_iter", 1)
+    for name, v in (("t_max", t_max), ("rtol", rtol), ("atol", atol)):
+        as_real(v, name, positive=True)
+    if period is not None:
+        period = as_real(period, "period", positive=True)
+    if jacobi is not None:
+        jacobi = as_real(jacobi, "jacobi")
+    try:
+        g = np.asarray(guess, dtype=np.float64).ravel()
+    except (TypeError, ValueError):
+        raise ValueError(f"invalid argument `guess`: must be finite (x0, z0, vy0) or a (6,) state, got {guess!r}") from None
     if g.shape == (6,):
         g = g[[0, 2, 4]]
     if g.shape != (3,) or not np.all(np.isfinite(g)):
@@ -174,13 +189,21 @@ def correct_periodic(
     The least-squares Newton step absorbs the conserved Jacobi constant's redundant equation.
     """
     sys_ = resolve_system(system)
-    patches = np.ascontiguousarray(np.atleast_2d(np.asarray(states, dtype=np.float64)))
+    as_number(tol, "tol", positive=True)
+    as_count(max_iter, "max_iter", 1)
+    for name, v in (("rtol", rtol), ("atol", atol)):
+        as_real(v, name, positive=True)
+    if jacobi is not None:
+        jacobi = as_real(jacobi, "jacobi")
+    try:
+        patches = np.ascontiguousarray(np.atleast_2d(np.asarray(states, dtype=np.float64)))
+    except (TypeError, ValueError):
+        raise ValueError(f"invalid argument `states`: must be (6,) or (n, 6) finite numbers, got {states!r}") from None
     if patches.ndim != 2 or patches.shape[1] != 6:
         raise ValueError(f"invalid argument `states`: must be (6,) or (n, 6), got shape {np.shape(states)}")
     if not np.all(np.isfinite(patches)):
         raise ValueError("invalid argument `states`: must be finite")
-    if not (math.isfinite(period) and period > 0):
-        raise ValueError(f"invalid argument `period`: must be finite and > 0, got {period!r}")
+    as_number(period, "period", positive=True)
     if fixed_period and jacobi is not None:
         raise ValueError("invalid argument: give `jacobi` or `fixed_period=True`, not both")
     if fixed_period:

@@ -10,7 +10,8 @@ from typing import Literal
 import numpy as np
 
 from .. import _core
-from .._checks import as_direction, as_state, as_states, as_time_span
+from .._checks import as_count, as_direction, as_float_array, as_real, as_state, as_states, as_time_span
+from .._errors import CollisionError
 from .system import System, resolve_system
 
 __all__ = ["Event", "EventHit", "Stats", "Trajectory", "BatchResult", "propagate", "propagate_many"]
@@ -95,7 +96,9 @@ class Trajectory:
 
     ``t`` (n,) and ``y`` (n, 6) hold every accepted step (or the ``t_eval`` times); ``stm`` is
     the 6x6 state transition matrix from t0 to ``t_final`` when asked for; ``status`` is
-    ``"completed"`` or ``"event"`` (a terminal event stopped it: ``event_index``).
+    ``"completed"``, ``"event"`` (a terminal event stopped it: ``event_index``) or
+    ``"collision"`` (only on the ``trajectory`` attribute of a :class:`librate.CollisionError`:
+    it ends on the collision sphere of ``collision_primary``, 1 or 2, at ``t_final``).
     """
 
     system: System
@@ -108,6 +111,7 @@ class Trajectory:
     status: str
     event_index: int | None
     stats: Stats
+    collision_primary: int | None = None
 
     def events_of(self, index: int) -> list[EventHit]:
         """The hits of one event of the ``events`` list."""
@@ -123,27 +127,58 @@ class Trajectory:
 class BatchResult:
     """Result of :func:`propagate_many`: final states ``y`` (n, 6), ``stm`` (n, 6, 6) when asked,
     ``ok`` (n,) and, for members that failed, ``errors`` {index: exception} (their rows are NaN,
-    flagged by ``ok``); ``stats`` (n, 3): accepted, rejected steps and RHS evaluations."""
+    flagged by ``ok``); ``stats`` (n, 3): accepted, rejected steps and RHS evaluations;
+    ``status`` (n,): "completed", "collision_primary1" / "collision_primary2" (the member reached
+    that primary: a :class:`librate.CollisionError` in ``errors``) or "failed" (another error)."""
 
     y: np.ndarray
     stm: np.ndarray | None
     ok: np.ndarray
     errors: dict[int, Exception] = field(default_factory=dict)
     stats: np.ndarray | None = None
+    status: np.ndarray | None = None
+
+
+#: What counts as a collision with a primary (the ``collision`` argument of :func:`propagate`).
+COLLISION_MODES = ("radius", "point", None)
+
+
+def collision_radii(system: System, collision) -> tuple[float, float] | None:
+    """The collision radii (LU) passed to the core: ``"radius"``: the system's radii (a primary
+    of radius 0 gets the core's tiny point radius, 1e-8 LU); ``"point"``: that tiny radius for
+    both (point masses, only the singularity counts); ``None``: no collision check."""
+    if collision is None:
+        return None
+    if not isinstance(collision, str) or collision not in ("radius", "point"):
+        raise ValueError(f"invalid argument `collision`: must be 'radius' (the system's radii), 'point' (point masses) or None, got {collision!r}")
+    if collision == "point":
+        return (0.0, 0.0)
+    return (system.r1_km / system.lu_km, system.r2_km / system.lu_km)
+
+
+def _primary_name(system: System, k: int) -> str:
+    if system.name.startswith("earth-moon"):
+        return ("the Earth", "the Moon")[k - 1]
+    return ("the larger primary", "the smaller primary")[k - 1]
 
 
 def integration_options(rtol, atol, h0, h_min, h_max, max_steps, safety, fixed_step) -> dict:
-    if not isinstance(max_steps, (int, np.integer)) or max_steps < 1:
-        raise ValueError(f"invalid argument `max_steps`: must be an integer >= 1, got {max_steps!r}")
+    """The integrator settings, each checked for its type here (the core checks the ranges);
+    every error names the parameter. With ``fixed_step`` the adaptive step options (h0, h_min,
+    h_max, safety) do not apply: giving any of them is an error, not silently ignored."""
+    if fixed_step is not None:
+        for name, value, default in (("h0", h0, None), ("h_min", h_min, 0.0), ("h_max", h_max, math.inf), ("safety", safety, 0.8)):
+            if value != default:
+                raise ValueError(f"invalid argument `{name}`: adaptive step options do not apply with fixed_step; got {name} = {value!r}")
     return dict(
-        rtol=float(rtol),
-        atol=float(atol),
-        h0=None if h0 is None else float(h0),
-        h_min=float(h_min),
-        h_max=float(h_max),
-        max_steps=int(max_steps),
-        safety=float(safety),
-        fixed_step=None if fixed_step is None else float(fixed_step),
+        rtol=as_real(rtol, "rtol", positive=True),
+        atol=as_real(atol, "atol", positive=True),
+        h0=None if h0 is None else as_real(h0, "h0", positive=True),
+        h_min=as_real(h_min, "h_min", nonnegative=True),
+        h_max=as_real(h_max, "h_max", positive=True, allow_inf=True),
+        max_steps=as_count(max_steps, "max_steps", 1),
+        safety=as_real(safety, "safety", positive=True),
+        fixed_step=None if fixed_step is None else as_real(fixed_step, "fixed_step", positive=True),
     )
 
 
@@ -163,6 +198,7 @@ def propagate(
     max_steps: int = 1_000_000,
     safety: float = 0.8,
     fixed_step: float | None = None,
+    collision: str | None = "radius",
 ) -> Trajectory:
     """Propagate a CR3BP state with the adaptive RKF7(8) integrator (8th-order solution
     propagated), forward or backward in time.
@@ -177,9 +213,18 @@ def propagate(
     events: :class:`Event` objects to locate.
     t_eval: output times (monotonic, inside the span) instead of every accepted step.
     h0, h_min, h_max, max_steps, safety: step control; ``fixed_step`` switches to fixed steps.
+    collision: reaching a primary stops the integration with :class:`librate.CollisionError`:
+        ``"radius"`` (default): within the system's radius of either primary (``r1_km``,
+        ``r2_km``; a primary of radius 0 counts as a point, 1e-8 LU); ``"point"``: point masses
+        (only that tiny sphere about each primary); ``None``: no check (the bare point-mass
+        model, singular at the primaries).
 
-    Raises ``ValueError`` for bad arguments and :class:`librate.IntegrationError` (with ``t``
-    and ``steps``) when the integration cannot reach tf.
+    Raises ``ValueError`` for bad arguments, :class:`librate.CollisionError` (a subclass of
+    :class:`librate.IntegrationError`, with ``t``, ``primary`` (1 or 2), ``distance``,
+    ``radius`` and ``trajectory``: the trajectory up to the collision sphere, status
+    ``"collision"``) when the trajectory reaches a primary, also for a state starting inside
+    one (then at t0), and :class:`librate.IntegrationError` (with ``t`` and ``steps``) when the
+    integration cannot reach tf.
     """
     sys_ = resolve_system(system)
     s = as_state(state)
@@ -188,12 +233,14 @@ def propagate(
     for e in evs:
         if not isinstance(e, Event):
             raise ValueError(f"invalid argument `events`: must be librate.Event objects, got {e!r}")
-    te = None if t_eval is None else np.ascontiguousarray(t_eval, dtype=np.float64).ravel()
+    te = None if t_eval is None else as_float_array(t_eval, "t_eval").ravel()
+    radii = collision_radii(sys_, collision)
     r = _core.propagate(
         sys_.mu, s, t0, tf, stm=bool(stm), t_eval=te, events=[e._spec(sys_) for e in evs],
-        options=integration_options(rtol, atol, h0, h_min, h_max, max_steps, safety, fixed_step),
+        options=integration_options(rtol, atol, h0, h_min, h_max, max_steps, safety, fixed_step), collision=radii,
     )
-    return Trajectory(
+    err = r.get("collision")
+    tr = Trajectory(
         system=sys_,
         t=r["t"],
         y=r["y"],
@@ -204,7 +251,21 @@ def propagate(
         status=r["status"],
         event_index=r["event_index"],
         stats=Stats(*r["stats"]),
+        collision_primary=None if err is None else int(err.primary),
     )
+    if err is not None:
+        raise _collision(sys_, err, tr)
+    return tr
+
+
+def _collision(system: System, err, trajectory: Trajectory | None):
+    """The core's CollisionError, its message naming the primary, with the partial trajectory."""
+    what = f"collision with {_primary_name(system, int(err.primary))} (primary {int(err.primary)})"
+    new = CollisionError(str(err).replace(str(err).split(" at t = ")[0], what, 1))
+    for k in ("t", "steps", "kind", "primary", "distance", "radius"):
+        setattr(new, k, getattr(err, k))
+    new.trajectory = trajectory
+    return new
 
 
 def propagate_many(
@@ -224,6 +285,7 @@ def propagate_many(
     fixed_step: float | None = None,
     threads: int | None = None,
     on_error: Literal["raise", "mask"] = "raise",
+    collision: str | None = "radius",
 ) -> BatchResult:
     """Propagate (n, 6) states from ``t0`` to ``t_final`` (one time, or one per state) on all
     cores, with the GIL released. Each member is integrated exactly as :func:`propagate` would,
@@ -231,24 +293,33 @@ def propagate_many(
 
     ``on_error="raise"`` raises the first member's error (its ``batch_result`` attribute keeps
     every finished member); ``"mask"`` returns NaN rows flagged by ``ok`` and listed in ``errors``.
+    ``collision`` as in :func:`propagate`: a member reaching a primary has ``ok = False``,
+    ``status`` "collision_primary1" or "collision_primary2" and a
+    :class:`librate.CollisionError` in ``errors``.
     """
     sys_ = resolve_system(system)
     arr = as_states(states)
     if not np.all(np.isfinite(arr)) and on_error == "raise":
         bad = int(np.argwhere(~np.isfinite(arr))[0][0])
         raise ValueError(f"invalid argument `states`: row {bad} is not finite")
-    tf = np.ascontiguousarray(np.atleast_1d(np.asarray(t_final, dtype=np.float64)).ravel())
+    tf = np.ascontiguousarray(np.atleast_1d(as_float_array(t_final, "t_final")).ravel())
+    if not np.all(np.isfinite(tf)):
+        raise ValueError(f"invalid argument `t_final`: must be finite, got {t_final!r}")
+    t0 = as_real(t0, "t0")
     if tf.size not in (1, arr.shape[0]):
         raise ValueError(f"invalid argument `t_final`: must be one time or one per state ({arr.shape[0]}), got {tf.size}")
     if on_error not in ("raise", "mask"):
         raise ValueError(f"invalid argument `on_error`: must be 'raise' or 'mask', got {on_error!r}")
-    if threads is not None and (not isinstance(threads, (int, np.integer)) or threads < 1):
+    if threads is not None and (isinstance(threads, (bool, np.bool_)) or not isinstance(threads, (int, np.integer)) or threads < 1):
         raise ValueError(f"invalid argument `threads`: must be an integer >= 1 or None (all cores), got {threads!r}")
+    radii = collision_radii(sys_, collision)
     r = _core.propagate_many(
         sys_.mu, arr, float(t0), tf, stm=bool(stm), threads=None if threads is None else int(threads),
-        options=integration_options(rtol, atol, h0, h_min, h_max, max_steps, safety, fixed_step),
+        options=integration_options(rtol, atol, h0, h_min, h_max, max_steps, safety, fixed_step), collision=radii,
     )
-    result = BatchResult(y=r["y"], stm=r["stm"], ok=r["ok"], errors=dict(r["errors"]), stats=r["stats"])
+    errors = {i: (_collision(sys_, e, None) if isinstance(e, CollisionError) else e) for i, e in r["errors"]}
+    status = np.array(["completed", "collision_primary1", "collision_primary2", "failed"])[np.asarray(r["status"], dtype=np.intp)]
+    result = BatchResult(y=r["y"], stm=r["stm"], ok=r["ok"], errors=errors, stats=r["stats"], status=status)
     if result.errors and on_error == "raise":
         index, err = next(iter(result.errors.items()))
         err.add_note(f"in member {index} of propagate_many ({len(result.errors)} of {arr.shape[0]} members failed)") if hasattr(err, "add_note") else None

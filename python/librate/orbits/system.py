@@ -7,7 +7,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import _core
-from .._checks import as_states
+from .._checks import as_real, as_states
 
 __all__ = ["System"]
 
@@ -33,10 +33,11 @@ class System:
     name: str = "custom"
 
     def __post_init__(self) -> None:
-        # Validated by the core; raises ValueError naming the offending constant.
-        name, mu, lu, tu, r1, r2 = _core.system_validate(
-            str(self.name), float(self.mu), float(self.lu_km), float(self.tu_s), float(self.r1_km), float(self.r2_km)
-        )
+        # Types here, values by the core; raises ValueError naming the offending constant.
+        if not isinstance(self.name, str):
+            raise ValueError(f"invalid argument `name`: must be a string, got {self.name!r}")
+        nums = [as_real(getattr(self, k), k, allow_inf=True) for k in ("mu", "lu_km", "tu_s", "r1_km", "r2_km")]
+        name, mu, lu, tu, r1, r2 = _core.system_validate(self.name, *nums)
         for field, value in (("mu", mu), ("lu_km", lu), ("tu_s", tu), ("r1_km", r1), ("r2_km", r2)):
             object.__setattr__(self, field, value)
 
@@ -115,6 +116,8 @@ def resolve_system(system) -> System:
     if isinstance(system, System):
         return system
     if isinstance(system, str):
+        if system not in System.presets():
+            raise ValueError(f"invalid argument `system`: unknown system preset {system!r}; known presets: {', '.join(System.presets())}")
         return System.preset(system)
     raise ValueError(f"invalid argument `system`: must be a librate.System or a preset name ({', '.join(System.presets())}), got {system!r}")
 

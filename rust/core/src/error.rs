@@ -16,13 +16,17 @@ pub enum IntegrationError {
     /// The state or its derivative became NaN or infinite (e.g. the trajectory reached a primary).
     #[error("non-finite state at t = {t:.15e} after {steps} steps (collision with a primary?)")]
     NonFinite { t: f64, steps: usize },
+    /// The trajectory reached a primary: its distance to primary `primary` (1: the larger, at
+    /// x = -mu; 2: the smaller, at x = 1 - mu) fell to the collision `radius` (nondimensional).
+    #[error("collision with primary {primary} ({}) at t = {t:.15e}: distance {distance:.3e} <= collision radius {radius:.3e} LU", if *primary == 1 { "the larger, at x = -mu" } else { "the smaller, at x = 1 - mu" })]
+    Collision { t: f64, steps: usize, primary: u8, distance: f64, radius: f64 },
 }
 
 impl IntegrationError {
     /// Time at which the integration stopped.
     pub fn t(&self) -> f64 {
         match *self {
-            Self::StepSizeUnderflow { t, .. } | Self::MaxStepsExceeded { t, .. } | Self::NonFinite { t, .. } => t,
+            Self::StepSizeUnderflow { t, .. } | Self::MaxStepsExceeded { t, .. } | Self::NonFinite { t, .. } | Self::Collision { t, .. } => t,
         }
     }
     /// Steps (accepted and rejected) taken before the failure.
@@ -30,7 +34,8 @@ impl IntegrationError {
         match *self {
             Self::StepSizeUnderflow { steps, .. }
             | Self::MaxStepsExceeded { steps, .. }
-            | Self::NonFinite { steps, .. } => steps,
+            | Self::NonFinite { steps, .. }
+            | Self::Collision { steps, .. } => steps,
         }
     }
 }

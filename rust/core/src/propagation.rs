@@ -3,7 +3,7 @@
 use rayon::prelude::*;
 
 use crate::cr3bp::{check_mu, Cr3bp, Cr3bpStm, STM_DIM};
-use crate::error::{check_finite, invalid, Result};
+use crate::error::{check_finite, invalid, Error, IntegrationError, Result};
 use crate::integrate::{solve, Event, EventFn, Options, Output, State, Stats, Status};
 
 /// Scalar event functions on a CR3BP state (the first six components).
@@ -82,6 +82,117 @@ pub struct Trajectory {
     pub events: Vec<EventHit>,
     pub status: Status,
     pub stats: Stats,
+    /// Set when [`propagate_checked`] stopped at a collision with a primary (then `t_final`
+    /// and `state_final` are the state on the collision sphere and `status` is `Terminated`).
+    pub collision: Option<CollisionHit>,
+}
+
+/// Collision radius (LU) of a primary without a physical radius: the distance below which the
+/// point-mass field is treated as singular.
+pub const POINT_COLLISION_RADIUS: f64 = 1e-8;
+
+/// Collision spheres about the two primaries (nondimensional radii, > 0).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Collision {
+    pub radii: [f64; 2],
+}
+
+/// Where a propagation met a primary: `primary` 1 (at x = -mu) or 2 (at x = 1 - mu).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CollisionHit {
+    pub primary: u8,
+    pub t: f64,
+    pub distance: f64,
+    pub radius: f64,
+}
+
+impl Collision {
+    /// The spheres of the given radii; a radius of 0 means [`POINT_COLLISION_RADIUS`].
+    pub fn new(radii: [f64; 2]) -> Result<Self> {
+        for (k, r) in radii.iter().enumerate() {
+            if !(r.is_finite() && *r >= 0.0) {
+                return Err(invalid("collision", format!("radius of primary {} must be finite and >= 0, got {r}", k + 1)));
+            }
+        }
+        Ok(Self { radii: radii.map(|r| if r > 0.0 { r } else { POINT_COLLISION_RADIUS }) })
+    }
+
+    fn center(mu: f64, k: usize) -> [f64; 3] {
+        [if k == 0 { -mu } else { 1.0 - mu }, 0.0, 0.0]
+    }
+
+    fn distance(mu: f64, k: usize, s: &[f64]) -> f64 {
+        let c = Self::center(mu, k);
+        ((s[0] - c[0]).powi(2) + (s[1] - c[1]).powi(2) + (s[2] - c[2]).powi(2)).sqrt()
+    }
+
+    /// The first primary whose sphere holds `state` (distance <= radius).
+    pub fn inside(&self, mu: f64, state: &[f64]) -> Option<CollisionHit> {
+        (0..2).find_map(|k| {
+            let d = Self::distance(mu, k, state);
+            (d <= self.radii[k]).then_some(CollisionHit { primary: k as u8 + 1, t: f64::NAN, distance: d, radius: self.radii[k] })
+        })
+    }
+}
+
+impl CollisionHit {
+    /// The typed error of this collision.
+    pub fn error(&self, steps: usize) -> Error {
+        IntegrationError::Collision { t: self.t, steps, primary: self.primary, distance: self.distance, radius: self.radius }.into()
+    }
+}
+
+/// [`propagate`] with collisions: reaching the sphere of `collision` about either primary is a
+/// terminal event. The trajectory then ends on that sphere with `collision` set (its `events`
+/// hold only the caller's events). A state that starts inside a sphere collides at t0.
+#[allow(clippy::too_many_arguments)]
+pub fn propagate_checked(
+    mu: f64,
+    state: &[f64; 6],
+    t0: f64,
+    tf: f64,
+    opts: &Options,
+    with_stm: bool,
+    output: Output<'_>,
+    events: &[EventSpec],
+    collision: &Collision,
+) -> Result<Trajectory> {
+    check_mu(mu)?;
+    check_finite("state", state)?;
+    if let Some(mut hit) = collision.inside(mu, state) {
+        hit.t = t0;
+        let stm = with_stm.then(|| std::array::from_fn(|i| std::array::from_fn(|j| if i == j { 1.0 } else { 0.0 })));
+        return Ok(Trajectory {
+            t: vec![t0],
+            states: state.to_vec(),
+            t_final: t0,
+            state_final: *state,
+            stm_final: stm,
+            events: Vec::new(),
+            status: Status::Terminated { event: events.len() + hit.primary as usize - 1 },
+            stats: Stats::default(),
+            collision: Some(hit),
+        });
+    }
+    let n = events.len();
+    let mut all = events.to_vec();
+    for k in 0..2 {
+        all.push(EventSpec { kind: EventKind::Distance { center: Collision::center(mu, k), radius: collision.radii[k] }, direction: -1, terminal: true });
+    }
+    let mut tr = propagate(mu, state, t0, tf, opts, with_stm, output, &all)?;
+    if let Status::Terminated { event } = tr.status {
+        if event >= n {
+            let k = event - n;
+            tr.collision = Some(CollisionHit {
+                primary: k as u8 + 1,
+                t: tr.t_final,
+                distance: Collision::distance(mu, k, &tr.state_final),
+                radius: collision.radii[k],
+            });
+        }
+    }
+    tr.events.retain(|e| e.index < n);
+    Ok(tr)
 }
 
 /// Propagate one CR3BP state from t0 to tf (either direction).
@@ -118,13 +229,13 @@ pub fn propagate(
                 EventHit { index: r.index, t: r.t, state: s, stm: Some(m) }
             })
             .collect();
-        Ok(Trajectory { t: sol.t, states, t_final: sol.t_final, state_final, stm_final: Some(stm), events, status: sol.status, stats: sol.stats })
+        Ok(Trajectory { t: sol.t, states, t_final: sol.t_final, state_final, stm_final: Some(stm), events, status: sol.status, stats: sol.stats, collision: None })
     } else {
         let sys = Cr3bp { mu };
         let evs: Vec<Event<[f64; 6]>> = events.iter().map(|e| Event::new(&e.kind, e.direction, e.terminal)).collect();
         let sol = solve(&sys, t0, state, tf, opts, output, &evs)?;
         let events = sol.events.iter().map(|r| EventHit { index: r.index, t: r.t, state: r.y, stm: None }).collect();
-        Ok(Trajectory { t: sol.t, states: sol.y, t_final: sol.t_final, state_final: sol.y_final, stm_final: None, events, status: sol.status, stats: sol.stats })
+        Ok(Trajectory { t: sol.t, states: sol.y, t_final: sol.t_final, state_final: sol.y_final, stm_final: None, events, status: sol.status, stats: sol.stats, collision: None })
     }
 }
 
@@ -154,7 +265,10 @@ pub fn with_threads<R: Send>(threads: Option<usize>, f: impl FnOnce() -> R + Sen
 /// Propagate many states from t0 to their final times (one shared, or one per state) on all
 /// cores. Each member is integrated exactly as [`propagate`] would, independently of the
 /// others, so the results are bit-identical to one-at-a-time calls whatever the thread count.
-/// One member failing does not lose the others: each carries its own `Result`.
+/// One member failing does not lose the others: each carries its own `Result`. With
+/// `collision`, a member that reaches a primary's sphere is an
+/// [`IntegrationError::Collision`] (see [`propagate_checked`]).
+#[allow(clippy::too_many_arguments)]
 pub fn propagate_many(
     mu: f64,
     states: &[[f64; 6]],
@@ -163,6 +277,7 @@ pub fn propagate_many(
     opts: &Options,
     with_stm: bool,
     threads: Option<usize>,
+    collision: Option<&Collision>,
 ) -> Result<Vec<Result<FinalState>>> {
     check_mu(mu)?;
     opts.validate()?;
@@ -172,7 +287,13 @@ pub fn propagate_many(
     check_finite("t_final", t_final)?;
     let run = |i: usize| -> Result<FinalState> {
         let tf = if t_final.len() == 1 { t_final[0] } else { t_final[i] };
-        let tr = propagate(mu, &states[i], t0, tf, opts, with_stm, Output::Final, &[])?;
+        let tr = match collision {
+            Some(c) => propagate_checked(mu, &states[i], t0, tf, opts, with_stm, Output::Final, &[], c)?,
+            None => propagate(mu, &states[i], t0, tf, opts, with_stm, Output::Final, &[])?,
+        };
+        if let Some(hit) = tr.collision {
+            return Err(hit.error(tr.stats.steps()));
+        }
         Ok(FinalState { state: tr.state_final, stm: tr.stm_final, stats: tr.stats })
     };
     with_threads(threads, || (0..states.len()).into_par_iter().map(run).collect())

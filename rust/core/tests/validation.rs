@@ -304,9 +304,9 @@ fn val_batch_matches_single_calls_for_any_thread_count() {
     let opts = Options::with_tolerances(1e-12, 1e-12);
     let mut states: Vec<[f64; 6]> = (0..40).map(|i| [0.80 + 0.004 * i as f64, 0.0, 0.0, 0.0, 0.45 + 0.002 * i as f64, 0.01]).collect();
     states[7] = [f64::NAN, 0.0, 0.0, 0.0, 0.0, 0.0]; // an invalid member fails alone
-    let one = propagate_many(MU, &states, 0.0, &[3.0], &opts, true, Some(1)).unwrap();
-    let two = propagate_many(MU, &states, 0.0, &[3.0], &opts, true, Some(2)).unwrap();
-    let all = propagate_many(MU, &states, 0.0, &[3.0], &opts, true, None).unwrap();
+    let one = propagate_many(MU, &states, 0.0, &[3.0], &opts, true, Some(1), None).unwrap();
+    let two = propagate_many(MU, &states, 0.0, &[3.0], &opts, true, Some(2), None).unwrap();
+    let all = propagate_many(MU, &states, 0.0, &[3.0], &opts, true, None, None).unwrap();
     assert_eq!(one, two);
     assert_eq!(one, all);
     assert!(one[7].is_err());
@@ -384,4 +384,40 @@ fn val_multiple_shooting_recovers_a_dro() {
     let one = propagate(MU, &shot.patches[0], 0.0, shot.period, &opts, false, Output::Final, &[]).unwrap();
     let closure = (0..6).map(|i| (one.state_final[i] - shot.patches[0][i]).abs()).fold(0.0, f64::max);
     assert!(closure < 1e-10, "closure {closure:.3e}");
+}
+
+/// Issue 12 #5: a state at the Moon's centre "completed" with speeds of 1e8. With collision
+/// spheres it collides at t0; a fall towards the Moon stops on its surface, typed, in a batch too.
+#[test]
+fn val_collision_with_a_primary_is_a_typed_outcome() {
+    use librate_core::propagation::{propagate_checked, Collision, POINT_COLLISION_RADIUS};
+    let opts = Options::with_tolerances(1e-12, 1e-12);
+    let r_moon = 1737.4 / 384400.0;
+    let spheres = Collision::new([6371.0 / 384400.0, r_moon]).unwrap();
+    // at the centre: collision at t0, primary 2
+    let tr = propagate_checked(MU, &[1.0 - MU, 0.0, 0.0, 0.0, 0.0, 0.0], 0.0, 1.0, &opts, false, Output::Steps, &[], &spheres).unwrap();
+    let hit = tr.collision.expect("collision");
+    assert_eq!((hit.primary, hit.t), (2, 0.0));
+    // released at rest 0.02 LU from the Moon: falls onto its surface
+    let tr = propagate_checked(MU, &[1.0 - MU + 0.02, 0.0, 0.0, 0.0, 0.0, 0.0], 0.0, 1.0, &opts, false, Output::Steps, &[], &spheres).unwrap();
+    let hit = tr.collision.expect("collision");
+    assert_eq!(hit.primary, 2);
+    assert!(hit.t > 0.0 && hit.t < 1.0, "{}", hit.t);
+    assert!((hit.distance - r_moon).abs() < 1e-9, "{} vs {r_moon}", hit.distance);
+    assert!(tr.state_final.iter().all(|v| v.is_finite() && v.abs() < 10.0));
+    // point masses: the tiny default sphere
+    let point = Collision::new([0.0, 0.0]).unwrap();
+    assert_eq!(point.radii, [POINT_COLLISION_RADIUS; 2]);
+    let tr = propagate_checked(MU, &[-MU, 0.0, 0.0, 0.0, 0.0, 0.0], 0.0, 1.0, &opts, false, Output::Steps, &[], &point).unwrap();
+    assert_eq!(tr.collision.map(|h| h.primary), Some(1));
+    // a batch: the colliding member is a typed error, the others are untouched
+    let states = [[0.8, 0.0, 0.0, 0.0, 0.5, 0.0], [1.0 - MU + 0.02, 0.0, 0.0, 0.0, 0.0, 0.0]];
+    let out = propagate_many(MU, &states, 0.0, &[1.0], &opts, false, Some(1), Some(&spheres)).unwrap();
+    let plain = propagate_many(MU, &states[..1], 0.0, &[1.0], &opts, false, Some(1), None).unwrap();
+    assert_eq!(out[0], plain[0]);
+    match &out[1] {
+        Err(Error::Integration(IntegrationError::Collision { primary: 2, t, .. })) => assert!(*t > 0.0 && *t < 1.0),
+        other => panic!("expected a collision, got {other:?}"),
+    }
+    assert!(Collision::new([f64::NAN, 0.0]).is_err());
 }

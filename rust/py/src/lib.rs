@@ -9,7 +9,7 @@ use librate_core::error::Error;
 use librate_core::integrate::{Options, Output, Status};
 use librate_core::periodic::{correct_multiple_shooting, MemberCondition, Constraint, Evaluation, Stability, SymmetricShooting, Var};
 use numpy::Complex64;
-use librate_core::propagation::{self, EventKind, EventSpec};
+use librate_core::propagation::{self, Collision, EventKind, EventSpec};
 use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray1, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::create_exception;
@@ -31,6 +31,12 @@ create_exception!(
 );
 create_exception!(
     librate,
+    CollisionError,
+    IntegrationError,
+    "The trajectory reached a primary (the system's radius, or a tiny sphere for point masses). Attributes: t, steps, primary (1 or 2), distance, radius."
+);
+create_exception!(
+    librate,
     ConvergenceError,
     LibrateError,
     "An iterative solver did not converge. Attributes: iterations, residual, tolerance."
@@ -41,12 +47,21 @@ pub(crate) fn to_py(e: Error) -> PyErr {
     Python::attach(|py| match &e {
         Error::InvalidArgument { .. } => PyValueError::new_err(e.to_string()),
         Error::Integration(ie) => {
-            let err = IntegrationError::new_err(e.to_string());
+            let err = match ie {
+                librate_core::IntegrationError::Collision { .. } => CollisionError::new_err(e.to_string()),
+                _ => IntegrationError::new_err(e.to_string()),
+            };
             let v = err.value(py);
             let kind = match ie {
                 librate_core::IntegrationError::StepSizeUnderflow { .. } => "step_size_underflow",
                 librate_core::IntegrationError::MaxStepsExceeded { .. } => "max_steps_exceeded",
                 librate_core::IntegrationError::NonFinite { .. } => "non_finite",
+                librate_core::IntegrationError::Collision { primary, distance, radius, .. } => {
+                    let _ = v.setattr("primary", *primary);
+                    let _ = v.setattr("distance", *distance);
+                    let _ = v.setattr("radius", *radius);
+                    "collision"
+                }
             };
             let _ = v.setattr("t", ie.t());
             let _ = v.setattr("steps", ie.steps());
@@ -109,7 +124,7 @@ fn event_specs(events: Vec<(String, Vec<f64>, i8, bool)>) -> PyResult<Vec<EventS
 
 /// Propagate one CR3BP state; returns a dict of arrays (see `librate.propagate`).
 #[pyfunction]
-#[pyo3(signature = (mu, state, t0, tf, *, options, stm, t_eval, events))]
+#[pyo3(signature = (mu, state, t0, tf, *, options, stm, t_eval, events, collision=None))]
 #[allow(clippy::too_many_arguments)]
 fn propagate<'py>(
     py: Python<'py>,
@@ -121,10 +136,12 @@ fn propagate<'py>(
     stm: bool,
     t_eval: Option<PyReadonlyArray1<'py, f64>>,
     events: Vec<(String, Vec<f64>, i8, bool)>,
+    collision: Option<(f64, f64)>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let s = state6("state", state.as_slice()?)?;
     let opts = Options::from(options);
     let specs = event_specs(events)?;
+    let spheres = collision.map(|(a, b)| Collision::new([a, b])).transpose().map_err(to_py)?;
     let times: Option<Vec<f64>> = t_eval.map(|a| a.as_array().to_vec());
     let tr = py
         .detach(|| {
@@ -132,7 +149,10 @@ fn propagate<'py>(
                 Some(t) => Output::At(t),
                 None => Output::Steps,
             };
-            propagation::propagate(mu, &s, t0, tf, &opts, stm, output, &specs)
+            match &spheres {
+                Some(c) => propagation::propagate_checked(mu, &s, t0, tf, &opts, stm, output, &specs, c),
+                None => propagation::propagate(mu, &s, t0, tf, &opts, stm, output, &specs),
+            }
         })
         .map_err(to_py)?;
     let n = tr.t.len();
@@ -148,10 +168,12 @@ fn propagate<'py>(
         .map(|e| (e.index, e.t, e.state.to_vec().into_pyarray(py), e.stm.as_ref().map(|m| mat6(py, m))))
         .collect();
     out.set_item("events", evs)?;
-    let (status, event_index) = match tr.status {
-        Status::Completed => ("completed", None),
-        Status::Terminated { event } => ("event", Some(event)),
+    let (status, event_index) = match (tr.status, tr.collision) {
+        (_, Some(_)) => ("collision", None),
+        (Status::Completed, None) => ("completed", None),
+        (Status::Terminated { event }, None) => ("event", Some(event)),
     };
+    out.set_item("collision", tr.collision.map(|h| to_py(h.error(tr.stats.steps())).into_value(py)))?;
     out.set_item("status", status)?;
     out.set_item("event_index", event_index)?;
     out.set_item("stats", (tr.stats.accepted, tr.stats.rejected, tr.stats.rhs_evals))?;
@@ -160,7 +182,7 @@ fn propagate<'py>(
 
 /// Propagate many states to their final times on all cores; failed members are reported, not raised.
 #[pyfunction]
-#[pyo3(signature = (mu, states, t0, t_final, *, options, stm, threads))]
+#[pyo3(signature = (mu, states, t0, t_final, *, options, stm, threads, collision=None))]
 #[allow(clippy::too_many_arguments)]
 fn propagate_many<'py>(
     py: Python<'py>,
@@ -171,19 +193,23 @@ fn propagate_many<'py>(
     options: OptionsArg,
     stm: bool,
     threads: Option<usize>,
+    collision: Option<(f64, f64)>,
 ) -> PyResult<Bound<'py, PyDict>> {
+    let spheres = collision.map(|(a, b)| Collision::new([a, b])).transpose().map_err(to_py)?;
     if states.shape()[1] != 6 {
         return Err(PyValueError::new_err(format!("invalid argument `states`: must have shape (n, 6), got {:?}", states.shape())));
     }
     let rows: Vec<[f64; 6]> = states.as_array().rows().into_iter().map(|r| std::array::from_fn(|j| r[j])).collect();
     let tf: Vec<f64> = t_final.as_array().to_vec();
     let opts = Options::from(options);
-    let results = py.detach(|| propagation::propagate_many(mu, &rows, t0, &tf, &opts, stm, threads)).map_err(to_py)?;
+    let results = py.detach(|| propagation::propagate_many(mu, &rows, t0, &tf, &opts, stm, threads, spheres.as_ref())).map_err(to_py)?;
     let n = results.len();
     let mut y = Vec::with_capacity(n * 6);
     let mut m = Vec::with_capacity(if stm { n * 36 } else { 0 });
     let mut ok = Vec::with_capacity(n);
     let mut stats = Vec::with_capacity(n * 3);
+    // per member: 0 completed, 1 / 2 collision with primary 1 / 2, 3 another integration error
+    let mut status: Vec<u8> = Vec::with_capacity(n);
     let errors = pyo3::types::PyList::empty(py);
     for (i, r) in results.iter().enumerate() {
         match r {
@@ -193,6 +219,7 @@ fn propagate_many<'py>(
                     m.extend(p.iter().flatten());
                 }
                 ok.push(true);
+                status.push(0);
                 stats.extend([f.stats.accepted as u64, f.stats.rejected as u64, f.stats.rhs_evals as u64]);
             }
             Err(e) => {
@@ -201,6 +228,10 @@ fn propagate_many<'py>(
                     m.extend([f64::NAN; 36]);
                 }
                 ok.push(false);
+                status.push(match e {
+                    Error::Integration(librate_core::IntegrationError::Collision { primary, .. }) => *primary,
+                    _ => 3,
+                });
                 stats.extend([0u64; 3]);
                 errors.append((i, to_py(e.clone()).into_value(py)))?;
             }
@@ -210,6 +241,7 @@ fn propagate_many<'py>(
     out.set_item("y", y.into_pyarray(py).reshape([n, 6])?)?;
     out.set_item("stm", if stm { Some(m.into_pyarray(py).reshape([n, 6, 6])?) } else { None })?;
     out.set_item("ok", ok.into_pyarray(py))?;
+    out.set_item("status", status.into_pyarray(py))?;
     out.set_item("errors", errors)?;
     out.set_item("stats", stats.into_pyarray(py).reshape([n, 3])?)?;
     Ok(out)
@@ -385,6 +417,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     let py = m.py();
     m.add("LibrateError", py.get_type::<LibrateError>())?;
     m.add("IntegrationError", py.get_type::<IntegrationError>())?;
+    m.add("CollisionError", py.get_type::<CollisionError>())?;
     m.add("ConvergenceError", py.get_type::<ConvergenceError>())?;
     m.add_function(wrap_pyfunction!(propagate, m)?)?;
     m.add_function(wrap_pyfunction!(propagate_many, m)?)?;

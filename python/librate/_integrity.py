@@ -1,0 +1,52 @@
+"""Digests of saved arrays, independent of the file format (base layer: the orbit families and
+the application's result files both use them)."""
+
+from __future__ import annotations
+
+import hashlib
+import json
+
+import numpy as np
+
+__all__ = ["CHECKSUM_ATTR", "array_digest", "dataset_checksums", "missing_zarr_chunks"]
+
+#: The attribute of a saved Dataset holding the digests of its variables (JSON).
+CHECKSUM_ATTR = "librate_checksums"
+
+
+def array_digest(values) -> str:
+    """A hex digest of an array's shape and values, independent of how a file format stores
+    them (numbers as float64 with one NaN, text as UTF-8)."""
+    a = np.asarray(values)
+    h = hashlib.blake2b(digest_size=16)
+    h.update(repr(a.shape).encode())
+    if a.dtype.kind in "biuf":
+        f = np.ascontiguousarray(a, dtype=np.float64)
+        h.update(np.where(np.isnan(f), np.nan, f).tobytes())  # one NaN, whatever its payload
+    else:
+        h.update("\0".join(x.decode() if isinstance(x, bytes) else str(x) for x in a.ravel().tolist()).encode())
+    return h.hexdigest()
+
+
+def dataset_checksums(ds) -> str:
+    """The JSON digests of every variable (coordinates included) of an xarray Dataset."""
+    return json.dumps({str(k): array_digest(np.asarray(ds[k].values)) for k in ds.variables})
+
+
+def missing_zarr_chunks(store, name: str) -> list[str]:
+    """The chunk files a Zarr v2 array ``name`` of the local store folder ``store`` should have
+    and has not (a missing chunk silently reads as the fill value)."""
+    import itertools
+    from pathlib import Path
+
+    p = Path(store)
+    try:
+        meta = json.loads((p / name / ".zarray").read_text())
+        shape, chunks, sep = meta["shape"], meta["chunks"], meta.get("dimension_separator", ".")
+    except (OSError, ValueError, KeyError, TypeError):
+        return []
+    if any(n == 0 for n in shape):
+        return []
+    counts = [-(-n // c) for n, c in zip(shape, chunks)]
+    keys = [sep.join(map(str, idx)) for idx in itertools.product(*[range(c) for c in counts])] if counts else ["0"]
+    return [f"{name}/{k}" for k in keys if not (p / name / k).is_file()]
