@@ -15,6 +15,7 @@ from collections.abc import Callable
 
 import numpy as np
 
+from .._checks import as_count, as_number
 from .._core import __version__
 from ..orbits.families import OrbitFamily
 from ..orbits.periodic import PeriodicOrbit
@@ -82,6 +83,11 @@ def periodicity_map(
         return _stack_srp(maps, plates)
     srp = check_srp(srp)
     kzs, wz = map_grid(kz, wz0, n_periods)
+    chunk = as_count(chunk, "chunk", 1)
+    threads = None if threads is None else as_count(threads, "threads", 1)
+    for name, v in (("rtol", rtol), ("atol", atol)):
+        if not (as_number(v, name, positive=True) >= (1e-15 if name == "rtol" else 0)):
+            raise ValueError(f"invalid argument `rtol`: must be >= 1e-15 (below double precision), got {v!r}")
     no, nk, nw = len(olist), kzs.size, wz.size
     dwz = np.full((no, nk, nw), np.nan)
     dphi = np.full((no, nk, nw), np.nan)

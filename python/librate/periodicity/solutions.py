@@ -64,6 +64,9 @@ def clear_forcing_cache() -> None:
 def sweep(forcing, t_final, phi0, wz0, kz, *, stm=False, rtol=MAP_RTOL, atol=MAP_ATOL, chunk=64, threads=None, srp=None, eps=None):
     """The engine over broadcast (phi0, wz0, kz[, eps]) arrays; ``srp`` a FlatPlate (its eps
     overridden per case by ``eps`` when given)."""
+    chunk = as_count(chunk, "chunk", 1)
+    threads = None if threads is None else as_count(threads, "threads", 1)
+    rtol, atol = as_number(rtol, "rtol", positive=True), as_number(atol, "atol", positive=True)
     n = np.broadcast(np.asarray(phi0), np.asarray(wz0), np.asarray(kz), np.asarray(0.0 if eps is None else eps)).shape
     flat = lambda a: np.ascontiguousarray(np.broadcast_to(np.asarray(a, dtype=np.float64), n)).ravel()  # noqa: E731
     p, w, k = flat(phi0), flat(wz0), flat(kz)

@@ -44,6 +44,17 @@ impl Default for Options {
     }
 }
 
+/// The integration tolerances every integrator accepts: atol > 0 and 1e-15 <= rtol (below that
+/// the error estimate is double-precision noise).
+pub fn check_tolerances(rtol: f64, atol: f64) -> Result<()> {
+    check_positive("rtol", rtol)?;
+    check_positive("atol", atol)?;
+    if rtol < 1e-15 {
+        return Err(invalid("rtol", format!("must be >= 1e-15 (below double precision), got {rtol}")));
+    }
+    Ok(())
+}
+
 impl Options {
     pub fn with_tolerances(rtol: f64, atol: f64) -> Self {
         Self { rtol, atol, ..Self::default() }
@@ -51,11 +62,7 @@ impl Options {
 
     /// Check every setting, naming the offending one.
     pub fn validate(&self) -> Result<()> {
-        check_positive("rtol", self.rtol)?;
-        check_positive("atol", self.atol)?;
-        if self.rtol < 1e-15 {
-            return Err(invalid("rtol", format!("must be >= 1e-15 (below double precision), got {}", self.rtol)));
-        }
+        check_tolerances(self.rtol, self.atol)?;
         if let Some(h0) = self.h0 {
             check_positive("h0", h0)?;
         }

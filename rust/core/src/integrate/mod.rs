@@ -15,7 +15,7 @@ pub mod stepper;
 pub mod tableau;
 
 pub use controller::{Controller, StepControl};
-pub use driver::{solve, solve_piecewise, Options, Output, Solution, Status};
+pub use driver::{check_tolerances, solve, solve_piecewise, Options, Output, Solution, Status};
 pub use events::{Event, EventFn, EventRecord};
 pub use stepper::Rkf78;
 

@@ -36,8 +36,7 @@ pub fn sweep(
     threads: Option<usize>,
 ) -> Result<Vec<Outcome>> {
     check_positive("t_final", t_final)?;
-    check_positive("rtol", opts.rtol)?;
-    check_positive("atol", opts.atol)?;
+    crate::integrate::check_tolerances(opts.rtol, opts.atol)?;
     if chunk == 0 {
         return Err(invalid("chunk", "must be >= 1"));
     }

@@ -590,8 +590,7 @@ fn is_multiple(t: f64, unit: f64) -> bool {
 
 fn validate_options(opts: &CorrectorOptions) -> Result<()> {
     check_positive("tol", opts.tol)?;
-    check_positive("rtol", opts.rtol)?;
-    check_positive("atol", opts.atol)?;
+    crate::integrate::check_tolerances(opts.rtol, opts.atol)?;
     check_positive("max_wz_step", opts.max_wz_step)?;
     check_positive("max_angle_step", opts.max_angle_step)?;
     check_positive("phase_step", opts.phase_step)?;
