@@ -2,27 +2,26 @@
 (and its allowed range) before any work, never an OverflowError, a ZeroDivisionError, an empty
 result or a "did not converge after -5 iterations"."""
 
+import librate
 import numpy as np
 import pytest
 
-import librate
-
 EM = librate.System.preset("earth-moon")
-O = librate.dro(EM, x0=0.85)
+ORBIT = librate.dro(EM, x0=0.85)
 WZ = np.linspace(-1.0, 1.0, 50)
 
 BAD = [
-    ("map rtol below double precision", lambda: librate.periodicity_map(O, kz=0.8, wz0=WZ, rtol=1e-30), "rtol"),
-    ("map negative chunk", lambda: librate.periodicity_map(O, kz=0.8, wz0=WZ, chunk=-1), "chunk"),
-    ("map negative threads", lambda: librate.periodicity_map(O, kz=0.8, wz0=WZ, threads=-2), "threads"),
-    ("find n_grid = 0", lambda: librate.find_periodic_attitudes(O, kz=0.8, wz0_range=(-1, 1), n_grid=0), "n_grid"),
-    ("continue_srp min_step = 0", lambda: librate.continue_srp(librate.periodic_attitude(O, kz=0.8, n=0), librate.FlatPlate(0.1), min_step=0),
+    ("map rtol below double precision", lambda: librate.periodicity_map(ORBIT, kz=0.8, wz0=WZ, rtol=1e-30), "rtol"),
+    ("map negative chunk", lambda: librate.periodicity_map(ORBIT, kz=0.8, wz0=WZ, chunk=-1), "chunk"),
+    ("map negative threads", lambda: librate.periodicity_map(ORBIT, kz=0.8, wz0=WZ, threads=-2), "threads"),
+    ("find n_grid = 0", lambda: librate.find_periodic_attitudes(ORBIT, kz=0.8, wz0_range=(-1, 1), n_grid=0), "n_grid"),
+    ("continue_srp min_step = 0", lambda: librate.continue_srp(librate.periodic_attitude(ORBIT, kz=0.8, n=0), librate.FlatPlate(0.1), min_step=0),
      "min_step"),
-    ("tol = 0", lambda: librate.periodic_attitude(O, kz=0.8, n=0, tol=0.0), "tol"),
-    ("max_iter = -5", lambda: librate.periodic_attitude(O, kz=0.8, n=0, max_iter=-5), "max_iter"),
-    ("method with free theta_sun0", lambda: librate.periodic_attitude(O, kz=0.8, n=0, srp=librate.FlatPlate(0.1), free="theta_sun0", method="half"),
+    ("tol = 0", lambda: librate.periodic_attitude(ORBIT, kz=0.8, n=0, tol=0.0), "tol"),
+    ("max_iter = -5", lambda: librate.periodic_attitude(ORBIT, kz=0.8, n=0, max_iter=-5), "max_iter"),
+    ("method with free theta_sun0", lambda: librate.periodic_attitude(ORBIT, kz=0.8, n=0, srp=librate.FlatPlate(0.1), free="theta_sun0", method="half"),
      "method"),
-    ("n not a whole number of turns over K periods", lambda: librate.periodic_attitude(O, kz=0.8, n=0.3, n_periods=2), "n"),
+    ("n not a whole number of turns over K periods", lambda: librate.periodic_attitude(ORBIT, kz=0.8, n=0.3, n_periods=2), "n"),
 ]
 
 
@@ -33,5 +32,5 @@ def test_bad_input_names_the_parameter(name, call, param):
 
 
 def test_numpy_integers_are_counts():
-    s = librate.periodic_attitude(O, kz=0.8, n=np.int64(0), max_iter=np.int64(30))
+    s = librate.periodic_attitude(ORBIT, kz=0.8, n=np.int64(0), max_iter=np.int64(30))
     assert s.residual < 1e-9
