@@ -34,3 +34,18 @@ def test_bad_input_names_the_parameter(name, call, param):
 def test_numpy_integers_are_counts():
     s = librate.periodic_attitude(ORBIT, kz=0.8, n=np.int64(0), max_iter=np.int64(30))
     assert s.residual < 1e-9
+
+
+def test_an_orbit_through_a_primary_is_a_typed_collision_and_the_map_keeps_the_others():
+    """Issue 12 (collisions in every map): an 'orbit' started at the Moon's centre makes no
+    forcing table of infinite S, C: orbit_forcing raises CollisionError (primary 2), and a map
+    over [good, bad] computes the good orbit's row, leaves the bad one uncomputed (status 255,
+    NaN, computed False, complete 0) with a warning naming it."""
+    mu = EM.mu
+    bad = librate.PeriodicOrbit(EM, np.array([1 - mu, 0, 0, 0, 0, 0.0]), 1.0, 3.0, "dro")
+    with pytest.raises(librate.CollisionError):
+        librate.periodicity.orbit_forcing(bad)
+    with pytest.warns(UserWarning, match="orbit 1 .* skipped"):
+        ds = librate.periodicity_map([ORBIT, bad], kz=0.8, wz0=WZ, solve=False)
+    assert bool(ds.computed.values[0]) and not bool(ds.computed.values[1]) and ds.attrs["complete"] == 0
+    assert np.all(np.isfinite(ds.dwz.values[0])) and np.all(np.isnan(ds.dwz.values[1])) and np.all(ds.status.values[1] == 255)

@@ -17,6 +17,7 @@ import numpy as np
 
 from .._checks import as_count, as_number
 from .._core import __version__
+from .._errors import LibrateError
 from ..orbits.families import OrbitFamily
 from ..orbits.periodic import PeriodicOrbit
 from .solutions import MAP_ATOL, MAP_RTOL, AttitudeSolution, candidates, check_orbit, check_srp, is_symmetric, orbit_forcing, refine, sweep
@@ -99,7 +100,13 @@ def periodicity_map(
     complete = True
     try:
         for i, o in enumerate(olist):
-            r = sweep(orbit_forcing(o), n_periods * o.period, phi0, wz_grid, kz_grid, rtol=rtol, atol=atol, chunk=chunk, threads=threads, srp=srp)
+            try:
+                forcing = orbit_forcing(o)
+            except LibrateError as err:  # e.g. an orbit through a primary (CollisionError): its row stays uncomputed
+                complete = False
+                warnings.warn(f"periodicity_map: orbit {i} (x0 = {o.x0:.10g}) skipped, its row left uncomputed: {err}", stacklevel=2)
+                continue
+            r = sweep(forcing, n_periods * o.period, phi0, wz_grid, kz_grid, rtol=rtol, atol=atol, chunk=chunk, threads=threads, srp=srp)
             dwz[i], dphi[i], phi_t[i] = (r[k].reshape(nk, nw) for k in ("dwz", "dphi", "phi_t"))
             status[i] = r["status"].reshape(nk, nw)
             if solve:

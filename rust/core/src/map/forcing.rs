@@ -13,7 +13,7 @@ use crate::attitude::{forcing_sc, Forcing};
 use crate::cr3bp::check_mu;
 use crate::error::{check_finite, check_positive, invalid, Error, Result};
 use crate::integrate::{Options, Output};
-use crate::propagation::propagate;
+use crate::propagation::{propagate_checked, Collision};
 
 /// Chebyshev degree per segment.
 pub const DEGREE: usize = 12;
@@ -76,7 +76,12 @@ impl OrbitForcing {
             let mut all: Vec<(f64, bool)> = fit_t.iter().map(|&t| (t, true)).chain(check_t.iter().map(|&t| (t, false))).collect();
             all.sort_by(|a, b| a.0.total_cmp(&b.0));
             let ts: Vec<f64> = all.iter().map(|a| a.0).collect();
-            let tr = propagate(mu, state0, 0.0, period, &opts, false, Output::At(&ts), &[])?;
+            // an orbit through a primary (within the point-mass sphere) is a typed collision,
+            // never a table of infinite S, C
+            let tr = propagate_checked(mu, state0, 0.0, period, &opts, false, Output::At(&ts), &[], &Collision::new([0.0, 0.0])?)?;
+            if let Some(hit) = tr.collision {
+                return Err(hit.error(tr.stats.accepted));
+            }
             let (mut fit, mut check) = (Vec::with_capacity(fit_t.len()), Vec::with_capacity(check_t.len()));
             for (s, a) in tr.states.chunks_exact(6).zip(&all) {
                 if a.1 { fit.push(forcing_sc(mu, s, primaries)) } else { check.push(forcing_sc(mu, s, primaries)) }
