@@ -15,7 +15,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from .._checks import as_count, as_number
+from .._checks import as_count, as_float_array, as_number
 from .._core import __version__
 from .._errors import LibrateError
 from ..orbits.families import OrbitFamily
@@ -125,14 +125,15 @@ def periodicity_map(
 
 def map_grid(kz, wz0, n_periods):
     """Validated Kz values and (strictly increasing) inertial rates of a map."""
-    kzs = np.atleast_1d(np.asarray(kz, dtype=np.float64))
+    if isinstance(kz, (bool, np.bool_)) or (isinstance(kz, (list, tuple)) and any(isinstance(v, (bool, np.bool_)) for v in kz)):
+        raise ValueError(f"invalid argument `kz`: values must be numbers in [-1, 1], got {kz!r}")
+    kzs = np.atleast_1d(as_float_array(kz, "kz"))
     if kzs.ndim != 1 or kzs.size == 0 or not np.all(np.isfinite(kzs)) or np.any(np.abs(kzs) > 1):
         raise ValueError(f"invalid argument `kz`: values must be finite and in [-1, 1], got {kz!r}")
-    wz = np.asarray(wz0, dtype=np.float64).ravel()
+    wz = as_float_array(wz0, "wz0").ravel()
     if wz.size < 2 or not np.all(np.isfinite(wz)) or np.any(np.diff(wz) <= 0):
         raise ValueError("invalid argument `wz0`: must be a finite, strictly increasing array of at least 2 rates")
-    if not isinstance(n_periods, (int, np.integer)) or n_periods < 1:
-        raise ValueError(f"invalid argument `n_periods`: must be an integer >= 1, got {n_periods!r}")
+    n_periods = as_count(n_periods, "n_periods", 1)
     return kzs, wz
 
 

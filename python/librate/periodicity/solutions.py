@@ -97,7 +97,7 @@ def check_kinds(kinds) -> tuple[str, ...]:
 
 
 def check_kz(kz) -> float:
-    if not (isinstance(kz, (int, float, np.floating, np.integer)) and math.isfinite(kz) and -1 <= kz <= 1):
+    if isinstance(kz, bool) or not (isinstance(kz, (int, float, np.floating, np.integer)) and math.isfinite(kz) and -1 <= kz <= 1):
         raise ValueError(f"invalid argument `kz`: must be a number in [-1, 1], got {kz!r}")
     return float(kz)
 
