@@ -24,9 +24,12 @@ def as_float_array(value, name: str) -> np.ndarray:
     if isinstance(value, (str, bytes)) or value is None:
         raise ValueError(f"invalid argument `{name}`: must be numbers, got {value!r}")
     try:
-        return np.asarray(value, dtype=np.float64)
-    except (TypeError, ValueError):
+        raw = np.asarray(value)
+    except (TypeError, ValueError):  # ragged
         raise ValueError(f"invalid argument `{name}`: must be numbers, got {value!r}") from None
+    if raw.dtype.kind not in "iuf":  # strings (even '0'), bools, objects
+        raise ValueError(f"invalid argument `{name}`: must be numbers, got {value!r}")
+    return raw.astype(np.float64)
 
 
 def as_state(value, name: str = "state") -> np.ndarray:
