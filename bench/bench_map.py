@@ -66,6 +66,7 @@ import xarray  # noqa: F401  (imported here so the large-map timings do not incl
 from librate import _core
 from librate.periodicity import MAP_ATOL, MAP_RTOL, clear_forcing_cache, sweep
 from scipy.integrate import solve_ivp
+from timing import race
 
 X0 = 0.70
 KZ = 0.8
@@ -86,18 +87,6 @@ def timed(fn, repeat):
         out = fn()
         best = min(best, time.perf_counter() - t0)
     return out, best
-
-
-def race(fns, rounds):
-    """Call every function once per round, `rounds` times; {name: (last result, best, median)}."""
-    times = {k: [] for k in fns}
-    out = {}
-    for _ in range(rounds):
-        for k, fn in fns.items():
-            t0 = time.perf_counter()
-            out[k] = fn()
-            times[k].append(time.perf_counter() - t0)
-    return {k: (out[k], min(v), float(np.median(v))) for k, v in times.items()}
 
 
 def accuracy(phi, wz, ref):

@@ -21,32 +21,10 @@ Run: python bench/bench_solve.py [--rounds N]
 import argparse
 import os
 import platform
-import time
 
 import librate
 import numpy as np
-
-
-def cpu_name() -> str:
-    try:
-        with open("/proc/cpuinfo") as f:
-            for line in f:
-                if line.startswith("model name"):
-                    return line.split(":", 1)[1].strip()
-    except OSError:
-        pass
-    return platform.processor() or platform.machine()
-
-
-def race(fns, rounds):
-    times = {k: [] for k in fns}
-    out = {}
-    for _ in range(rounds):
-        for k, fn in fns.items():
-            t0 = time.perf_counter()
-            out[k] = fn()
-            times[k].append(time.perf_counter() - t0)
-    return out, {k: (min(v), float(np.median(v))) for k, v in times.items()}
+from timing import cpu_name, race
 
 
 def main():
@@ -69,7 +47,9 @@ def main():
         "srp_map 41 eps x 400 rates, K = 2": lambda: librate.srp_map(o2, kz=0.6, wz0=np.linspace(-1.6, 1.2, 400),
                                                                       eps=np.linspace(0, 2, 41), cs=0.4, cd=0.1),
     }
-    out, t = race(fns, args.rounds)
+    res = race(fns, args.rounds)
+    out = {k: v[0] for k, v in res.items()}
+    t = {k: (v[1], v[2]) for k, v in res.items()}
     ref = t["map alone (2000 rates)"][0]
     print(f"\n{'what':36s} {'best':>10s} {'median':>10s} {'ratio to the map alone':>24s}")
     for k, (best, med) in t.items():
