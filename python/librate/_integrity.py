@@ -8,7 +8,7 @@ import json
 
 import numpy as np
 
-__all__ = ["CHECKSUM_ATTR", "array_digest", "dataset_checksums", "missing_zarr_chunks"]
+__all__ = ["CHECKSUM_ATTR", "array_digest", "dataset_checksums", "missing_zarr_chunks", "remove_path", "write_atomically"]
 
 #: The attribute of a saved Dataset holding the digests of its variables (JSON).
 CHECKSUM_ATTR = "librate_checksums"
@@ -50,3 +50,36 @@ def missing_zarr_chunks(store, name: str) -> list[str]:
     counts = [-(-n // c) for n, c in zip(shape, chunks)]
     keys = [sep.join(map(str, idx)) for idx in itertools.product(*[range(c) for c in counts])] if counts else ["0"]
     return [f"{name}/{k}" for k in keys if not (p / name / k).is_file()]
+
+
+def remove_path(p) -> None:
+    """Remove a file, a link or a folder tree, if there."""
+    import shutil
+    from pathlib import Path
+
+    q = Path(p)
+    if q.is_dir() and not q.is_symlink():
+        shutil.rmtree(q)
+    elif q.exists() or q.is_symlink():
+        q.unlink()
+
+
+def write_atomically(ds, p) -> None:
+    """Write the xarray Dataset ``ds`` to ``p`` (``.zarr``: Zarr v2 folder, consolidated; else
+    netCDF 3 via scipy), all or nothing: into a temporary sibling, then renamed over ``p``. The
+    caller decides whether ``p`` may be replaced."""
+    import os
+    from pathlib import Path
+
+    p = Path(p)
+    tmp = p.with_name(f".{p.name}.tmp-{os.getpid()}")
+    remove_path(tmp)
+    try:
+        if p.suffix == ".zarr":
+            ds.to_zarr(tmp, mode="w-", zarr_format=2, consolidated=True)
+        else:
+            ds.to_netcdf(tmp, engine="scipy")
+        remove_path(p)
+        os.replace(tmp, p)
+    finally:
+        remove_path(tmp)

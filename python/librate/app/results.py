@@ -11,13 +11,13 @@ librate result is refused, never overwritten.
 from __future__ import annotations
 
 import inspect
-import os
-import shutil
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
 import numpy as np
+
+from .._integrity import write_atomically
 
 __all__ = ["RESULT_KINDS", "open_result", "read_attrs", "result_kind", "run_map_to", "save_dataset", "save_family", "solutions_dataset",
            "verify_result"]
@@ -202,13 +202,6 @@ def _check_target(p: Path) -> None:
         ds.close()
 
 
-def _remove(p: Path) -> None:
-    if p.is_dir():
-        shutil.rmtree(p)
-    elif p.exists():
-        p.unlink()
-
-
 def save_dataset(ds, path: str | Path) -> Path:
     """Write ``ds`` to ``path`` (``.zarr``: Zarr v2 folder, consolidated; ``.nc``: netCDF 3 via
     scipy), creating the folder. All or nothing: written to a temporary sibling and renamed.
@@ -218,18 +211,7 @@ def save_dataset(ds, path: str | Path) -> Path:
         raise ValueError(f"invalid argument `path`: must end in .zarr (Zarr) or .nc (netCDF), got {str(p)!r}")
     p.parent.mkdir(parents=True, exist_ok=True)
     _check_target(p)
-    tmp = p.with_name(f".{p.name}.tmp-{os.getpid()}")
-    _remove(tmp)
-    ds = _with_checksums(ds)
-    try:
-        if p.suffix == ".zarr":
-            ds.to_zarr(tmp, mode="w", zarr_format=2, consolidated=True)
-        else:
-            ds.to_netcdf(tmp, engine="scipy")
-        _remove(p)
-        os.replace(tmp, p)
-    finally:
-        _remove(tmp)
+    write_atomically(_with_checksums(ds), p)
     return p
 
 

@@ -230,11 +230,9 @@ class OrbitFamily:
         All or nothing: written to a temporary sibling, then renamed. An existing ``path`` is
         replaced only when it is a librate family file; anything else there (a foreign file,
         a folder with other files) is refused with ``FileExistsError``, never overwritten."""
-        import os
-        import shutil
         from pathlib import Path
 
-        from .._integrity import CHECKSUM_ATTR, dataset_checksums
+        from .._integrity import CHECKSUM_ATTR, dataset_checksums, write_atomically
 
         p = Path(path)
         if p.suffix not in (".zarr", ".nc"):
@@ -248,24 +246,7 @@ class OrbitFamily:
         ds = self.to_dataset()
         ds.attrs[CHECKSUM_ATTR] = dataset_checksums(ds)
         p.parent.mkdir(parents=True, exist_ok=True)
-        tmp = p.with_name(f".{p.name}.tmp-{os.getpid()}")
-
-        def remove(q):
-            if q.is_dir() and not q.is_symlink():
-                shutil.rmtree(q)
-            elif q.exists() or q.is_symlink():
-                q.unlink()
-
-        remove(tmp)
-        try:
-            if p.suffix == ".zarr":
-                ds.to_zarr(tmp, mode="w-", zarr_format=2, consolidated=True)
-            else:
-                ds.to_netcdf(tmp, engine="scipy")
-            remove(p)
-            os.replace(tmp, p)
-        finally:
-            remove(tmp)
+        write_atomically(ds, p)
 
     @classmethod
     def load(cls, path) -> OrbitFamily:
