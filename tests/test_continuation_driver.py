@@ -135,3 +135,51 @@ def test_jump_guard_rejects_a_silent_branch_switch():
 def test_step_rules_validated(bad):
     with pytest.raises(ValueError, match="invalid argument"):
         StepRules(**bad)
+
+
+class Batched(Implicit):
+    """The reference problem with a ``batch_key`` and ``correct_many``/``correct_batch`` (each
+    request still solved by the reference Newton), counting the batched calls."""
+
+    batches = 0
+
+    def __init__(self, key, *args):
+        super().__init__(*args)
+        self.batch_key = key
+
+    def correct_many(self, requests):
+        Batched.batches += 1
+        out = []
+        for pb, g, c in requests:
+            try:
+                out.append(pb.correct(g, c))
+            except CorrectionFailed:
+                out.append(None)
+        return out
+
+    def correct_batch(self, guesses, constraints, problems=None):
+        return self.correct_many(list(zip(problems or [self] * len(guesses), guesses, constraints)))
+
+
+def test_lockstep_runs_each_branch_as_alone():
+    """run_lockstep (several branches advanced together, their corrections batched per
+    batch_key) returns exactly the Branch each run gives alone: same points (bitwise, the
+    reference corrector being deterministic), folds, marks and end reason; rounds are shared,
+    so there are fewer batched calls than corrections."""
+    from librate.solving.continuation import arclength_steps, run_lockstep
+
+    radii = [1.0, 1.5, 0.7]
+
+    def problem(r, key):
+        return Batched(key, lambda x, r=r: x[0] ** 2 + x[1] ** 2 - r * r, lambda x: np.array([2 * x[0], 2 * x[1]]))
+
+    kw = dict(direction=1, rules=StepRules(ds=0.1, ds_max=0.3), max_points=40, marks=(0.25, 0.5), stop_at_fold=True)
+    alone = [arclength(problem(r, None), Point(np.array([0.0, r])), **kw) for r in radii]
+    Batched.batches = 0
+    pbs = [problem(r, "circle") for r in radii]
+    together = run_lockstep([(pb, arclength_steps(pb, Point(np.array([0.0, r])), **kw)) for pb, r in zip(pbs, radii)])
+    for a, b, r in zip(alone, together, radii):
+        assert len(a.points) == len(b.points) and all(np.array_equal(p.x, q.x) for p, q in zip(a.points, b.points))
+        assert [m.x.tolist() for m in a.marked] == [m.x.tolist() for m in b.marked] and len(b.marked) == 2
+        assert a.end_reason == b.end_reason and abs(b.folds[0].parameter - r) <= 1e-8
+    assert 0 < Batched.batches < sum(pb.calls for pb in pbs)

@@ -212,6 +212,7 @@ def attitude_correct(
     max_wz_step: float = 0.5, max_angle_step: float = 0.5, threads: int | None = None, chunk: int = 64,
     parameter: str | None = None, condition: tuple[float, float, float, float] | None = None,
     parameter_step: float = 1e-6, max_parameter_step: float = 0.5, monodromy: bool = True, max_halvings: int = 10,
+    conditions: _F64 | None = None,
 ) -> CorrectionBatch: ...
 
 @final

@@ -17,7 +17,16 @@ from .._checks import as_count, as_number
 from .._errors import ConvergenceError
 from ..attitude.srp import FlatPlate, Sun
 from ..orbits.periodic import PeriodicOrbit
-from ..solving.continuation import Constraint, CorrectionFailed, Point, StepRules, arclength
+from ..solving.continuation import (
+    Constraint,
+    CorrectionFailed,
+    Point,
+    StepRules,
+    arclength,
+    arclength_steps,
+    correct_together,
+    run_lockstep,
+)
 from .solutions import (
     KINDS,
     STEP_MAX_HALVINGS,
@@ -34,7 +43,7 @@ from .solutions import (
     verified,
 )
 
-__all__ = ["periodic_attitude", "KzBranch", "kz_branch", "EpsBranch", "SrpContinuation", "continue_srp", "eps_branch", "branch_solutions",
+__all__ = ["periodic_attitude", "KzBranch", "kz_branch", "EpsBranch", "SrpContinuation", "continue_srp", "eps_branch", "eps_branches", "branch_solutions",
            "branch_fold"]
 
 
@@ -231,29 +240,54 @@ class EpsBranch:
     def __init__(self, orbit, kz, n_total, kind, n_periods, plate: FlatPlate):
         self.orbit, self.kz, self.n_total, self.kind, self.n_periods, self.plate = orbit, kz, n_total, kind, n_periods, plate
 
+    @property
+    def batch_key(self):
+        """Branches on one orbit with one body and plate (eps aside) are corrected together."""
+        p = self.plate
+        return (id(self.orbit), self.kz, self.n_periods, float(p.cs), float(p.cd), float(p.sun.theta0), float(p.sun.pressure))
+
     def correct(self, guess, c):
-        a_e, a_p, a_w = c.a
-        b = correct(self.orbit, kz=self.kz, n_total=self.n_total, kind=self.kind, phi0=float(guess[1]), wz0=float(guess[2]),
-                    n_periods=self.n_periods, srp=self.plate, eps=float(guess[0]), closure="full", free="phi0",
-                    max_iter=STEP_MAX_ITER, max_halvings=STEP_MAX_HALVINGS, bordered=("eps", (a_p, a_w, a_e, c.b)))
+        b = self.corrections([(self, guess, c)])
         if not b.converged[0]:
             raise CorrectionFailed(f"eps branch: {b.reason[0]}")
-        j = b.jacobian[0]  # columns (angle, wz0, eps)
-        return Point(np.array([b.parameter[0], b.phi0[0], b.wz0[0]]), {"j": j[:, [2, 0, 1]], "trace": float(np.trace(b.monodromy[0]))},
-                     int(b.iterations[0]))
+        return self._point(b, 0)
+
+    def correct_many(self, requests):
+        """The bordered corrections of several branches' requests [(problem, guess, condition)]
+        (problems with this one's batch_key), in one Rust call."""
+        b = self.corrections(requests)
+        return [self._point(b, i) if b.converged[i] else None for i in range(len(requests))]
+
+    def corrections(self, requests):
+        """The Rust corrector's CorrectionBatch of the bordered corrections of ``requests``
+        [(problem, guess, condition)] (problems with this one's batch_key), in one call."""
+        g = np.array([r[1] for r in requests], dtype=float)
+        cond = np.array([[c.a[1], c.a[2], c.a[0], c.b] for _, _, c in requests], dtype=float)  # (a_phi0, a_wz0, a_eps, b)
+        return correct(self.orbit, kz=self.kz, n_total=[p.n_total for p, _, _ in requests], kind=[p.kind for p, _, _ in requests],
+                       phi0=g[:, 1], wz0=g[:, 2], n_periods=self.n_periods, srp=self.plate, eps=g[:, 0], closure="full", free="phi0",
+                       max_iter=STEP_MAX_ITER, max_halvings=STEP_MAX_HALVINGS, bordered=("eps", cond))
+
+    @staticmethod
+    def _point(b, i):
+        j = b.jacobian[i]  # columns (angle, wz0, eps)
+        return Point(np.array([b.parameter[i], b.phi0[i], b.wz0[i]]), {"j": j[:, [2, 0, 1]], "trace": float(np.trace(b.monodromy[i]))},
+                     int(b.iterations[i]))
 
     def tangent(self, pt):
         j = pt.data["j"]
         return np.cross(j[0], j[1])
 
-    def correct_batch(self, guesses, constraints):
+    def correct_batch(self, guesses, constraints, problems=None):
         """Points at fixed eps (the continuation's marks), all corrected in one call: the plain
-        full-period correction in (phi0, wz0) at each one's eps."""
+        full-period correction in (phi0, wz0) at each one's eps; ``problems``: the branch of each
+        guess (branches with this one's batch_key), default this one."""
         g = np.array(guesses, dtype=float)
         for c in constraints:
             if c.fixed_index != 0:
                 raise ValueError("EpsBranch.correct_batch: only conditions fixing eps")
-        b = correct(self.orbit, kz=self.kz, n_total=self.n_total, kind=self.kind, phi0=g[:, 1], wz0=g[:, 2], n_periods=self.n_periods,
+        owners = [self] * len(g) if problems is None else problems
+        b = correct(self.orbit, kz=self.kz, n_total=[p.n_total for p in owners], kind=[p.kind for p in owners], phi0=g[:, 1], wz0=g[:, 2],
+                    n_periods=self.n_periods,
                     srp=self.plate, eps=np.array([c.b for c in constraints]), closure="full", free="phi0", monodromy=False,
                     max_iter=STEP_MAX_ITER, max_halvings=STEP_MAX_HALVINGS)
         return [Point(np.array([c.b, b.phi0[i], b.wz0[i]]), None, int(b.iterations[i])) if b.converged[i] else None
@@ -270,26 +304,41 @@ def eps_branch(solution: AttitudeSolution, srp, *, steps: int = 10, min_step: fl
     """The driver's Branch of :func:`continue_srp` (points and marks corrected, not yet
     re-propagated: each point's ``data`` holds its Jacobian and monodromy trace); None when the
     target is the starting eps."""
-    srp = check_srp(srp)
-    if srp is None:
-        raise ValueError("invalid argument `srp`: the target plate is required")
-    if not isinstance(solution, AttitudeSolution):
-        raise ValueError("invalid argument `solution`: must be a librate.AttitudeSolution")
+    return eps_branches([(solution, srp, marks)], steps=steps, min_step=min_step)[0]
+
+
+def eps_branches(jobs, *, steps: int = 10, min_step: float = 1e-7) -> list:
+    """:func:`eps_branch` of every job (solution, target plate, marks), continued in lock step
+    (:func:`librate.solving.continuation.run_lockstep`): each round, the corrections of all
+    branches on one orbit and plate go to the Rust corrector in one call. Each branch is the one
+    :func:`eps_branch` gives alone (to the corrector's tolerance)."""
     steps = as_count(steps, "steps", 1)
     min_step = as_number(min_step, "min_step", positive=True)
-    e0 = 0.0 if solution.srp is None else float(solution.srp.eps)
-    target = float(srp.eps)
-    if target == e0:
-        return None
-    problem = EpsBranch(solution.orbit, solution.kz, solution.n_total, solution.kind, solution.n_periods, srp)
-    try:
-        first = problem.correct(np.array([e0, solution.phi0, solution.wz0]), Constraint.fix(3, 0, e0))
-    except CorrectionFailed as e:
-        raise ConvergenceError(f"continue_srp: the starting solution does not correct at eps = {e0}: {e}") from None
-    h = abs(target - e0) / steps
-    rules = StepRules(ds=h, ds_min=min(min_step, h), ds_max=max(h, min(4 * h, 0.25)))
-    return arclength(problem, first, direction=1 if target > e0 else -1, target=target, stop_at_fold=True, locate_bifurcations=False,
-                     marks=tuple(float(m) for m in marks), rules=rules, max_points=10_000, name="eps")
+    todo = []
+    for j, (solution, srp, marks) in enumerate(jobs):
+        srp = check_srp(srp)
+        if srp is None:
+            raise ValueError("invalid argument `srp`: the target plate is required")
+        if not isinstance(solution, AttitudeSolution):
+            raise ValueError("invalid argument `solution`: must be a librate.AttitudeSolution")
+        e0 = 0.0 if solution.srp is None else float(solution.srp.eps)
+        target = float(srp.eps)
+        if target != e0:
+            problem = EpsBranch(solution.orbit, solution.kz, solution.n_total, solution.kind, solution.n_periods, srp)
+            todo.append((j, problem, e0, target, solution, tuple(float(m) for m in marks)))
+    firsts = correct_together([(p, np.array([e0, s.phi0, s.wz0]), Constraint.fix(3, 0, e0)) for _, p, e0, _, s, _ in todo])
+    runs = []
+    for (_, problem, e0, target, solution, marks), first in zip(todo, firsts):
+        if first is None:
+            raise ConvergenceError(f"continue_srp: the starting solution (wz0 = {solution.wz0:.10g}) does not correct at eps = {e0}")
+        h = abs(target - e0) / steps
+        rules = StepRules(ds=h, ds_min=min(min_step, h), ds_max=max(h, min(4 * h, 0.25)))
+        runs.append((problem, arclength_steps(problem, first, direction=1 if target > e0 else -1, target=target, stop_at_fold=True,
+                                              locate_bifurcations=False, marks=marks, rules=rules, max_points=10_000, name="eps")))
+    out: list = [None] * len(jobs)
+    for job, branch in zip((t[0] for t in todo), run_lockstep(runs)):
+        out[job] = branch
+    return out
 
 
 def branch_solutions(solution: AttitudeSolution, srp, points) -> list[AttitudeSolution]:

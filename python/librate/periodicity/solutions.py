@@ -207,7 +207,7 @@ def correct(orbit: PeriodicOrbit, *, kz, n_total, kind, phi0, wz0, n_periods: in
     together: kz, n_total, kind, phi0, wz0, and theta_sun0 / eps overriding the plate's):
     ``closure`` "half" (symmetric, over K T / 2) or "full" (over K T); ``free`` "phi0" or
     "sun_phase"; ``bordered``: (parameter "kz" or "eps", condition (a_angle, a_wz0, a_parameter,
-    b)) for the continuation driver. Returns the core's CorrectionBatch."""
+    b), or one such row per candidate) for the continuation driver. Returns the core's CorrectionBatch."""
     cols = np.broadcast_arrays(np.asarray(kz, dtype=float), np.asarray(n_total, dtype=float), np.asarray(kind), np.asarray(phi0, dtype=float),
                                np.asarray(wz0, dtype=float), np.asarray(0.0 if eps is None else eps, dtype=float),
                                np.asarray(0.0 if theta_sun0 is None else theta_sun0, dtype=float))
@@ -220,7 +220,11 @@ def correct(orbit: PeriodicOrbit, *, kz, n_total, kind, phi0, wz0, n_periods: in
     T = n_periods * orbit.period
     kw = {}
     if bordered is not None:
-        kw = dict(parameter=bordered[0], condition=tuple(float(v) for v in bordered[1]))
+        cond = np.asarray(bordered[1], dtype=float)
+        if cond.ndim == 2:  # one condition per candidate (branches corrected together)
+            kw = dict(parameter=bordered[0], condition=tuple(cond[0]), conditions=np.ascontiguousarray(np.broadcast_to(cond, (k.size, 4))))
+        else:
+            kw = dict(parameter=bordered[0], condition=tuple(float(v) for v in cond))
     return _core.attitude_correct(orbit_forcing(orbit), p, w, k, turns_of(nt, kd), t_final=0.5 * T if closure == "half" else T,
                                   closure=closure, free=free, tol=float(tol), max_iter=int(max_iter), rtol=SOLVE_RTOL, atol=SOLVE_ATOL,
                                   monodromy=monodromy, max_halvings=int(max_halvings), **extra, **kw)

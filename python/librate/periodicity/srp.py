@@ -6,9 +6,7 @@ a Sun-pointing body (:func:`sun_pointing_accelerations`)."""
 from __future__ import annotations
 
 import math
-import os
 from collections.abc import Sequence
-from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
@@ -19,7 +17,7 @@ from ..attitude.srp import FacetBody, FlatPlate, Sun, force_torque
 from ..constants import SOLAR_PRESSURE_1AU, SUN_SYNODIC_PERIOD
 from ..orbits.periodic import PeriodicOrbit
 from ..orbits.system import check_system
-from .branches import branch_fold, branch_solutions, eps_branch
+from .branches import branch_fold, eps_branches
 from .solutions import (
     check_kinds,
     check_kz,
@@ -27,6 +25,7 @@ from .solutions import (
     find_periodic_attitudes,
     orbit_forcing,
     sweep,
+    verified,
 )
 
 __all__ = ["srp_map", "sun_pointing_accelerations", "sun_resonance", "sun_angle"]
@@ -124,37 +123,35 @@ def srp_map(
     if solve:
         window = (float(wz[0]), float(wz[-1]))
 
-        def trace(job):
-            """Continue ``start`` (at e_start) through the grid ``values`` in order (one
-            pseudo-arclength run to the last value, corrected exactly at each grid value on the
-            way; only those re-propagated); one branch, ending at the grid's end or at a
-            located fold. Independent of every other branch: branches run on worker threads
-            (the corrector releases the GIL) and are assembled in order."""
-            start, e_start, values, origin = job
-            target = plate.with_eps(float(values[-1]))
-            br = eps_branch(start, target, steps=steps, marks=[float(e) for e in values])
-            pts = [(float(p.x[0]), float(p.x[2]), float(p.x[1]), float(p.data["trace"])) for p in br.points]
-            marked = [(float(p.x[0]), si) for p, si in zip(br.marked, branch_solutions(start, target, br.marked))]
-            if br.reached:
-                end = (math.nan, math.nan, False, "reached the end of the eps grid")
-            else:
-                f = branch_fold(br)
-                fold = f is not None and f["located"]
-                last = br.points[-1]
-                end = (float(f["eps"]) if fold else float(last.x[0]), float(last.x[2]), fold, br.end_reason)
-            return pts, marked, (start.n_total, start.kind, origin, e_start) + end
-
         def run(jobs, lead):
-            """Trace the branches of ``jobs`` in parallel; record them in order, each after its
+            """Continue each job's ``start`` (at e_start) through the grid ``values`` in order
+            (one pseudo-arclength run to the last value, corrected exactly at each grid value
+            on the way; only those re-propagated), ending at the grid's end or at a located
+            fold. The branches run in lock step (:func:`eps_branches`: each round's corrections
+            of every branch in one Rust call) and are recorded in order, each after its
             ``lead`` solutions ((eps, solution) recorded at the branch's index first)."""
-            with ThreadPoolExecutor(max_workers=max(1, min(len(jobs), os.cpu_count() or 1))) as pool:
-                done = list(pool.map(trace, jobs))
-            for (pts, marked, info), first in zip(done, lead):
+            brs = eps_branches([(start, plate.with_eps(float(values[-1])), [float(e) for e in values]) for start, _, values, _ in jobs],
+                               steps=steps)
+            # every branch's marked points re-propagated in one batch
+            owners = [(start, p) for (start, _, _, _), br in zip(jobs, brs) for p in br.marked]
+            checked = iter(verified(orbit, kz=kz, n_total=[s_.n_total for s_, _ in owners], kind=[s_.kind for s_, _ in owners],
+                                    phi0=[p.x[1] for _, p in owners], wz0=[p.x[2] for _, p in owners], n_periods=n_periods,
+                                    plates=[plate.with_eps(float(p.x[0])) for _, p in owners], iterations=[p.iterations for _, p in owners]))
+            for (start, e_start, _, origin), br, first in zip(jobs, brs, lead):
+                pts = [(float(p.x[0]), float(p.x[2]), float(p.x[1]), float(p.data["trace"])) for p in br.points]
+                marked = [(float(p.x[0]), next(checked)) for p in br.marked]
+                if br.reached:
+                    end = (math.nan, math.nan, False, "reached the end of the eps grid")
+                else:
+                    f = branch_fold(br)
+                    fold = f is not None and f["located"]
+                    last = br.points[-1]
+                    end = (float(f["eps"]) if fold else float(last.x[0]), float(last.x[2]), fold, br.end_reason)
                 b = len(branches)
                 sols.extend((b, e, s_) for e, s_ in first)
                 path.extend((b, *pt) for pt in pts)
                 sols.extend((b, e, s_) for e, s_ in marked)
-                branches.append(info)
+                branches.append((start.n_total, start.kind, origin, e_start) + end)
 
         pos, neg = es[es > 0], es[es < 0][::-1]
         jobs, lead = [], []

@@ -23,6 +23,13 @@ tangent changes sign between two accepted points and are then *located*: the arc
 the two points is searched (Illinois regula falsi on that tangent component) until the fold's
 parameter is known to ``fold_tol``. Bifurcations are detected where a problem's test function
 (for example a stability index minus one) changes sign, and located the same way.
+
+The algorithms are generators (:func:`arclength_steps`, :func:`natural_steps`): they yield each
+correction they need and receive the corrected point. :func:`arclength` and :func:`natural`
+correct them one by one; :func:`run_lockstep` advances many branches together and corrects each
+round's requests in one call per group of compatible problems (``batch_key``/``correct_many``:
+for example every branch of an SRP map in one Rust call, the SIMD lanes full). A branch takes
+the same path either way.
 """
 
 from __future__ import annotations
@@ -46,7 +53,12 @@ __all__ = [
     "CorrectionFailed",
     "StepRules",
     "natural",
+    "natural_steps",
     "arclength",
+    "arclength_steps",
+    "run_lockstep",
+    "correct_together",
+    "correct_marks",
 ]
 
 
@@ -134,7 +146,10 @@ class ContinuationProblem(Protocol):
     Optional: ``guard(points, new, ratio)`` returns a reason to reject ``new`` (a jump) or None;
     ``tests(point)`` returns named bifurcation test functions; ``correct_batch(guesses,
     constraints)`` corrects many independent points at once (a list of Point or None), used for
-    the marks of :func:`arclength`.
+    the marks of :func:`arclength`; ``batch_key`` (hashable) with ``correct_many(requests)``:
+    problems of one type with equal keys correct the requests [(problem, guess, constraint)] of
+    several branches in one call (:func:`run_lockstep`), and their ``correct_batch`` takes
+    ``problems=`` (the owner of each guess) to correct the marks of several branches at once.
     """
 
     parameter_index: int
@@ -174,14 +189,126 @@ class StepRules:
             raise ValueError(f"invalid argument `growth`: must be >= 1, got {self.growth}")
 
 
-def _try(problem, guess, constraint) -> Point | None:
+def _try(problem, guess, constraint):
+    """Ask the runner to correct ``guess`` under ``constraint`` (a generator step: the driver's
+    algorithms yield their corrections, so that one runner can correct the requests of many
+    branches together); the corrected Point, or None when the correction failed."""
+    pt = yield (np.asarray(guess, dtype=float), constraint)
+    return pt
+
+
+class _Marks(list):
+    """A request for many independent corrections at once (a branch's marks): [(guess,
+    constraint)], answered with a list of Point or None."""
+
+
+def _correct(problem, guess, constraint) -> Point | None:
+    """The one place a problem's corrector is called for a single point."""
     try:
-        pt = problem.correct(np.asarray(guess, dtype=float), constraint)
+        pt = problem.correct(guess, constraint)
     except LibrateError:
         return None
-    if not np.all(np.isfinite(pt.x)):
-        return None
-    return pt
+    return _finite(pt)
+
+
+def _finite(pt: Point | None) -> Point | None:
+    return pt if pt is not None and np.all(np.isfinite(pt.x)) else None
+
+
+def _run(problem, steps):
+    """Drive one branch's generator, correcting each request alone."""
+    try:
+        request = next(steps)
+        while True:
+            answer = correct_marks([(problem, *r) for r in request]) if isinstance(request, _Marks) else _correct(problem, *request)
+            request = steps.send(answer)
+    except StopIteration as done:
+        return done.value
+
+
+def _groups(problems, method: str) -> dict:
+    """Indices of the problems that one call of ``method`` can serve together (same type and
+    ``batch_key``); a problem without either stands alone."""
+    groups: dict = {}
+    for i, problem in enumerate(problems):
+        key = getattr(problem, "batch_key", None)
+        groups.setdefault((type(problem), key) if key is not None and hasattr(problem, method) else ("alone", id(problem)), []).append(i)
+    return groups
+
+
+def correct_marks(requests: list) -> list[Point | None]:
+    """Independent corrections at fixed parameter values [(problem, guess, constraint)] (the
+    marks of one or many branches): one ``correct_batch(guesses, constraints, problems)`` call
+    per group of compatible problems (``batch_key``), else the problem's own ``correct_batch``,
+    else one by one."""
+    out: list[Point | None] = [None] * len(requests)
+    for key, idx in _groups([r[0] for r in requests], "correct_batch").items():
+        problem = requests[idx[0]][0]
+        batch = getattr(problem, "correct_batch", None)
+        if batch is None:
+            for i in idx:
+                out[i] = _correct(*requests[i])
+            continue
+        extra = {} if key[0] == "alone" else {"problems": [requests[i][0] for i in idx]}
+        try:
+            got = batch([requests[i][1] for i in idx], [requests[i][2] for i in idx], **extra)
+        except LibrateError:
+            got = [None] * len(idx)
+        for i, pt in zip(idx, got):
+            out[i] = _finite(pt)
+    return out
+
+
+def correct_together(requests: list) -> list[Point | None]:
+    """Correct one round of requests [(problem, guess, constraint)] of lock-step branches:
+    problems that share a ``batch_key`` are corrected in one call of their ``correct_many``
+    (e.g. one Rust call integrating every branch's trajectories in the SIMD lanes), the others
+    one by one. Results in request order."""
+    out: list[Point | None] = [None] * len(requests)
+    for key, idx in _groups([r[0] for r in requests], "correct_many").items():
+        if key[0] == "alone":
+            for i in idx:
+                out[i] = _correct(*requests[i])
+            continue
+        problem = requests[idx[0]][0]
+        try:
+            got = problem.correct_many([requests[i] for i in idx])
+        except LibrateError:
+            got = [None] * len(idx)
+        for i, pt in zip(idx, got):
+            out[i] = _finite(pt)
+    return out
+
+
+def run_lockstep(branches: Sequence[tuple[Any, Any]]) -> list:
+    """Run several continuations in lock step: ``branches`` are (problem, steps) pairs, steps a
+    generator from :func:`arclength_steps` (or :func:`natural_steps`); each round, every live
+    branch's pending correction is gathered and corrected together (:func:`correct_together`).
+    Returns each generator's result (a Branch), in order. Each branch takes exactly the path it
+    takes alone: only the grouping of the corrector calls changes."""
+    results: list = [None] * len(branches)
+    pending: dict[int, tuple] = {}
+    for i, (problem, steps) in enumerate(branches):
+        try:
+            pending[i] = next(steps)
+        except StopIteration as done:
+            results[i] = done.value
+    while pending:
+        order = sorted(pending)
+        single = [i for i in order if not isinstance(pending[i], _Marks)]
+        answers = dict(zip(single, correct_together([(branches[i][0], *pending[i]) for i in single])))
+        flat = [(i, r) for i in order if isinstance(pending[i], _Marks) for r in pending[i]]
+        got = iter(correct_marks([(branches[i][0], *r) for i, r in flat]))
+        for i in order:
+            if isinstance(pending[i], _Marks):
+                answers[i] = [next(got) for _ in pending[i]]
+        for i in order:
+            try:
+                pending[i] = branches[i][1].send(answers[i])
+            except StopIteration as done:
+                results[i] = done.value
+                del pending[i]
+    return results
 
 
 def _norm(problem, v) -> float:
@@ -215,7 +342,12 @@ def _guard(problem, points, new, ratio) -> str | None:
     return f(points, new, ratio) if f is not None else None
 
 
-def natural(
+def natural(problem: ContinuationProblem, first: Point, targets: Sequence[float], **options) -> Branch:
+    """Natural-parameter continuation (:func:`natural_steps`), each correction alone."""
+    return _run(problem, natural_steps(problem, first, targets, **options))
+
+
+def natural_steps(
     problem: ContinuationProblem,
     first: Point,
     targets: Sequence[float],
@@ -223,14 +355,15 @@ def natural(
     rules: StepRules | None = None,
     name: str = "parameter",
     stop: Callable[[Point], str | None] | None = None,
-) -> Branch:
+):
     """Natural-parameter continuation through the parameter values ``targets`` (the points
     returned are exactly at them). Prediction: linear extrapolation of every component from the
     last two corrected points (thesis eq. 20-22). Between targets the step is halved on a failed
     correction or a jump and doubled after a success; the run ends at the last target, at a
     ``stop`` reason, or when the step falls below ``rules.ds_min`` (in the parameter) with the
     reason. A fold ahead shows as the step collapsing: the end reason then names the last
-    parameter reached."""
+    parameter reached. A generator: it yields its corrections (:func:`run_lockstep`) and returns
+    the Branch."""
     rules = rules or StepRules()
     k = problem.parameter_index
     n = first.x.size
@@ -255,7 +388,7 @@ def natural(
                 guess = last.x.copy()
                 prev_step = abs(trial - last.x[k])
             guess[k] = trial
-            pt = _try(problem, guess, Constraint.fix(n, k, trial))
+            pt = yield from _try(problem, guess, Constraint.fix(n, k, trial))
             status = "fail"
             if pt is not None:
                 ratio = abs(trial - last.x[k]) / max(prev_step, 1e-300)
@@ -291,7 +424,12 @@ def natural(
     return branch
 
 
-def arclength(
+def arclength(problem: ContinuationProblem, first: Point, **options) -> Branch:
+    """Pseudo-arclength continuation (:func:`arclength_steps`), each correction alone."""
+    return _run(problem, arclength_steps(problem, first, **options))
+
+
+def arclength_steps(
     problem: ContinuationProblem,
     first: Point,
     *,
@@ -307,8 +445,10 @@ def arclength(
     marks: Sequence[float] = (),
     name: str = "parameter",
     stop: Callable[[Point], str | None] | None = None,
-) -> Branch:
-    """Pseudo-arclength continuation from ``first``, through folds.
+):
+    """Pseudo-arclength continuation from ``first``, through folds. A generator: it yields its
+    corrections (:func:`run_lockstep` corrects those of many branches together) and returns the
+    Branch.
 
     ``direction``: the initial sense, a vector in x or +-1 for the sense of the parameter.
     ``bounds``: the parameter's range; the branch ends on the bound it reaches (the last point
@@ -343,18 +483,13 @@ def arclength(
     branch = Branch(points)
     pending_marks: list = []  # (guess, condition, step, point if already on the mark)
 
-    def finish() -> Branch:
+    def finish():
         """Correct the marks met on the way, in one batch when the problem can
         (``correct_batch``), and keep those that land near their guess."""
         todo = [i for i, pm in enumerate(pending_marks) if pm[3] is None]
         got: dict[int, Point | None] = {}
-        batch = getattr(problem, "correct_batch", None)
-        if todo and batch is not None:
-            for i, pt in zip(todo, batch([pending_marks[i][0] for i in todo], [pending_marks[i][1] for i in todo])):
-                got[i] = pt if pt is not None and np.all(np.isfinite(pt.x)) else None
-        else:
-            for i in todo:
-                got[i] = _try(problem, pending_marks[i][0], pending_marks[i][1])
+        if todo:
+            got = dict(zip(todo, (yield _Marks((pending_marks[i][0], pending_marks[i][1]) for i in todo))))
         for i, (guess, _, step, on) in enumerate(pending_marks):
             pm = on if on is not None else got.get(i)
             if pm is not None and _norm(problem, pm.x - guess) <= rules.jump * step + 1e-12:
@@ -369,16 +504,16 @@ def arclength(
         a = tb / sx
         return Constraint(a, float(np.dot(a, base.x)) + s)
 
-    def at(base: Point, tb: np.ndarray, s: float) -> Point | None:
-        return _try(problem, base.x + s * tb * sx, constraint(base, tb, s))
+    def at(base: Point, tb: np.ndarray, s: float):
+        return (yield from _try(problem, base.x + s * tb * sx, constraint(base, tb, s)))
 
-    def land(value: float) -> Point | None:
+    def land(value: float):
         """The point exactly at parameter ``value``, from the last point along the tangent."""
         last = points[-1]
         dp = t[k] * sx[k]
         guess = last.x + (value - last.x[k]) / dp * t * sx if dp != 0 else last.x.copy()
         guess[k] = value
-        pt = _try(problem, guess, Constraint.fix(n, k, value))
+        pt = yield from _try(problem, guess, Constraint.fix(n, k, value))
         if pt is not None and _norm(problem, pt.x - guess) <= rules.jump * max(_norm(problem, guess - last.x), rules.ds_min) + 1e-9:
             return pt
         return None
@@ -394,18 +529,18 @@ def arclength(
                                                      (hi, "parameter range end", False))
                          if e is not None and math.isfinite(e) and (base.x[k] - e) * (p_pred - e) < 0 and base.x[k] != e), None)
             if edge is not None:
-                landed = land(edge[0])
+                landed = yield from land(edge[0])
                 if landed is not None:
                     points.append(landed)
                     branch.reached = edge[2]
                     branch.end_reason = f"{edge[1]}: {name} = {edge[0]:.12g}"
-                    return finish()
+                    return (yield from finish())
                 ds *= 0.5
                 if ds < rules.ds_min:
                     branch.end_reason = f"step floor: could not land on {name} = {edge[0]:.12g} from {base.x[k]:.12g} (step below {rules.ds_min:g})"
-                    return finish()
+                    return (yield from finish())
                 continue
-            new = at(base, t, ds)
+            new = yield from at(base, t, ds)
             status = "fail"
             t_new = None
             if new is not None:
@@ -428,23 +563,23 @@ def arclength(
             ds *= 0.5
             if ds < rules.ds_min:
                 branch.end_reason = f"step floor: arclength step below {rules.ds_min:g} at {name} = {base.x[k]:.12g} after {len(points)} points"
-                return finish()
+                return (yield from finish())
         assert t_new is not None and new is not None
         # a fold: the parameter component of the tangent changes sign
         if t[k] * t_new[k] < 0:
-            fold = _locate_fold(problem, base, t, ds, new, t_new, at, fold_tol) if locate else Fold(float(new.x[k]), new, False, abs(new.x[k] - base.x[k]))
+            fold = (yield from _locate_fold(problem, base, t, ds, new, t_new, at, fold_tol)) if locate else Fold(float(new.x[k]), new, False, abs(new.x[k] - base.x[k]))
             branch.folds.append(fold)
             if stop_at_fold:
                 if fold.located:
                     points.append(fold.point)  # the branch ends on its turning point
                 branch.end_reason = f"fold at {name} = {fold.parameter:.12g}" + ("" if fold.located else f" (not located: within {fold.tolerance:.2g})")
-                return finish()
+                return (yield from finish())
         tests_new = _tests(problem, new)
         for test, v in tests_new.items():
             u = tests_prev.get(test)
             if u is not None and math.isfinite(u) and math.isfinite(v) and u * v < 0:
                 if locate and locate_bifurcations:
-                    branch.bifurcations.append(_locate_sign(problem, test, base, t, ds, u, v, new, at, fold_tol))
+                    branch.bifurcations.append((yield from _locate_sign(problem, test, base, t, ds, u, v, new, at, fold_tol)))
                 else:  # the linear interpolation of the test function between the two points
                     w = u / (u - v)
                     branch.bifurcations.append(Bifurcation(test, float(base.x[k] + w * (new.x[k] - base.x[k])), new, False))
@@ -460,16 +595,17 @@ def arclength(
         why = stop(new) if stop else None
         if why:
             branch.end_reason = why
-            return finish()
+            return (yield from finish())
         if new.iterations <= rules.easy_iterations:
             ds = min(ds * rules.growth, rules.ds_max)
     branch.end_reason = f"completed: max_points = {max_points} reached"
-    return finish()
+    return (yield from finish())
 
 
 def _illinois(f, a: float, fa: float, b: float, fb: float, done: Callable[[float, float], bool], max_iter: int = 60):
-    """Regula falsi (Illinois) on [a, b] with f(a) f(b) < 0; ``f`` returns (value, payload) or
-    None where it cannot be evaluated (then the interval is bisected)."""
+    """Regula falsi (Illinois) on [a, b] with f(a) f(b) < 0; ``f`` (a generator of corrections,
+    as this one) returns (value, payload) or None where it cannot be evaluated (then the interval
+    is bisected)."""
     side = 0
     best = None
     for _ in range(max_iter):
@@ -478,10 +614,10 @@ def _illinois(f, a: float, fa: float, b: float, fb: float, done: Callable[[float
         c = b - fb * (b - a) / (fb - fa) if fb != fa else 0.5 * (a + b)
         if not (min(a, b) < c < max(a, b)):
             c = 0.5 * (a + b)
-        r = f(c)
+        r = yield from f(c)
         if r is None:
             c = 0.5 * (a + b)
-            r = f(c)
+            r = yield from f(c)
             if r is None:
                 return best, False
         fc, payload = r
@@ -531,11 +667,11 @@ def _locate_fold(problem, base, t, ds, new, t_new, at, tol) -> Fold:
         c = a - wa * (b - a) / (wb - wa) if wb != wa else 0.5 * (a + b)
         if not a < c < b:
             c = 0.5 * (a + b)
-        pc = at(base, t, c)
+        pc = yield from at(base, t, c)
         tc = None if pc is None else _unit_tangent(problem, pc, t, pc.x - base.x)
         if tc is None:
             c = 0.5 * (a + b)
-            pc = at(base, t, c)
+            pc = yield from at(base, t, c)
             tc = None if pc is None else _unit_tangent(problem, pc, t, pc.x - base.x)
             if tc is None:
                 break
@@ -559,7 +695,7 @@ def _locate_sign(problem, name, base, t, ds, u, v, new, at, tol) -> Bifurcation:
     k = problem.parameter_index
 
     def f(s):
-        pt = at(base, t, s)
+        pt = yield from at(base, t, s)
         if pt is None:
             return None
         val = _tests(problem, pt).get(name)
@@ -570,7 +706,7 @@ def _locate_sign(problem, name, base, t, ds, u, v, new, at, tol) -> Bifurcation:
     state = {"last": None}
 
     def g(s):
-        r = f(s)
+        r = yield from f(s)
         if r is not None:
             state["last"] = r[1]
         return r
@@ -578,7 +714,7 @@ def _locate_sign(problem, name, base, t, ds, u, v, new, at, tol) -> Bifurcation:
     def done(a, b):
         return abs(b - a) * max(abs(t[k]), 1e-16) * problem.scale[k] <= tol
 
-    best, ok = _illinois(g, 0.0, u, ds, v, done)
+    best, ok = yield from _illinois(g, 0.0, u, ds, v, done)
     if best is None or not ok:
         # not located (the corrector cannot converge next to it, as at a branch point, where the
         # extended Jacobian is singular): the linear interpolation of the test function

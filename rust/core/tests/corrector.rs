@@ -365,6 +365,39 @@ fn val_bordered_correction_is_the_continuation_corrector() {
     assert!(!r.converged());
 }
 
+/// Branches corrected in one batch (lock-step continuation): candidates with their own linear
+/// conditions, in one `correct_bordered` call, land where each lands alone (1e-10: lock-step
+/// lanes share their step size, so only the last bits may differ), each on its own condition
+/// (1e-12); a non-finite or zero per-candidate condition is an argument error naming the
+/// candidate.
+#[test]
+fn val_per_candidate_conditions_batch_branches() {
+    let (s0, t) = dro1266();
+    let f = table(&s0, t);
+    let opts = CorrectorOptions::default();
+    let base = Bordered::fixed(Parameter::Kz, 0.8);
+    let cands = [
+        Candidate::new(0.0, -1.40, 0.75, -1.0).with_condition([0.0, 0.0, 1.0], 0.8),
+        Candidate::new(0.0, -1.45, 0.80, -1.0).with_condition([0.0, 0.6, 0.8], 0.6 * -1.45 + 0.8 * 0.8 + 0.01),
+        Candidate::new(0.0, 1.0, 0.3, 0.0).with_condition([0.0, 0.0, 1.0], 0.3),
+        Candidate::new(0.0, 1.0 + 2.0 * PI / t, 0.2, 1.0).with_condition([0.0, 0.0, 1.0], 0.25),
+    ];
+    let all = correct_bordered(&f, 0.5 * t, Closure::Half, Free::Phi0, &base, &cands, &opts).unwrap();
+    for (c, r) in cands.iter().zip(&all) {
+        assert!(r.converged(), "{:?}", r.reason);
+        let (a, b) = c.condition.unwrap();
+        assert!((a[1] * r.wz0 + a[2] * r.parameter - b).abs() <= 1e-12);
+        let alone = Bordered { a, b, ..base };
+        let one = correct_bordered(&f, 0.5 * t, Closure::Half, Free::Phi0, &alone, &[Candidate { condition: None, ..*c }], &opts).unwrap()[0];
+        assert!(one.converged() && (one.wz0 - r.wz0).abs() < 1e-10 && (one.parameter - r.parameter).abs() < 1e-10, "{} vs {}", one.wz0, r.wz0);
+    }
+    let bad = [Candidate::new(0.0, 1.0, 0.3, 0.0).with_condition([0.0, f64::NAN, 1.0], 0.3)];
+    let e = correct_bordered(&f, 0.5 * t, Closure::Half, Free::Phi0, &base, &bad, &opts).unwrap_err().to_string();
+    assert!(e.contains("candidate 0") && e.contains('a'), "{e}");
+    let zero = [Candidate::new(0.0, 1.0, 0.3, 0.0).with_condition([0.0, 0.0, 0.0], 0.3)];
+    assert!(correct_bordered(&f, 0.5 * t, Closure::Half, Free::Phi0, &base, &zero, &opts).is_err());
+}
+
 /// The correction across a planar orbit family (the orbit's x0 freed). References: (1) with x0
 /// fixed at a value between members it equals the plain half-period correction on the DRO
 /// corrected directly at that x0 (1e-10: both orbits corrected to 1e-12); (2) its x0 column

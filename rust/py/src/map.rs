@@ -6,7 +6,7 @@ use librate_core::periodic::{
     correct_across_family, correct_bordered, correct_planar_attitudes, verify_planar_attitudes, Bordered, Candidate, Closure, CorrectorOptions, Free, Parameter, PlanarFamily,
     PlanarStart,
 };
-use numpy::{IntoPyArray, PyArrayMethods, PyReadonlyArray1};
+use numpy::{IntoPyArray, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::exceptions::{PyKeyError, PyValueError};
 use pyo3::prelude::*;
 
@@ -277,7 +277,7 @@ impl PyCorrectionBatch {
 #[pyfunction]
 #[pyo3(signature = (forcing, phi0, wz0, kz, turns, *, t_final, closure, free="phi0", eps=None, cs=None, cd=None, theta_sun0=None,
     tol=1e-12, max_iter=40, rtol=1e-13, atol=1e-13, max_steps=200_000, max_wz_step=0.5, max_angle_step=0.5, threads=None, chunk=64,
-    parameter=None, condition=None, parameter_step=1e-6, max_parameter_step=0.5, monodromy=true, max_halvings=10))]
+    parameter=None, condition=None, parameter_step=1e-6, max_parameter_step=0.5, monodromy=true, max_halvings=10, conditions=None))]
 #[allow(clippy::too_many_arguments)]
 fn attitude_correct<'py>(
     py: Python<'py>,
@@ -308,6 +308,7 @@ fn attitude_correct<'py>(
     max_parameter_step: f64,
     monodromy: bool,
     max_halvings: u32,
+    conditions: Option<PyReadonlyArray2<'py, f64>>,
 ) -> PyResult<PyCorrectionBatch> {
     let bordered = match (parameter, condition) {
         (None, None) => None,
@@ -337,7 +338,19 @@ fn attitude_correct<'py>(
         return Err(PyValueError::new_err(format!("invalid argument: phi0, wz0, kz and turns must have one length, got {}, {}, {}, {}", p.len(), n, k.len(), tu.len())));
     }
     let (e, s, d, th) = (per_case(&eps, "eps", n)?, per_case(&cs, "cs", n)?, per_case(&cd, "cd", n)?, per_case(&theta_sun0, "theta_sun0", n)?);
-    let cands: Vec<Candidate> = (0..n).map(|i| Candidate::new(p[i], w[i], k[i], tu[i]).with_plate(e[i], s[i], d[i], th[i])).collect();
+    let mut cands: Vec<Candidate> = (0..n).map(|i| Candidate::new(p[i], w[i], k[i], tu[i]).with_plate(e[i], s[i], d[i], th[i])).collect();
+    if let Some(c) = &conditions {
+        let c = c.as_array();
+        if bordered.is_none() || c.shape() != [n, 4] {
+            return Err(PyValueError::new_err(format!(
+                "invalid argument `conditions`: one row (a_angle, a_wz0, a_parameter, b) per candidate, shape ({n}, 4), with `parameter` and `condition`; got shape {:?}",
+                c.shape()
+            )));
+        }
+        for (i, cand) in cands.iter_mut().enumerate() {
+            *cand = cand.with_condition([c[[i, 0]], c[[i, 1]], c[[i, 2]]], c[[i, 3]]);
+        }
+    }
     let opts = CorrectorOptions { tol, max_iter, rtol, atol, max_steps, max_wz_step, max_angle_step, threads, chunk, monodromy, max_halvings, ..CorrectorOptions::default() };
     let f = &forcing.inner;
     let out = py

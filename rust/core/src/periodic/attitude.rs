@@ -69,7 +69,10 @@ pub enum Free {
 /// Why the corrector stopped on a candidate.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum StopReason {
-    /// Residual max-norm <= tol.
+    /// Residual max-norm <= tol; or, where no Newton step descends any more, <= tol times the
+    /// largest |d F / d x| (at least 1): the integration's noise floor amplified by the
+    /// motion's instability (|trace| of the monodromy ~ 1e3 for some SRP-dominated motions),
+    /// the unknowns then being known to about tol.
     Converged,
     /// `max_iter` Newton steps taken without convergence.
     MaxIterations,
@@ -105,18 +108,27 @@ pub struct Candidate {
     pub turns: f64,
     /// The starting orbit's x0 for [`correct_across_family`] (NaN otherwise).
     pub x0: f64,
+    /// This candidate's linear condition (a, b) of a bordered correction, replacing the
+    /// [`Bordered`]'s own: candidates of different branches corrected in one batch.
+    pub condition: Option<([f64; 3], f64)>,
 }
 
 impl Candidate {
     /// A gravity-gradient-only candidate.
     pub fn new(phi0: f64, wz0: f64, kz: f64, turns: f64) -> Self {
-        Self { case: Case::new(phi0, wz0, kz), turns, x0: f64::NAN }
+        Self { case: Case::new(phi0, wz0, kz), turns, x0: f64::NAN, condition: None }
     }
 
     /// The same candidate started on the orbit of the family member at `x0`
     /// ([`correct_across_family`]).
     pub fn with_x0(self, x0: f64) -> Self {
         Self { x0, ..self }
+    }
+
+    /// The same candidate closed by its own linear condition `a . (angle, wz0, parameter) = b`
+    /// in a bordered correction (each branch of a lock-step continuation has its own).
+    pub fn with_condition(self, a: [f64; 3], b: f64) -> Self {
+        Self { condition: Some((a, b)), ..self }
     }
 
     /// The same candidate with a flat plate (SRP amplitude `eps`, coefficients, Sun phase).
@@ -423,14 +435,22 @@ impl Form {
             let (rp, rm) = (self.closure_residual(c, x, &o[j]), self.closure_residual(c, x, &o[j + 1]));
             jac[PARAM] = (rp[0] - rm[0]) / (pp - pm);
             jac[3 + PARAM] = (rp[1] - rm[1]) / (pp - pm);
-            f[2] = b.a[0] * x[0] + b.a[1] * x[1] + b.a[2] * x[2] - b.b;
-            jac[6..9].copy_from_slice(&b.a);
+            let (a, rhs) = c.condition.unwrap_or((b.a, b.b));
+            f[2] = a[0] * x[0] + a[1] * x[1] + a[2] * x[2] - rhs;
+            jac[6..9].copy_from_slice(&a);
         }
         let rows = self.rows();
         let norm = rows.iter().fold(0.0f64, |a, &i| a.max(f[i].abs()));
         let merit = rows.iter().map(|&i| f[i] * f[i]).sum::<f64>().sqrt();
         let used = rows.iter().all(|&i| self.cols().iter().all(|&j| jac[3 * i + j].is_finite()));
         (norm.is_finite() && merit.is_finite() && used).then_some(Point { x, f, norm, merit, jac, stm: m })
+    }
+
+    /// The largest |d F / d x| of the closure rows in use (at least 1): the factor by which
+    /// errors in the unknowns, and the integration's own, show in the residual.
+    fn conditioning(&self, p: &Point) -> f64 {
+        let rows = self.rows().iter().filter(|&&r| r < PARAM);
+        rows.flat_map(|&r| self.cols().iter().map(move |&c| p.jac[3 * r + c].abs())).fold(1.0, f64::max)
     }
 
     /// Newton direction at p (minimum-norm step when J is rank-deficient) and whether J was;
@@ -494,7 +514,9 @@ impl Track {
                         self.next_step(form, opts);
                     }
                     None if halvings >= opts.max_halvings => {
-                        self.phase = Phase::Done(if !integrated {
+                        self.phase = Phase::Done(if integrated && cur.norm <= opts.tol * form.conditioning(&cur) {
+                            StopReason::Converged
+                        } else if !integrated {
                             StopReason::IntegrationFailed
                         } else if self.rank_deficient {
                             StopReason::SingularJacobian
@@ -713,7 +735,7 @@ pub fn correct_bordered(
     candidates: &[Candidate],
     opts: &CorrectorOptions,
 ) -> Result<Vec<Correction>> {
-    validate_bordered(bordered, closure)?;
+    validate_bordered(bordered, closure, candidates)?;
     if bordered.parameter == Parameter::OrbitX0 {
         return Err(invalid("parameter", "the orbit's x0 is freed by correct_across_family"));
     }
@@ -723,19 +745,31 @@ pub fn correct_bordered(
     run(form, candidates, opts, &on_table(forcing, t_final, opts))
 }
 
-fn validate_bordered(bordered: &Bordered, closure: Closure) -> Result<()> {
-    check_finite("a", &bordered.a)?;
-    if !bordered.b.is_finite() {
-        return Err(invalid("b", format!("must be finite, got {}", bordered.b)));
+fn validate_condition(a: &[f64; 3], b: f64, closure: Closure, whose: &str) -> Result<()> {
+    if let Some(i) = a.iter().position(|v| !v.is_finite()) {
+        return Err(invalid("a", format!("{whose}must be finite, component {i} is {}", a[i])));
+    }
+    if !b.is_finite() {
+        return Err(invalid("b", format!("{whose}must be finite, got {b}")));
+    }
+    if closure == Closure::Half && a[0] != 0.0 {
+        return Err(invalid("a", format!("{whose}the half-period closure has no angle unknown: a[0] must be 0")));
+    }
+    if a.iter().all(|&v| v == 0.0) {
+        return Err(invalid("a", format!("{whose}the linear condition needs a non-zero row")));
+    }
+    Ok(())
+}
+
+fn validate_bordered(bordered: &Bordered, closure: Closure, candidates: &[Candidate]) -> Result<()> {
+    validate_condition(&bordered.a, bordered.b, closure, "")?;
+    for (i, c) in candidates.iter().enumerate() {
+        if let Some((a, b)) = c.condition {
+            validate_condition(&a, b, closure, &format!("candidate {i}: "))?;
+        }
     }
     check_positive("step", bordered.step)?;
     check_positive("max_step", bordered.max_step)?;
-    if closure == Closure::Half && bordered.a[0] != 0.0 {
-        return Err(invalid("a", "the half-period closure has no angle unknown: a[0] must be 0"));
-    }
-    if bordered.a.iter().all(|&v| v == 0.0) {
-        return Err(invalid("a", "the linear condition needs a non-zero row"));
-    }
     if bordered.parameter == Parameter::Eps && closure == Closure::Half {
         return Err(invalid("parameter", "eps breaks the mirror symmetry: continue in eps with Closure::Full"));
     }
@@ -751,7 +785,12 @@ type Integrate<'a> = dyn Fn(&[Case], &[f64], bool) -> Result<Vec<Outcome>> + Syn
 fn on_table<'a>(forcing: &'a OrbitForcing, t_final: f64, opts: &CorrectorOptions) -> impl Fn(&[Case], &[f64], bool) -> Result<Vec<Outcome>> + Sync + 'a {
     let lane = LaneOptions { rtol: opts.rtol, atol: opts.atol, max_steps: opts.max_steps, sun_omega: opts.sun_omega };
     let chunk = opts.chunk;
-    move |cases: &[Case], _: &[f64], full: bool| map::sweep(forcing, if full { 2.0 * t_final } else { t_final }, cases, &lane, true, chunk, None)
+    move |cases: &[Case], _: &[f64], full: bool| {
+        // small batches (a few branches of a lock-step continuation) still spread over every
+        // worker: no more than an even share per task (results do not depend on the chunk)
+        let share = cases.len().div_ceil(rayon::current_num_threads()).max(1);
+        map::sweep(forcing, if full { 2.0 * t_final } else { t_final }, cases, &lane, true, chunk.min(share), None)
+    }
 }
 
 const FAILED: Outcome = Outcome { phi_t: f64::NAN, wz_t: f64::NAN, stm: [f64::NAN; 4], accepted: 0, rejected: 0, status: LaneStatus::Failed };
@@ -883,7 +922,7 @@ pub fn correct_across_family(family: &PlanarFamily, bordered: &Bordered, candida
     if bordered.parameter != Parameter::OrbitX0 {
         return Err(invalid("parameter", "correct_across_family frees the orbit's x0 (Parameter::OrbitX0)"));
     }
-    validate_bordered(bordered, Closure::Half)?;
+    validate_bordered(bordered, Closure::Half, candidates)?;
     validate_options(opts)?;
     validate_candidates(Closure::Half, Free::Phi0, candidates)?;
     let form = Form { closure: Closure::Half, free: Free::Phi0, h: opts.phase_step, bordered: Some(*bordered), bounds: family.range() };
