@@ -4,7 +4,12 @@ A family is computed by continuation (``librate.orbits.continuation``), every me
 its monodromy matrix (batch-propagated on all cores), and bifurcations located where a
 stability index crosses +1 or -1. :class:`OrbitFamily` holds the members, finds members by x0,
 z0, period or Jacobi constant by root finding on the family (returning a corrected orbit),
-and saves to / loads from a self-describing netCDF or Zarr file (xarray Dataset).
+saves to / loads from a self-describing netCDF or Zarr file (xarray Dataset), and reads and
+writes the JPL Three-Body Periodic Orbits catalog's JSON format (:mod:`librate.orbits.jpl`).
+
+Where ``state0`` lies: planar families start on the x axis. Spatial families (halos, NRHOs)
+start at the x-z-plane crossing in the branch's hemisphere, as the JPL catalog lists them: a
+southern halo at its crossing with z < 0 (apolune for the NRHOs), a northern one at z > 0.
 """
 
 from __future__ import annotations
@@ -20,7 +25,7 @@ from .._checks import as_count, as_real
 from .._errors import ConvergenceError, LibrateError
 from ..constants import SUN_SYNODIC_PERIOD
 from .continuation import continue_arclength, continue_natural, geometry
-from .periodic import SHOOT_ATOL, SHOOT_RTOL, PeriodicOrbit, correct_symmetric
+from .periodic import SHOOT_ATOL, SHOOT_RTOL, PeriodicOrbit, correct_symmetric, real_if_real
 from .propagation import propagate_many
 from .system import System, resolve_system
 
@@ -34,8 +39,14 @@ class OrbitFamily:
     Arrays over members: ``state0`` (n, 6) initial states on the x-z plane, ``state_half`` (n, 6)
     the states at the half-period crossing (the other symmetric point of the same orbit),
     ``period`` (TU), ``jacobi``, ``eigenvalues`` (n, 6) complex, ``stability_indices`` (n, 2)
-    complex ([in-plane, out-of-plane] for planar families). ``end_reason`` says why the
-    continuation stopped; ``bifurcations`` lists the members where an index crosses +1 or -1.
+    ([in-plane, out-of-plane] for planar families; float when every index is real, complex
+    only when some member has a complex pair). ``end_reason`` says why the continuation
+    stopped; ``bifurcations`` lists the members where an index crosses +1 or -1.
+
+    For spatial families ``state0`` is the crossing in the branch's hemisphere (z < 0 for a
+    southern halo, z > 0 for a northern one), the JPL catalog's convention; ``x0`` and ``z0``
+    refer to it. A family read by :meth:`from_jpl` keeps the catalog's crossing and carries
+    ``import_report``, the per-row record of the import (not saved by :meth:`save`).
     """
 
     system: System
@@ -50,6 +61,7 @@ class OrbitFamily:
     end_reason: str = ""
     bifurcations: list[dict] = field(default_factory=list)
     parameters: dict = field(default_factory=dict)
+    import_report: object = field(default=None, repr=False, compare=False)
 
     # --- construction ----------------------------------------------------------------------
     @classmethod
@@ -65,9 +77,20 @@ class OrbitFamily:
         for i in range(len(members)):
             if batch.ok[i]:
                 eig[i], nu[i] = _core.stability(np.ascontiguousarray(batch.stm[i]), not spatial)
-        fam = cls(system, kind, spatial, state0, half, period, np.array([m.jacobi for m in members]), eig, nu, end_reason, [], dict(parameters or {}))
+        fam = cls(system, kind, spatial, state0, half, period, np.array([m.jacobi for m in members]), eig, real_if_real(nu), end_reason, [],
+                  dict(parameters or {}))
         fam.bifurcations = fam._find_bifurcations()
         return fam
+
+    def _hemisphere_first(self, sign: float) -> None:
+        """Put each member's ``state0`` at its x-z-plane crossing farther into the hemisphere
+        ``sign`` (-1 south, +1 north), swapping it with ``state_half`` where needed (the same
+        orbit, started half a period later), and relocate the bifurcations on the new x0."""
+        swap = sign * self.state_half[:, 2] > sign * self.state0[:, 2]
+        s0 = np.where(swap[:, None], self.state_half, self.state0)
+        self.state_half = np.where(swap[:, None], self.state0, self.state_half)
+        self.state0 = s0
+        self.bifurcations = self._find_bifurcations()
 
     def _find_bifurcations(self) -> list[dict]:
         names = ("in-plane", "out-of-plane") if not self.spatial else ("index 1", "index 2")
@@ -118,55 +141,64 @@ class OrbitFamily:
 
     # --- lookup ----------------------------------------------------------------------------
     def member(self, *, x0: float | None = None, z0: float | None = None, period: float | None = None,
-               period_days: float | None = None, jacobi: float | None = None, which: int = 0) -> PeriodicOrbit:
+               period_days: float | None = None, jacobi: float | None = None, which: int | None = None) -> PeriodicOrbit:
         """The corrected member with the given x0, z0, period (TU or days) or Jacobi constant.
 
-        Root finding on the family: the target is bracketed between two members (for halos,
-        also among the half-period crossing states), the guess interpolated linearly, and the
-        orbit corrected with that quantity imposed. ``which`` picks among several brackets.
-        Raises ``ValueError`` when the value is outside the family's range.
+        Root finding on the family: every interval between consecutive members where the
+        quantity crosses the value is a candidate (``x0`` and ``z0`` are those of ``state0``:
+        for spatial families the crossing in the branch's hemisphere); the guess is
+        interpolated linearly and the orbit corrected with that quantity imposed, so the
+        returned ``state0`` is at the same crossing as the family's. A value exactly at a
+        member returns that member (re-corrected).
+
+        The candidates are ordered by period (increasing). When several members have the value
+        (x0, z0 and the Jacobi constant are not monotonic along a halo family), ``ValueError``
+        lists them with their periods and ``which`` (an index into that list) picks one; with a
+        single candidate ``which`` may be omitted or 0. Raises ``ValueError`` when the value is
+        outside the family's range.
         """
         given = {k: v for k, v in dict(x0=x0, z0=z0, period=period, period_days=period_days, jacobi=jacobi).items() if v is not None}
         if len(given) != 1:
             raise ValueError("invalid argument: give exactly one of x0, z0, period, period_days, jacobi")
         (name, value), = given.items()
+        user = name
         value = as_real(value, name)
         if name == "period_days":
             name, value = "period", self.system.from_days(value)
         if name == "z0" and not self.spatial:
             raise ValueError("invalid argument `z0`: this family is planar (z0 = 0)")
-        sets = [self.state0] + ([self.state_half] if self.spatial else [])
-        brackets = []
-        for states in sets:
-            q = {"x0": states[:, 0], "z0": states[:, 2], "period": self.period, "jacobi": self.jacobi}[name]
-            d = q - value
-            for i in range(len(d) - 1):
-                if d[i] == 0 or d[i] * d[i + 1] < 0:
-                    w = 0.0 if d[i] == 0 else d[i] / (d[i] - d[i + 1])
-                    brackets.append((states[i] + w * (states[i + 1] - states[i]), i))
-            if d[-1] == 0:
-                brackets.append((states[-1], len(d) - 1))
-        if not brackets:
-            # the ranges searched: for halos, z0 at the half-period crossing too (the other
-            # side of the x-y plane), so the accepted values may form two intervals
-            user = next(iter(given))
-            spans = []
-            for st, what in zip(sets, ("initial states", "half-period crossings")):
-                q = {"x0": st[:, 0], "z0": st[:, 2], "period": self.period, "jacobi": self.jacobi}[name]
-                if user == "period_days":
-                    q = self.system.period_days(q)
-                spans.append(f"[{np.min(q):.10g}, {np.max(q):.10g}]" + (f" ({what})" if len(sets) > 1 and name in ("x0", "z0") else ""))
-                if name not in ("x0", "z0"):
-                    break
+        if which is not None and (isinstance(which, (bool, np.bool_)) or not isinstance(which, (int, np.integer))):
+            raise ValueError(f"invalid argument `which`: must be an integer index into the candidates (ordered by period), got {which!r}")
+        q = {"x0": self.state0[:, 0], "z0": self.state0[:, 2], "period": self.period, "jacobi": self.jacobi}[name]
+        d = q - value
+        cands = []  # (period, state0) interpolated at the crossing of the value
+        for i in range(len(d) - 1):
+            if d[i] == 0 or d[i] * d[i + 1] < 0:
+                w = 0.0 if d[i] == 0 else d[i] / (d[i] - d[i + 1])
+                cands.append((float(self.period[i] + w * (self.period[i + 1] - self.period[i])), self.state0[i] + w * (self.state0[i + 1] - self.state0[i])))
+        if len(d) and d[-1] == 0:
+            cands.append((float(self.period[-1]), self.state0[-1]))
+        if not cands:
+            shown = self.system.period_days(q) if user == "period_days" else q
+            where = " (at state0, the crossing in the branch's hemisphere)" if self.spatial and name in ("x0", "z0") else ""
             raise ValueError(
                 f"invalid argument `{user}`: {float(given[user])!r} is outside the {self.kind} family's range "
-                f"{' or '.join(spans)} (family end: {self.end_reason})"
+                f"[{np.min(shown):.10g}, {np.max(shown):.10g}]{where} (family end: {self.end_reason})"
             )
-        if not 0 <= which < len(brackets):
-            raise ValueError(f"invalid argument `which`: the value is bracketed {len(brackets)} time(s); which must be in 0..{len(brackets) - 1}")
-        guess, _ = brackets[which]
+        cands.sort(key=lambda c: c[0])
+        listing = "; ".join(f"which={k}: period {t:.10g} TU ({self.system.period_days(t):.6g} d), x0 {s[0]:.10g}, z0 {s[2]:.10g}"
+                            for k, (t, s) in enumerate(cands))
+        if which is None and len(cands) > 1:
+            err = ValueError(f"ambiguous `{user}` = {float(given[user])!r}: {len(cands)} members of the {self.kind} family have it "
+                             f"(values interpolated between members, ordered by period); pass which= to pick one: {listing}")
+            err.candidates = [{"period": t, "state0": s.copy()} for t, s in cands]  # type: ignore[attr-defined]
+            raise err
+        k = 0 if which is None else int(which)
+        if not 0 <= k < len(cands):
+            raise ValueError(f"invalid argument `which`: {len(cands)} member(s) have {user} = {float(given[user])!r}, so which must be in "
+                             f"0..{len(cands) - 1} (ordered by period: {listing}); got {which!r}")
+        g = cands[k][1].copy()
         kw = {"x0": dict(fix="x0"), "z0": dict(fix="z0"), "period": dict(period=value), "jacobi": dict(jacobi=value)}[name]
-        g = guess.copy()
         if name == "x0":
             g[0] = value
         elif name == "z0":
@@ -219,9 +251,15 @@ class OrbitFamily:
                 "bifurcations": repr(self.bifurcations),
                 "parameters": repr(self.parameters),
                 "conventions": "CR3BP synodic frame, nondimensional; Earth at (-mu,0,0), Moon at (1-mu,0,0)",
+                STATE0_ATTR: self._state0_convention(),
             },
         )
         return ds
+
+    def _state0_convention(self) -> str:
+        if not self.spatial:
+            return "planar"
+        return "jpl" if "jpl_family" in self.parameters else "hemisphere"
 
     def save(self, path) -> None:
         """Write to netCDF (``.nc``) or Zarr (``.zarr``), with a digest of every variable
@@ -255,7 +293,13 @@ class OrbitFamily:
         Raises ``FileNotFoundError``, or ``ValueError`` saying why ``path`` is not a (valid)
         librate family file: unreadable (empty, truncated, garbage, not netCDF or Zarr), another
         kind of file (no family variables or attributes), or damaged (a missing chunk, or a
-        variable that does not match its stored checksum)."""
+        variable that does not match its stored checksum).
+
+        Files written before librate stored spatial families at the branch's hemisphere
+        crossing (no attribute ``state0_convention``) held ``state0`` at the other crossing;
+        a halo family's is converted on loading (each member's two crossings swapped, which
+        ``parameters["state0_converted"]`` records). A spatial family without a known branch
+        cannot be converted and is refused with ``ValueError``."""
         import ast
         import json
         from pathlib import Path
@@ -326,13 +370,27 @@ class OrbitFamily:
                 params = ast.literal_eval(str(a["parameters"]))
             except (ValueError, TypeError, SyntaxError, LibrateError) as err:
                 raise ValueError(f"{not_family}: invalid attributes ({type(err).__name__}: {err})") from None
-            return cls(
+            convention = a.get(STATE0_ATTR)
+            if spatial and convention is None and params.get("branch") not in ("north", "south"):
+                raise ValueError(f"{name!r} holds a spatial family written by an older librate, with state0 at the crossing continued from "
+                                 "its first member; without a halo branch (parameters['branch'] = 'north' or 'south') it cannot be converted "
+                                 "to the branch-hemisphere convention: recompute the family and save it again")
+            fam = cls(
                 system, str(a["kind"]), spatial,
                 values["state0"].copy(), values["state_half"].copy(), values["period"].copy(), values["jacobi"].copy(),
                 values["eigenvalues_real"] + 1j * values["eigenvalues_imag"],
-                values["stability_real"] + 1j * values["stability_imag"],
+                real_if_real(values["stability_real"] + 1j * values["stability_imag"]),
                 str(a["end_reason"]), bif, params,
             )
+            if spatial and convention is None:
+                fam._hemisphere_first(_check_branch(params["branch"]))
+                fam.parameters["state0_converted"] = "file written before the branch-hemisphere convention: crossings swapped on loading"
+            return fam
+
+
+#: Dataset attribute naming where a spatial family's state0 lies: "hemisphere" (the crossing in
+#: the branch's hemisphere), "jpl" (the catalog's crossing, for imported families), "planar".
+STATE0_ATTR = "state0_convention"
 
 
 # --- DROs ------------------------------------------------------------------------------------
@@ -557,8 +615,9 @@ def halo_family(system: System | str = "earth-moon", point: int = 2, branch: str
     ``branch`` follows the usual convention (and the JPL catalog's): a southern halo has its
     largest excursion from the x-y plane (apolune, for L2) below it, z < 0; a northern one
     above. The two are mirror images under z -> -z, so one is computed and mirrored. ``state0``
-    is the symmetric crossing continued from the Lyapunov start (the side of L toward the
-    larger primary); ``state_half`` the other one.
+    is each member's x-z-plane crossing in the branch's hemisphere (the one with the smaller z
+    for south, the larger for north), as the JPL catalog lists them; ``state_half`` the other
+    one. Neither x0 nor z0 is monotonic along the family; the period is, for L2.
     """
     sys_ = resolve_system(system)
     point = _check_point(point)
@@ -586,6 +645,7 @@ def halo_family(system: System | str = "earth-moon", point: int = 2, branch: str
         flip = np.array([1.0, 1.0, -1.0, 1.0, 1.0, -1.0])
         fam.state0 = fam.state0 * flip
         fam.state_half = fam.state_half * flip
+    fam._hemisphere_first(sign)
     return fam
 
 
@@ -596,9 +656,14 @@ def _cached_halo(system: System, point: int, branch: str) -> OrbitFamily:
 
 def halo(system: System | str = "earth-moon", point: int = 2, branch: str = "south", *, x0: float | None = None,
          z0: float | None = None, period: float | None = None, period_days: float | None = None,
-         jacobi: float | None = None, which: int = 0) -> PeriodicOrbit:
+         jacobi: float | None = None, which: int | None = None) -> PeriodicOrbit:
     """One halo orbit at L1/L2 (north or south branch) by x0, z0, period (TU or days) or Jacobi
-    constant, found on the family (computed once per system and cached)."""
+    constant, found on the family (computed once per system and cached).
+
+    ``x0`` and ``z0`` are those of ``state0``, the x-z-plane crossing in the branch's
+    hemisphere (the JPL catalog's). When several members have the value, ``ValueError`` lists
+    them with their periods; ``which`` (an index, ordered by period) picks one
+    (:meth:`OrbitFamily.member`)."""
     sys_ = resolve_system(system)
     point = _check_point(point)
     _check_branch(branch)
