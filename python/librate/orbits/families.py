@@ -175,9 +175,9 @@ class OrbitFamily:
         for i in range(len(d) - 1):
             if d[i] == 0 or d[i] * d[i + 1] < 0:
                 w = 0.0 if d[i] == 0 else d[i] / (d[i] - d[i + 1])
-                cands.append((float(self.period[i] + w * (self.period[i + 1] - self.period[i])), self.state0[i] + w * (self.state0[i + 1] - self.state0[i])))
+                cands.append((float(self.period[i] + w * (self.period[i + 1] - self.period[i])), self.state0[i] + w * (self.state0[i + 1] - self.state0[i]), i))
         if len(d) and d[-1] == 0:
-            cands.append((float(self.period[-1]), self.state0[-1]))
+            cands.append((float(self.period[-1]), self.state0[-1], len(d) - 1))
         if not cands:
             shown = self.system.period_days(q) if user == "period_days" else q
             where = " (at state0, the crossing in the branch's hemisphere)" if self.spatial and name in ("x0", "z0") else ""
@@ -187,17 +187,55 @@ class OrbitFamily:
             )
         cands.sort(key=lambda c: c[0])
         listing = "; ".join(f"which={k}: period {t:.10g} TU ({self.system.period_days(t):.6g} d), x0 {s[0]:.10g}, z0 {s[2]:.10g}"
-                            for k, (t, s) in enumerate(cands))
+                            for k, (t, s, _) in enumerate(cands))
         if which is None and len(cands) > 1:
             err = ValueError(f"ambiguous `{user}` = {float(given[user])!r}: {len(cands)} members of the {self.kind} family have it "
                              f"(values interpolated between members, ordered by period); pass which= to pick one: {listing}")
-            err.candidates = [{"period": t, "state0": s.copy()} for t, s in cands]  # type: ignore[attr-defined]
+            err.candidates = [{"period": t, "state0": s.copy()} for t, s, _ in cands]  # type: ignore[attr-defined]
             raise err
         k = 0 if which is None else int(which)
         if not 0 <= k < len(cands):
             raise ValueError(f"invalid argument `which`: {len(cands)} member(s) have {user} = {float(given[user])!r}, so which must be in "
                              f"0..{len(cands) - 1} (ordered by period: {listing}); got {which!r}")
-        g = cands[k][1].copy()
+        _, guess, i = cands[k]
+        if guess is self.state0[i] or i == len(self) - 1:  # the value is a member's
+            return self._correct_at(guess, name, value)
+        a, b = self.state0[i], self.state0[i + 1]
+        try:
+            orbit = self._correct_at(guess, name, value)
+            if _between(orbit.state0, a, b):
+                return orbit
+        except ConvergenceError:
+            pass
+        # The correction left the bracket (near a fold of the quantity the two solutions are
+        # close) or failed: continue the family finely from member i past member i + 1 (the
+        # continuation driver, pseudo-arclength) and correct from the fine bracket.
+        start = correct_symmetric(self.system, a, spatial=self.spatial, fix="x0", family=self.kind)
+        pa, chord = a[[0, 2, 4]], b[[0, 2, 4]] - a[[0, 2, 4]]
+        length = float(np.linalg.norm(chord))
+
+        def past(o, _g):
+            return "past the next member" if np.dot(np.array([o.x0, o.z0, o.vy0]) - pa, chord) >= 1.05 * length**2 else None
+
+        fine = continue_arclength(self.system, start, spatial=self.spatial, orient=chord, ds=length / 10, ds_min=length * 1e-6,
+                                  ds_max=length / 5, max_members=80, family=self.kind, check_geometry=False, stop=past).members
+        col = {"x0": lambda o: o.x0, "z0": lambda o: o.z0, "period": lambda o: o.period, "jacobi": lambda o: o.jacobi}[name]
+        fq = np.array([col(o) for o in fine]) - value
+        for j in range(len(fine) - 1):
+            if fq[j] == 0:
+                return fine[j]
+            if fq[j] * fq[j + 1] < 0:
+                w = fq[j] / (fq[j] - fq[j + 1])
+                fa, fb = fine[j].state0, fine[j + 1].state0
+                orbit = self._correct_at(fa + w * (fb - fa), name, value)
+                if _between(orbit.state0, fa, fb):
+                    return orbit
+                break
+        raise ConvergenceError(f"{self.kind} member at {name} = {value!r} between members {i} and {i + 1}: the correction converged "
+                               "outside that interval, also from the family continued finely between them")
+
+    def _correct_at(self, guess: np.ndarray, name: str, value: float) -> PeriodicOrbit:
+        g = np.array(guess, dtype=float)
         kw = {"x0": dict(fix="x0"), "z0": dict(fix="z0"), "period": dict(period=value), "jacobi": dict(jacobi=value)}[name]
         if name == "x0":
             g[0] = value
@@ -214,6 +252,78 @@ class OrbitFamily:
             raise ValueError(f"invalid argument `kind`: must be 'synodic' or 'sun', got {kind!r}")
         base = 2 * math.pi if kind == "synodic" else SUN_SYNODIC_PERIOD
         return self.member(period=base / k)
+
+    # --- the JPL catalog format ---------------------------------------------------------------
+    @classmethod
+    def from_jpl(cls, source) -> OrbitFamily:
+        """A family from a JPL Three-Body Periodic Orbits API response (a dict, or the path of
+        its JSON file, e.g. ``https://ssd-api.jpl.nasa.gov/periodic_orbits.api?sys=earth-moon&family=halo&libr=2&branch=S``),
+        any family and system the format carries.
+
+        The system is the file's: mass ratio ``mass_ratio``, units ``lunit`` (km) and ``tunit``
+        (s); a preset when they match one (``earth-moon-jpl`` for the Earth-Moon catalog, whose
+        radii are then used), otherwise a new :class:`System` with the secondary's radius from
+        the file. Every row is re-corrected in librate's dynamics, except rows that pass within
+        a primary's radius (flagged) and rows not at a perpendicular x-z-plane crossing (see
+        :func:`librate.orbits.jpl.recorrect`). The members keep the catalog's crossing as
+        ``state0`` and are ordered along the family (the catalog sorts rows by Jacobi constant;
+        :func:`librate.orbits.jpl.order_along_family`).
+
+        ``import_report`` (an xarray Dataset over the file's rows) records each row's closure
+        before and after the correction, its status and flags, and its member index;
+        ``parameters`` keep the catalog's family, libration point, branch and signature.
+        Raises ``ValueError`` for a file that is not such a response and
+        :class:`librate.LibrateError` when no row could be re-corrected.
+        """
+        from .jpl import kind_from_jpl, order_along_family, read_jpl, recorrect
+
+        cat = read_jpl(source)
+        kind = kind_from_jpl(cat.family, cat.libration_point, cat.branch)
+        spatial = bool(np.any(np.abs(cat.states[:, 2]) > 1e-9) or np.any(np.abs(cat.states[:, 5]) > 1e-9))
+        members, rows, report = recorrect(cat, kind, spatial)
+        if not members:
+            raise LibrateError(f"no row of the JPL {kind} file could be re-corrected ({len(cat.period)} rows): "
+                               f"{sorted(set(str(s) for s in report['status'].values))}")
+        order = order_along_family(np.array([m.state0 for m in members]), np.array([m.period for m in members]))
+        members = [members[i] for i in order]
+        rows = [rows[i] for i in order]
+        member = np.full(len(cat.period), -1, dtype=np.int64)
+        member[np.array(rows, dtype=np.intp)] = np.arange(len(rows))
+        report["member"] = ("row", member)
+        n_in = int(report["within_primary1_radius"].sum() + report["within_primary2_radius"].sum())
+        params = {"jpl_family": cat.family, "jpl_libration_point": cat.libration_point, "jpl_branch": cat.branch,
+                  "jpl_signature": cat.header.get("signature"), "jpl_count": cat.header.get("count"), "jpl_rows": rows}
+        if cat.libration_point and cat.libration_point.isdigit():
+            params["point"] = int(cat.libration_point)
+        if cat.branch in ("N", "S"):
+            params["branch"] = "north" if cat.branch == "N" else "south"
+        end = (f"imported from the JPL catalog: {len(members)} of {len(cat.period)} rows re-corrected, "
+               f"{n_in} passing within a primary's radius flagged")
+        fam = cls.from_members(cat.system, kind, spatial, members, end, params)
+        fam.import_report = report
+        return fam
+
+    def to_jpl(self, path) -> None:
+        """Write the family as a JPL Three-Body Periodic Orbits API response (JSON; the format
+        :meth:`from_jpl` reads): the system block (mass ratio, units, radius of the secondary,
+        L1..L5), family / libration point / branch (the catalog's names, e.g. halo, 2, S),
+        limits, and one row per member: ``state0``, Jacobi constant, period and the catalog's
+        stability index (|lambda| + 1/|lambda|)/2 of the largest multiplier
+        (:func:`librate.orbits.jpl.jpl_stability`). The signature names librate as the source."""
+        import json
+        from pathlib import Path
+
+        from .._core import __version__
+        from .jpl import jpl_document, jpl_stability
+
+        p = Path(path)
+        if p.suffix.lower() != ".json":
+            raise ValueError(f"invalid argument `path`: must end in .json, got {str(path)!r}")
+        doc = jpl_document(self.system, self.kind, self.parameters, self.state0, self.jacobi, self.period, jpl_stability(self.eigenvalues), __version__)
+        p.parent.mkdir(parents=True, exist_ok=True)
+        tmp = p.with_name(p.name + ".tmp")
+        tmp.write_text(json.dumps(doc), encoding="utf-8")
+        tmp.replace(p)
 
     # --- I/O -------------------------------------------------------------------------------
     def to_dataset(self):
@@ -386,6 +496,20 @@ class OrbitFamily:
                 fam._hemisphere_first(_check_branch(params["branch"]))
                 fam.parameters["state0_converted"] = "file written before the branch-hemisphere convention: crossings swapped on loading"
             return fam
+
+
+def _between(state: np.ndarray, a: np.ndarray, b: np.ndarray, margin: float = 0.1) -> bool:
+    """Whether ``state`` lies on the family between members ``a`` and ``b``: its (x0, z0, vy0)
+    projects onto the chord a -> b within [-margin, 1 + margin] of its length and lies within
+    half a chord of it."""
+    p, pa, pb = state[[0, 2, 4]], a[[0, 2, 4]], b[[0, 2, 4]]
+    c = pb - pa
+    cc = float(np.dot(c, c))
+    if cc == 0.0:
+        return bool(np.allclose(p, pa, rtol=0, atol=1e-9))
+    u = float(np.dot(p - pa, c)) / cc
+    off = float(np.linalg.norm(p - pa - u * c))
+    return -margin <= u <= 1 + margin and off <= 0.5 * math.sqrt(cc)
 
 
 #: Dataset attribute naming where a spatial family's state0 lies: "hemisphere" (the crossing in
