@@ -227,3 +227,43 @@ def test_stability_indices_are_real_where_real(south, em):
     assert real_if_real(np.array([1.5 + 0j, -0.7 + 0j])).dtype == np.float64
     c = real_if_real(np.array([0.8 + 0.3j, 0.8 - 0.3j]))
     assert c.dtype == np.complex128 and c[0] == 0.8 + 0.3j
+
+
+def test_study_names_an_ambiguous_z0():
+    """A study selecting a halo by a z0 that two members have is refused with both periods and the
+    way out (select by period), not reported as outside the family."""
+    from librate.app.study import Study, StudyError
+
+    st = Study.from_dict({"system": {"preset": "earth-moon-jpl"}, "orbits": {"kind": "halo", "point": 2, "branch": "south", "z0": [-0.2023174456]}})
+    with pytest.raises(StudyError, match=r"orbits\.z0 = \[-0\.2023174456\]: 2 members .* \(periods 10\.26, 10\.53 d\).*orbits\.period_days"):
+        st.build_orbits()
+
+
+def test_old_planar_files_load_unchanged(tmp_path, em):
+    """Planar families never changed convention: an old file (no state0_convention) loads as is."""
+    from librate._integrity import CHECKSUM_ATTR, dataset_checksums, write_atomically
+
+    fam = librate.dro_family(em, x0=[0.9, 0.85])
+    ds = fam.to_dataset()
+    del ds.attrs["state0_convention"]
+    ds.attrs[CHECKSUM_ATTR] = dataset_checksums(ds)
+    write_atomically(ds, tmp_path / "old.nc")
+    back = librate.OrbitFamily.load(tmp_path / "old.nc")
+    np.testing.assert_array_equal(back.state0, fam.state0)
+    assert back.stability_indices.dtype == np.float64 and "state0_converted" not in back.parameters
+
+
+def test_planar_round_trip_with_librate_data(em, tmp_path):
+    """Round trip of a planar family (librate's own DROs, not catalog data): family "dro", no
+    libration point, the earth-moon preset recognised from mass ratio and units, members back to
+    1e-10 (ordered from the longest period) and the in-plane / out-of-plane indices to 1e-6."""
+    fam = librate.dro_family(em, x0=[0.9, 0.85, 0.8])
+    p = tmp_path / "dro.json"
+    fam.to_jpl(p)
+    doc = json.loads(p.read_text())
+    assert doc["family"] == "dro" and "libration_point" not in doc and "branch" not in doc
+    back = librate.OrbitFamily.from_jpl(p)
+    assert back.kind == "dro" and not back.spatial and back.system == em
+    # members are ordered along the family from the longest period: x0 = 0.8 first
+    np.testing.assert_allclose(back.state0, fam.state0[::-1], rtol=0, atol=1e-10)
+    np.testing.assert_allclose(back.stability_indices, fam.stability_indices[::-1], rtol=1e-6)

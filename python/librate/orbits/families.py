@@ -198,7 +198,7 @@ class OrbitFamily:
             raise ValueError(f"invalid argument `which`: {len(cands)} member(s) have {user} = {float(given[user])!r}, so which must be in "
                              f"0..{len(cands) - 1} (ordered by period: {listing}); got {which!r}")
         _, guess, i = cands[k]
-        if guess is self.state0[i] or i == len(self) - 1:  # the value is a member's
+        if i == len(self) - 1:  # the value is the last member's
             return self._correct_at(guess, name, value)
         a, b = self.state0[i], self.state0[i + 1]
         try:
@@ -658,11 +658,12 @@ def _one_target(kw: dict) -> tuple[str, float]:
 
 
 def dro(system: System | str = "earth-moon", *, x0: float | None = None, period: float | None = None,
-        period_days: float | None = None, jacobi: float | None = None) -> PeriodicOrbit:
+        period_days: float | None = None, jacobi: float | None = None, which: int | None = None) -> PeriodicOrbit:
     """One corrected DRO, chosen by x0, period (TU or days) or Jacobi constant.
 
     Near the Moon (x0 >= 0.8) x0 is corrected directly; otherwise the member is found on the
-    whole family (computed once per system and cached)."""
+    whole family (computed once per system and cached); ``which`` as in
+    :meth:`OrbitFamily.member`, for a value that several members have."""
     sys_ = resolve_system(system)
     name, value = _one_target(dict(x0=x0, period=period, period_days=period_days, jacobi=jacobi))
     value = as_real(value, name)
@@ -671,7 +672,7 @@ def dro(system: System | str = "earth-moon", *, x0: float | None = None, period:
             raise ValueError(f"invalid argument `x0`: DROs start between the primaries, -mu < x0 < 1 - mu; got {value!r}")
         if value >= 0.8:
             return correct_dro(sys_, value)
-    return _default_dro_family(sys_).member(**{name: value})
+    return _default_dro_family(sys_).member(**{name: value}, which=which)
 
 
 # --- Lyapunov and halo orbits -----------------------------------------------------------------
@@ -716,11 +717,13 @@ def _cached_lyapunov(system: System, point: int) -> OrbitFamily:
 
 
 def lyapunov(system: System | str = "earth-moon", point: int = 1, *, x0: float | None = None,
-             period: float | None = None, period_days: float | None = None, jacobi: float | None = None) -> PeriodicOrbit:
-    """One planar Lyapunov orbit at L1/L2, by x0, period (TU or days) or Jacobi constant."""
+             period: float | None = None, period_days: float | None = None, jacobi: float | None = None,
+             which: int | None = None) -> PeriodicOrbit:
+    """One planar Lyapunov orbit at L1/L2, by x0, period (TU or days) or Jacobi constant
+    (``which`` as in :meth:`OrbitFamily.member`, for a value that several members have)."""
     sys_ = resolve_system(system)
     name, value = _one_target(dict(x0=x0, period=period, period_days=period_days, jacobi=jacobi))
-    return _cached_lyapunov(sys_, _check_point(point)).member(**{name: value})
+    return _cached_lyapunov(sys_, _check_point(point)).member(**{name: value}, which=which)
 
 
 def _check_branch(branch) -> float:

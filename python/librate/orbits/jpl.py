@@ -325,7 +325,7 @@ def jpl_document(system: System, kind: str, parameters: dict, state0: np.ndarray
     lp = system.lagrange_points()
     block = {
         "name": system.name,
-        "mass_ratio": f"{system.mu:.15e}",
+        "mass_ratio": f"{system.mu:.16e}",
         "lunit": system.lu_km,
         "tunit": system.tu_s,
         "radius_secondary": system.r2_km,
