@@ -286,7 +286,8 @@ def order_along_family(states: np.ndarray, period: np.ndarray) -> np.ndarray:
     """Indices that put catalog rows in order along their family (the catalog sorts rows by Jacobi
     constant, which is not monotonic along a halo family): a nearest-neighbour chain in
     (x0, z0, vy0, period), each scaled by its spread, started at one end of the family (the row
-    farthest from the row farthest from row 0), oriented from the longer period to the shorter."""
+    farthest from the row farthest from row 0; rows the chain left for last after a long jump
+    are moved to its start), oriented from the longer period to the shorter."""
     n = len(period)
     if n <= 2:
         return np.argsort(-period, kind="stable")
@@ -308,6 +309,14 @@ def order_along_family(states: np.ndarray, period: np.ndarray) -> np.ndarray:
         i = int(np.argmin(d))
         order.append(i)
         used[i] = True
+    # A start one row short of the true end leaves that row for last, after a long jump back:
+    # move such rows to the front, where they are the nearest to the chain's first row.
+    for _ in range(n):
+        link = np.linalg.norm(np.diff(p[order], axis=0), axis=1)
+        last = order[-1]
+        if link[-1] <= 3.0 * np.median(link) or np.linalg.norm(p[last] - p[order[0]]) >= link[-1]:
+            break
+        order = [last] + order[:-1]
     out = np.array(order)
     return out if period[out[0]] >= period[out[-1]] else out[::-1]
 
