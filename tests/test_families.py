@@ -97,8 +97,7 @@ def test_jpl_catalog_l2_southern_halo():
     2.3834910105144469 and Jacobi constant 3.01517767456737. Tolerance 1e-8."""
     jpl = librate.System.preset("earth-moon-jpl")
     fam = librate.halo_family(jpl, 2, "south")
-    hits = [fam.member(x0=1.0829551779304256, which=w) for w in range(2)]
-    o = min(hits, key=lambda h: abs(h.z0 + 0.2023))
+    o = fam.member(x0=1.0829551779304256)  # state0 at the catalog's crossing: one member has this x0
     assert o.z0 == pytest.approx(-0.20231744561698364, abs=1e-8)
     assert o.vy0 == pytest.approx(-0.20102644884016102, abs=1e-8)
     assert o.period == pytest.approx(2.3834910105144469, abs=1e-8)
@@ -113,11 +112,17 @@ def test_jpl_catalog_l2_southern_halo():
 
 def test_halo_bifurcates_from_lyapunov(em):
     """The halo family starts where the L2 Lyapunov family's out-of-plane index crosses +1: its
-    first member (z0 = 2e-3) lies within 1e-4 in x0 of the bifurcating Lyapunov orbit."""
+    first member (|z| = 2e-3) crosses the x-z plane within 1e-4 in x of the bifurcating Lyapunov
+    orbit's two x-axis crossings (state0 is the crossing in the branch's hemisphere, here the
+    far side of L2; state_half the one continued from the Lyapunov start)."""
     lyap = librate.lyapunov_family(em, 2)
     bif = [b for b in lyap.bifurcations if b["index"] == "out-of-plane"][0]
     halo = librate.halo_family(em, 2, "north")
-    assert abs(halo.x0[0] - bif["x0"]) < 1e-4
+    i = bif["member"]
+    w = (bif["x0"] - lyap.x0[i]) / (lyap.x0[i + 1] - lyap.x0[i])
+    far = lyap.state_half[i, 0] + w * (lyap.state_half[i + 1, 0] - lyap.state_half[i, 0])
+    assert abs(halo.state_half[0, 0] - bif["x0"]) < 1e-4 and abs(halo.x0[0] - far) < 1e-4
+    assert halo.z0[0] > 0 > halo.state_half[0, 2]
     assert halo.parameters["bifurcation_x0"] == bif["x0"]
     # Lyapunov orbits circulate about their point: their initial x0 lies on L's Earth side.
     assert np.all(lyap.x0 < em.lagrange_points()[1, 0])

@@ -711,8 +711,14 @@ class Study(BaseModel):
             for v in values:
                 try:
                     out.append(find(v))
-                except ValueError:  # outside the family's range: name the key and the range
-                    span = {"x0": fam.x0, "z0": np.concatenate([fam.state0[:, 2], fam.state_half[:, 2]]), "period_days": fam.period_days,
+                except ValueError as err:  # outside the family's range (or ambiguous): name the key and the range
+                    cands = getattr(err, "candidates", None)
+                    if cands:
+                        days = ", ".join(f"{fam.system.period_days(c['period']):.4g}" for c in cands)
+                        raise StudyError([_problem(f"orbits.{key}", _grid_raw(sel), f"{len(cands)} members of the {fam.kind} family have {key} = {float(v):g} "
+                                                   f"(periods {days} d)",
+                                                   "a value that one member has, or select by orbits.period_days")]) from None
+                    span = {"x0": fam.x0, "z0": fam.z0, "period_days": fam.period_days,
                             "resonance": 2 * math.pi / fam.period, "sun_resonance": _sun_period() / fam.period}[key]
                     what = {"x0": "x0 (LU)", "z0": "z0 (LU)", "period_days": "periods (days)", "resonance": "k = 2 pi / T",
                             "sun_resonance": "k = Ts / T"}[key]

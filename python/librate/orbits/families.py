@@ -4,7 +4,12 @@ A family is computed by continuation (``librate.orbits.continuation``), every me
 its monodromy matrix (batch-propagated on all cores), and bifurcations located where a
 stability index crosses +1 or -1. :class:`OrbitFamily` holds the members, finds members by x0,
 z0, period or Jacobi constant by root finding on the family (returning a corrected orbit),
-and saves to / loads from a self-describing netCDF or Zarr file (xarray Dataset).
+saves to / loads from a self-describing netCDF or Zarr file (xarray Dataset), and reads and
+writes the JPL Three-Body Periodic Orbits catalog's JSON format (:mod:`librate.orbits.jpl`).
+
+Where ``state0`` lies: planar families start on the x axis. Spatial families (halos, NRHOs)
+start at the x-z-plane crossing in the branch's hemisphere, as the JPL catalog lists them: a
+southern halo at its crossing with z < 0 (apolune for the NRHOs), a northern one at z > 0.
 """
 
 from __future__ import annotations
@@ -20,7 +25,7 @@ from .._checks import as_count, as_real
 from .._errors import ConvergenceError, LibrateError
 from ..constants import SUN_SYNODIC_PERIOD
 from .continuation import continue_arclength, continue_natural, geometry
-from .periodic import SHOOT_ATOL, SHOOT_RTOL, PeriodicOrbit, correct_symmetric
+from .periodic import SHOOT_ATOL, SHOOT_RTOL, PeriodicOrbit, correct_symmetric, real_if_real
 from .propagation import propagate_many
 from .system import System, resolve_system
 
@@ -34,8 +39,14 @@ class OrbitFamily:
     Arrays over members: ``state0`` (n, 6) initial states on the x-z plane, ``state_half`` (n, 6)
     the states at the half-period crossing (the other symmetric point of the same orbit),
     ``period`` (TU), ``jacobi``, ``eigenvalues`` (n, 6) complex, ``stability_indices`` (n, 2)
-    complex ([in-plane, out-of-plane] for planar families). ``end_reason`` says why the
-    continuation stopped; ``bifurcations`` lists the members where an index crosses +1 or -1.
+    ([in-plane, out-of-plane] for planar families; float when every index is real, complex
+    only when some member has a complex pair). ``end_reason`` says why the continuation
+    stopped; ``bifurcations`` lists the members where an index crosses +1 or -1.
+
+    For spatial families ``state0`` is the crossing in the branch's hemisphere (z < 0 for a
+    southern halo, z > 0 for a northern one), the JPL catalog's convention; ``x0`` and ``z0``
+    refer to it. A family read by :meth:`from_jpl` keeps the catalog's crossing and carries
+    ``import_report``, the per-row record of the import (not saved by :meth:`save`).
     """
 
     system: System
@@ -50,6 +61,7 @@ class OrbitFamily:
     end_reason: str = ""
     bifurcations: list[dict] = field(default_factory=list)
     parameters: dict = field(default_factory=dict)
+    import_report: object = field(default=None, repr=False, compare=False)
 
     # --- construction ----------------------------------------------------------------------
     @classmethod
@@ -65,9 +77,20 @@ class OrbitFamily:
         for i in range(len(members)):
             if batch.ok[i]:
                 eig[i], nu[i] = _core.stability(np.ascontiguousarray(batch.stm[i]), not spatial)
-        fam = cls(system, kind, spatial, state0, half, period, np.array([m.jacobi for m in members]), eig, nu, end_reason, [], dict(parameters or {}))
+        fam = cls(system, kind, spatial, state0, half, period, np.array([m.jacobi for m in members]), eig, real_if_real(nu), end_reason, [],
+                  dict(parameters or {}))
         fam.bifurcations = fam._find_bifurcations()
         return fam
+
+    def _hemisphere_first(self, sign: float) -> None:
+        """Put each member's ``state0`` at its x-z-plane crossing farther into the hemisphere
+        ``sign`` (-1 south, +1 north), swapping it with ``state_half`` where needed (the same
+        orbit, started half a period later), and relocate the bifurcations on the new x0."""
+        swap = sign * self.state_half[:, 2] > sign * self.state0[:, 2]
+        s0 = np.where(swap[:, None], self.state_half, self.state0)
+        self.state_half = np.where(swap[:, None], self.state0, self.state_half)
+        self.state0 = s0
+        self.bifurcations = self._find_bifurcations()
 
     def _find_bifurcations(self) -> list[dict]:
         names = ("in-plane", "out-of-plane") if not self.spatial else ("index 1", "index 2")
@@ -118,55 +141,102 @@ class OrbitFamily:
 
     # --- lookup ----------------------------------------------------------------------------
     def member(self, *, x0: float | None = None, z0: float | None = None, period: float | None = None,
-               period_days: float | None = None, jacobi: float | None = None, which: int = 0) -> PeriodicOrbit:
+               period_days: float | None = None, jacobi: float | None = None, which: int | None = None) -> PeriodicOrbit:
         """The corrected member with the given x0, z0, period (TU or days) or Jacobi constant.
 
-        Root finding on the family: the target is bracketed between two members (for halos,
-        also among the half-period crossing states), the guess interpolated linearly, and the
-        orbit corrected with that quantity imposed. ``which`` picks among several brackets.
-        Raises ``ValueError`` when the value is outside the family's range.
+        Root finding on the family: every interval between consecutive members where the
+        quantity crosses the value is a candidate (``x0`` and ``z0`` are those of ``state0``:
+        for spatial families the crossing in the branch's hemisphere); the guess is
+        interpolated linearly and the orbit corrected with that quantity imposed, so the
+        returned ``state0`` is at the same crossing as the family's. A value exactly at a
+        member returns that member (re-corrected).
+
+        The candidates are ordered by period (increasing). When several members have the value
+        (x0, z0 and the Jacobi constant are not monotonic along a halo family), ``ValueError``
+        lists them with their periods and ``which`` (an index into that list) picks one; with a
+        single candidate ``which`` may be omitted or 0. Raises ``ValueError`` when the value is
+        outside the family's range.
         """
         given = {k: v for k, v in dict(x0=x0, z0=z0, period=period, period_days=period_days, jacobi=jacobi).items() if v is not None}
         if len(given) != 1:
             raise ValueError("invalid argument: give exactly one of x0, z0, period, period_days, jacobi")
         (name, value), = given.items()
+        user = name
         value = as_real(value, name)
         if name == "period_days":
             name, value = "period", self.system.from_days(value)
         if name == "z0" and not self.spatial:
             raise ValueError("invalid argument `z0`: this family is planar (z0 = 0)")
-        sets = [self.state0] + ([self.state_half] if self.spatial else [])
-        brackets = []
-        for states in sets:
-            q = {"x0": states[:, 0], "z0": states[:, 2], "period": self.period, "jacobi": self.jacobi}[name]
-            d = q - value
-            for i in range(len(d) - 1):
-                if d[i] == 0 or d[i] * d[i + 1] < 0:
-                    w = 0.0 if d[i] == 0 else d[i] / (d[i] - d[i + 1])
-                    brackets.append((states[i] + w * (states[i + 1] - states[i]), i))
-            if d[-1] == 0:
-                brackets.append((states[-1], len(d) - 1))
-        if not brackets:
-            # the ranges searched: for halos, z0 at the half-period crossing too (the other
-            # side of the x-y plane), so the accepted values may form two intervals
-            user = next(iter(given))
-            spans = []
-            for st, what in zip(sets, ("initial states", "half-period crossings")):
-                q = {"x0": st[:, 0], "z0": st[:, 2], "period": self.period, "jacobi": self.jacobi}[name]
-                if user == "period_days":
-                    q = self.system.period_days(q)
-                spans.append(f"[{np.min(q):.10g}, {np.max(q):.10g}]" + (f" ({what})" if len(sets) > 1 and name in ("x0", "z0") else ""))
-                if name not in ("x0", "z0"):
-                    break
+        if which is not None and (isinstance(which, (bool, np.bool_)) or not isinstance(which, (int, np.integer))):
+            raise ValueError(f"invalid argument `which`: must be an integer index into the candidates (ordered by period), got {which!r}")
+        q = {"x0": self.state0[:, 0], "z0": self.state0[:, 2], "period": self.period, "jacobi": self.jacobi}[name]
+        d = q - value
+        cands = []  # (period, state0) interpolated at the crossing of the value
+        for i in range(len(d) - 1):
+            if d[i] == 0 or d[i] * d[i + 1] < 0:
+                w = 0.0 if d[i] == 0 else d[i] / (d[i] - d[i + 1])
+                cands.append((float(self.period[i] + w * (self.period[i + 1] - self.period[i])), self.state0[i] + w * (self.state0[i + 1] - self.state0[i]), i))
+        if len(d) and d[-1] == 0:
+            cands.append((float(self.period[-1]), self.state0[-1], len(d) - 1))
+        if not cands:
+            shown = self.system.period_days(q) if user == "period_days" else q
+            where = " (at state0, the crossing in the branch's hemisphere)" if self.spatial and name in ("x0", "z0") else ""
             raise ValueError(
                 f"invalid argument `{user}`: {float(given[user])!r} is outside the {self.kind} family's range "
-                f"{' or '.join(spans)} (family end: {self.end_reason})"
+                f"[{np.min(shown):.10g}, {np.max(shown):.10g}]{where} (family end: {self.end_reason})"
             )
-        if not 0 <= which < len(brackets):
-            raise ValueError(f"invalid argument `which`: the value is bracketed {len(brackets)} time(s); which must be in 0..{len(brackets) - 1}")
-        guess, _ = brackets[which]
+        cands.sort(key=lambda c: c[0])
+        listing = "; ".join(f"which={k}: period {t:.10g} TU ({self.system.period_days(t):.6g} d), x0 {s[0]:.10g}, z0 {s[2]:.10g}"
+                            for k, (t, s, _) in enumerate(cands))
+        if which is None and len(cands) > 1:
+            err = ValueError(f"ambiguous `{user}` = {float(given[user])!r}: {len(cands)} members of the {self.kind} family have it "
+                             f"(values interpolated between members, ordered by period); pass which= to pick one: {listing}")
+            err.candidates = [{"period": t, "state0": s.copy()} for t, s, _ in cands]  # type: ignore[attr-defined]
+            raise err
+        k = 0 if which is None else int(which)
+        if not 0 <= k < len(cands):
+            raise ValueError(f"invalid argument `which`: {len(cands)} member(s) have {user} = {float(given[user])!r}, so which must be in "
+                             f"0..{len(cands) - 1} (ordered by period: {listing}); got {which!r}")
+        _, guess, i = cands[k]
+        if i == len(self) - 1:  # the value is the last member's
+            return self._correct_at(guess, name, value)
+        a, b = self.state0[i], self.state0[i + 1]
+        try:
+            orbit = self._correct_at(guess, name, value)
+            if _between(orbit.state0, a, b):
+                return orbit
+        except ConvergenceError:
+            pass
+        # The correction left the bracket (near a fold of the quantity the two solutions are
+        # close) or failed: continue the family finely from member i past member i + 1 (the
+        # continuation driver, pseudo-arclength) and correct from the fine bracket.
+        start = correct_symmetric(self.system, a, spatial=self.spatial, fix="x0", family=self.kind)
+        pa, chord = a[[0, 2, 4]], b[[0, 2, 4]] - a[[0, 2, 4]]
+        length = float(np.linalg.norm(chord))
+
+        def past(o, _g):
+            return "past the next member" if np.dot(np.array([o.x0, o.z0, o.vy0]) - pa, chord) >= 1.05 * length**2 else None
+
+        fine = continue_arclength(self.system, start, spatial=self.spatial, orient=chord, ds=length / 10, ds_min=length * 1e-6,
+                                  ds_max=length / 5, max_members=80, family=self.kind, check_geometry=False, stop=past).members
+        col = {"x0": lambda o: o.x0, "z0": lambda o: o.z0, "period": lambda o: o.period, "jacobi": lambda o: o.jacobi}[name]
+        fq = np.array([col(o) for o in fine]) - value
+        for j in range(len(fine) - 1):
+            if fq[j] == 0:
+                return fine[j]
+            if fq[j] * fq[j + 1] < 0:
+                w = fq[j] / (fq[j] - fq[j + 1])
+                fa, fb = fine[j].state0, fine[j + 1].state0
+                orbit = self._correct_at(fa + w * (fb - fa), name, value)
+                if _between(orbit.state0, fa, fb):
+                    return orbit
+                break
+        raise ConvergenceError(f"{self.kind} member at {name} = {value!r} between members {i} and {i + 1}: the correction converged "
+                               "outside that interval, also from the family continued finely between them")
+
+    def _correct_at(self, guess: np.ndarray, name: str, value: float) -> PeriodicOrbit:
+        g = np.array(guess, dtype=float)
         kw = {"x0": dict(fix="x0"), "z0": dict(fix="z0"), "period": dict(period=value), "jacobi": dict(jacobi=value)}[name]
-        g = guess.copy()
         if name == "x0":
             g[0] = value
         elif name == "z0":
@@ -182,6 +252,78 @@ class OrbitFamily:
             raise ValueError(f"invalid argument `kind`: must be 'synodic' or 'sun', got {kind!r}")
         base = 2 * math.pi if kind == "synodic" else SUN_SYNODIC_PERIOD
         return self.member(period=base / k)
+
+    # --- the JPL catalog format ---------------------------------------------------------------
+    @classmethod
+    def from_jpl(cls, source) -> OrbitFamily:
+        """A family from a JPL Three-Body Periodic Orbits API response (a dict, or the path of
+        its JSON file, e.g. ``https://ssd-api.jpl.nasa.gov/periodic_orbits.api?sys=earth-moon&family=halo&libr=2&branch=S``),
+        any family and system the format carries.
+
+        The system is the file's: mass ratio ``mass_ratio``, units ``lunit`` (km) and ``tunit``
+        (s); a preset when they match one (``earth-moon-jpl`` for the Earth-Moon catalog, whose
+        radii are then used), otherwise a new :class:`System` with the secondary's radius from
+        the file. Every row is re-corrected in librate's dynamics, except rows that pass within
+        a primary's radius (flagged) and rows not at a perpendicular x-z-plane crossing (see
+        :func:`librate.orbits.jpl.recorrect`). The members keep the catalog's crossing as
+        ``state0`` and are ordered along the family (the catalog sorts rows by Jacobi constant;
+        :func:`librate.orbits.jpl.order_along_family`).
+
+        ``import_report`` (an xarray Dataset over the file's rows) records each row's closure
+        before and after the correction, its status and flags, and its member index;
+        ``parameters`` keep the catalog's family, libration point, branch and signature.
+        Raises ``ValueError`` for a file that is not such a response and
+        :class:`librate.LibrateError` when no row could be re-corrected.
+        """
+        from .jpl import kind_from_jpl, order_along_family, read_jpl, recorrect
+
+        cat = read_jpl(source)
+        kind = kind_from_jpl(cat.family, cat.libration_point, cat.branch)
+        spatial = bool(np.any(np.abs(cat.states[:, 2]) > 1e-9) or np.any(np.abs(cat.states[:, 5]) > 1e-9))
+        members, rows, report = recorrect(cat, kind, spatial)
+        if not members:
+            raise LibrateError(f"no row of the JPL {kind} file could be re-corrected ({len(cat.period)} rows): "
+                               f"{sorted(set(str(s) for s in report['status'].values))}")
+        order = order_along_family(np.array([m.state0 for m in members]), np.array([m.period for m in members]))
+        members = [members[i] for i in order]
+        rows = [rows[i] for i in order]
+        member = np.full(len(cat.period), -1, dtype=np.int64)
+        member[np.array(rows, dtype=np.intp)] = np.arange(len(rows))
+        report["member"] = ("row", member)
+        n_in = int(report["within_primary1_radius"].sum() + report["within_primary2_radius"].sum())
+        params = {"jpl_family": cat.family, "jpl_libration_point": cat.libration_point, "jpl_branch": cat.branch,
+                  "jpl_signature": cat.header.get("signature"), "jpl_count": cat.header.get("count"), "jpl_rows": rows}
+        if cat.libration_point and cat.libration_point.isdigit():
+            params["point"] = int(cat.libration_point)
+        if cat.branch in ("N", "S"):
+            params["branch"] = "north" if cat.branch == "N" else "south"
+        end = (f"imported from the JPL catalog: {len(members)} of {len(cat.period)} rows re-corrected, "
+               f"{n_in} passing within a primary's radius flagged")
+        fam = cls.from_members(cat.system, kind, spatial, members, end, params)
+        fam.import_report = report
+        return fam
+
+    def to_jpl(self, path) -> None:
+        """Write the family as a JPL Three-Body Periodic Orbits API response (JSON; the format
+        :meth:`from_jpl` reads): the system block (mass ratio, units, radius of the secondary,
+        L1..L5), family / libration point / branch (the catalog's names, e.g. halo, 2, S),
+        limits, and one row per member: ``state0``, Jacobi constant, period and the catalog's
+        stability index (|lambda| + 1/|lambda|)/2 of the largest multiplier
+        (:func:`librate.orbits.jpl.jpl_stability`). The signature names librate as the source."""
+        import json
+        from pathlib import Path
+
+        from .._core import __version__
+        from .jpl import jpl_document, jpl_stability
+
+        p = Path(path)
+        if p.suffix.lower() != ".json":
+            raise ValueError(f"invalid argument `path`: must end in .json, got {str(path)!r}")
+        doc = jpl_document(self.system, self.kind, self.parameters, self.state0, self.jacobi, self.period, jpl_stability(self.eigenvalues), __version__)
+        p.parent.mkdir(parents=True, exist_ok=True)
+        tmp = p.with_name(p.name + ".tmp")
+        tmp.write_text(json.dumps(doc), encoding="utf-8")
+        tmp.replace(p)
 
     # --- I/O -------------------------------------------------------------------------------
     def to_dataset(self):
@@ -219,9 +361,15 @@ class OrbitFamily:
                 "bifurcations": repr(self.bifurcations),
                 "parameters": repr(self.parameters),
                 "conventions": "CR3BP synodic frame, nondimensional; Earth at (-mu,0,0), Moon at (1-mu,0,0)",
+                STATE0_ATTR: self._state0_convention(),
             },
         )
         return ds
+
+    def _state0_convention(self) -> str:
+        if not self.spatial:
+            return "planar"
+        return "jpl" if "jpl_family" in self.parameters else "hemisphere"
 
     def save(self, path) -> None:
         """Write to netCDF (``.nc``) or Zarr (``.zarr``), with a digest of every variable
@@ -255,7 +403,13 @@ class OrbitFamily:
         Raises ``FileNotFoundError``, or ``ValueError`` saying why ``path`` is not a (valid)
         librate family file: unreadable (empty, truncated, garbage, not netCDF or Zarr), another
         kind of file (no family variables or attributes), or damaged (a missing chunk, or a
-        variable that does not match its stored checksum)."""
+        variable that does not match its stored checksum).
+
+        Files written before librate stored spatial families at the branch's hemisphere
+        crossing (no attribute ``state0_convention``) held ``state0`` at the other crossing;
+        a halo family's is converted on loading (each member's two crossings swapped, which
+        ``parameters["state0_converted"]`` records). A spatial family without a known branch
+        cannot be converted and is refused with ``ValueError``."""
         import ast
         import json
         from pathlib import Path
@@ -326,13 +480,41 @@ class OrbitFamily:
                 params = ast.literal_eval(str(a["parameters"]))
             except (ValueError, TypeError, SyntaxError, LibrateError) as err:
                 raise ValueError(f"{not_family}: invalid attributes ({type(err).__name__}: {err})") from None
-            return cls(
+            convention = a.get(STATE0_ATTR)
+            if spatial and convention is None and params.get("branch") not in ("north", "south"):
+                raise ValueError(f"{name!r} holds a spatial family written by an older librate, with state0 at the crossing continued from "
+                                 "its first member; without a halo branch (parameters['branch'] = 'north' or 'south') it cannot be converted "
+                                 "to the branch-hemisphere convention: recompute the family and save it again")
+            fam = cls(
                 system, str(a["kind"]), spatial,
                 values["state0"].copy(), values["state_half"].copy(), values["period"].copy(), values["jacobi"].copy(),
                 values["eigenvalues_real"] + 1j * values["eigenvalues_imag"],
-                values["stability_real"] + 1j * values["stability_imag"],
+                real_if_real(values["stability_real"] + 1j * values["stability_imag"]),
                 str(a["end_reason"]), bif, params,
             )
+            if spatial and convention is None:
+                fam._hemisphere_first(_check_branch(params["branch"]))
+                fam.parameters["state0_converted"] = "file written before the branch-hemisphere convention: crossings swapped on loading"
+            return fam
+
+
+def _between(state: np.ndarray, a: np.ndarray, b: np.ndarray, margin: float = 0.1) -> bool:
+    """Whether ``state`` lies on the family between members ``a`` and ``b``: its (x0, z0, vy0)
+    projects onto the chord a -> b within [-margin, 1 + margin] of its length and lies within
+    half a chord of it."""
+    p, pa, pb = state[[0, 2, 4]], a[[0, 2, 4]], b[[0, 2, 4]]
+    c = pb - pa
+    cc = float(np.dot(c, c))
+    if cc == 0.0:
+        return bool(np.allclose(p, pa, rtol=0, atol=1e-9))
+    u = float(np.dot(p - pa, c)) / cc
+    off = float(np.linalg.norm(p - pa - u * c))
+    return -margin <= u <= 1 + margin and off <= 0.5 * math.sqrt(cc)
+
+
+#: Dataset attribute naming where a spatial family's state0 lies: "hemisphere" (the crossing in
+#: the branch's hemisphere), "jpl" (the catalog's crossing, for imported families), "planar".
+STATE0_ATTR = "state0_convention"
 
 
 # --- DROs ------------------------------------------------------------------------------------
@@ -476,11 +658,12 @@ def _one_target(kw: dict) -> tuple[str, float]:
 
 
 def dro(system: System | str = "earth-moon", *, x0: float | None = None, period: float | None = None,
-        period_days: float | None = None, jacobi: float | None = None) -> PeriodicOrbit:
+        period_days: float | None = None, jacobi: float | None = None, which: int | None = None) -> PeriodicOrbit:
     """One corrected DRO, chosen by x0, period (TU or days) or Jacobi constant.
 
     Near the Moon (x0 >= 0.8) x0 is corrected directly; otherwise the member is found on the
-    whole family (computed once per system and cached)."""
+    whole family (computed once per system and cached); ``which`` as in
+    :meth:`OrbitFamily.member`, for a value that several members have."""
     sys_ = resolve_system(system)
     name, value = _one_target(dict(x0=x0, period=period, period_days=period_days, jacobi=jacobi))
     value = as_real(value, name)
@@ -489,7 +672,7 @@ def dro(system: System | str = "earth-moon", *, x0: float | None = None, period:
             raise ValueError(f"invalid argument `x0`: DROs start between the primaries, -mu < x0 < 1 - mu; got {value!r}")
         if value >= 0.8:
             return correct_dro(sys_, value)
-    return _default_dro_family(sys_).member(**{name: value})
+    return _default_dro_family(sys_).member(**{name: value}, which=which)
 
 
 # --- Lyapunov and halo orbits -----------------------------------------------------------------
@@ -534,11 +717,13 @@ def _cached_lyapunov(system: System, point: int) -> OrbitFamily:
 
 
 def lyapunov(system: System | str = "earth-moon", point: int = 1, *, x0: float | None = None,
-             period: float | None = None, period_days: float | None = None, jacobi: float | None = None) -> PeriodicOrbit:
-    """One planar Lyapunov orbit at L1/L2, by x0, period (TU or days) or Jacobi constant."""
+             period: float | None = None, period_days: float | None = None, jacobi: float | None = None,
+             which: int | None = None) -> PeriodicOrbit:
+    """One planar Lyapunov orbit at L1/L2, by x0, period (TU or days) or Jacobi constant
+    (``which`` as in :meth:`OrbitFamily.member`, for a value that several members have)."""
     sys_ = resolve_system(system)
     name, value = _one_target(dict(x0=x0, period=period, period_days=period_days, jacobi=jacobi))
-    return _cached_lyapunov(sys_, _check_point(point)).member(**{name: value})
+    return _cached_lyapunov(sys_, _check_point(point)).member(**{name: value}, which=which)
 
 
 def _check_branch(branch) -> float:
@@ -557,8 +742,9 @@ def halo_family(system: System | str = "earth-moon", point: int = 2, branch: str
     ``branch`` follows the usual convention (and the JPL catalog's): a southern halo has its
     largest excursion from the x-y plane (apolune, for L2) below it, z < 0; a northern one
     above. The two are mirror images under z -> -z, so one is computed and mirrored. ``state0``
-    is the symmetric crossing continued from the Lyapunov start (the side of L toward the
-    larger primary); ``state_half`` the other one.
+    is each member's x-z-plane crossing in the branch's hemisphere (the one with the smaller z
+    for south, the larger for north), as the JPL catalog lists them; ``state_half`` the other
+    one. Neither x0 nor z0 is monotonic along the family; the period is, for L2.
     """
     sys_ = resolve_system(system)
     point = _check_point(point)
@@ -586,6 +772,7 @@ def halo_family(system: System | str = "earth-moon", point: int = 2, branch: str
         flip = np.array([1.0, 1.0, -1.0, 1.0, 1.0, -1.0])
         fam.state0 = fam.state0 * flip
         fam.state_half = fam.state_half * flip
+    fam._hemisphere_first(sign)
     return fam
 
 
@@ -596,9 +783,14 @@ def _cached_halo(system: System, point: int, branch: str) -> OrbitFamily:
 
 def halo(system: System | str = "earth-moon", point: int = 2, branch: str = "south", *, x0: float | None = None,
          z0: float | None = None, period: float | None = None, period_days: float | None = None,
-         jacobi: float | None = None, which: int = 0) -> PeriodicOrbit:
+         jacobi: float | None = None, which: int | None = None) -> PeriodicOrbit:
     """One halo orbit at L1/L2 (north or south branch) by x0, z0, period (TU or days) or Jacobi
-    constant, found on the family (computed once per system and cached)."""
+    constant, found on the family (computed once per system and cached).
+
+    ``x0`` and ``z0`` are those of ``state0``, the x-z-plane crossing in the branch's
+    hemisphere (the JPL catalog's). When several members have the value, ``ValueError`` lists
+    them with their periods; ``which`` (an index, ordered by period) picks one
+    (:meth:`OrbitFamily.member`)."""
     sys_ = resolve_system(system)
     point = _check_point(point)
     _check_branch(branch)

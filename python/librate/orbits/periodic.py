@@ -12,13 +12,26 @@ from .. import _core
 from .._checks import as_count, as_number, as_real
 from .system import System, resolve_system
 
-__all__ = ["PeriodicOrbit", "correct_symmetric", "correct_periodic"]
+__all__ = ["PeriodicOrbit", "correct_symmetric", "correct_periodic", "real_if_real"]
 
 _VARS = {"x0": 0, "z0": 1, "vy0": 2}
 # Tolerances of the shooting propagations: the 8th-order solution at 1e-13 puts the
 # closure of a corrected member near 1e-12.
 SHOOT_RTOL = 1e-13
 SHOOT_ATOL = 1e-13
+
+
+def real_if_real(nu) -> np.ndarray:
+    """Stability indices as float when every one is real, complex otherwise.
+
+    The core returns each index nu = x / 2 from the roots x of Broucke's quadratic: real ones
+    (a real discriminant: a saddle pair, or a pair on the unit circle) have imaginary part
+    exactly 0, a complex quadruplet of multipliers gives a genuinely complex pair. So the
+    float array loses nothing; a complex array is returned only when some index is complex."""
+    a = np.asarray(nu)
+    if not np.iscomplexobj(a):
+        return a.astype(np.float64, copy=True)
+    return a.real.copy() if np.all(a.imag == 0) else a.copy()
 
 
 @dataclass(frozen=True)
@@ -79,8 +92,9 @@ class PeriodicOrbit:
 
     @property
     def stability_indices(self) -> np.ndarray:
-        """The two non-trivial stability indices (complex; real for a stable orbit)."""
-        return self._stability[1]
+        """The two non-trivial stability indices: a float array when both are real (saddle
+        pairs and stable pairs), complex only for a complex quadruplet of multipliers."""
+        return real_if_real(self._stability[1])
 
     @property
     def is_stable(self) -> bool:
