@@ -208,3 +208,27 @@ def test_l1_northern_halo_family(em):
         tr = o.propagate(rtol=1e-14, atol=1e-14)
         scale = max(1.0, np.linalg.norm(o.state0)) * max(1.0, np.max(np.abs(fam.eigenvalues[i])))
         assert np.max(np.abs(tr.y_final - o.state0)) / scale < 1e-10
+
+
+def test_bifurcations_located_by_the_driver(dros, em):
+    """The continuation driver locates the DRO family's bifurcation (out-of-plane index = +1,
+    thesis Fig. 5, near x0 = 0.27) to 1e-8 in x0 with its test function nu - 1. Reference: the DRO
+    corrected at that x0, its index from an independent full-period propagation with the STM:
+    |nu - 1| <= 1e-6 (1e-8 in x0 times d nu / d x0 ~ 10, plus the propagation's accuracy)."""
+    (b,) = [b for b in dros.bifurcations if b["index"] == "out-of-plane"]
+    assert b["located"] and dros.x0[b["member"]] > b["x0"] > dros.x0[b["member"] + 1]
+    nu = librate.dro(em, x0=b["x0"]).stability_indices[1]
+    assert abs(nu - 1.0) <= 1e-6
+
+
+@pytest.mark.parametrize("which", ["dro", "halo"])
+def test_monodromy_from_the_half_period_stm(em, which):
+    """The monodromy the corrector derives from the half-period STM, S Phi(T/2)^-1 S Phi(T/2)
+    (mirror symmetry with time reversal), equals the full-period propagation's to 1e-9 relative
+    to its largest entry, on a stable DRO and an unstable halo (|lambda| ~ 1e2)."""
+    from librate.orbits.periodic import symmetric_monodromy
+
+    o = librate.dro(em, x0=0.7) if which == "dro" else librate.halo(em, 2, "south", which=0, period=3.0)
+    m = symmetric_monodromy(librate.correct_symmetric(em, o.state0[[0, 2, 4]], spatial=which == "halo", fix="x0"))
+    ref = o.monodromy
+    assert np.max(np.abs(m - ref)) <= 1e-9 * np.max(np.abs(ref))

@@ -17,8 +17,8 @@ import numpy as np
 
 from .. import _core
 from .._errors import LibrateError
-from ..solving.continuation import Branch, Constraint, Point, StepRules, arclength, natural
-from .periodic import SHOOT_ATOL, SHOOT_RTOL, PeriodicOrbit, orbit_from_core
+from ..solving.continuation import Bifurcation, Branch, Constraint, Point, StepRules, arclength, natural
+from .periodic import SHOOT_ATOL, SHOOT_RTOL, PeriodicOrbit, index_tests, orbit_from_core, symmetric_monodromy
 from .system import System
 
 __all__ = ["Geometry", "geometry", "continue_natural", "continue_arclength", "ContinuationResult"]
@@ -50,11 +50,16 @@ def geometry(orbit: PeriodicOrbit) -> Geometry:
 
 @dataclass
 class ContinuationResult:
+    """The members of a continued family, their geometries, why the run ended, and the
+    bifurcations the driver found on the way (sign changes of the stability-index test
+    functions, located to 1e-8 in the parameter; ``after``: the member before each)."""
+
     members: list[PeriodicOrbit]
     geometries: list[Geometry]
     end_reason: str
     rejected_jumps: int = 0
     extra: dict = field(default_factory=dict)
+    bifurcations: list[Bifurcation] = field(default_factory=list)
 
 
 def _correct(system: System, p, spatial: bool, kind: str, values, family: str, t_max: float) -> PeriodicOrbit:
@@ -133,6 +138,14 @@ class SymmetricFamilyProblem:
     def tangent(self, pt: Point) -> np.ndarray:
         return tangent(pt.data, self.spatial)
 
+    def tests(self, pt: Point) -> dict[str, float]:
+        """Bifurcation tests: each stability index minus +-1 (:func:`librate.orbits.periodic.index_tests`),
+        from the monodromy the half-period correction gives (no extra propagation)."""
+        m = symmetric_monodromy(pt.data)
+        if m is None:
+            return {}
+        return index_tests(_core.stability(np.ascontiguousarray(m), not self.spatial)[1], self.spatial)
+
     def guard(self, points: list[Point], new: Point, ratio: float) -> str | None:
         if not _smooth([p.data for p in points], new.data, ratio):
             return "Jacobi constant or period jump"
@@ -150,7 +163,8 @@ class SymmetricFamilyProblem:
 
 def _result(problem: SymmetricFamilyProblem, branch: Branch, points: list[Point]) -> ContinuationResult:
     members = [p.data for p in points]
-    return ContinuationResult(members, [problem.geometries.get(id(m)) for m in members], branch.end_reason, branch.rejected_jumps)
+    return ContinuationResult(members, [problem.geometries.get(id(m)) for m in members], branch.end_reason, branch.rejected_jumps,
+                              bifurcations=list(branch.bifurcations))
 
 
 def _stop(problem, stop):
@@ -209,5 +223,5 @@ def continue_arclength(
     problem = SymmetricFamilyProblem(system, spatial=spatial, family=family, t_max=t_max, check_geometry=check_geometry)
     rules = StepRules(ds=ds, ds_min=ds_min, ds_max=ds_max, jump=0.5, max_turn=0.5)
     br = arclength(problem, problem.point(first), direction=np.asarray(orient, dtype=float), rules=rules, max_points=max_members,
-                   locate=False, name="x0", stop=_stop(problem, stop))
+                   name="x0", stop=_stop(problem, stop))
     return _result(problem, br, br.points)

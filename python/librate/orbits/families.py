@@ -24,12 +24,23 @@ from .. import _core
 from .._checks import as_count, as_real
 from .._errors import ConvergenceError, LibrateError
 from ..constants import SUN_SYNODIC_PERIOD
+from ..solving.continuation import sign_changes
 from .continuation import continue_arclength, continue_natural, geometry
-from .periodic import SHOOT_ATOL, SHOOT_RTOL, PeriodicOrbit, correct_symmetric, real_if_real
+from .periodic import INDEX_TESTS, SHOOT_ATOL, SHOOT_RTOL, PeriodicOrbit, correct_symmetric, index_tests, real_if_real
 from .propagation import propagate_many
 from .system import System, resolve_system
 
 __all__ = ["OrbitFamily", "correct_dro", "dro", "dro_family", "lyapunov", "lyapunov_family", "halo", "halo_family"]
+
+
+def _bifurcation_record(b) -> dict:
+    """A family's record of one of the driver's bifurcations: the member before it, the index and
+    its level, and the located orbit's two x-z-plane crossings (x0, z0 and x0_half, z0_half)."""
+    index, level, kind = INDEX_TESTS[b.name]
+    orbit = b.point.data
+    half = orbit._evaluation["crossing"] if orbit._evaluation is not None else orbit.state0
+    return {"member": int(b.after), "index": index, "type": kind, "level": level, "x0": float(b.parameter), "z0": float(orbit.state0[2]),
+            "x0_half": float(half[0]), "z0_half": float(half[2]), "located": bool(b.located)}
 
 
 @dataclass
@@ -65,7 +76,13 @@ class OrbitFamily:
 
     # --- construction ----------------------------------------------------------------------
     @classmethod
-    def from_members(cls, system: System, kind: str, spatial: bool, members: list[PeriodicOrbit], end_reason: str, parameters=None) -> OrbitFamily:
+    def from_members(cls, system: System, kind: str, spatial: bool, members: list[PeriodicOrbit], end_reason: str, parameters=None,
+                     bifurcations=None) -> OrbitFamily:
+        """The family of ``members`` (in order along it), with their stability from one batched
+        propagation. ``bifurcations``: the continuation driver's (located; see
+        :class:`librate.orbits.continuation.ContinuationResult`); without them (members known
+        without a run: an import, a selection) the sign changes of the same test functions
+        between consecutive members, interpolated linearly."""
         if not members:
             raise LibrateError(f"the {kind} family has no member ({end_reason})")
         state0 = np.array([m.state0 for m in members])
@@ -79,7 +96,10 @@ class OrbitFamily:
                 eig[i], nu[i] = _core.stability(np.ascontiguousarray(batch.stm[i]), not spatial)
         fam = cls(system, kind, spatial, state0, half, period, np.array([m.jacobi for m in members]), eig, real_if_real(nu), end_reason, [],
                   dict(parameters or {}))
-        fam.bifurcations = fam._find_bifurcations()
+        if bifurcations is None:
+            fam.bifurcations = fam._find_bifurcations()
+        else:
+            fam.bifurcations = [_bifurcation_record(b) for b in bifurcations]
         return fam
 
     def _hemisphere_first(self, sign: float) -> None:
@@ -90,24 +110,24 @@ class OrbitFamily:
         s0 = np.where(swap[:, None], self.state_half, self.state0)
         self.state_half = np.where(swap[:, None], self.state0, self.state_half)
         self.state0 = s0
-        self.bifurcations = self._find_bifurcations()
+        if not all("z0_half" in b for b in self.bifurcations):  # records of an older file: detect again
+            self.bifurcations = self._find_bifurcations()
+        for b in self.bifurcations:
+            if sign * b["z0_half"] > sign * b["z0"]:
+                b["x0"], b["z0"], b["x0_half"], b["z0_half"] = b["x0_half"], b["z0_half"], b["x0"], b["z0"]
 
     def _find_bifurcations(self) -> list[dict]:
-        names = ("in-plane", "out-of-plane") if not self.spatial else ("index 1", "index 2")
+        """Sign changes of the stability-index test functions between consecutive members,
+        interpolated linearly (the driver's detection rule, without a corrector to locate)."""
+        tests = [index_tests(nu, self.spatial) for nu in self.stability_indices]
         out = []
-        for j in range(2):
-            nu = self.stability_indices[:, j]
-            for i in range(len(nu) - 1):
-                a, b = nu[i], nu[i + 1]
-                if abs(a.imag) > 1e-6 or abs(b.imag) > 1e-6 or not (np.isfinite(a) and np.isfinite(b)):
-                    continue
-                for level, kind in ((1.0, "tangent (+1): a new family branches off, or a fold"), (-1.0, "period-doubling (-1)")):
-                    if (a.real - level) * (b.real - level) < 0:
-                        w = (level - a.real) / (b.real - a.real)
-                        out.append(
-                            {"member": i, "index": names[j], "type": kind, "level": level,
-                             "x0": float(self.state0[i, 0] + w * (self.state0[i + 1, 0] - self.state0[i, 0]))}
-                        )
+        for i in range(len(tests) - 1):
+            for name, _, _, w in sign_changes(tests[i], tests[i + 1]):
+                index, level, kind = INDEX_TESTS[name]
+                x0, z0, xh, zh = (float(a[i] + w * (a[i + 1] - a[i])) for a in (self.state0[:, 0], self.state0[:, 2], self.state_half[:, 0],
+                                                                               self.state_half[:, 2]))
+                out.append({"member": i, "index": index, "type": kind, "level": level, "x0": x0, "z0": z0, "x0_half": xh, "z0_half": zh,
+                            "located": False})
         return out
 
     # --- access ----------------------------------------------------------------------------
@@ -642,7 +662,7 @@ def dro_family(system: System | str = "earth-moon", x0=None, *, check_geometry: 
                 err.missing, err.found, err.end_reason = missing, [float(v) for v in got], res.end_reason
                 raise err
             params["missing_x0"] = missing
-    return OrbitFamily.from_members(sys_, "dro", False, res.members, res.end_reason, params)
+    return OrbitFamily.from_members(sys_, "dro", False, res.members, res.end_reason, params, bifurcations=res.bifurcations)
 
 
 @functools.lru_cache(maxsize=8)
@@ -708,7 +728,8 @@ def lyapunov_family(system: System | str = "earth-moon", point: int = 1, *, max_
         sys_, first, spatial=False, orient=np.array([-1.0, 0.0, 0.0]), ds=2e-3, ds_max=ds_max, max_members=max_members,
         family=f"lyapunov-L{point}", check_geometry=check_geometry, stop=_collision_stop(sys_, (sys_.r1_km, sys_.r2_km)),
     )
-    return OrbitFamily.from_members(sys_, f"lyapunov-L{point}", False, res.members, res.end_reason, {"point": point})
+    return OrbitFamily.from_members(sys_, f"lyapunov-L{point}", False, res.members, res.end_reason, {"point": point},
+                                    bifurcations=res.bifurcations)
 
 
 @functools.lru_cache(maxsize=8)
@@ -765,13 +786,15 @@ def halo_family(system: System | str = "earth-moon", point: int = 2, branch: str
         family=name, check_geometry=check_geometry, stop=_collision_stop(sys_, (sys_.r1_km, sys_.r2_km)),
     )
     fam = OrbitFamily.from_members(sys_, name, True, res.members, res.end_reason,
-                                   {"point": point, "branch": branch, "bifurcation_x0": bif["x0"]})
+                                   {"point": point, "branch": branch, "bifurcation_x0": bif["x0"]}, bifurcations=res.bifurcations)
     # Name the branch by the sign of z where |z| is largest along the family (apolune).
     both = np.concatenate([fam.state0[:, 2], fam.state_half[:, 2]])
     if np.sign(both[np.argmax(np.abs(both))]) != sign:
         flip = np.array([1.0, 1.0, -1.0, 1.0, 1.0, -1.0])
         fam.state0 = fam.state0 * flip
         fam.state_half = fam.state_half * flip
+        for b in fam.bifurcations:
+            b["z0"], b["z0_half"] = -b["z0"], -b["z0_half"]
     fam._hemisphere_first(sign)
     return fam
 

@@ -12,7 +12,7 @@ from .. import _core
 from .._checks import as_count, as_number, as_real
 from .system import System, resolve_system
 
-__all__ = ["PeriodicOrbit", "correct_symmetric", "correct_periodic", "real_if_real"]
+__all__ = ["PeriodicOrbit", "correct_symmetric", "correct_periodic", "real_if_real", "INDEX_TESTS", "index_tests", "symmetric_monodromy"]
 
 _VARS = {"x0": 0, "z0": 1, "vy0": 2}
 # Tolerances of the shooting propagations: the 8th-order solution at 1e-13 puts the
@@ -112,6 +112,36 @@ class PeriodicOrbit:
         kwargs.setdefault("rtol", SHOOT_RTOL)
         kwargs.setdefault("atol", SHOOT_ATOL)
         return propagate(self.system, self.state0, n_periods * self.period, **kwargs)
+
+
+#: The stability-index test functions of symmetric orbit families: name -> (index, level, type).
+#: nu - level changes sign where a pair of multipliers passes +1 (a family branches off, or a
+#: fold) or -1 (period doubling); undefined (NaN) where the index is complex.
+INDEX_TESTS = {
+    f"{index} {level:+.0f}": (index, level, kind)
+    for index in ("in-plane", "out-of-plane", "index 1", "index 2")
+    for level, kind in ((1.0, "tangent (+1): a new family branches off, or a fold"), (-1.0, "period-doubling (-1)"))
+}
+
+
+def index_tests(stability_indices, spatial: bool) -> dict[str, float]:
+    """The test functions of one orbit: nu_j - 1 and nu_j + 1 for its two stability indices
+    ([in-plane, out-of-plane], or [index 1, index 2] for spatial families); NaN where nu_j is
+    complex (|Im| > 1e-6)."""
+    names = ("index 1", "index 2") if spatial else ("in-plane", "out-of-plane")
+    out = {}
+    for name, nu in zip(names, np.asarray(stability_indices).ravel()):
+        real = np.isfinite(nu) and abs(complex(nu).imag) <= 1e-6
+        for level in (1.0, -1.0):
+            out[f"{name} {level:+.0f}"] = float(complex(nu).real - level) if real else math.nan
+    return out
+
+
+def symmetric_monodromy(orbit: PeriodicOrbit) -> np.ndarray | None:
+    """The monodromy of a symmetric orbit from its half-period STM (the core's correction
+    carries it: Phi(T) = S Phi(T/2)^-1 S Phi(T/2)), or None when the orbit has none."""
+    m = None if orbit._evaluation is None else orbit._evaluation.get("monodromy")
+    return None if m is None else np.asarray(m, dtype=float)
 
 
 def correct_symmetric(

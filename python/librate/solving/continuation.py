@@ -34,6 +34,7 @@ the same path either way.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
@@ -59,6 +60,7 @@ __all__ = [
     "run_lockstep",
     "correct_together",
     "correct_marks",
+    "sign_changes",
 ]
 
 
@@ -109,12 +111,16 @@ class Fold:
 
 @dataclass(frozen=True)
 class Bifurcation:
-    """Where the problem's test function ``name`` changes sign."""
+    """Where the problem's test function ``name`` changes sign: ``parameter`` (located to the
+    run's tolerance, or ``located`` False: interpolated linearly in the test function), the
+    ``point`` there (or the nearest corrected one) and ``after``, the index of the branch's
+    point before it."""
 
     name: str
     parameter: float
     point: Point
     located: bool
+    after: int = -1
 
 
 @dataclass
@@ -337,6 +343,19 @@ def _tests(problem, point) -> dict[str, float]:
     return dict(f(point)) if f is not None else {}
 
 
+def sign_changes(before: dict[str, float], after: dict[str, float]) -> list[tuple[str, float, float, float]]:
+    """The test functions that change sign between two consecutive points: (name, value
+    before, value after, w) with w in (0, 1) the zero of their linear interpolation. The one
+    detection rule of the driver, also applied to members known without a corrector (e.g. a
+    family read from a catalog)."""
+    out = []
+    for name, v in after.items():
+        u = before.get(name)
+        if u is not None and math.isfinite(u) and math.isfinite(v) and u * v < 0:
+            out.append((name, u, v, u / (u - v)))
+    return out
+
+
 def _guard(problem, points, new, ratio) -> str | None:
     f = getattr(problem, "guard", None)
     return f(points, new, ratio) if f is not None else None
@@ -355,6 +374,8 @@ def natural_steps(
     rules: StepRules | None = None,
     name: str = "parameter",
     stop: Callable[[Point], str | None] | None = None,
+    locate_bifurcations: bool = True,
+    tol: float = 1e-8,
 ):
     """Natural-parameter continuation through the parameter values ``targets`` (the points
     returned are exactly at them). Prediction: linear extrapolation of every component from the
@@ -362,12 +383,16 @@ def natural_steps(
     correction or a jump and doubled after a success; the run ends at the last target, at a
     ``stop`` reason, or when the step falls below ``rules.ds_min`` (in the parameter) with the
     reason. A fold ahead shows as the step collapsing: the end reason then names the last
-    parameter reached. A generator: it yields its corrections (:func:`run_lockstep`) and returns
-    the Branch."""
+    parameter reached. Bifurcations: where a test function of ``problem.tests`` changes sign
+    between two accepted points, located to ``tol`` in the parameter by corrections at fixed
+    parameter values in between (Illinois), unless ``locate_bifurcations`` is False (then
+    interpolated linearly). A generator: it yields its corrections (:func:`run_lockstep`) and
+    returns the Branch."""
     rules = rules or StepRules()
     k = problem.parameter_index
     n = first.x.size
     history = [first]
+    tests_prev = _tests(problem, first)
     out: list[Point] = []
     branch = Branch(out)
     for target in (float(v) for v in np.atleast_1d(np.asarray(targets, dtype=float))):
@@ -403,6 +428,15 @@ def natural_steps(
                 else:
                     status = "ok"
             if status == "ok":
+                tests_new = _tests(problem, pt)
+                for test, u, v, w in sign_changes(tests_prev, tests_new):
+                    if locate_bifurcations:
+                        b = yield from _locate_natural(problem, test, last, pt, u, v, tol)
+                    else:
+                        b = Bifurcation(test, float(last.x[k] + w * (pt.x[k] - last.x[k])), pt, False)
+                    # "after": the index of the last returned point (at a target) before it
+                    branch.bifurcations.append(dataclasses.replace(b, after=len(out) - 1))
+                tests_prev = tests_new
                 history.append(pt)
                 why = stop(pt) if stop else None
                 if why:
@@ -575,14 +609,12 @@ def arclength_steps(
                 branch.end_reason = f"fold at {name} = {fold.parameter:.12g}" + ("" if fold.located else f" (not located: within {fold.tolerance:.2g})")
                 return (yield from finish())
         tests_new = _tests(problem, new)
-        for test, v in tests_new.items():
-            u = tests_prev.get(test)
-            if u is not None and math.isfinite(u) and math.isfinite(v) and u * v < 0:
-                if locate and locate_bifurcations:
-                    branch.bifurcations.append((yield from _locate_sign(problem, test, base, t, ds, u, v, new, at, fold_tol)))
-                else:  # the linear interpolation of the test function between the two points
-                    w = u / (u - v)
-                    branch.bifurcations.append(Bifurcation(test, float(base.x[k] + w * (new.x[k] - base.x[k])), new, False))
+        for test, u, v, w in sign_changes(tests_prev, tests_new):
+            if locate and locate_bifurcations:
+                b = yield from _locate_sign(problem, test, base, t, ds, u, v, new, at, fold_tol)
+            else:  # the linear interpolation of the test function between the two points
+                b = Bifurcation(test, float(base.x[k] + w * (new.x[k] - base.x[k])), new, False)
+            branch.bifurcations.append(dataclasses.replace(b, after=len(points) - 1))
         tests_prev = tests_new
         for m in marks:
             if (base.x[k] - m) * (new.x[k] - m) < 0 or new.x[k] == m:
@@ -689,6 +721,28 @@ def _locate_fold(problem, base, t, ds, new, t_new, at, tol) -> Fold:
         if b - a <= 1e-15 * ds:
             break
     return Fold(float(est), pa if abs(ga) < abs(gb) else pb, False, float(err))
+
+
+def _locate_natural(problem, name, a: Point, b: Point, u: float, v: float, tol: float):
+    """A sign change of the test ``name`` between the accepted points ``a`` and ``b`` of a
+    natural-parameter run, located to ``tol`` in the parameter: Illinois iterations on the test
+    function of points corrected at fixed parameter values (guesses interpolated linearly)."""
+    k = problem.parameter_index
+    n = a.x.size
+
+    def f(p):
+        w = (p - a.x[k]) / (b.x[k] - a.x[k])
+        guess = a.x + w * (b.x - a.x)
+        guess[k] = p
+        pt = yield from _try(problem, guess, Constraint.fix(n, k, p))
+        val = None if pt is None else _tests(problem, pt).get(name)
+        return None if val is None or not math.isfinite(val) else (val, pt)
+
+    best, ok = yield from _illinois(f, float(a.x[k]), u, float(b.x[k]), v, lambda lo, hi: abs(hi - lo) <= tol)
+    if best is None or not ok:
+        w = u / (u - v)
+        return Bifurcation(name, float(a.x[k] + w * (b.x[k] - a.x[k])), b if best is None else best[1], False)
+    return Bifurcation(name, float(best[0]), best[1], True)
 
 
 def _locate_sign(problem, name, base, t, ds, u, v, new, at, tol) -> Bifurcation:

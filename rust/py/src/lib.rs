@@ -318,6 +318,7 @@ fn evaluation_dict<'py>(py: Python<'py>, e: &Evaluation) -> PyResult<Bound<'py, 
     d.set_item("jacobi", e.jacobi)?;
     d.set_item("djacobi", e.djacobi.to_vec())?;
     d.set_item("crossing", e.crossing.to_vec())?;
+    d.set_item("monodromy", e.monodromy().map(|m| m.iter().map(|r| r.to_vec()).collect::<Vec<_>>()))?;
     Ok(d)
 }
 

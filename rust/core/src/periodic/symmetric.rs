@@ -65,6 +65,21 @@ pub struct Evaluation {
     pub djacobi: [f64; 3],
     /// State at the crossing.
     pub crossing: [f64; 6],
+    /// State transition matrix Phi(T/2, 0) to the crossing.
+    pub stm_half: [[f64; 6]; 6],
+}
+
+impl Evaluation {
+    /// The monodromy matrix of the symmetric orbit from the half-period STM alone:
+    /// Phi(T, 0) = S Phi(T/2, 0)^-1 S Phi(T/2, 0), S = diag(1, -1, 1, -1, 1, -1) (the mirror
+    /// x-z-plane symmetry with time reversal maps the second half of the orbit onto the first);
+    /// exact at a periodic orbit, to the integration's accuracy. None when Phi(T/2) is singular.
+    pub fn monodromy(&self) -> Option<[[f64; 6]; 6]> {
+        let phi = nalgebra::Matrix6::from_fn(|i, j| self.stm_half[i][j]);
+        let s = nalgebra::Matrix6::from_diagonal(&nalgebra::Vector6::new(1.0, -1.0, 1.0, -1.0, 1.0, -1.0));
+        let m = s * phi.try_inverse()? * s * phi;
+        m.iter().all(|v| v.is_finite()).then(|| std::array::from_fn(|i| std::array::from_fn(|j| m[(i, j)])))
+    }
 }
 
 /// A corrected symmetric orbit.
@@ -145,6 +160,7 @@ impl SymmetricShooting {
             jacobi: jacobi(mu, &s0),
             djacobi: [2.0 * g[0], 2.0 * g[2], -2.0 * p[2]],
             crossing: s,
+            stm_half: phi,
         })
     }
 
