@@ -475,3 +475,22 @@ def test_core_rejects_bad_bodies_itself():
                       ((100.0, [10.0, 0.0], [1.0, 1.0], 50.0, 0.0), "direction")]:
         with pytest.raises(ValueError, match=f"`{name}`: appendage 1"):
             librate._core.flexible_body_check((1e3, [1e4, 1e4, 2e4], [good, bad]))
+
+
+def test_resolve_follows_the_branch_from_the_rigid_solution(dro, low):
+    """The coupled re-solve is a continuation in the compliance 1/f^2 (the shared driver) from a
+    stiffened copy of the body, where the quasi-static start is accurate, to the body itself. At
+    a tenth of the low-frequency preset's frequencies (arrays at 40 days, slower than the
+    orbit) a direct Newton from the quasi-static state stopped without descent when this was
+    written; the continuation
+    returns the solution connected to the rigid N = -1 motion. Reference: an independent
+    re-propagation of the coupled model from the returned state repeats after one period
+    (attitude to 1e-8, deflections to 1e-8 of their amplitude)."""
+    sol = librate.periodic_attitude(dro, kz=low.kz, n=-1)
+    body = low.scaled(0.1)
+    r = librate.flexible_periodic(sol, body)
+    assert r.reason == "converged" and r.start_factor > 10 and r.residual < 1e-10
+    tr = librate.propagate_attitude(EM, dro.state0, (r.phi0, r.wz0), body, dro.period, deflection=(r.q0, r.qdot0), rtol=1e-13, atol=1e-13)
+    assert abs(tr.phi[-1] - r.phi0 + 2 * math.pi) < 1e-8 and abs(tr.wz[-1] - r.wz0) < 1e-8
+    amp = np.max(np.abs(tr.flex.q), axis=0)
+    assert np.all(np.abs(tr.flex.q[-1] - r.q0) <= 1e-8 * amp)

@@ -16,6 +16,7 @@ from ..attitude.flexible import FlexibleBody, flexible_run_inputs, quasi_static
 from ..attitude.propagate import propagate_attitude
 from ..orbits.propagation import integration_options
 from ..orbits.system import System
+from ..solving.continuation import Constraint, CorrectionFailed, Point, StepRules, natural
 from .solutions import AttitudeSolution
 
 __all__ = ["FlexiblePeriodic", "FrequencyScan", "flexible_periodic", "frequency_scan"]
@@ -38,6 +39,9 @@ class FlexiblePeriodic:
     ``residual`` (scaled: rad, rad/TU and q relative to the quasi-static amplitude),
     ``iterations``, why it stopped (``reason``, "converged" or the failure), ``multipliers``
     (eigenvalues of the coupled monodromy) and ``full_shift`` = (phi0 - phi0_rigid, wz0 - wz0_rigid).
+    A body whose lowest frequency is not well above the attitude and orbital rates is re-solved by
+    continuation in the compliance 1/f^2 from a copy stiffened by ``start_factor`` (:class:`CompliancePath`,
+    the shared continuation driver; 1: corrected directly from the quasi-static state).
     """
 
     solution: object
@@ -58,6 +62,7 @@ class FlexiblePeriodic:
     iterations: int | None = None
     multipliers: np.ndarray | None = None
     reason: str | None = None
+    start_factor: float = 1.0
 
     @property
     def full_shift(self) -> np.ndarray | None:
@@ -140,17 +145,70 @@ def flexible_periodic(
     if not resolve:
         return FlexiblePeriodic(**out)
 
-    # One call of the Rust corrector: globalised Newton on all 2 + 2n initial values, residuals
-    # scaled by the quasi-static amplitudes, the Jacobian's columns integrated in parallel.
+    # The re-solve: the Rust corrector (globalised Newton on all 2 + 2n initial values, residuals
+    # scaled by the quasi-static amplitudes, the Jacobian's columns integrated in parallel),
+    # driven by the continuation driver in the compliance s = 1/f^2 from a stiff start, where the
+    # quasi-static state is accurate, to the body itself (s = 1); one correction when the body is
+    # stiff enough already.
     omega = body.frequencies_nd(sys_)
     qscale = np.maximum(np.max(np.abs(qs.q), axis=0), 1e-12)
-    scale = np.concatenate([[1.0, 1.0], qscale, qscale * omega])
-    x, res, it, reason, mono = _core.flexible_correct_periodic(sys_.mu, arg, [True, True], s0, T, [float(v) for v in x], float(turns),
-                                                               [float(v) for v in scale], options=opts, tol=float(tol), max_iter=int(max_iter))
-    x = np.asarray(x)
-    out.update(phi0=float(x[0]), wz0=float(x[1]), q0=x[2:2 + n].copy(), qdot0=x[2 + n:].copy(), residual=float(res),
-               iterations=int(it), multipliers=np.linalg.eigvals(mono) if np.all(np.isfinite(mono)) else None, reason=reason)
+    problem = CompliancePath(sys_, body, s0, T, turns, opts, qscale, tol, max_iter)
+    f0 = max(1.0, STIFF_START * max(abs(wz0), 2 * math.pi / T) / float(np.min(omega)))
+    c0 = 1.0 / (f0 * f0)
+    start = f"the body stiffened x{f0:.4g}" if c0 < 1.0 else "the quasi-static state"
+    out["start_factor"] = f0
+    try:
+        first = problem.correct(np.concatenate([[c0, phi0, wz0], c0 * qs.q[0], c0 * qs.qdot[0]]), Constraint.fix(3 + 2 * n, 0, c0))
+    except CorrectionFailed as e:
+        return FlexiblePeriodic(**out, reason=f"not re-solved: the correction from {start} failed ({e})")
+    br = natural(problem, first, [1.0], rules=StepRules(ds_min=1e-4 * (1.0 - c0) + 1e-12), name="compliance 1/f^2")
+    if not br.reached:
+        return FlexiblePeriodic(**out, reason=f"not re-solved: the continuation from {start} stopped: {br.end_reason}")
+    last = br.points[-1]
+    x, mono = last.x[1:], last.data["monodromy"]
+    out.update(phi0=float(x[0]), wz0=float(x[1]), q0=x[2:2 + n].copy(), qdot0=x[2 + n:].copy(), residual=float(last.data["residual"]),
+               iterations=int(last.iterations), multipliers=np.linalg.eigvals(mono) if np.all(np.isfinite(mono)) else None,
+               reason=last.data["reason"])
     return FlexiblePeriodic(**out)
+
+
+#: The re-solve starts from a body stiffened until its lowest clamped frequency is this many times
+#: the larger of the attitude rate and the orbital rate (quasi-static start accurate to ~1e-3).
+STIFF_START = 30.0
+
+
+class CompliancePath:
+    """The coupled model's periodic solution continued in the compliance s = 1/f^2 (the body's
+    frequencies multiplied by f = 1/sqrt(s)), for the continuation driver (natural parameter):
+    x = (s, phi0, wz0, q0, qdot0), each point corrected by the Rust corrector at fixed s. The
+    quasi-static deflection is linear in s, so the driver's linear predictor starts close."""
+
+    parameter_index = 0
+
+    def __init__(self, sys_, body, s0, T, turns, opts, qscale, tol, max_iter):
+        self.sys, self.body, self.s0, self.T, self.turns, self.opts = sys_, body, s0, T, turns, opts
+        self.qscale, self.omega = qscale, body.frequencies_nd(sys_)
+        self.tol, self.max_iter = tol, max_iter
+        self.scale = np.concatenate([[1.0, 1.0, 1.0], qscale, qscale * self.omega])
+
+    def correct(self, guess, c):
+        if c.fixed_index != 0:
+            raise ValueError("CompliancePath: natural continuation only (the compliance fixed)")
+        s = float(c.b)
+        if not s > 0:
+            raise CorrectionFailed(f"compliance {s} out of range")
+        f = 1.0 / math.sqrt(s)
+        b = self.body if s == 1.0 else self.body.scaled(f)
+        scale = np.concatenate([[1.0, 1.0], self.qscale * s, self.qscale * s * self.omega * f])
+        x, res, it, reason, mono = _core.flexible_correct_periodic(self.sys.mu, b._core_arg(self.sys.tu_s), [True, True], self.s0, self.T,
+                                                                   [float(v) for v in guess[1:]], float(self.turns), [float(v) for v in scale],
+                                                                   options=self.opts, tol=float(self.tol), max_iter=int(self.max_iter))
+        if reason != "converged":
+            raise CorrectionFailed(f"flexible re-solve at compliance {s:.6g}: {reason}")
+        return Point(np.concatenate([[s], x]), {"residual": float(res), "reason": reason, "monodromy": np.asarray(mono)}, int(it))
+
+    def tangent(self, pt):
+        return None
 
 
 # --- low frequencies: the coupled response against the structural frequency --------------------
