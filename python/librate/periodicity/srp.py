@@ -1,4 +1,4 @@
-"""Solar radiation pressure on periodic attitude motions (thesis ch. 4, PHYSICS.md sec. 6):
+"""Solar radiation pressure on periodic attitude motions (thesis ch. 4, docs/physics.md, solar radiation pressure):
 the flat-plate amplitude eps continued by :func:`librate.continue_srp`, the
 (eps, rate) periodicity map with its solution branches (:func:`srp_map`) and the accelerations on
 a Sun-pointing body (:func:`sun_pointing_accelerations`)."""
@@ -73,7 +73,7 @@ def srp_map(
 
     With ``solve``, the solutions: SRP breaks the mirror symmetry, so with phi0 fixed there is no
     curve of solutions in the plane (the two zero contours cross only at isolated points); the
-    solutions shown are BRANCHES with phi0 free (PHYSICS.md sec. 6), continued by
+    solutions shown are BRANCHES with phi0 free (docs/physics.md, solar radiation pressure), continued by
     :func:`librate.continue_srp` through the grid's eps values (``steps`` per interval) until
     the grid ends or the branch folds: from eps = 0, the gravity-only solutions of the listed
     ``kinds`` with wz0 in the window (:func:`librate.find_periodic_attitudes`), away from 0 on
