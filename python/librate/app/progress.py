@@ -38,6 +38,8 @@ def reporter(desc: str, unit: str, show: bool | None = None) -> Callable[[int, i
         b = state.get("bar")
         if b is None:
             b = state["bar"] = bar(total, desc, unit, True)
+        if total != b.total:  # work found along the way (srp_map's branches)
+            b.total = total
         b.update(done - b.n)
         if done >= total:
             b.close()

@@ -7,7 +7,8 @@ from __future__ import annotations
 
 import math
 import os
-from collections.abc import Sequence
+import threading
+from collections.abc import Callable, Sequence
 from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
@@ -58,6 +59,7 @@ def srp_map(
     solve: bool = True,
     kinds: Sequence[str] = ("periodic",),
     steps: int = 4,
+    progress: Callable[[int, int], None] | None = None,
 ):
     """A flat-plate SRP periodicity map of one orbit over (eps, initial rate), for
     :func:`librate.plotting.plot_srp_map` (thesis Figs. 35-36, 40-41).
@@ -94,8 +96,25 @@ def srp_map(
     0.05 of 2 there, where Phi - I is singular; otherwise the continuation failed, e.g. at once
     for a strongly unstable start, trace ~1e5; and ``branch_end_reason`` from
     :func:`librate.continue_srp`). Returns an xarray Dataset.
+
+    ``progress``: called as ``progress(done, total)`` after the grid's sweep and after each
+    branch (from worker threads, one call at a time); ``total`` grows as the branches to trace
+    are found, and ``done == total`` at the end.
     """
     import xarray as xr
+
+    if progress is not None and not callable(progress):
+        raise ValueError(f"invalid argument `progress`: must be a callable progress(done, total) or None, got {progress!r}")
+    counts = {"done": 0, "total": 2}  # the sweep, one per branch (added as found), the assembly
+    count_lock = threading.Lock()
+
+    def advance(done: int = 1, more: int = 0) -> None:
+        if progress is None:
+            return
+        with count_lock:
+            counts["done"] += done
+            counts["total"] += more
+            progress(counts["done"], counts["total"])
 
     orbit = check_orbit(orbit)
     kz = check_kz(kz)
@@ -119,6 +138,7 @@ def srp_map(
     r = sweep(orbit_forcing(orbit), n_periods * orbit.period, phi0, w_grid, kz, srp=plate, eps=e_grid)
     shape = (es.size, wz.size)
     data = {k: np.asarray(r[k]).reshape(shape) for k in ("dwz", "dphi", "phi_t", "status")}
+    advance()
 
     sols, path, branches = [], [], []
     if solve:
@@ -142,11 +162,15 @@ def srp_map(
                 fold = f is not None and f["located"]
                 last = br.points[-1]
                 end = (float(f["eps"]) if fold else float(last.x[0]), float(last.x[2]), fold, br.end_reason)
+            advance()
             return pts, marked, (start.n_total, start.kind, origin, e_start) + end
 
         def run(jobs, lead):
             """Trace the branches of ``jobs`` in parallel; record them in order, each after its
             ``lead`` solutions ((eps, solution) recorded at the branch's index first)."""
+            advance(0, len(jobs))
+            if not jobs:
+                return
             with ThreadPoolExecutor(max_workers=max(1, min(len(jobs), os.cpu_count() or 1))) as pool:
                 done = list(pool.map(trace, jobs))
             for (pts, marked, info), first in zip(done, lead):
@@ -248,6 +272,7 @@ def srp_map(
     )
     if not solve:
         ds = ds.drop_vars([v for v in ds.data_vars if v.startswith(("sol_", "path_", "branch_"))])
+    advance()  # the solutions assembled: done == total
     return ds
 
 
