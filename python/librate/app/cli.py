@@ -541,7 +541,13 @@ def plot(result_path, quiet) -> None:
 
     try:
         p = resolve_result_path(result_path)
+    except (ValueError, FileNotFoundError) as err:
+        raise UserError(str(err)) from None
+    try:
         _refuse_damaged_store(p)
+    except ValueError as err:  # damage, not a mistake: exit status 1, as `librate verify`
+        raise click.ClickException(str(err)) from None
+    try:
         res = open_result(p)
     except (ValueError, FileNotFoundError) as err:
         raise UserError(str(err)) from None
