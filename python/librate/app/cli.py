@@ -47,15 +47,15 @@ def main() -> None:
 
     \b
     Start here:
-      librate demo                      the DRO map at Kz = 0.8 with no study file
-      librate init study.toml           write a commented example study
-      librate family study.toml         the orbit family (continuation), saved + figures
-      librate solve study.toml          periodic attitude motions of each orbit, as a table
-      librate map study.toml            the attitude periodicity map (thesis Fig. 24)
-      librate plot librate-out/map.zarr re-draw the figures of any saved result
+      librate demo                         the DRO map at Kz = 0.8 with no study file
+      librate init study.toml              write a commented example study
+      librate family study.toml            the orbit family (continuation), saved + figures
+      librate solve study.toml             periodic attitude motions of each orbit, as a table
+      librate map study.toml               the attitude periodicity map (thesis Fig. 24)
+      librate plot librate-out/map.zarr    re-draw the figures of any saved result
       librate verify librate-out/map.zarr  checksums: name any damaged chunk or row
-      librate dros --x0 0.9             correct DROs and check that they close
-      librate info                      version, system presets and their constants
+      librate dros --x0 0.9                correct DROs and check that they close
+      librate info                         version, system presets and their constants
 
     \b
     Every command writes <command>.zarr (or .nc) and <command>_<figure>.png into its output
