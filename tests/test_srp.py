@@ -220,3 +220,21 @@ def test_unstable_motion_converges_at_the_noise_floor(sun12):
     for p, s in zip(pbs, found):
         pt = p.correct_many([(p, np.array([2.0, s.phi0, s.wz0]), Constraint.fix(3, 0, 2.0))])[0]
         assert branch_solutions(s, plate, [pt])[0].residual < 1e-9
+
+
+def test_srp_map_reports_progress_per_branch(sun12):
+    """issue 14: srp_map ran ~20 s with no progress. progress(done, total) comes after the sweep
+    and after each branch, never with done > total, and ends at done == total == 2 + the number
+    of branches (the sweep, the branches, the assembly); the map is the same with or without it."""
+    calls = []
+    args = dict(kz=0.6, wz0=np.linspace(-1.25, 0.05, 60), eps=np.linspace(0.0, 0.5, 4), cs=0.4, cd=0.1)
+    ds = librate.srp_map(sun12, progress=lambda done, total: calls.append((done, total)), **args)
+    assert ds.sizes["branch"] >= 1
+    assert calls[-1] == (2 + ds.sizes["branch"],) * 2
+    assert all(d <= t for d, t in calls) and [d for d, _ in calls] == sorted(d for d, _ in calls)
+    assert sum(1 for a, b in zip(calls, calls[1:]) if b[0] > a[0]) == 1 + ds.sizes["branch"]  # sweep + branches, then the end
+    plain = librate.srp_map(sun12, **args)
+    for v in ("dwz", "sol_wz0", "path_eps"):
+        np.testing.assert_array_equal(ds[v].values, plain[v].values)
+    with pytest.raises(ValueError, match="invalid argument `progress`"):
+        librate.srp_map(sun12, progress=3, **args)

@@ -393,3 +393,18 @@ def test_flexible_body_cannot_be_mapped(tmp_path):
     with pytest.raises(StudyError) as info:
         _flex_study(tmp_path, "sample-station", purpose="map")
     assert info.value.problems[0].startswith("body.flexible") and "solve" in info.value.problems[0]
+
+
+def test_study_changes_names_the_keys_a_result_depends_on():
+    """What `librate map` prints when it refuses a result of other inputs (issue 14): the dotted
+    keys that differ, tables flattened, only the sections the result depends on."""
+    from librate.app.results import RESULT_INPUTS, study_changes
+
+    a = Study.from_dict({"orbits": {"kind": "dro", "x0": {"start": 0.9, "stop": 0.5, "num": 3}}, "body": {"kz": 0.8}}).to_json()
+    b = Study.from_dict({"orbits": {"kind": "dro", "x0": {"start": 0.9, "stop": 0.5, "num": 4}}, "body": {"kz": 0.5},
+                         "output": {"folder": "elsewhere"}}).to_json()
+    assert study_changes(a, a) == []
+    assert study_changes(a, b, RESULT_INPUTS["map"]) == ["body.kz: 0.8 -> 0.5", "orbits.x0.num: 3 -> 4"]
+    assert study_changes(a, b, RESULT_INPUTS["family"]) == ["orbits.x0.num: 3 -> 4"]  # the body does not change a family
+    assert 'output.folder: "librate-out" -> "elsewhere"' in study_changes(a, b)
+    assert study_changes(None, a) == ["(study): none recorded in the existing result"]

@@ -1,4 +1,4 @@
-"""Physical constants of the Earth-Moon-Sun problem (PHYSICS.md section 1), defined once in the
+"""Physical constants of the Earth-Moon-Sun problem (docs/physics.md, units and constants), defined once in the
 Rust core (``rust/core/src/constants.rs``) and read from it here."""
 
 from ._core import N_SUN, OMEGA_SUN, SOLAR_PRESSURE_1AU, SUN_SYNODIC_PERIOD

@@ -24,6 +24,22 @@ from ..orbits.system import System
 _CONTEXT = {"help_option_names": ["-h", "--help"], "max_content_width": 100}
 
 
+class UserError(click.ClickException):
+    """A user mistake (a bad option value, an output that cannot or may not be written, a path
+    that is not a result): one line on stderr, exit status 2, no traceback."""
+
+    exit_code = 2
+
+
+class StudyInvalid(UserError):
+    """An invalid study file: every problem listed, exit status 2, nothing computed."""
+
+
+def _say(text: str) -> None:
+    """A note on stderr (what a run reuses or replaces): shown even with --quiet."""
+    click.echo(text, err=True)
+
+
 @click.group(context_settings=_CONTEXT)
 @click.version_option(__version__, prog_name="librate")
 def main() -> None:
@@ -31,13 +47,21 @@ def main() -> None:
 
     \b
     Start here:
-      librate init study.toml          write a commented example study
-      librate family study.toml        the orbit family (continuation), saved + figures
-      librate solve study.toml         periodic attitude motions of each orbit, as a table
-      librate map study.toml           the attitude periodicity map (thesis Fig. 24)
-      librate plot librate-out/map.zarr   re-draw figures from a saved result
-      librate verify librate-out/map.zarr checksums: name any damaged chunk or row
-      librate demo                     the DRO map at Kz = 0.8 with no study file
+      librate demo                         the DRO map at Kz = 0.8 with no study file
+      librate init study.toml              write a commented example study
+      librate family study.toml            the orbit family (continuation), saved + figures
+      librate solve study.toml             periodic attitude motions of each orbit, as a table
+      librate map study.toml               the attitude periodicity map (thesis Fig. 24)
+      librate plot librate-out/map.zarr    re-draw the figures of any saved result
+      librate verify librate-out/map.zarr  checksums: name any damaged chunk or row
+      librate dros --x0 0.9                correct DROs and check that they close
+      librate info                         version, system presets and their constants
+
+    \b
+    Every command writes <command>.zarr (or .nc) and <command>_<figure>.png into its output
+    folder (--out, default librate-out), so commands never overwrite each other. Re-running a
+    command resumes or reuses its result when the inputs are the same; a result of other
+    inputs is refused, naming what changed, unless --force (which says what it replaces).
 
     Units: nondimensional CR3BP units (LU = distance between the primaries, TU = 1 / mean
     motion; rates in 1/TU, the synodic frame turns at rate 1), angles in rad, periods in days.
@@ -45,13 +69,13 @@ def main() -> None:
     """
 
 
-@main.command(context_settings=_CONTEXT)
+@main.command(context_settings=_CONTEXT, short_help="Version, system presets and their constants, optional parts.")
 def info() -> None:
     """Show the version, the system presets with their constants, and the optional parts.
 
     For each preset: the mass ratio mu, the length unit LU (km), the time unit TU (s and
-    days) and the x coordinate of L1 (LU). Optional parts: matplotlib (figures), the chunked
-    map runner (resumable and distributed maps) and Dask.
+    days) and the x coordinate of L1 (LU). Parts: matplotlib (figures, required), the chunked
+    map runner (resumable and distributed maps) and Dask (optional).
     """
     import importlib.util
 
@@ -61,7 +85,7 @@ def info() -> None:
         l1 = s.lagrange_points()[0, 0]
         click.echo(f"  {name:16s} mu = {s.mu:.15g}  LU = {s.lu_km} km  TU = {s.tu_s} s ({s.tu_days:.6f} d)  L1 x = {l1:.15f}")
     parts = {
-        "figures (matplotlib)": importlib.util.find_spec("matplotlib") is not None,
+        "figures (matplotlib, a required dependency)": importlib.util.find_spec("matplotlib") is not None,
         "chunked, resumable map runner (librate.app.runner)": importlib.util.find_spec("librate.app.runner") is not None,
         "distributed runs (dask.distributed)": importlib.util.find_spec("dask") is not None,
     }
@@ -69,13 +93,36 @@ def info() -> None:
         click.echo(f"  {what}: {'available' if ok else 'not installed'}")
 
 
-@main.command(context_settings=_CONTEXT)
-@click.option("--system", "system_name", default="earth-moon", show_default=True, help="System preset.")
+_FORCE_HELP = ("--resume (default): continue or reuse the result in the output folder when it was made from the same inputs "
+               "(a result of other inputs is refused, naming what changed). --force: recompute and replace it, saying what it replaces.")
+_PRESET = click.Choice(System.presets())
+
+# the demo's options, as the study keys its result records (for "changed: --kz 0.8 -> 0.5")
+_DEMO_KEYS = {"system.preset": "--system", "body.kz": "--kz", "orbits.x0.num": "--orbits", "rates.wz0.num": "--rates"}
+
+
+def _demo_study(system_name: str, kz: float, n_orbits: int, n_rates: int) -> str:
+    import json
+
+    return json.dumps({"system": {"preset": system_name}, "orbits": {"kind": "dro", "x0": {"start": 0.95, "stop": 0.15, "num": n_orbits}},
+                       "body": {"kz": kz}, "rates": {"wz0": {"start": -3.0, "stop": 2.0, "num": n_rates}}}, sort_keys=True)
+
+
+def _in_cli_words(message: str, keys: dict[str, str]) -> str:
+    for key, option in keys.items():
+        message = message.replace(f"{key}: ", f"{option} ")
+    return message
+
+
+@main.command(context_settings=_CONTEXT, short_help="The DRO attitude periodicity map at Kz = 0.8, no study file needed.")
+@click.option("--system", "system_name", default="earth-moon", show_default=True, type=_PRESET, help="System preset.")
 @click.option("--kz", default=0.8, show_default=True, type=click.FloatRange(-1, 1), help="Inertia parameter Kz = (Iy - Ix)/Iz.")
 @click.option("--orbits", "n_orbits", default=60, show_default=True, type=click.IntRange(2, 2000), help="DRO family members, x0 from 0.95 to 0.15.")
 @click.option("--rates", "n_rates", default=1000, show_default=True, type=click.IntRange(10, 100000), help="Initial rates, phidot0 in [-4, 1] (wz0 in [-3, 2]).")
-@click.option("--out", "out_dir", default="librate-out", show_default=True, type=click.Path(file_okay=False), help="Output folder for the map (netCDF).")
-def demo(system_name: str, kz: float, n_orbits: int, n_rates: int, out_dir: str) -> None:
+@click.option("--out", "out_dir", default="librate-out", show_default=True, type=click.Path(file_okay=False), help="Output folder for demo.nc and the demo_*.png figures.")
+@click.option("--resume/--force", default=True, help=_FORCE_HELP)
+@click.option("--quiet", "-q", is_flag=True, help="No progress bars and no table; print only the written paths.")
+def demo(system_name: str, kz: float, n_orbits: int, n_rates: int, out_dir: str, resume: bool, quiet: bool) -> None:
     """The main job on a default study: the attitude periodicity map of the DRO family (thesis
     Fig. 24), its periodic solutions refined by Newton and grouped into families by N (Figs.
     27-29), saved as netCDF with PNG figures in the output folder.
@@ -83,63 +130,78 @@ def demo(system_name: str, kz: float, n_orbits: int, n_rates: int, out_dir: str)
     Computes the DRO family by continuation, integrates the planar attitude of a body with the
     given Kz along every member for a grid of initial rates (Rust engine, SIMD lanes, all
     cores), finds where wz(T) = wz0 and phi(T) = 2 pi N, and prints the solutions by N.
-    """
-    import pathlib
 
+    \b
+    Writes to the output folder:
+      demo.nc        the map (as `librate map` writes it): dwz, dphi, phi_T over
+                     (orbit, kz, wz0), the solutions sol_*, units and parameters
+      demo_contours.png, demo_residuals.png, demo_solutions.png, demo_orbits.png
+                     Fig. 24, Fig. 23 (first orbit), Figs. 27-29, Fig. 3
+    `librate plot OUT/demo.nc` re-draws the first three from the file.
+    """
     from ..orbits.families import dro_family
     from ..periodicity.maps import periodicity_map
+    from .progress import reporter
+    from .results import ResultExists, check_output, open_result, save_dataset
 
+    out = Path(out_dir)
+    path = out / "demo.nc"
+    study = _demo_study(system_name, kz, n_orbits, n_rates)
+    try:
+        decision = check_output(path, "map", study, force=not resume, say=lambda text: _say(_in_cli_words(text, _DEMO_KEYS)))
+    except ResultExists as err:
+        raise UserError(_in_cli_words(str(err), _DEMO_KEYS)) from None
+    except FileExistsError as err:
+        raise UserError(str(err)) from None
+    _check_writable(out, "--out")
+    if decision == "resume":
+        _say(f"reused: {path} already holds this map (same options; --force recomputes it)")
+        ds = open_result(path)
+        if not quiet:
+            _demo_summary(ds)
+        click.echo(f"written: {path} (earlier)")
+        return
     system = System.preset(system_name)
     t0 = time.perf_counter()
     fam = dro_family(system, x0=np.linspace(0.95, 0.15, n_orbits))
     t1 = time.perf_counter()
-    click.echo(f"DRO family: {len(fam)} members, x0 {fam.x0[0]:.3f} -> {fam.x0[-1]:.3f}, period {fam.period_days.min():.2f} to {fam.period_days.max():.2f} d ({t1 - t0:.2f} s)")
+    _echo(quiet, f"DRO family: {len(fam)} members, x0 {fam.x0[0]:.3f} -> {fam.x0[-1]:.3f}, period {fam.period_days.min():.2f} to {fam.period_days.max():.2f} d ({t1 - t0:.2f} s)")
     wz0 = np.linspace(-3.0, 2.0, n_rates)
-    done = [0]
-
-    def progress(k, total):
-        if click.get_text_stream("stdout").isatty() and (k == total or k % max(1, total // 20) == 0):
-            click.echo(f"  map: {k}/{total} orbits", err=True)
-        done[0] = k
-
-    ds = periodicity_map(fam, kz=kz, wz0=wz0, progress=progress)
+    ds = periodicity_map(fam, kz=kz, wz0=wz0, progress=reporter("periodicity map (and solutions)", "orbit", None if not quiet else False))
     t2 = time.perf_counter()
     n_traj = ds.dwz.size
-    click.echo(f"periodicity map: {len(fam)} orbits x {n_rates} rates at Kz = {kz}: {n_traj} attitude trajectories in {t2 - t1:.2f} s ({n_traj / (t2 - t1):,.0f} per s, with solving)")
-    click.echo(f"solutions (phi(T) = 2 pi N, wz(T) = wz0, refined by Newton, residual from an independent re-propagation): {ds.sizes['solution']}")
+    _echo(quiet, f"periodicity map: {len(fam)} orbits x {n_rates} rates at Kz = {kz}: {n_traj} attitude trajectories in {t2 - t1:.2f} s ({n_traj / (t2 - t1):,.0f} per s, with solving)")
+    if not quiet:
+        _demo_summary(ds)
+    from .._core import __version__
+
+    ds.attrs.update({"librate_result": "map", "librate_command": "demo", "study": study, "librate_version": __version__})
+    try:
+        save_dataset(ds, path)
+    except OSError as err:
+        raise UserError(f"--out {out}: cannot write {path.name} there ({err.strerror or err})") from None
+    click.echo(f"written: {path} (xarray Dataset: dwz, dphi, phi_T over (orbit, kz, wz0), solutions, units and parameters)")
+    _figures(ds, path, ("map", "residuals", "solutions"), quiet, extra={"family": lambda lp: lp.plot_family(fam)})
+
+
+def _demo_summary(ds, shown_n: int = 3) -> None:
+    n_, kind_ = ds.sol_n.values, ds.sol_kind.values.astype(str)
+    listed = np.abs(n_) <= shown_n
+    total = int(ds.sizes["solution"])
+    omitted = "" if listed.all() else f"; listed below: |N| <= {shown_n} ({int(listed.sum())}), {total - int(listed.sum())} with |N| > {shown_n} omitted"
+    click.echo(f"solutions (phi(T) = 2 pi N, wz(T) = wz0, refined by Newton, residual from an independent re-propagation): {total}{omitted}")
     click.echo(f"{'N':>4} {'kind':>10} {'count':>6} {'stable':>7} {'phidot0 range [1/TU]':>24} {'max residual':>13}")
-    for (n, kind) in sorted(set(zip(ds.sol_n.values.tolist(), ds.sol_kind.values.tolist())), key=lambda x: (x[1], x[0])):
-        sel = (ds.sol_n.values == n) & (ds.sol_kind.values == kind)
-        if abs(n) > 3:
+    for (n, kind) in sorted(set(zip(n_.tolist(), kind_.tolist())), key=lambda x: (x[1], x[0])):
+        if abs(n) > shown_n:
             continue
+        sel = (n_ == n) & (kind_ == kind)
         pd = ds.sol_phidot0.values[sel]
         click.echo(f"{n:>4g} {kind:>10} {int(sel.sum()):>6} {int(ds.sol_stable.values[sel].sum()):>7} {pd.min():>11.4f} .. {pd.max():<10.4f} {ds.sol_residual.values[sel].max():>13.1e}")
-    out = pathlib.Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
-    path = out / f"dro_map_kz{kz:g}.nc"
-    ds.to_netcdf(path, engine="scipy")
-    click.echo(f"written: {path} (xarray Dataset: dwz, dphi, phi_T over (orbit, kz, wz0), solutions, units and parameters)")
-    try:
-        import matplotlib
-
-        matplotlib.use("Agg")
-        from .. import plotting as lp
-    except ImportError:
-        click.echo("figures skipped: matplotlib is not installed (pip install 'librate[plot]')")
-        return
-    figures = {
-        "map.png": lp.plot_map(ds),
-        "solution_families.png": lp.plot_solution_families(ds, n=(1, 0, -1)),
-        "family.png": lp.plot_family(fam),
-    }
-    for name, fig in figures.items():
-        lp.save_figure(fig, out / name, close=True)
-    click.echo(f"figures: {', '.join(str(out / n) for n in figures)} (thesis Fig. 24, Figs. 27-29, Fig. 3)")
 
 
-@main.command(name="dros", context_settings=_CONTEXT)
-@click.option("--system", "system_name", default="earth-moon", show_default=True, help="System preset.")
-@click.option("--x0", "x0_values", multiple=True, type=float, help="DRO start(s) on the x axis (default: 0.96 0.93 0.90 0.87 0.84 0.81).")
+@main.command(name="dros", context_settings=_CONTEXT, short_help="Correct distant retrograde orbits and check that each closes.")
+@click.option("--system", "system_name", default="earth-moon", show_default=True, type=_PRESET, help="System preset.")
+@click.option("--x0", "x0_values", multiple=True, type=float, help="DRO start(s) on the x axis, between the primaries (default: 0.96 0.93 0.90 0.87 0.84 0.81).")
 def dros(system_name: str, x0_values: tuple[float, ...]) -> None:
     """Correct a set of distant retrograde orbits and check each over one full period.
 
@@ -148,13 +210,22 @@ def dros(system_name: str, x0_values: tuple[float, ...]) -> None:
     """
     system = System.preset(system_name)
     xs = x0_values or (0.96, 0.93, 0.90, 0.87, 0.84, 0.81)
+    lo, hi = -system.mu, 1.0 - system.mu
+    for x0 in xs:
+        if not lo < x0 < hi:
+            raise UserError(f"--x0 {x0:g}: a DRO starts between the primaries, {lo:.6g} < x0 < {hi:.6g} LU (Earth at -mu, Moon at 1 - mu)")
     click.echo(f"Distant retrograde orbits in {system.name} (mu = {system.mu}), corrected by half-period shooting:")
     click.echo(f"{'x0':>8} {'ydot0':>18} {'period [TU]':>16} {'period [d]':>11} {'Jacobi':>17} {'iter':>4} {'closure':>9} {'time':>7}")
     guess = None
     for x0 in xs:
         t_start = time.perf_counter()
-        orbit = correct_dro(system, x0, guess)
-        one = propagate(system, orbit.state0, orbit.period, rtol=1e-13, atol=1e-13, t_eval=[orbit.period], collision="point")
+        try:
+            orbit = correct_dro(system, x0, guess)
+            one = propagate(system, orbit.state0, orbit.period, rtol=1e-13, atol=1e-13, t_eval=[orbit.period], collision="point")
+        except ValueError as err:
+            raise UserError(f"--x0 {x0:g}: {err}") from None
+        except LibrateError as err:
+            raise click.ClickException(f"--x0 {x0:g}: {type(err).__name__}: {str(err).splitlines()[0]}") from None
         closure = float(np.max(np.abs(one.y[-1] - orbit.state0)))
         elapsed = time.perf_counter() - t_start
         click.echo(
@@ -166,13 +237,19 @@ def dros(system_name: str, x0_values: tuple[float, ...]) -> None:
 
 
 # --- studies ------------------------------------------------------------------------------------
-class StudyInvalid(click.ClickException):
-    """An invalid study file: every problem listed, exit status 2, nothing computed."""
-
-    exit_code = 2
+_FAILURES = (FileExistsError, RuntimeError, ValueError, LibrateError, OSError)
 
 
-_FAILURES = (FileExistsError, RuntimeError, ValueError, LibrateError)
+def _check_writable(folder: Path, what: str) -> None:
+    """Refuse, before any work, an output folder that cannot be created or written."""
+    import tempfile
+
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        with tempfile.TemporaryFile(dir=folder):
+            pass
+    except OSError as err:
+        raise UserError(f"{what} {folder}: cannot write there ({err.strerror or type(err).__name__})") from None
 
 
 def _failure(err: Exception) -> click.ClickException:
@@ -182,7 +259,13 @@ def _failure(err: Exception) -> click.ClickException:
 
     if isinstance(err, StudyError):
         return StudyInvalid(str(err))
-    return click.ClickException(f"{type(err).__name__}: {err}" if isinstance(err, LibrateError) else str(err))
+    if isinstance(err, LibrateError):  # the computation failed: exit status 1
+        return click.ClickException(f"{type(err).__name__}: {err}")
+    if isinstance(err, (ValueError, FileExistsError)):  # a refused output, a member not on the family
+        return UserError(str(err))
+    if isinstance(err, OSError):
+        return UserError(f"{getattr(err, 'filename', None) or 'output'}: cannot write there ({err.strerror or type(err).__name__})")
+    return click.ClickException(str(err))
 
 
 def _overrides(sets: tuple[str, ...]) -> dict:
@@ -207,19 +290,9 @@ def _load_study(path: str | None, purpose: str, overrides: dict):
         raise StudyInvalid(str(err)) from None
 
 
-def _progress(quiet: bool):
-    """A progress line on stderr (done/total, rate, ETA), only in a terminal and without --quiet."""
-    if quiet or not sys.stderr.isatty():
-        return None
-    t0 = time.perf_counter()
-
-    def report(done: int, total: int) -> None:
-        el = max(time.perf_counter() - t0, 1e-9)
-        rate = done / el
-        eta = (total - done) / rate if rate > 0 else float("nan")
-        click.echo(f"\r  {done}/{total} ({100 * done / max(total, 1):3.0f}%)  {rate:.2f}/s  ETA {eta:5.0f} s ", err=True, nl=done >= total)
-
-    return report
+def _show(quiet: bool) -> bool | None:
+    """Progress bars: never with --quiet, else only in a terminal (None: decided on stderr)."""
+    return False if quiet else None
 
 
 def _echo(quiet: bool, text: str) -> None:
@@ -230,7 +303,7 @@ def _echo(quiet: bool, text: str) -> None:
 _SET_HELP = "Override a study key, KEY=VALUE with a TOML value (repeatable): --set body.kz=0.5 --set rates.wz0.num=200."
 
 
-@main.command(context_settings=_CONTEXT)
+@main.command(context_settings=_CONTEXT, short_help="Write a commented example study file to start from.")
 @click.argument("path", default="study.toml", type=click.Path(dir_okay=False))
 @click.option("--force", is_flag=True, help="Overwrite PATH if it exists.")
 def init(path: str, force: bool) -> None:
@@ -244,9 +317,12 @@ def init(path: str, force: bool) -> None:
 
     p = Path(path)
     if p.exists() and not force:
-        raise click.ClickException(f"{p} exists: not overwritten (use --force to replace it)")
-    p.parent.mkdir(parents=True, exist_ok=True)
-    p.write_text(EXAMPLE_STUDY, encoding="utf-8")
+        raise UserError(f"{p} exists: not overwritten (use --force to replace it)")
+    try:
+        p.parent.mkdir(parents=True, exist_ok=True)
+        p.write_text(EXAMPLE_STUDY, encoding="utf-8")
+    except OSError as err:
+        raise UserError(f"{p}: cannot write there ({err.strerror or type(err).__name__})") from None
     click.echo(f"written: {p}\nnext: librate map {p}   (or: librate family {p}, librate solve {p})")
 
 
@@ -264,7 +340,7 @@ def _x0_option(text: str):
     return vals
 
 
-@main.command(context_settings=_CONTEXT)
+@main.command(context_settings=_CONTEXT, short_help="An orbit family by continuation, saved with its figures.")
 @click.argument("study", required=False, type=click.Path(exists=True, dir_okay=False))
 @click.option("--kind", help="Family: dro, lyapunov or halo (orbits.kind).")
 @click.option("--point", type=int, help="Lagrange point 1 or 2, for lyapunov and halo (orbits.point).")
@@ -275,8 +351,9 @@ def _x0_option(text: str):
 @click.option("--format", "fmt", help="zarr or netcdf (output.format).")
 @click.option("--set", "sets", multiple=True, metavar="KEY=VALUE", help=_SET_HELP)
 @click.option("--out", "out_dir", type=click.Path(file_okay=False), help="Output folder (default: output.folder of the study, else librate-out).")
+@click.option("--resume/--force", default=True, help=_FORCE_HELP)
 @click.option("--quiet", "-q", is_flag=True, help="Print only the written paths.")
-def family(study, kind, point, branch, x0, members, system_name, fmt, sets, out_dir, quiet) -> None:
+def family(study, kind, point, branch, x0, members, system_name, fmt, sets, out_dir, resume, quiet) -> None:
     """Compute an orbit family by continuation and save it, from STUDY and/or options.
 
     \b
@@ -294,8 +371,9 @@ def family(study, kind, point, branch, x0, members, system_name, fmt, sets, out_
                                   constant, monodromy eigenvalues and stability indices, with
                                   the study (JSON) and the version as attributes;
                                   reload with librate.open_result(path)
-      family.png, period.png, stability.png   orbits coloured by Jacobi constant, period
-                                  against x0 with the resonances, stability indices
+      family_orbits.png, family_period.png, family_stability.png   orbits coloured by Jacobi
+                                  constant, period against x0 with the resonances, stability
+    A family of the same [system] and [orbits] is reused; one of others is refused (--force).
     """
     ov = {}
     for key, value in (("orbits.kind", kind), ("orbits.point", point), ("orbits.branch", branch), ("orbits.members", members),
@@ -307,9 +385,10 @@ def family(study, kind, point, branch, x0, members, system_name, fmt, sets, out_
     ov = {k: _quote(v) for k, v in ov.items()}  # option words stay strings
     ov.update(_overrides(sets))
     st = _load_study(study, "family", ov)
+    _check_writable(st.output_dir(out_dir), "--out" if out_dir else "output.folder")
     t0 = time.perf_counter()
     try:
-        fam, path = st.run_family(out_dir)
+        fam, path = st.run_family(out_dir, force=not resume, say=_say)
     except _FAILURES as err:
         raise _failure(err) from None
     el = time.perf_counter() - t0
@@ -319,7 +398,7 @@ def family(study, kind, point, branch, x0, members, system_name, fmt, sets, out_
     for b in fam.bifurcations:
         _echo(quiet, f"  bifurcation: {b['index']} index, {b['type']}, near x0 = {b['x0']:.6g}")
     click.echo(f"written: {path}")
-    _figures(fam, path.parent, st.figures(("family", "period", "stability")), quiet)
+    _figures(fam, path, st.figures(("family", "period", "stability")), quiet)
 
 
 def _quote(v):
@@ -329,12 +408,13 @@ def _quote(v):
     return json.dumps(v) if isinstance(v, str) else v
 
 
-@main.command(context_settings=_CONTEXT)
+@main.command(context_settings=_CONTEXT, short_help="The periodic attitude motions of each orbit, as a table.")
 @click.argument("study", type=click.Path(exists=True, dir_okay=False))
 @click.option("--set", "sets", multiple=True, metavar="KEY=VALUE", help=_SET_HELP)
 @click.option("--out", "out_dir", type=click.Path(file_okay=False), help="Output folder (default: output.folder of the study).")
+@click.option("--resume/--force", default=True, help=_FORCE_HELP)
 @click.option("--quiet", "-q", is_flag=True, help="No progress and no table; print only the written path.")
-def solve(study, sets, out_dir, quiet) -> None:
+def solve(study, sets, out_dir, resume, quiet) -> None:
     """Find the periodic attitude motions of each orbit and Kz of STUDY in its rate window.
 
     For every selected orbit (period T) and every Kz of [body], scans the study's grid of
@@ -348,15 +428,19 @@ def solve(study, sets, out_dir, quiet) -> None:
 
     \b
     Prints one line per solution and writes to the output folder:
-      solutions.zarr (or solutions.nc)  over `solution`: orbit index, x0 (LU), period (d), Kz,
-                      N, kind, wz0 and phidot0 (1/TU), phi0 (rad), trace, stable, residual,
+      solve.zarr (or solve.nc)  over `solution`: orbit index, x0 (LU), period (d), Kz, N,
+                      kind, wz0 and phidot0 (1/TU), phi0 (rad), trace, stable, residual,
                       with the study (JSON) and the version as attributes
-      solutions.png   the solutions' rates against x0
+      solve_solutions.png   the solutions' rates against x0
+    A table of the same inputs is reused; one of other inputs is refused (--force).
     """
+    from .progress import reporter
+
     st = _load_study(study, "solve", _overrides(sets))
+    _check_writable(st.output_dir(out_dir), "--out" if out_dir else "output.folder")
     t0 = time.perf_counter()
     try:
-        ds, path = st.run_solve(out_dir, progress=_progress(quiet))
+        ds, path = st.run_solve(out_dir, progress=reporter("solutions", "orbit-Kz", _show(quiet)), force=not resume, say=_say)
     except _FAILURES as err:
         raise _failure(err) from None
     el = time.perf_counter() - t0
@@ -369,15 +453,15 @@ def solve(study, sets, out_dir, quiet) -> None:
             click.echo(f"{r['orbit']:>5d} {r['x0']:>9.5f} {r['period_days']:>8.4f} {r['kz']:>6.3g} {r['n']:>4g} {r['kind']:>9} {r['wz0']:>13.8f} "
                        f"{r['phidot0']:>13.8f} {r['phi0']:>9.5f} {r['trace']:>10.4g} {'yes' if r['stable'] else 'no':>6} {r['residual']:>9.1e}")
     click.echo(f"written: {path}")
-    _figures(ds, path.parent, st.figures(("solutions",)), quiet)
+    _figures(ds, path, st.figures(("solutions",)), quiet)
 
 
-@main.command(name="map", context_settings=_CONTEXT)
+@main.command(name="map", context_settings=_CONTEXT, short_help="The attitude periodicity map of a study (thesis Fig. 24).")
 @click.argument("study", type=click.Path(exists=True, dir_okay=False))
 @click.option("--out", "out_dir", type=click.Path(file_okay=False), help="Output folder (default: output.folder of the study); the map goes to OUT/map.zarr.")
 @click.option("--quiet", "-q", is_flag=True, help="No progress bar and no summary; print only the written paths.")
 @click.option("--scheduler", metavar="tcp://HOST:PORT", help="Run the map's chunks on this Dask scheduler (needs librate.app.runner and dask.distributed).")
-@click.option("--resume/--no-resume", default=True, show_default=True, help="Continue an interrupted map in OUT/map.zarr from its finished chunks; --no-resume recomputes it.")
+@click.option("--resume/--force", default=True, help=_FORCE_HELP)
 @click.option("--set", "sets", multiple=True, metavar="KEY=VALUE", help=_SET_HELP)
 def map_(study, out_dir, quiet, scheduler, resume, sets) -> None:
     """Compute the attitude periodicity map of STUDY (thesis Fig. 24) and its solutions.
@@ -388,7 +472,9 @@ def map_(study, out_dir, quiet, scheduler, resume, sets) -> None:
     dphi = phi(T) - phi0 wrapped to (-pi, pi] (rad) and the unwrapped phi(T); periodic motions
     lie where both vanish and are refined by Newton (N net turns, kind, stability, residual).
     A map is written chunk by chunk and resumable: re-running the same command after an
-    interruption continues from the finished chunks.
+    interruption continues from the finished chunks (also after editing keys the map does
+    not depend on, such as [output]); a map of other inputs is refused, naming the changed
+    keys, unless --force.
 
     \b
     Writes to the output folder:
@@ -396,15 +482,16 @@ def map_(study, out_dir, quiet, scheduler, resume, sets) -> None:
                    period (TU), period_days, kz, wz0 and phidot0 = wz0 - 1 (1/TU); the
                    solutions sol_* along `solution`; the study (JSON) and the version as
                    attributes (map.nc too with output.format = "netcdf")
-      map.png      zero contours of dwz and dphi over (orbit period, phidot0) with the
-                   solutions by N (one file per Kz: map_kz<Kz>.png when several)
-      residuals.png  dwz and dphi against phidot0 for the first orbit (thesis Fig. 23)
-      solutions.png  the solution families across the orbits (thesis Figs. 27-29)
+      map_contours.png   zero contours of dwz and dphi over (orbit period, phidot0) with
+                   the solutions by N (one file per Kz: map_contours_kz<Kz>.png)
+      map_residuals.png  dwz and dphi against phidot0, first orbit (thesis Fig. 23)
+      map_solutions.png  the solution families across the orbits (thesis Figs. 27-29)
     """
     st = _load_study(study, "map", _overrides(sets))
+    _check_writable(st.output_dir(out_dir), "--out" if out_dir else "output.folder")
     t0 = time.perf_counter()
     try:
-        ds, path = st.run_map(out_dir, scheduler=scheduler, progress=_progress(quiet), resume=resume)
+        ds, path = st.run_map(out_dir, scheduler=scheduler, progress=_show(quiet), force=not resume, say=_say)
     except _FAILURES as err:
         raise _failure(err) from None
     el = time.perf_counter() - t0
@@ -414,7 +501,7 @@ def map_(study, out_dir, quiet, scheduler, resume, sets) -> None:
                    + ("" if int(ds.attrs.get("complete", 1)) else "  [INCOMPLETE: interrupted; re-run to resume]"))
         _solution_summary(ds)
     click.echo(f"written: {path}")
-    _figures(ds, path.parent, st.figures(("map", "residuals", "solutions")), quiet)
+    _figures(ds, path, st.figures(("map", "residuals", "solutions")), quiet)
 
 
 def _solution_summary(ds) -> None:
@@ -430,32 +517,41 @@ def _solution_summary(ds) -> None:
         click.echo(f"{n:>4g} {kind:>10} {int(sel.sum()):>6} {int(stable[sel].sum()):>7} {pd[sel].min():>11.4f} .. {pd[sel].max():<10.4f} {res[sel].max():>13.1e}")
 
 
-@main.command(context_settings=_CONTEXT)
+@main.command(context_settings=_CONTEXT, short_help="Re-draw the figures of any saved result, without recomputing.")
 @click.argument("result_path", type=click.Path(exists=True))
 @click.option("--quiet", "-q", is_flag=True, help="Print only the written paths.")
 def plot(result_path, quiet) -> None:
     """Re-draw the figures of a saved result, without recomputing.
 
-    RESULT_PATH: a family, map or solutions result written by `librate family`, `map` or
-    `solve` (a .zarr folder or a .nc file; or an output folder holding one of them). The PNGs
-    are written next to it:
+    RESULT_PATH: a result written by any command (`family`, `solve`, `map`, `demo`) or by
+    the Python API (`OrbitFamily.save`, a map saved with `to_netcdf`): a .zarr folder or a .nc
+    file, or an output folder holding one of them. The PNGs are written next to it, named
+    after it (STEM_FIGURE.png for STEM.zarr or STEM.nc), so they replace only the figures of
+    that result:
 
     \b
-      family     family.png (orbits coloured by Jacobi constant), period.png (period in days
-                 against x0, with the 1:k resonances), stability.png (stability indices)
-      map        map.png (zero contours and solutions; map_kz<Kz>.png per Kz when several),
-                 residuals.png (dwz, dphi against phidot0 for the first orbit),
-                 solutions.png (solution families across the orbits)
-      solutions  solutions.png (initial rates phidot0 of the solutions against x0)
+      a family   STEM_orbits.png (orbits coloured by Jacobi constant), STEM_period.png
+                 (period in days against x0, with the 1:k resonances), STEM_stability.png
+      a map      STEM_contours.png (zero contours and solutions; STEM_contours_kz<Kz>.png
+                 per Kz when several), STEM_residuals.png (dwz, dphi against phidot0 for
+                 the first orbit), STEM_solutions.png (solution families across the orbits)
+      solutions  STEM_solutions.png (initial rates phidot0 of the solutions against x0)
     """
     from .results import open_result, resolve_result_path
 
     try:
         p = resolve_result_path(result_path)
+    except (ValueError, FileNotFoundError) as err:
+        raise UserError(str(err)) from None
+    try:
         _refuse_damaged_store(p)
+    except ValueError as err:  # damage, not a mistake: exit status 1, as `librate verify`
+        raise click.ClickException(str(err)) from None
+    try:
         res = open_result(p)
     except (ValueError, FileNotFoundError) as err:
-        raise click.ClickException(str(err)) from None
+        raise UserError(str(err)) from None
+    _check_writable(p.parent, "the folder of RESULT_PATH,")
     from ..orbits.families import OrbitFamily
 
     if isinstance(res, OrbitFamily):
@@ -465,7 +561,7 @@ def plot(result_path, quiet) -> None:
         kind = res.attrs.get("librate_result") or ("map" if "dwz" in res.variables else "solutions")
         _echo(quiet, f"{kind}: {', '.join(f'{k} {v}' for k, v in res.sizes.items())}")
         names = ("map", "residuals", "solutions") if "dwz" in res.variables else ("solutions",)
-    written = _figures(res, p.parent, names, quiet)
+    written = _figures(res, p, names, quiet)
     if not written:
         raise click.ClickException("no figure could be drawn (see the messages above)")
 
@@ -481,7 +577,7 @@ def _refuse_damaged_store(p: Path) -> None:
         raise ValueError(rep.describe())
 
 
-@main.command(context_settings=_CONTEXT)
+@main.command(context_settings=_CONTEXT, short_help="Check a saved result for damage, without recomputing it.")
 @click.argument("result_path", type=click.Path(exists=True))
 def verify(result_path) -> None:
     """Check a saved result for damage, without recomputing it.
@@ -492,23 +588,33 @@ def verify(result_path) -> None:
     rows not computed yet, missing, truncated or garbled chunks, and damaged coordinates or
     solutions are named. Other results (family, solutions, map.nc): every variable is read and
     compared with its stored checksum. Exit status 0 when intact, 1 when damaged or
-    incomplete (re-running the same `librate map` recomputes the damaged rows).
+    incomplete (re-running the same `librate map` recomputes the damaged rows), 2 when
+    RESULT_PATH is not a librate result.
     """
-    from .results import verify_result
+    from .results import resolve_result_path, verify_result
 
     try:
-        ok, report = verify_result(result_path)
+        p = resolve_result_path(result_path)
+        if not (p.is_dir() or p.suffix == ".nc"):
+            raise ValueError(f"{str(p)!r} is neither a netCDF file (.nc) nor a Zarr store (.zarr folder)")
+        ok, report = verify_result(p)
     except (ValueError, FileNotFoundError) as err:
-        raise click.ClickException(str(err)) from None
+        raise UserError(str(err)) from None
     click.echo(report)
     if not ok:
         sys.exit(1)
 
 
-def _figures(result, folder: Path, names, quiet: bool) -> list[Path]:
-    """Draw the named figures of a result into ``folder``; a figure that does not apply or
-    fails is skipped with a note (matplotlib missing: all skipped)."""
-    if not names:
+#: The file suffix of each figure: a result STEM.zarr gets STEM_<suffix>.png beside it.
+_FIGURE_FILES = {"family": "orbits", "period": "period", "stability": "stability", "map": "contours", "residuals": "residuals",
+                 "solutions": "solutions"}
+
+
+def _figures(result, path: Path, names, quiet: bool, extra: dict | None = None) -> list[Path]:
+    """Draw the named figures of the result saved at ``path`` beside it, as
+    ``<stem>_<figure>.png``; ``extra``: more figures, ``{name: make(plotting_module)}``. A
+    figure that does not apply or fails is skipped with a note (the result is kept)."""
+    if not names and not extra:
         return []
     try:
         import matplotlib
@@ -517,44 +623,51 @@ def _figures(result, folder: Path, names, quiet: bool) -> list[Path]:
         import matplotlib.pyplot as plt
 
         from .. import plotting as lp
-    except ImportError:
-        click.echo("figures skipped: matplotlib is not installed (pip install 'librate[plot]')", err=True)
+    except ImportError as err:
+        click.echo(f"figures skipped: matplotlib, a required dependency of librate, cannot be imported ({err}); reinstall librate", err=True)
         return []
     from ..orbits.families import OrbitFamily
+    from .progress import bar
 
+    folder, stem = path.parent, path.stem
+    fname = lambda name, tail="": f"{stem}_{_FIGURE_FILES.get(name, name)}{tail}.png"
     jobs = []
     if isinstance(result, OrbitFamily):
         table = {"family": lambda: lp.plot_family(result, n_orbits=30), "period": lambda: lp.plot_period(result),
                  "stability": lambda: lp.plot_stability(result)}
-        jobs = [(f"{n}.png", table[n]) for n in names if n in table]
+        jobs = [(fname(n), table[n]) for n in names if n in table]
     elif "dwz" in result.variables:
         kzs = np.atleast_1d(result["kz"].values)
         for name in names:
             if name == "map":
                 if result.sizes["orbit"] < 2:
-                    click.echo("map.png skipped: a periodicity map figure needs at least 2 orbits", err=True)
+                    click.echo(f"{fname('map')} skipped: a periodicity map figure needs at least 2 orbits", err=True)
                     continue
                 for j, kz in enumerate(kzs):
-                    fname = "map.png" if kzs.size == 1 else f"map_kz{kz:g}.png"
-                    jobs.append((fname, lambda j=j: lp.plot_map(result, kz_index=j)))
+                    jobs.append((fname("map", "" if kzs.size == 1 else f"_kz{kz:g}"), lambda j=j: lp.plot_map(result, kz_index=j)))
             elif name == "residuals":
-                jobs.append(("residuals.png", lambda: lp.plot_residuals(result, orbit_index=0, kz=float(kzs[0]))))
+                jobs.append((fname("residuals"), lambda: lp.plot_residuals(result, orbit_index=0, kz=float(kzs[0]))))
             elif name == "solutions" and "sol_wz0" in result.variables:
                 if result.sizes["orbit"] < 2 or result.sizes.get("solution", 0) == 0:
                     continue
-                jobs.append(("solutions.png", lambda: lp.plot_solution_families(result)))
+                jobs.append((fname("solutions"), lambda: lp.plot_solution_families(result)))
     elif "sol_wz0" in result.variables and "solutions" in names and result.sizes.get("solution", 0):
-        jobs.append(("solutions.png", lambda: _solutions_scatter(result)))
+        jobs.append((fname("solutions"), lambda: _solutions_scatter(result)))
+    for name, make in (extra or {}).items():
+        jobs.append((fname(name), lambda make=make: make(lp)))
     written = []
-    for fname, make in jobs:
-        try:
-            fig = make()
-        except Exception as err:  # a figure must not lose the computed result
-            click.echo(f"{fname} skipped: {type(err).__name__}: {err}", err=True)
-            continue
-        written.append(lp.save_figure(fig, folder / fname))
-        plt.close(fig)
-        click.echo(f"written: {folder / fname}")
+    with bar(len(jobs), "figures", "figure", _show(quiet)) as progress:
+        for name, make in jobs:
+            try:
+                fig = make()
+            except Exception as err:  # a figure must not lose the computed result
+                progress.write(f"{name} skipped: {type(err).__name__}: {err}", file=sys.stderr)
+                progress.update(1)
+                continue
+            written.append(lp.save_figure(fig, folder / name))
+            plt.close(fig)
+            progress.update(1)
+            progress.write(f"written: {folder / name}", file=sys.stdout)
     return written
 
 

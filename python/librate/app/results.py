@@ -19,12 +19,20 @@ import numpy as np
 
 from .._integrity import write_atomically
 
-__all__ = ["RESULT_KINDS", "open_result", "read_attrs", "result_kind", "run_map_to", "save_dataset", "save_family", "solutions_dataset",
-           "verify_result"]
+__all__ = ["RESULT_INPUTS", "RESULT_KINDS", "RESULT_STEMS", "ResultExists", "check_output", "describe_result", "open_result", "read_attrs", "result_kind", "run_map_to", "save_dataset", "save_family", "solutions_dataset",
+           "study_changes", "verify_result"]
 
 #: The kinds of result, as stored in the ``librate_result`` attribute.
 RESULT_KINDS = ("family", "solutions", "map")
-_NAMES = ("map.zarr", "family.zarr", "solutions.zarr", "map.nc", "family.nc", "solutions.nc")
+#: The file each command writes its result to (``<stem>.zarr`` or ``<stem>.nc``): the name says
+#: which command made it. Its figures are ``<stem>_<figure>.png`` beside it.
+RESULT_STEMS = {"family": "family", "solve": "solve", "map": "map", "demo": "demo"}
+#: The study sections each kind of result depends on: a change elsewhere (e.g. ``output``, or
+#: ``body`` for a family) leaves the result valid, so it is resumed rather than refused.
+RESULT_INPUTS = {"family": ("system", "orbits"), "solutions": ("system", "orbits", "body", "torques", "rates", "solver"),
+                 "map": ("system", "orbits", "body", "torques", "rates", "solver")}
+# older names, still read: solutions.* (librate solve before 0.2), dro_map_kz*.nc (librate demo)
+_NAMES = tuple(f"{stem}{ext}" for stem in (*RESULT_STEMS.values(), "solutions") for ext in (".zarr", ".nc"))
 
 
 def _is_zarr(p: Path) -> bool:
@@ -52,13 +60,130 @@ def resolve_result_path(path: str | Path) -> Path:
     if not p.exists():
         raise FileNotFoundError(f"no result at {str(p)!r}")
     if p.is_dir() and not _is_zarr(p):
-        found = [p / n for n in _NAMES if (p / n).exists()]
+        found = [p / n for n in _NAMES if (p / n).exists()] + sorted(p.glob("dro_map_kz*.nc"))
+        # a map.nc exported beside its map.zarr is the same result: the .zarr stands for both
+        found = [f for f in found if not (f.suffix == ".nc" and f.with_suffix(".zarr") in found)]
         if len(found) == 1:
             return found[0]
         if not found:
             raise ValueError(f"{str(p)!r} is a folder with no librate result in it (looked for {', '.join(_NAMES)}) and not a Zarr store")
         raise ValueError(f"{str(p)!r} holds several results ({', '.join(f.name for f in found)}): give one of them")
     return p
+
+
+def study_changes(old: str | dict | None, new: str | dict | None, sections: tuple[str, ...] | None = None) -> list[str]:
+    """The study keys that differ between two studies (JSON text or dicts), as
+    ``"body.kz: 0.8 -> 0.5"`` lines in key order (tables flattened: ``rates.wz0.num: 300 -> 50``); only the keys under ``sections`` count (all
+    when None). A missing study (a result saved by the Python API) differs in ``(study)``."""
+    import json
+
+    if old is None or new is None:
+        return [] if old is new else ["(study): none recorded in the existing result"]
+    a = json.loads(old) if isinstance(old, str) else old
+    b = json.loads(new) if isinstance(new, str) else new
+
+    def flat(d, prefix=""):
+        out = {}
+        for k, v in d.items():
+            key = f"{prefix}{k}"
+            if isinstance(v, dict) and v:
+                out.update(flat(v, key + "."))
+            else:
+                out[key] = v
+        return out
+
+    fa, fb = flat(a), flat(b)
+    keep = (lambda k: True) if sections is None else (lambda k: k.split(".", 1)[0] in sections)
+    show = lambda v: "(unset)" if v is None else json.dumps(v)
+    return [f"{k}: {show(fa.get(k))} -> {show(fb.get(k))}" for k in sorted(set(fa) | set(fb)) if keep(k) and fa.get(k) != fb.get(k)]
+
+
+class ResultExists(FileExistsError):
+    """The output path holds a librate result that a run would replace: from other inputs
+    (``changes`` names the keys), or of another kind. Re-run with ``force=True`` (``--force``)."""
+
+    def __init__(self, message: str, changes: list[str] | None = None):
+        super().__init__(message)
+        self.changes = list(changes or [])
+
+
+def describe_result(path: str | Path) -> str:
+    """One line on a saved result: its kind, size and the librate version that wrote it."""
+    try:
+        ds = _open_dataset(Path(path))
+    except ValueError:
+        return f"{path} (unreadable)"
+    try:
+        kind = result_kind(ds) or "unknown"
+        sizes = ", ".join(f"{k} {v}" for k, v in ds.sizes.items() if k in ("member", "orbit", "kz", "wz0", "solution"))
+        if not sizes and "complete" in ds.attrs:
+            sizes = "unfinished"
+        version = ds.attrs.get("librate_version")
+        return f"{path} (a librate {kind}{': ' + sizes if sizes else ''}{', librate ' + str(version) if version else ''})"
+    finally:
+        ds.close()
+
+
+def check_output(path: str | Path, kind: str, study: str | None, *, force: bool = False, say: Callable[[str], None] | None = None) -> str:
+    """Decide what a run may do with its output ``path`` (a ``.zarr`` or ``.nc`` result of
+    ``kind``; ``study``: the run's study as JSON). Returns ``"new"`` (nothing there),
+    ``"resume"`` (a result of the same kind from the same inputs: continue or reuse it; only
+    keys that do not change this result, such as ``output.*``, may differ) or ``"replace"``
+    (``force``: the existing result is replaced, after ``say`` names it). Raises
+    :class:`ResultExists` naming the changed study keys, or ``FileExistsError`` when the path
+    holds something that is not a librate result (refused even with ``force``)."""
+    p = Path(path)
+    if not p.exists():
+        return "new"
+    if p.is_dir() and not any(p.iterdir()):
+        return "new"
+    found = _existing_result(p)
+    if found is None:
+        raise FileExistsError(f"{str(p)!r} exists and is not a librate result: refusing to overwrite it; remove it or choose another output folder")
+    old_kind, attrs = found
+    old_study = attrs.get("study")
+    changes = []
+    if old_kind != kind:
+        changes.append(f"(result): a {old_kind or 'result of unknown kind'} -> a {kind}")
+    else:
+        changes += study_changes(old_study, study, RESULT_INPUTS.get(kind))
+        if old_study is not None and study is not None:
+            from .._core import __version__
+
+            old_version = attrs.get("librate_version")
+            if old_version is not None and str(old_version) != __version__:
+                changes.append(f"librate version: {old_version} -> {__version__}")
+    if force:
+        if say is not None:
+            say(f"--force: replacing {describe_result(p)}" + (f"; changed: {'; '.join(changes)}" if changes else ""))
+        return "replace"
+    if not changes:
+        return "resume"
+    raise ResultExists(f"{p} holds a {old_kind or 'result'} of other inputs (changed: {'; '.join(changes)}): "
+                       "not replaced; run again with --force to replace it, or choose another --out", changes)
+
+
+def _existing_result(p: Path) -> tuple[str | None, dict] | None:
+    """``(kind, root attributes)`` of the librate result or map store at ``p`` (also an
+    unfinished map store, which xarray cannot open yet), or None when it is not one."""
+    if _is_zarr(p):
+        try:
+            import zarr
+
+            attrs = dict(zarr.open_group(str(p), mode="r", use_consolidated=False).attrs)
+        except Exception:  # noqa: BLE001 - foreign or damaged: judged below
+            attrs = {}
+        if attrs.get("librate_store") == "periodicity_map":
+            return "map", attrs
+    try:
+        ds = _open_dataset(p)
+    except ValueError:
+        return None
+    try:
+        kind = result_kind(ds)
+        return None if kind is None else (kind, dict(ds.attrs))
+    finally:
+        ds.close()
 
 
 def _open_dataset(p: Path):
@@ -282,7 +407,7 @@ def run_map_to(
     atol: float | None = None,
     resume: bool = True,
     scheduler=None,
-    progress: Callable[[int, int], None] | None = None,
+    progress: bool | None = None,
     attrs: dict[str, Any] | None = None,
 ):
     """A periodicity map written to the Zarr ``store`` (a ``.zarr`` folder). Uses
@@ -290,6 +415,7 @@ def run_map_to(
     installed; otherwise :func:`librate.periodicity_map` in this process, written with
     ``to_zarr`` (an existing store with the same study and complete is reused; a store of
     another study is refused unless ``resume=False``; a foreign folder is always refused).
+    ``progress``: progress bars on stderr (None: only when stderr is a terminal).
     Returns ``(dataset, store_path)``."""
     store = Path(store)
     attrs = dict(attrs or {})
@@ -318,7 +444,7 @@ def run_map_to(
             if old is not None:
                 old.close()
             raise FileExistsError(f"{str(store)!r} exists and is not a librate map: refusing to overwrite it; remove it or choose another --out")
-        same = old.attrs.get("study") == attrs.get("study")
+        same = not study_changes(old.attrs.get("study"), attrs.get("study"), RESULT_INPUTS["map"])
         complete = int(old.attrs.get("complete", 0)) == 1
         if resume and same and complete:
             ds = old.load()
@@ -326,11 +452,15 @@ def run_map_to(
             return ds, store
         old.close()
         if resume and not same:
-            raise FileExistsError(f"{str(store)!r} holds a map of a different study: refusing to overwrite it; remove it, choose another --out, or run with --no-resume to replace it")
+            raise ResultExists(f"{store} holds a map of another study (changed: {'; '.join(study_changes(old.attrs.get('study'), attrs.get('study')))}): "
+                               "not replaced; pass resume=False (--force) to replace it, or choose another folder")
     kw = {} if rtol is None else {"rtol": rtol}
     if atol is not None:
         kw["atol"] = atol
-    ds = periodicity_map(orbits, kz=kz, wz0=wz0, phi0=phi0, n_periods=n_periods, srp=srp, solve=True, progress=progress, **kw)
+    from .progress import reporter
+
+    ds = periodicity_map(orbits, kz=kz, wz0=wz0, phi0=phi0, n_periods=n_periods, srp=srp, solve=True,
+                         progress=reporter("periodicity map", "orbit", progress), **kw)
     ds.attrs.update(attrs)
     save_dataset(ds, store)
     return ds, store

@@ -16,7 +16,6 @@ import contextlib
 import hashlib
 import json
 import os
-import sys
 import warnings
 from pathlib import Path
 
@@ -25,6 +24,7 @@ import numpy as np
 from .._integrity import array_digest
 from ..periodicity.maps import map_coords, map_dataset, map_grid, map_solutions_dataset, orbits_of, solutions_from_rows
 from ..periodicity.solutions import MAP_ATOL, MAP_RTOL, check_orbit, check_srp, orbit_forcing, sweep
+from .progress import bar as progress_bar
 from .store import ROW_VARS, check_rows, open_map_group, read_array, row_checksum, writer_lock
 
 __all__ = ["run_map"]
@@ -55,7 +55,7 @@ def _fingerprint(olist, kzs, wz, phi0, n_periods, srp, rtol, atol) -> str:
     return h.hexdigest()
 
 
-def _create_store(out: Path, fingerprint: str, shape, coords: dict):
+def _create_store(out: Path, fingerprint: str, shape, coords: dict, attrs: dict | None = None):
     """A new store, built in a temporary sibling folder and renamed into place: ``out`` is
     either absent (or an empty folder) or a complete, marked, empty store; never half-made."""
     import shutil
@@ -78,7 +78,7 @@ def _create_store(out: Path, fingerprint: str, shape, coords: dict):
                    attributes={"_ARRAY_DIMENSIONS": ["orbit", "checksum_of"], "columns": " ".join(ROW_VARS),
                                "long_name": "64-bit BLAKE2b digest of each row of dwz, dphi, phi_T, status"})
     _write_coords(g, coords)
-    g.attrs.put(_base_attrs(fingerprint, coords, complete=0))
+    g.attrs.put(_base_attrs(fingerprint, coords, complete=0, attrs=attrs))
     if out.exists():
         out.rmdir()  # an empty folder (checked by the caller)
     os.replace(tmp, out)
@@ -93,13 +93,15 @@ def _write_coords(g, coords: dict) -> None:
         a[:] = values
 
 
-def _base_attrs(fingerprint: str, coords: dict, complete: int) -> dict:
-    """The root attributes every state of the store carries (the marker first of all)."""
-    return {"librate_store": "periodicity_map", "fingerprint": fingerprint, "complete": int(complete),
+def _base_attrs(fingerprint: str, coords: dict, complete: int, attrs: dict | None = None) -> dict:
+    """The root attributes every state of the store carries (the marker first of all), with the
+    caller's text attributes (e.g. the study), so that an unfinished store says what it holds."""
+    extra = {k: v for k, v in (attrs or {}).items() if isinstance(v, str)}
+    return {**extra, "librate_store": "periodicity_map", "fingerprint": fingerprint, "complete": int(complete),
             "coord_checksums": {name: array_digest(values) for name, (_, values, _) in coords.items()}}
 
 
-def _open_store(out: Path, fingerprint: str, shape, resume: bool, coords: dict):
+def _open_store(out: Path, fingerprint: str, shape, resume: bool, coords: dict, attrs: dict | None = None):
     """Open (resume) or create the store at ``out``; the caller holds the writer lock.
     Returns ``(group, damaged)``: the rows whose data do not match their checksums."""
     if out.exists() and not out.is_dir():
@@ -109,7 +111,7 @@ def _open_store(out: Path, fingerprint: str, shape, resume: bool, coords: dict):
 
         shutil.rmtree(stale, ignore_errors=True)
     if not out.exists() or not any(out.iterdir()):
-        return _create_store(out, fingerprint, shape, coords), {}
+        return _create_store(out, fingerprint, shape, coords, attrs), {}
     try:
         g = open_map_group(out, mode="r+")
     except ValueError as err:
@@ -136,7 +138,7 @@ def _open_store(out: Path, fingerprint: str, shape, resume: bool, coords: dict):
     zmeta = out / ".zmetadata"
     if zmeta.exists():
         zmeta.unlink()
-    g.attrs.put(_base_attrs(fingerprint, coords, complete=0))
+    g.attrs.put(_base_attrs(fingerprint, coords, complete=0, attrs=attrs))
     for name, (_, values, _) in coords.items():  # the coordinates are known: repair, never trust
         try:
             same = name in g and np.array_equal(read_array(g, name), values)
@@ -198,8 +200,8 @@ def run_map(
     store at ``out`` (resumable; see the module docs), and return it as an xarray Dataset.
 
     ``scheduler``: None (local, all cores), a Dask ``distributed.Client``, or its address
-    ("tcp://host:port"): each orbit row becomes a task. ``progress``: a progress bar with rate
-    and ETA on stderr (default: only when stderr is a terminal). ``attrs``: extra attributes
+    ("tcp://host:port"): each orbit row becomes a task. ``progress``: progress bars (the rows,
+    then the solutions) with rate and ETA on stderr (default: only when stderr is a terminal). ``attrs``: extra attributes
     (e.g. the study as JSON). Without ``out`` nothing is written (and nothing can be resumed).
     """
     olist, family = orbits_of(orbits)
@@ -226,7 +228,7 @@ def run_map(
 def _run(olist, family, kzs, wz, coords, fp, args, out, resume, scheduler, progress, solve, attrs, *, phi0, n_periods, srp, rtol, atol):
     no, nk, nw = len(olist), kzs.size, wz.size
     if out is not None:
-        store, damaged = _open_store(Path(out), fp, (no, nk, nw), resume, coords)
+        store, damaged = _open_store(Path(out), fp, (no, nk, nw), resume, coords, attrs)
         done = _done_flags(store, damaged)
         if damaged:
             warnings.warn(f"{out}: {len(damaged)} damaged row(s) are recomputed: "
@@ -249,10 +251,7 @@ def _run(olist, family, kzs, wz, coords, fp, args, out, resume, scheduler, progr
         done[i] = True
 
     todo = [i for i in range(no) if not done[i]]
-    show = sys.stderr.isatty() if progress is None else bool(progress)
-    from tqdm.auto import tqdm
-
-    bar = tqdm(total=no, initial=no - len(todo), disable=not show, unit="orbit", desc="periodicity map", file=sys.stderr)
+    bar = progress_bar(no, "periodicity map", "orbit", progress, initial=no - len(todo))
     try:
         if scheduler is None:
             for i in todo:
@@ -278,9 +277,11 @@ def _run(olist, family, kzs, wz, coords, fp, args, out, resume, scheduler, progr
                       complete=done.all(), attrs={"fingerprint": fp, **(attrs or {})})
     if solve:
         sols = []
-        for i, o in enumerate(olist):
-            # one batch per orbit, as periodicity_map does (the same lock-step companions: the same bits)
-            sols += [(i, s) for s in solutions_from_rows(o, kzs, float(phi0), wz, grid["phi_T"][i], int(n_periods), srp)]
+        with progress_bar(no, "solutions (Newton)", "orbit", progress) as sbar:
+            for i, o in enumerate(olist):
+                # one batch per orbit, as periodicity_map does (the same lock-step companions: the same bits)
+                sols += [(i, s) for s in solutions_from_rows(o, kzs, float(phi0), wz, grid["phi_T"][i], int(n_periods), srp)]
+                sbar.update(1)
         ds = ds.merge(map_solutions_dataset(sols))
     if store is not None:
         _finalise(store, Path(out), ds, fp, coords)

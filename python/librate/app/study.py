@@ -810,37 +810,58 @@ class Study(BaseModel):
         want = self.output.figures
         return [f for f in available if want is None or f in want]
 
-    def result_attrs(self, kind: str) -> dict:
-        """Attributes every result carries: the result kind, the full study (JSON) and the
-        package version."""
+    def result_attrs(self, kind: str, command: str | None = None) -> dict:
+        """Attributes every result carries: the result kind, the command that made it, the full
+        study (JSON) and the package version."""
         from .._core import __version__
 
-        return {"librate_result": kind, "study": self.to_json(), "librate_version": __version__}
+        return {"librate_result": kind, **({"librate_command": command} if command else {}), "study": self.to_json(),
+                "librate_version": __version__}
 
     # --- jobs ----------------------------------------------------------------------------------
-    def run_family(self, out: str | Path | None = None):
+    def _result_path(self, out, command: str) -> Path:
+        from .results import RESULT_STEMS
+
+        return self.output_dir(out) / (RESULT_STEMS[command] + (".zarr" if self.output.format == "zarr" else ".nc"))
+
+    def run_family(self, out: str | Path | None = None, *, force: bool = False, say: Callable[[str], None] | None = None):
         """Compute the orbit family (and the selected members, when the selection is a
         subset) and save it as ``family.zarr`` (or ``family.nc``) in the output folder with the
-        study and version as attributes. Returns ``(family, path)``."""
-        from .results import save_family
+        study and version as attributes. Returns ``(family, path)``.
 
+        An existing family of the same ``[system]`` and ``[orbits]`` is reused (``say`` tells);
+        one of other inputs raises :class:`~librate.app.results.ResultExists` naming the changed
+        keys, unless ``force`` (then it is replaced, after ``say`` names it)."""
+        from .results import check_output, open_result, save_family
+
+        path = self._result_path(out, "family")
+        if check_output(path, "family", self.to_json(), force=force, say=say) == "resume":
+            if say is not None:
+                say(f"reused: {path} already holds this family (--force recomputes it)")
+            return open_result(path), path
         fam = self.build_family()
         sel = self.build_orbits(fam)
         if isinstance(sel, list):
             sel = _family_of(fam, sel)
-        folder = self.output_dir(out)
-        path = save_family(sel, folder / ("family.zarr" if self.output.format == "zarr" else "family.nc"), self.result_attrs("family"))
+        path = save_family(sel, path, self.result_attrs("family", "family"))
         return sel, path
 
-    def run_solve(self, out: str | Path | None = None, progress: Callable[[int, int], None] | None = None):
+    def run_solve(self, out: str | Path | None = None, progress: Callable[[int, int], None] | None = None, *, force: bool = False,
+                  say: Callable[[str], None] | None = None):
         """The periodic attitude solutions of every selected orbit and Kz with wz0 in the rate
         window (:func:`librate.find_periodic_attitudes`, scanning on the study's rate grid),
-        saved as ``solutions.zarr`` (or ``.nc``). Returns ``(dataset, path)``; the Dataset has a
+        saved as ``solve.zarr`` (or ``.nc``). Returns ``(dataset, path)``; the Dataset has a
         ``solution`` dimension (orbit index, x0, period, Kz, N, kind, wz0, phidot0, phi0,
-        stability, residual)."""
+        stability, residual). An existing table of the same inputs is reused, one of other
+        inputs refused unless ``force``, as in :meth:`run_family`."""
         from ..periodicity.solutions import find_periodic_attitudes
-        from .results import save_dataset, solutions_dataset
+        from .results import check_output, open_result, save_dataset, solutions_dataset
 
+        path = self._result_path(out, "solve")
+        if check_output(path, "solutions", self.to_json(), force=force, say=say) == "resume":
+            if say is not None:
+                say(f"reused: {path} already holds these solutions (--force recomputes them)")
+            return open_result(path), path
         orbits = self.build_orbits()
         olist = list(orbits)
         wz = self.wz0_values()
@@ -856,36 +877,47 @@ class Study(BaseModel):
                 done += 1
                 if progress is not None:
                     progress(done, total)
-        ds = solutions_dataset(rows, olist, self.kz_values(), self.result_attrs("solutions"))
+        ds = solutions_dataset(rows, olist, self.kz_values(), self.result_attrs("solutions", "solve"))
         flex = self.build_flexible()
         if flex is not None and rows:
-            # Flexibility's first-order effect on each rigid solution (closed form, PHYSICS.md sec. 7).
+            # Flexibility's first-order effect on each rigid solution (the closed quasi-static form).
             from ..periodicity.flexible import flexible_periodic
 
             res = [flexible_periodic(sol, flex, resolve=False) for _, sol in rows]
             ds["flex_dphi0"] = ("solution", np.array([r.shift[0] for r in res]), {"units": "rad", "long_name": "first-order shift of phi0 from flexibility"})
             ds["flex_dwz0"] = ("solution", np.array([r.shift[1] for r in res]), {"units": "1/TU", "long_name": "first-order shift of wz0 from flexibility"})
             ds["flex_max_dphi"] = ("solution", np.array([r.max_dphi for r in res]), {"units": "rad", "long_name": "largest attitude departure over a period"})
-        folder = self.output_dir(out)
-        path = save_dataset(ds, folder / ("solutions.zarr" if self.output.format == "zarr" else "solutions.nc"))
+        path = save_dataset(ds, path)
         return ds, path
 
-    def run_map(self, out: str | Path | None = None, *, scheduler=None, progress=None, resume: bool = True):
+    def run_map(self, out: str | Path | None = None, *, scheduler=None, progress: bool | None = None, force: bool = False,
+                say: Callable[[str], None] | None = None):
         """The attitude periodicity map (grids of wz(T) - wz0 and phi(T) - phi0 over orbit x Kz
         x wz0, and the refined solutions) through ``librate.app.runner.run_map`` into
         ``map.zarr`` in the output folder (resumable), or, when the runner is not installed,
         through :func:`librate.periodicity_map` written with ``to_zarr``. With
         ``output.format = "netcdf"`` a ``map.nc`` copy is exported too. Returns
-        ``(dataset, path)``."""
-        from .results import run_map_to
+        ``(dataset, path)``.
+
+        A store of the same inputs (finished or interrupted) is resumed; one of other inputs
+        raises :class:`~librate.app.results.ResultExists` naming the changed keys, unless
+        ``force``: then it is removed (after ``say`` names it) and the map recomputed.
+        ``progress``: progress bars on stderr (None: only when stderr is a terminal)."""
+        import shutil
+
+        from .results import check_output, run_map_to
 
         folder = self.output_dir(out)
+        store = folder / "map.zarr"
+        # validated before the store is touched: a study error never costs an existing map
         orbits = self.build_orbits()
         srp = self.build_srp()
+        if check_output(store, "map", self.to_json(), force=force, say=say) == "replace":
+            shutil.rmtree(store)
         ds, path = run_map_to(
-            orbits, folder / "map.zarr", kz=self.kz_values(), wz0=self.wz0_values(), phi0=self.solver.phi0, n_periods=self.n_periods(),
-            srp=srp, rtol=self.solver.rtol, atol=self.solver.atol, resume=resume, scheduler=scheduler, progress=progress,
-            attrs=self.result_attrs("map"),
+            orbits, store, kz=self.kz_values(), wz0=self.wz0_values(), phi0=self.solver.phi0, n_periods=self.n_periods(),
+            srp=srp, rtol=self.solver.rtol, atol=self.solver.atol, resume=True, scheduler=scheduler, progress=progress,
+            attrs=self.result_attrs("map", "map"),
         )
         if self.output.format == "netcdf":
             from .results import save_dataset

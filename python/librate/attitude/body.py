@@ -1,4 +1,4 @@
-"""Rigid bodies and attitude conventions (thesis ch. 3.1; PHYSICS.md sec. 4).
+"""Rigid bodies and attitude conventions (thesis ch. 3.1; docs/physics.md, attitude).
 
 :class:`RigidBody` holds the principal moments of inertia; attitudes are scalar-last quaternions
 of the body relative to the synodic frame (:func:`quaternion_from_euler`).

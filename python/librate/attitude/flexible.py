@@ -1,4 +1,4 @@
-"""Flexible spacecraft (thesis ch. 5, PHYSICS.md sec. 7): a planar lumped-parameter model.
+"""Flexible spacecraft (thesis ch. 5, docs/physics.md, flexible spacecraft): a planar lumped-parameter model.
 
 A rigid hub (mass m0, principal moments (Ix0, Iy0, Iz0) about its centre, axes along the body
 axes) carries appendage masses m_j at body positions b_j, each deflecting by q_j along a unit
@@ -32,7 +32,7 @@ hub's centre sits where it balances them, h = -sum_j m_j b_j / m0.
   and first-order shift in closed form; re-solved with the full model at low frequencies);
 - :func:`librate.periodicity.frequency_scan`: the coupled response against the structural frequency (resonances).
 
-Two precisions on PHYSICS.md sec. 7. Omega_j = sqrt(k_j / m_j) is the *clamped-hub* frequency:
+Two precisions on the model (docs/physics.md, flexible spacecraft). Omega_j = sqrt(k_j / m_j) is the *clamped-hub* frequency:
 with the hub free to rotate and the centre of mass free to shift, the structural modes are
 stiffer (:meth:`FlexibleBody.modes`, sqrt(k / m_eff) with m_eff < m), and the damping ratio that
 sets the decay of the structural energy is the mode's, c / (2 sqrt(k m_eff)), not

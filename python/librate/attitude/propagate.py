@@ -1,4 +1,4 @@
-"""Rigid-body attitude coupled with the CR3BP orbit (thesis ch. 3.1-3.2, PHYSICS.md sec. 4).
+"""Rigid-body attitude coupled with the CR3BP orbit (thesis ch. 3.1-3.2, docs/physics.md, attitude).
 
 The 3-D model integrates the orbit (6), the quaternion q of the body relative to the synodic
 frame (scalar last) and the inertial angular velocity w in body axes; the planar reduced model

@@ -1,4 +1,4 @@
-"""Solar radiation pressure (thesis ch. 4; the models of PHYSICS.md sec. 6).
+"""Solar radiation pressure (thesis ch. 4; the models of docs/physics.md, solar radiation pressure).
 
 Two models: the general one (any list of :class:`Facet`, force and torque, lit only when facing
 the Sun; no self-shadowing) attached to a body as a :class:`FacetBody`, used by the 3-D model;
@@ -145,12 +145,12 @@ class FacetBody(RigidBody):
 
 @dataclass(frozen=True)
 class FlatPlate:
-    """The simplified planar SRP model (PHYSICS.md sec. 6): one two-sided flat plate with normal
+    """The simplified planar SRP model (docs/physics.md, solar radiation pressure): one two-sided flat plate with normal
     x_B and centre of pressure offset d along y_B; with alpha the Sun's angle in body axes,
     wzdot_srp = eps [(1 + Cs) cos(alpha)|cos(alpha)| + (2/3) Cd cos(alpha)],
     eps = P A d TU^2 / Iz (nondimensional; eps = P (A/m) TU^2 d / k^2 = 1.03e4 d/k^2 with d and k
-    in metres for A/m = 0.016 m^2/kg and the default TU: PHYSICS.md says "about 10 d/k^2 per
-    metre", which holds with d and k in km)."""
+    in metres for A/m = 0.016 m^2/kg and the default TU: the often quoted "about 10 d/k^2
+    per metre" holds with d and k in km)."""
 
     eps: float
     cs: float = 0.0

@@ -574,7 +574,7 @@ def correct_dro(
     rtol: float = SHOOT_RTOL,
     atol: float = SHOOT_ATOL,
 ) -> PeriodicOrbit:
-    """Correct the distant retrograde orbit through (x0, 0, 0) with ydot0 > 0 (PHYSICS.md sec. 3).
+    """Correct the distant retrograde orbit through (x0, 0, 0) with ydot0 > 0 (docs/physics.md, periodic orbits).
 
     Single shooting on the half period (thesis eq. 19): integrate with the STM to the next
     y = 0 crossing, located in time, and drive xdot there to zero by correcting ydot0 with x0

@@ -1,4 +1,4 @@
-"""Periodic orbits as truncated Fourier series in time (thesis eq. 44-45, PHYSICS.md section 3).
+"""Periodic orbits as truncated Fourier series in time (thesis eq. 44-45, docs/physics.md, periodic orbits).
 
 For a periodic orbit of period T each coordinate q in (x, y, z) is written
 

@@ -1,4 +1,4 @@
-"""Solution branches (thesis sec. 3.3, ch. 4; PHYSICS.md sec. 5-6): periodic attitude motions
+"""Solution branches (thesis sec. 3.3, ch. 4; docs/physics.md: periodic attitude motions, solar radiation pressure): periodic attitude motions
 continued by the shared driver (:mod:`librate.solving.continuation`) with the Rust corrector
 freeing one parameter: Kz for one orbit (:class:`KzBranch`), the flat-plate amplitude eps
 (:class:`EpsBranch`, :func:`continue_srp`). :func:`periodic_attitude` returns, by default, the
@@ -81,7 +81,7 @@ def periodic_attitude(
     (located to 1e-8); :func:`find_periodic_attitudes` lists every solution in a rate window. This
     needs the half-period (symmetric) formulation: an x-symmetric orbit started on the x axis and
     ``phi0`` a multiple of pi/2; otherwise the torque-free rate is the starting guess of a direct
-    correction. With ``srp`` (PHYSICS.md sec. 6) the gravity-only solution is then continued in
+    correction. With ``srp`` (docs/physics.md, solar radiation pressure) the gravity-only solution is then continued in
     the plate amplitude eps from 0 to ``srp.eps`` (``free="phi0"``: phi0 corrected with wz0; a
     fold before the target raises, naming its eps), or, with ``free="theta_sun0"``, corrected
     directly in (Sun phase, wz0) with phi0 kept from the gravity-only solution (the returned
@@ -89,7 +89,7 @@ def periodic_attitude(
 
     With a guess ``wz0``: the solution nearest to it, corrected directly. ``method``: "half"
     (phi(KT/2) = phi0 + pi turns, wz0 unknown), "newton" (the full-period step [Phi(KT) - I] d =
-    -F with phi0 free; PHYSICS.md: the correct form of thesis eq. 53), "auto": "half" when it
+    -F with phi0 free; the correct form of thesis eq. 53, docs/physics.md), "auto": "half" when it
     applies. The corrector is the Rust one (:func:`librate._core.attitude_correct`: globalised
     Newton, one call); the solution is re-propagated independently. Raises ConvergenceError.
     """
@@ -307,11 +307,12 @@ def eps_branch(solution: AttitudeSolution, srp, *, steps: int = 10, min_step: fl
     return eps_branches([(solution, srp, marks)], steps=steps, min_step=min_step)[0]
 
 
-def eps_branches(jobs, *, steps: int = 10, min_step: float = 1e-7) -> list:
+def eps_branches(jobs, *, steps: int = 10, min_step: float = 1e-7, done=None) -> list:
     """:func:`eps_branch` of every job (solution, target plate, marks), continued in lock step
     (:func:`librate.solving.continuation.run_lockstep`): each round, the corrections of all
     branches on one orbit and plate go to the Rust corrector in one call. Each branch is the one
-    :func:`eps_branch` gives alone (to the corrector's tolerance)."""
+    :func:`eps_branch` gives alone (to the corrector's tolerance). ``done(j)`` is called as job
+    j's branch ends."""
     steps = as_count(steps, "steps", 1)
     min_step = as_number(min_step, "min_step", positive=True)
     todo = []
@@ -336,7 +337,11 @@ def eps_branches(jobs, *, steps: int = 10, min_step: float = 1e-7) -> list:
         runs.append((problem, arclength_steps(problem, first, direction=1 if target > e0 else -1, target=target, stop_at_fold=True,
                                               locate_bifurcations=False, marks=marks, rules=rules, max_points=10_000, name="eps")))
     out: list = [None] * len(jobs)
-    for job, branch in zip((t[0] for t in todo), run_lockstep(runs)):
+    ids = [t[0] for t in todo]
+    for j in sorted(set(range(len(jobs))) - set(ids)):  # nothing to continue
+        if done is not None:
+            done(j)
+    for job, branch in zip(ids, run_lockstep(runs, done=None if done is None else (lambda i: done(ids[i])))):
         out[job] = branch
     return out
 

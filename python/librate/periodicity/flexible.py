@@ -1,4 +1,4 @@
-"""Flexibility and periodic attitude motion (PHYSICS.md sec. 7): what the appendages' flexibility
+"""Flexibility and periodic attitude motion (docs/physics.md, flexible spacecraft): what the appendages' flexibility
 does to a rigid periodic solution (:func:`flexible_periodic`, first order in closed form or the
 coupled model re-solved), and the coupled response against the structural frequency
 (:func:`frequency_scan`). The flexible models themselves are in :mod:`librate.attitude.flexible`."""

@@ -1,5 +1,5 @@
 """Periodicity maps: residual grids over (orbit, Kz, wz0) and the solutions they contain
-(thesis sec. 3.3, PHYSICS.md sec. 5), and the map Dataset builders shared with
+(thesis sec. 3.3, docs/physics.md, periodic attitude motions), and the map Dataset builders shared with
 :func:`librate.app.runner.run_map`.
 
 Grids run in the Rust engine (:func:`~librate.periodicity.solutions.sweep`, one orbit at a
@@ -68,7 +68,7 @@ def periodicity_map(
     ``srp``: a :class:`librate.FlatPlate` (with ``n_periods`` = K for Sun-resonant orbits,
     T = Ts / K); its parameters are stored as attributes. A list of plates (e.g. several eps or
     Cs) adds an ``srp`` dimension (orbit, srp, kz, wz0) with their parameters as coordinates. With SRP the mirror symmetry is broken
-    and solutions are refined in (phi0, wz0) together (PHYSICS.md sec. 6).
+    and solutions are refined in (phi0, wz0) together (docs/physics.md, solar radiation pressure).
     """
 
 

@@ -1,4 +1,4 @@
-"""Periodic orbit-attitude solutions (thesis sec. 3.3, PHYSICS.md sec. 5).
+"""Periodic orbit-attitude solutions (thesis sec. 3.3, docs/physics.md, periodic attitude motions).
 
 Along a periodic orbit of period T, a planar attitude motion started at phi(0) = phi0 with
 inertial rate wz(0) = wz0 is periodic when wz(T) = wz0 and phi(T) = phi0 + 2 pi N (N = net body

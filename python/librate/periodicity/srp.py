@@ -1,4 +1,4 @@
-"""Solar radiation pressure on periodic attitude motions (thesis ch. 4, PHYSICS.md sec. 6):
+"""Solar radiation pressure on periodic attitude motions (thesis ch. 4, docs/physics.md, solar radiation pressure):
 the flat-plate amplitude eps continued by :func:`librate.continue_srp`, the
 (eps, rate) periodicity map with its solution branches (:func:`srp_map`) and the accelerations on
 a Sun-pointing body (:func:`sun_pointing_accelerations`)."""
@@ -6,7 +6,8 @@ a Sun-pointing body (:func:`sun_pointing_accelerations`)."""
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+import threading
+from collections.abc import Callable, Sequence
 
 import numpy as np
 
@@ -57,6 +58,7 @@ def srp_map(
     solve: bool = True,
     kinds: Sequence[str] = ("periodic",),
     steps: int = 4,
+    progress: Callable[[int, int], None] | None = None,
 ):
     """A flat-plate SRP periodicity map of one orbit over (eps, initial rate), for
     :func:`librate.plotting.plot_srp_map` (thesis Figs. 35-36, 40-41).
@@ -72,7 +74,7 @@ def srp_map(
 
     With ``solve``, the solutions: SRP breaks the mirror symmetry, so with phi0 fixed there is no
     curve of solutions in the plane (the two zero contours cross only at isolated points); the
-    solutions shown are BRANCHES with phi0 free (PHYSICS.md sec. 6), continued by
+    solutions shown are BRANCHES with phi0 free (docs/physics.md, solar radiation pressure), continued by
     :func:`librate.continue_srp` through the grid's eps values (``steps`` per interval) until
     the grid ends or the branch folds: from eps = 0, the gravity-only solutions of the listed
     ``kinds`` with wz0 in the window (:func:`librate.find_periodic_attitudes`), away from 0 on
@@ -93,8 +95,25 @@ def srp_map(
     0.05 of 2 there, where Phi - I is singular; otherwise the continuation failed, e.g. at once
     for a strongly unstable start, trace ~1e5; and ``branch_end_reason`` from
     :func:`librate.continue_srp`). Returns an xarray Dataset.
+
+    ``progress``: called as ``progress(done, total)`` after the grid's sweep and after each
+    branch (from worker threads, one call at a time); ``total`` grows as the branches to trace
+    are found, and ``done == total`` at the end.
     """
     import xarray as xr
+
+    if progress is not None and not callable(progress):
+        raise ValueError(f"invalid argument `progress`: must be a callable progress(done, total) or None, got {progress!r}")
+    counts = {"done": 0, "total": 2}  # the sweep, one per branch (added as found), the assembly
+    count_lock = threading.Lock()
+
+    def advance(done: int = 1, more: int = 0) -> None:
+        if progress is None:
+            return
+        with count_lock:
+            counts["done"] += done
+            counts["total"] += more
+            progress(counts["done"], counts["total"])
 
     orbit = check_orbit(orbit)
     kz = check_kz(kz)
@@ -118,6 +137,7 @@ def srp_map(
     r = sweep(orbit_forcing(orbit), n_periods * orbit.period, phi0, w_grid, kz, srp=plate, eps=e_grid)
     shape = (es.size, wz.size)
     data = {k: np.asarray(r[k]).reshape(shape) for k in ("dwz", "dphi", "phi_t", "status")}
+    advance()
 
     sols, path, branches = [], [], []
     if solve:
@@ -130,8 +150,9 @@ def srp_map(
             fold. The branches run in lock step (:func:`eps_branches`: each round's corrections
             of every branch in one Rust call) and are recorded in order, each after its
             ``lead`` solutions ((eps, solution) recorded at the branch's index first)."""
+            advance(0, len(jobs))
             brs = eps_branches([(start, plate.with_eps(float(values[-1])), [float(e) for e in values]) for start, _, values, _ in jobs],
-                               steps=steps)
+                               steps=steps, done=lambda _: advance())
             # every branch's marked points re-propagated in one batch
             owners = [(start, p) for (start, _, _, _), br in zip(jobs, brs) for p in br.marked]
             checked = iter(verified(orbit, kz=kz, n_total=[s_.n_total for s_, _ in owners], kind=[s_.kind for s_, _ in owners],
@@ -245,6 +266,7 @@ def srp_map(
     )
     if not solve:
         ds = ds.drop_vars([v for v in ds.data_vars if v.startswith(("sol_", "path_", "branch_"))])
+    advance()  # the solutions assembled: done == total
     return ds
 
 

@@ -2,9 +2,9 @@
 (thesis sec. 3.3) and of solar radiation pressure (thesis ch. 4), drawn with matplotlib.
 
 This module is the only part of librate that uses matplotlib, and ``import librate`` does not
-import it: import it explicitly, ``import librate.plotting as lp`` (install with
-``pip install "librate[plot]"``). ``matplotlib.pyplot`` itself is imported only when a function
-has to create a figure.
+import it: import it explicitly, ``import librate.plotting as lp``. matplotlib is a required
+dependency (the command line draws its figures by default), installed with librate.
+``matplotlib.pyplot`` itself is imported only when a function has to create a figure.
 
 Every ``plot_*`` function takes the data (an :class:`~librate.OrbitFamily`,
 :class:`~librate.PeriodicOrbit` objects, a Dataset from :func:`librate.periodicity_map`,
@@ -68,7 +68,7 @@ try:
     from matplotlib.ticker import FuncFormatter, MultipleLocator
     from matplotlib.transforms import blended_transform_factory
 except ImportError as exc:  # pragma: no cover - depends on the environment
-    raise ImportError('librate.plotting needs matplotlib >= 3.6: pip install "librate[plot]"') from exc
+    raise ImportError("librate.plotting needs matplotlib >= 3.6, a required dependency of librate: reinstall librate") from exc
 
 from .._checks import as_count, as_number
 from ..attitude.flexible import FlexibleBody, QuasiStaticResponse
@@ -1136,7 +1136,7 @@ def plot_sun_motion(
     """The apparent motion of the Sun in the synodic frame (thesis Fig. 33).
 
     The Sun direction s(t) = (cos theta_s, sin theta_s, 0), theta_s(t) = omega_sun t + theta_sun0
-    (PHYSICS.md sec. 6; parallax neglected, so it is the same everywhere in the system), turns
+    (docs/physics.md, solar radiation pressure; parallax neglected, so it is the same everywhere in the system), turns
     CLOCKWISE at omega_sun = -(1 - n_sun) = :data:`librate.constants.OMEGA_SUN` (1/TU): one
     apparent solar period Ts = 2 pi / (1 - n_sun) (29.49 d with the Earth-Moon TU).
 

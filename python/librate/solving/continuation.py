@@ -286,19 +286,22 @@ def correct_together(requests: list) -> list[Point | None]:
     return out
 
 
-def run_lockstep(branches: Sequence[tuple[Any, Any]]) -> list:
+def run_lockstep(branches: Sequence[tuple[Any, Any]], done: Callable[[int], None] | None = None) -> list:
     """Run several continuations in lock step: ``branches`` are (problem, steps) pairs, steps a
     generator from :func:`arclength_steps` (or :func:`natural_steps`); each round, every live
     branch's pending correction is gathered and corrected together (:func:`correct_together`).
     Returns each generator's result (a Branch), in order. Each branch takes exactly the path it
-    takes alone: only the grouping of the corrector calls changes."""
+    takes alone: only the grouping of the corrector calls changes. ``done(i)`` is called as
+    branch i ends (e.g. for progress)."""
     results: list = [None] * len(branches)
     pending: dict[int, tuple] = {}
     for i, (problem, steps) in enumerate(branches):
         try:
             pending[i] = next(steps)
-        except StopIteration as done:
-            results[i] = done.value
+        except StopIteration as end:
+            results[i] = end.value
+            if done is not None:
+                done(i)
     while pending:
         order = sorted(pending)
         single = [i for i in order if not isinstance(pending[i], _Marks)]
@@ -311,9 +314,11 @@ def run_lockstep(branches: Sequence[tuple[Any, Any]]) -> list:
         for i in order:
             try:
                 pending[i] = branches[i][1].send(answers[i])
-            except StopIteration as done:
-                results[i] = done.value
+            except StopIteration as end:
+                results[i] = end.value
                 del pending[i]
+                if done is not None:
+                    done(i)
     return results
 
 

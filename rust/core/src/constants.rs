@@ -1,4 +1,4 @@
-//! Physical constants of the Earth-Moon-Sun problem (PHYSICS.md sec. 1 and 6), in one place.
+//! Physical constants of the Earth-Moon-Sun problem (docs/physics.md: units, solar radiation pressure), in one place.
 //! The binding module exposes them to Python (`librate._core.N_SUN`, ...).
 
 /// Sidereal month, days.

@@ -1,4 +1,4 @@
-//! Truncated Fourier series of a periodic orbit (thesis eq. 44-45, PHYSICS.md section 3).
+//! Truncated Fourier series of a periodic orbit (thesis eq. 44-45, docs/physics.md, periodic orbits).
 //!
 //! For a periodic orbit of period T and fundamental frequency w = 2 pi / T, each coordinate
 //! q in (x, y, z) is

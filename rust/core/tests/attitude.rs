@@ -71,7 +71,7 @@ fn val_symmetric_body_feels_no_planar_torque() {
 }
 
 /// The 3-D model started planar (rotation about z only) stays planar and agrees with the planar
-/// reduced model (PHYSICS.md sec. 4, thesis eq. 31-33) to 1e-10 over one period of a DRO.
+/// reduced model (docs/physics.md, attitude, thesis eq. 31-33) to 1e-10 over one period of a DRO.
 #[test]
 fn val_three_d_started_planar_matches_reduced_model() {
     let (orbit, period) = dro(0.75);

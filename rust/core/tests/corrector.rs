@@ -14,7 +14,7 @@ use librate_core::periodic::{
 use std::f64::consts::PI;
 
 const MU: f64 = 0.01215;
-/// Earth-Moon TU (PHYSICS.md): 375190 s.
+/// Earth-Moon TU: 375190 s (docs/physics.md).
 const TU_S: f64 = 375190.0;
 
 fn dro_x0(x0: f64) -> ([f64; 6], f64) {
@@ -87,7 +87,7 @@ fn val_torque_free_solutions_are_analytic() {
     }
 }
 
-/// Thesis Fig. 23 (PHYSICS.md sec. 5): on the 12.66-day DRO (mu = 0.01215, TU = 375190 s) with
+/// Thesis Fig. 23 (docs/physics.md, periodic attitude motions): on the 12.66-day DRO (mu = 0.01215, TU = 375190 s) with
 /// Kz = 0.8 the N = -1 solution is at phidot0 = wz0 - 1 = -2.4545 (4 digits: 1e-4). From the
 /// torque-free guess the half-period form converges (residual <= 1e-12); the independent
 /// re-propagation over the full period (scalar model, orbit integrated alongside, 1e-14)
@@ -232,7 +232,7 @@ fn val_line_search_globalises_newton() {
     }
 }
 
-/// PHYSICS.md sec. 6: with SRP and phi0 = 0 kept, periodic motions exist for special Sun
+/// docs/physics.md, solar radiation pressure: with SRP and phi0 = 0 kept, periodic motions exist for special Sun
 /// phases only. On the 1:2 Sun-resonant DRO (T = Ts / 2, K = 2), Kz = 0.8, N = -2, a flat plate
 /// eps = 0.5, cs = 0.4, cd = 0.1: Free::SunPhase from the gravity-only solution and Sun phase
 /// 1.4 converges (residual <= 1e-12) to the phase pi/2 (to 1e-9; the solution of the Python

@@ -1,4 +1,4 @@
-//! Validation of the flexible model (PHYSICS.md sec. 7): the energy integral on a circular
+//! Validation of the flexible model (docs/physics.md, flexible spacecraft): the energy integral on a circular
 //! two-body orbit, the rigid limit with the composite inertia, the quasi-static closed form and
 //! its attitude perturbation, angular-momentum conservation without torque. Each test names its
 //! reference and tolerance.
@@ -121,7 +121,7 @@ fn max_abs_diff(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max)
 }
 
-/// Rigid limit (PHYSICS.md sec. 7): with every k_j scaled by s, the flexible attitude converges
+/// Rigid limit (docs/physics.md, flexible spacecraft): with every k_j scaled by s, the flexible attitude converges
 /// to the rigid planar model's with Kz = |Z0| / I0 (composite inertia) at the predicted rate
 /// O(1/k): the max |phi - phi_rigid| over one period of the x0 = 0.8 DRO falls by 10 (+-25 %)
 /// per decade of stiffness, and the closed-form first-order perturbation dphi accounts for it
@@ -157,7 +157,7 @@ fn val_rigid_limit_with_composite_inertia() {
     assert!(rests[2] < rests[1]);
 }
 
-/// High-frequency case (PHYSICS.md sec. 7): the closed-form q_j = L_j / k_j along the rigid
+/// High-frequency case (docs/physics.md, flexible spacecraft): the closed-form q_j = L_j / k_j along the rigid
 /// solution matches the full model (started on the quasi-static manifold) with a relative error
 /// shrinking like (rate / Omega)^2: over two decades of Omega (100 to 10000 / TU) the error falls by
 /// 100 (+-30 %) per decade.

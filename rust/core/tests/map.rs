@@ -125,7 +125,7 @@ fn val_forcing_table_near_the_earth() {
     }
 }
 
-/// SRP in the engine (flat plate, PHYSICS.md sec. 6) against the scalar planar model with the
+/// SRP in the engine (flat plate, docs/physics.md, solar radiation pressure) against the scalar planar model with the
 /// same plate, over K = 2 revolutions of an orbit (t_final = 2 T), for several Sun phases and
 /// coefficient sets: 1e-9 relative in phi and wz, 1e-8 in the STM; bit-identical for any chunking.
 #[test]

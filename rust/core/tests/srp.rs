@@ -13,7 +13,7 @@ fn srp(facets: Vec<Facet>) -> FacetBody {
     FacetBody { facets, sun: Sun::default(), tu_s: 375190.0 }
 }
 
-/// PHYSICS.md sec. 6 / thesis Fig. 32: a fully absorbing plate feels P A cos(t) along -s; a
+/// docs/physics.md, solar radiation pressure / thesis Fig. 32: a fully absorbing plate feels P A cos(t) along -s; a
 /// perfectly specular one 2 P A cos^2(t) along -n; a plate edge-on or facing away feels nothing
 /// (tolerance 1e-15 relative).
 #[test]
@@ -96,7 +96,7 @@ fn val_torque_is_the_sum_of_moments() {
     }
 }
 
-/// The simplified planar model (PHYSICS.md sec. 6) is the two-facet plate: a two-sided plate
+/// The simplified planar model (docs/physics.md, solar radiation pressure) is the two-facet plate: a two-sided plate
 /// with normal x_B and centre of pressure offset d along y_B gives T_z / Iz * TU^2 equal to
 /// eps [(1 + Cs) cos a |cos a| + (2/3) Cd cos a], eps = P A d TU^2 / Iz, for Sun angles a all
 /// round (1e-14 relative).

@@ -244,7 +244,7 @@ fn val_stm_matches_finite_differences_and_has_unit_determinant() {
 
 /// L1, L2, L3 for mu = 0.01215 against an independent bisection on the classical quintics in
 /// gamma (distance to the nearer primary; Szebehely 1967), to 1e-10; L4/L5 equilateral; and
-/// the PHYSICS.md values 0.83692, 1.15568, -1.00506 to their printed digits.
+/// the reference values 0.83692, 1.15568, -1.00506 to their printed digits.
 #[test]
 fn val_lagrange_points_against_quintics() {
     let mu = MU;

@@ -1,4 +1,4 @@
-//! Coupled orbit-attitude equations of motion (PHYSICS.md sec. 4).
+//! Coupled orbit-attitude equations of motion (docs/physics.md, attitude).
 //!
 //! State (13): synodic position and velocity (6), the quaternion q = (q1, q2, q3, q4) of the
 //! body relative to the synodic frame, scalar last (4), and the inertial angular velocity w in

@@ -1,4 +1,4 @@
-//! Rigid-body attitude coupled with the CR3BP orbit (thesis ch. 3.1-3.2, PHYSICS.md sec. 4):
+//! Rigid-body attitude coupled with the CR3BP orbit (thesis ch. 3.1-3.2, docs/physics.md, attitude):
 //! the 3-D model (quaternion + Euler's equations, torques as plug-in models, optional orbital
 //! coupling and 13x13 STM) and the planar reduced model (phi, wz) along an orbit.
 

@@ -1,4 +1,4 @@
-//! The planar reduced attitude model along an orbit (PHYSICS.md sec. 4, thesis eq. 31, 33):
+//! The planar reduced attitude model along an orbit (docs/physics.md, attitude, thesis eq. 31, 33):
 //!   phidot = wz - 1,   wzdot = (3/2) Kz [S(t) cos 2phi - C(t) sin 2phi],
 //!   S = sum_i mu_i sin(2 theta_i) / r_i^3 = sum_i mu_i 2 x_i y_i / r_i^5,
 //!   C = sum_i mu_i cos(2 theta_i) / r_i^3 = sum_i mu_i (x_i^2 - y_i^2) / r_i^5,

@@ -1,4 +1,4 @@
-//! Solar radiation pressure (thesis ch. 4; our model, PHYSICS.md sec. 6).
+//! Solar radiation pressure (thesis ch. 4; our model, docs/physics.md, solar radiation pressure).
 //!
 //! Sun direction in the synodic frame, from the spacecraft to the Sun (parallax and the 5.1 deg
 //! lunar inclination neglected): s(t) = (cos(omega_sun t + theta_s0), sin(omega_sun t + theta_s0),
@@ -165,7 +165,7 @@ impl Torque for FacetBody {
     }
 }
 
-/// The simplified planar SRP model (PHYSICS.md sec. 6): one two-sided flat plate with normal
+/// The simplified planar SRP model (docs/physics.md, solar radiation pressure): one two-sided flat plate with normal
 /// x_B and centre of pressure offset d along y_B; with alpha = theta_sun(t) - phi,
 ///   wzdot_srp = eps [ (1 + Cs) cos(alpha) |cos(alpha)| + (2/3) Cd cos(alpha) ],
 /// eps = P A d TU^2 / Iz (nondimensional).

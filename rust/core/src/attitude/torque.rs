@@ -38,7 +38,7 @@ pub(crate) fn cross<R: Real>(a: &[R; 3], b: &[R; 3]) -> [R; 3] {
     [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
 }
 
-/// Gravity gradient of both primaries (PHYSICS.md sec. 4):
+/// Gravity gradient of both primaries (docs/physics.md, attitude):
 /// T = 3 sum_i mu_i / r_i^5 (r_i x I r_i), r_i the position relative to primary i in body
 /// axes, mu_1 = 1 - mu, mu_2 = mu. Either primary can be switched off (e.g. the two-body limit).
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -1,5 +1,5 @@
 //! The circular restricted three-body problem in the synodic (rotating) frame, nondimensional
-//! units (PHYSICS.md sections 1-2): Earth (m1) at (-mu, 0, 0), Moon (m2) at (1 - mu, 0, 0),
+//! units (docs/physics.md: units, the CR3BP): Earth (m1) at (-mu, 0, 0), Moon (m2) at (1 - mu, 0, 0),
 //! U = (x^2 + y^2)/2 + (1 - mu)/r1 + mu/r2,
 //! xdd - 2 yd = U_x, ydd + 2 xd = U_y, zdd = U_z, Jacobi constant C = 2U - |v|^2.
 

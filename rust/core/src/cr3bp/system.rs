@@ -18,7 +18,7 @@ pub struct SystemConstants {
     pub r2_km: f64,
 }
 
-/// `(name, mu, LU km, TU s, R1 km, R2 km)` of the presets (PHYSICS.md table 1). The radii are
+/// `(name, mu, LU km, TU s, R1 km, R2 km)` of the presets (docs/physics.md, units and constants). The radii are
 /// the IAU mean radii of the Earth (6371.0084 km) and the Moon (1737.4 km).
 pub const PRESETS: [(&str, f64, f64, f64, f64, f64); 2] = [
     ("earth-moon", 0.01215, 384400.0, 375190.0, 6371.0084, 1737.4),
@@ -84,7 +84,7 @@ mod tests {
     #[test]
     fn presets_and_units() {
         let em = SystemConstants::preset("earth-moon").unwrap();
-        // PHYSICS.md: TU = 375190 s = 4.342477 d
+        // TU = 375190 s = 4.342477 d
         assert!((em.tu_days() - 4.342477).abs() < 1e-6);
         // TU = sqrt(LU^3/GM): GM(Earth+Moon) = 398600.4 + 4902.8 = 403503 km^3/s^2 within 0.1 %
         assert!((em.gm_total_km3_s2() / 403503.2 - 1.0).abs() < 1e-3);

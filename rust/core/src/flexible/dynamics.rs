@@ -9,7 +9,7 @@ use crate::integrate::System;
 
 /// The tidal field of the enabled primaries [larger, smaller] at a synodic position:
 /// W = C + i S = sum_i mu_i zeta_i^2 / r_i^5 (zeta_i = x_i + i y_i relative to primary i:
-/// zeta^2 = (x^2 - y^2) + i 2 x y, so C, S are PHYSICS.md sec. 4's, computed by the planar
+/// zeta^2 = (x^2 - y^2) + i 2 x y, so C, S are those of the planar model (docs/physics.md, attitude), computed by the planar
 /// model's [`forcing_scp`]) and P = sum_i mu_i / r_i^3.
 #[inline(always)]
 pub fn tidal_field(mu: f64, pos: &[f64], primaries: [bool; 2]) -> (Complex<f64>, f64) {

@@ -1,4 +1,4 @@
-//! Flexible spacecraft (thesis ch. 5, PHYSICS.md sec. 7): a planar lumped-parameter model,
+//! Flexible spacecraft (thesis ch. 5, docs/physics.md, flexible spacecraft): a planar lumped-parameter model,
 //! coupled attitude-structure dynamics along a CR3BP orbit, and the quasi-static closed form
 //! for high structural frequencies.
 //!
@@ -47,7 +47,7 @@
 //!   P = sum_i mu_i / r_i^3,   Cb + i Sb = w = W e^{-2 i phi},   W = C + i S = sum_i mu_i zeta_i^2 / r_i^5,
 //!
 //! (zeta_i = x_i + i y_i the position relative to primary i in the synodic frame; C, S those of
-//! PHYSICS.md sec. 4, so Cb, Sb are the same sums with theta_i replaced by theta_i - phi). The hub
+//! the planar model, docs/physics.md: attitude; so Cb, Sb are the same sums with theta_i replaced by theta_i - phi). The hub
 //! adds its own second moments, -(3/4)(Iy0 - Ix0) Cb - (P/2)(Iz0 - (Ix0 + Iy0)/2):
 //!
 //!   V_tidal = -(1/2) sum_k m_k rho_k^T T_B rho_k - (3/4)(Iy0 - Ix0) Cb - (P/2)(Iz0 - (Ix0 + Iy0)/2).
@@ -86,7 +86,7 @@
 //! has dimension 2 + 2n.
 //!
 //! **Rigid limit**: with q = 0 the equation reduces to I0 wzdot = (3/2) Im(conj(Z0) w), the
-//! planar rigid model of PHYSICS.md sec. 4 with Kz = |Z0| / I0 for the principal x axis at
+//! planar rigid model of docs/physics.md, attitude with Kz = |Z0| / I0 for the principal x axis at
 //! arg(Z0) / 2 from the body x axis. As k_j -> infinity the deflections are quasi-static,
 //! q_j = O(1/k_j), and the attitude differs from the rigid composite one by O(1/k).
 //!

@@ -1,4 +1,4 @@
-//! Periodic motions of the flexible spacecraft (thesis ch. 5; PHYSICS.md sec. 7): the coupled
+//! Periodic motions of the flexible spacecraft (thesis ch. 5; docs/physics.md, flexible spacecraft): the coupled
 //! state x = (phi0, wz0, q0, qdot0) that repeats after one orbit period T (phi advanced by
 //! 2 pi turns), found by a globalised Newton method in Rust.
 //!

@@ -1,5 +1,5 @@
 //! Orbit data computed once per orbit and shared by every attitude trajectory on it: the
-//! gravity-gradient forcing S(t), C(t) of the planar model (PHYSICS.md sec. 4, atan2-free form)
+//! gravity-gradient forcing S(t), C(t) of the planar model (docs/physics.md, attitude, atan2-free form)
 //! as piecewise Chebyshev series over one period.
 //!
 //! The orbit is integrated once at tight tolerance and sampled at the Chebyshev nodes of every

@@ -17,7 +17,7 @@
 //! wz0) row-major. Carrying (cos phi, sin phi) as states (d/dt = phidot (-sin, cos)) removes the
 //! trigonometric calls of the gravity gradient (cos 2phi = c^2 - s^2, sin 2phi = 2 c s); phi
 //! itself is integrated (phidot = wz - 1) and gives the unwrapped phi(T). The flat-plate SRP
-//! law (PHYSICS.md sec. 6) is C1 only: a step never spans a lane's Sun-terminator crossing
+//! law (docs/physics.md, solar radiation pressure) is C1 only: a step never spans a lane's Sun-terminator crossing
 //! (cos(theta_sun - phi) = 0); the step is cut there (Illinois iterations on its length).
 //!
 //! Nothing of the physics or the step control is written here: the lanes call the laws the

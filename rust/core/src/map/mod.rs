@@ -1,4 +1,4 @@
-//! The periodicity-map engine (thesis sec. 3.3, PHYSICS.md sec. 5): planar attitude
+//! The periodicity-map engine (thesis sec. 3.3, docs/physics.md, periodic attitude motions): planar attitude
 //! trajectories along one orbit for many (phi0, wz0, Kz), integrated over one period (or K
 //! periods) in SIMD lanes on all cores, with the orbit forcing computed once per orbit.
 

@@ -1,4 +1,4 @@
-//! Periodic planar attitude motions along a periodic orbit (thesis sec. 3.3, PHYSICS.md sec. 5
+//! Periodic planar attitude motions along a periodic orbit (thesis sec. 3.3, docs/physics.md, periodic attitude motions
 //! and 6): a batched, globalised Newton corrector on the periodicity-map engine, and a batched
 //! independent verifier on the scalar model.
 //!

@@ -1,4 +1,4 @@
-//! Periodic orbits of the CR3BP (PHYSICS.md section 3): symmetric single shooting on the half
+//! Periodic orbits of the CR3BP (docs/physics.md, periodic orbits): symmetric single shooting on the half
 //! period, general multiple shooting (free period, phase condition), monodromy matrices and
 //! their stability indices; periodic planar attitude motions along an orbit (batched corrector
 //! and independent verifier).

@@ -1,0 +1,193 @@
+"""Regenerate the gallery's figures: the thesis figures librate reproduces.
+
+    python docs/gallery/gallery.py FIGURE [OUT]     e.g. fig24, or "all"
+    python docs/gallery/gallery.py --list
+
+Each figure is written to OUT (default: docs/gallery/img) as FIGURE.png and its runtime
+(computation and drawing, after the imports) is printed. The gallery pages state the command and
+the runtime measured with it.
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+
+import librate  # noqa: E402
+import librate.plotting as lp  # noqa: E402
+import numpy as np  # noqa: E402
+
+EM = librate.System.preset("earth-moon")
+
+
+def _dro_family():
+    return librate.dro_family(EM)
+
+
+def fig03():
+    """Fig. 3: the DRO family, orbits coloured by Jacobi constant."""
+    return lp.plot_family(_dro_family(), n_orbits=30)
+
+
+def fig05():
+    """Fig. 5: stability indices of the DRO family, the out-of-plane bifurcation marked."""
+    return lp.plot_stability(_dro_family())
+
+
+def fig06():
+    """Fig. 6: period of the DRO family with the synodic and Sun resonances."""
+    return lp.plot_period(_dro_family())
+
+
+def fig07():
+    """Figs. 7 and 10: the 1:1 to 1:4 synodic-resonant DROs in the Earth-centred inertial frame."""
+    fam = _dro_family()
+    return lp.plot_eci([fam.resonant(k) for k in (1, 2, 3, 4)], separate=True)
+
+
+def fig23():
+    """Fig. 23: residual curves of the 12.66-day DRO at Kz = 0.8 (N = -1 at phidot0 = -2.4545)."""
+    d = librate.dro(EM, period_days=12.66)
+    return lp.plot_residuals(d, kz=0.8, wz0=np.linspace(-2.5, 2.5, 2001))
+
+
+def _map():
+    fam = librate.dro_family(EM, x0=np.linspace(0.9, 0.3, 40))
+    return librate.periodicity_map(fam, kz=[0.2, 0.5, 0.8], wz0=np.linspace(-2.5, 2.5, 800))
+
+
+def fig24():
+    """Fig. 24: the periodicity map of the DRO family at Kz = 0.8."""
+    return lp.plot_map(_map(), kz_index=2)
+
+
+def fig27():
+    """Figs. 27-29: the solution families N = 1, 0, -1 across the DRO family, Kz = 0.2, 0.5, 0.8."""
+    return lp.plot_solution_families(_map(), n=(1, 0, -1))
+
+
+def fig30():
+    """Figs. 30-31: phi(t) and the rate of the periodic motions N = 1, 0, -1 (12.66-day DRO, Kz = 0.8)."""
+    d = librate.dro(EM, period_days=12.66)
+    return lp.plot_attitude_motion([librate.periodic_attitude(d, kz=0.8, n=k) for k in (1, 0, -1)])
+
+
+def fig33():
+    """Fig. 33: the apparent motion of the Sun in the synodic frame."""
+    return lp.plot_sun_motion(EM)
+
+
+def fig34():
+    """Fig. 34: the Sun-resonant DROs 1:2, 1:3, 1:4."""
+    return lp.plot_sun_resonant(_dro_family(), ks=(2, 3, 4))
+
+
+def _o2():
+    return _dro_family().resonant(2, "sun")
+
+
+def fig35():
+    """Figs. 35-36: the flat-plate SRP map over (eps, rate) on the 1:2 Sun-resonant DRO, Kz = 0.6."""
+    m = librate.srp_map(_o2(), kz=0.6, wz0=np.linspace(-1.6, 1.2, 400), eps=np.linspace(0, 2, 41), cs=0.4, cd=0.1)
+    return lp.plot_srp_map(m, reference=1.03)
+
+
+def fig37():
+    """Figs. 37-38: a gravity-only periodic motion and the same motion with SRP."""
+    g = librate.periodic_attitude(_o2(), kz=0.6, n=0, n_periods=2, wz0=0.934)
+    s = librate.continue_srp(g, librate.FlatPlate(0.6, cs=0.4, cd=0.1)).solutions[-1]
+    return lp.plot_srp_comparison(g, s)
+
+
+def fig39():
+    """Fig. 39: the accelerations on a Sun-pointing spacecraft along the 1:2 Sun-resonant DRO."""
+    return lp.plot_sun_pointing(EM, librate.FlatPlate(1.03, cs=0.4, cd=0.1), orbit=_o2(), kz=0.6)
+
+
+def fig40():
+    """Figs. 40-41: SRP maps for Cs = 0, 0.5, 1."""
+    o2 = _o2()
+    maps = [librate.srp_map(o2, kz=0.6, wz0=np.linspace(-1.6, 1.2, 300), eps=np.linspace(0, 2, 21), cs=c) for c in (0.0, 0.5, 1.0)]
+    return lp.plot_srp_maps(maps, reference=1.03)
+
+
+def fig42():
+    """Figs. 42-43: the sample station's lumped-parameter model."""
+    return lp.plot_flexible_body(librate.FlexibleBody.sample_station())
+
+
+def _flex_case():
+    d = librate.dro(EM, period_days=12.66)
+    low = librate.FlexibleBody.sample_station(low_frequency=True)
+    sol = librate.periodic_attitude(d, kz=low.kz, n=0)
+    return d, low, (sol.phi0, sol.wz0)
+
+
+def fig44():
+    """Fig. 44: flexible coordinates, closed quasi-static form against the full model."""
+    d, low, att = _flex_case()
+    body = low.scaled(10.0)
+    te = np.linspace(0, d.period, 301)
+    qs = librate.quasi_static(EM, d.state0, att, body, d.period, t_eval=te)
+    tr = librate.propagate_attitude(EM, d.state0, att, body, d.period, t_eval=te, deflection="quasi-static")
+    return lp.plot_flexible_coordinate(qs, tr, index=[1, 4], period=d.period)
+
+
+def fig45():
+    """Fig. 45: the low-frequency station's structural response and body rate against the rigid body."""
+    d, low, att = _flex_case()
+    te = np.linspace(0, d.period, 601)
+    tr = librate.propagate_attitude(EM, d.state0, att, low, d.period, t_eval=te, deflection="quasi-static")
+    rigid = librate.propagate_attitude(EM, d.state0, att, low.rigid_body(), d.period, planar=True, t_eval=te)
+    return lp.plot_flexible_response(tr, rigid, period=d.period)
+
+
+def fig46():
+    """Fig. 46: the response against the appendage stiffness (frequency scan)."""
+    d, low, att = _flex_case()
+    sc = librate.frequency_scan(EM, d.state0, att, low, 0.5 * d.period, [1.0, 10.0, 100.0], samples=201)
+    return lp.plot_frequency_scan(sc, index=[0, 4])
+
+
+FIGURES = {name: f for name, f in sorted(globals().items()) if name.startswith("fig") and callable(f)}
+
+
+def _shrink(path: Path) -> None:
+    """A palette PNG (96 colours): about a third of the size, for the committed gallery."""
+    from PIL import Image
+
+    Image.open(path).convert("RGB").quantize(colors=96, method=Image.Quantize.MEDIANCUT).save(path, optimize=True)
+
+
+def main(argv: list[str]) -> int:
+    if not argv or argv[0] in ("-h", "--help"):
+        print(__doc__)
+        return 0
+    if argv[0] == "--list":
+        for name, f in FIGURES.items():
+            print(f"{name}  {f.__doc__}")
+        return 0
+    names = list(FIGURES) if argv[0] == "all" else [argv[0]]
+    unknown = [n for n in names if n not in FIGURES]
+    if unknown:
+        print(f"unknown figure {unknown[0]!r}; one of: {', '.join(FIGURES)} or all", file=sys.stderr)
+        return 2
+    out = Path(argv[1]) if len(argv) > 1 else Path(__file__).resolve().parent / "img"
+    out.mkdir(parents=True, exist_ok=True)
+    for name in names:
+        t0 = time.perf_counter()
+        fig = FIGURES[name]()
+        path = lp.save_figure(fig, out / f"{name}.png", dpi=80, close=True)
+        elapsed = time.perf_counter() - t0
+        _shrink(path)
+        print(f"{name}: {elapsed:.1f} s  -> {path}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))

@@ -1,0 +1,52 @@
+"""The documentation stays in the repository and in step with the code (issue 14): nothing points
+at files outside the repository, the gallery has a page section, a command and a runtime for every
+figure its script makes, every command has a how-to, and the README keeps its two commands and
+links the docs. (The site itself is built with `mkdocs build --strict` in .ci/run.)"""
+
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+DOCS = ROOT / "docs"
+
+
+def test_nothing_points_outside_the_repository():
+    hits = []
+    for folder in ("python", "rust", "docs", "examples", "bench"):
+        for p in (ROOT / folder).rglob("*"):
+            if p.suffix in (".py", ".rs", ".md", ".pyi", ".toml") and "PHYSICS" in p.read_text(encoding="utf-8", errors="replace"):
+                hits.append(str(p.relative_to(ROOT)))
+    assert "PHYSICS" not in (ROOT / "README.md").read_text() and not hits, hits
+
+
+def test_every_gallery_figure_has_its_section_command_and_runtime():
+    res = subprocess.run([sys.executable, str(DOCS / "gallery" / "gallery.py"), "--list"], capture_output=True, text=True, timeout=120)
+    assert res.returncode == 0, res.stderr
+    figures = [line.split()[0] for line in res.stdout.splitlines() if line.strip()]
+    assert len(figures) >= 16
+    pages = "\n".join(p.read_text() for p in (DOCS / "gallery").glob("*.md"))
+    for f in figures:
+        assert f"](img/{f}.png)" in pages and (DOCS / "gallery" / "img" / f"{f}.png").is_file(), f
+        m = re.search(rf"\*\*Command:\*\* `python docs/gallery/gallery.py {f}` &nbsp; \*\*Runtime:\*\* ([\d.]+) s", pages)
+        assert m and float(m.group(1)) > 0, f
+
+
+def test_every_command_has_a_how_to():
+    from librate.app.cli import main
+
+    text = (DOCS / "cli.md").read_text()
+    for name in main.commands:
+        assert f"\n## {name}:" in text, name
+
+
+@pytest.mark.parametrize("command", ['pip install . && librate demo', 'pip install ".[test]" && cargo test && python -m pytest'])
+def test_readme_keeps_its_commands_and_links_the_docs(command):
+    readme = (ROOT / "README.md").read_text()
+    assert f"\n{command}\n" in readme
+    for link in re.findall(r"\]\((docs/[^)#]+)", readme):
+        assert (ROOT / link).exists(), link
+    assert "(docs/index.md)" in readme and "(docs/physics.md)" in readme
