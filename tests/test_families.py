@@ -232,3 +232,16 @@ def test_monodromy_from_the_half_period_stm(em, which):
     m = symmetric_monodromy(librate.correct_symmetric(em, o.state0[[0, 2, 4]], spatial=which == "halo", fix="x0"))
     ref = o.monodromy
     assert np.max(np.abs(m - ref)) <= 1e-9 * np.max(np.abs(ref))
+
+
+def test_family_progress(em):
+    """Issue 14: the families report progress(done, total) after each member (one progress
+    style on every step longer than a second): done never decreases, never exceeds total, and
+    the last call has done == total == the members found (DROs: the requested members;
+    Lyapunov: the members found, total max_members until the end)."""
+    for build in (lambda cb: librate.dro_family(em, x0=np.linspace(0.9, 0.5, 9), progress=cb),
+                  lambda cb: librate.lyapunov_family(em, 1, max_members=30, progress=cb)):
+        calls = []
+        fam = build(lambda d, t: calls.append((d, t)))
+        assert calls and all(d <= t for d, t in calls) and all(a[0] <= b[0] for a, b in zip(calls, calls[1:]))
+        assert calls[-1] == (len(fam), len(fam))

@@ -388,7 +388,9 @@ def family(study, kind, point, branch, x0, members, system_name, fmt, sets, out_
     _check_writable(st.output_dir(out_dir), "--out" if out_dir else "output.folder")
     t0 = time.perf_counter()
     try:
-        fam, path = st.run_family(out_dir, force=not resume, say=_say)
+        from .progress import reporter
+
+        fam, path = st.run_family(out_dir, force=not resume, say=_say, progress=reporter("orbit family", "member", _show(quiet)))
     except _FAILURES as err:
         raise _failure(err) from None
     el = time.perf_counter() - t0

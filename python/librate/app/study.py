@@ -662,19 +662,20 @@ class Study(BaseModel):
         r1, r2 = s.radii_km or (0.0, 0.0)
         return System(mu=s.mu, lu_km=s.lu_km, tu_s=s.tu_s, r1_km=r1, r2_km=r2, name=s.name or "custom")
 
-    def build_family(self, system=None):
+    def build_family(self, system=None, progress: Callable[[int, int], None] | None = None):
         """The orbit family this study works on (computed by continuation, takes 0.1 s to a few
         s): for DROs with ``orbits.x0``, exactly those members; otherwise the whole family (DRO
-        0.985 -> 0.005; Lyapunov or halo at ``orbits.point`` up to ``orbits.max_members``)."""
+        0.985 -> 0.005; Lyapunov or halo at ``orbits.point`` up to ``orbits.max_members``).
+        ``progress(done, total)`` after each member."""
         from ..orbits.families import dro_family, halo_family, lyapunov_family
 
         system = system or self.build_system()
         o = self.orbits
         if o.kind == "dro":
             if o.x0 is None:
-                return dro_family(system)
+                return dro_family(system, progress=progress)
             try:
-                return dro_family(system, x0=_grid_values(o.x0))
+                return dro_family(system, x0=_grid_values(o.x0), progress=progress)
             except LibrateError as err:
                 missing = getattr(err, "missing", None)
                 if not missing:
@@ -683,7 +684,7 @@ class Study(BaseModel):
                                            f"no DRO reached at x0 = {', '.join(f'{v:g}' for v in missing)} (the continuation ended: {err.end_reason}); "
                                            f"{len(err.found)} of the requested members were found",
                                            "x0 values on the DRO family, between the Moon and the DRO that grazes the Earth (about 0.985 to 0.005)")]) from None
-        kw = {} if o.max_members is None else {"max_members": o.max_members}
+        kw = {"progress": progress} if o.max_members is None else {"max_members": o.max_members, "progress": progress}
         if o.kind == "lyapunov":
             return lyapunov_family(system, o.point or 1, **kw)
         return halo_family(system, o.point or 2, o.branch or "south", **kw)
@@ -824,14 +825,16 @@ class Study(BaseModel):
 
         return self.output_dir(out) / (RESULT_STEMS[command] + (".zarr" if self.output.format == "zarr" else ".nc"))
 
-    def run_family(self, out: str | Path | None = None, *, force: bool = False, say: Callable[[str], None] | None = None):
+    def run_family(self, out: str | Path | None = None, *, force: bool = False, say: Callable[[str], None] | None = None,
+                   progress: Callable[[int, int], None] | None = None):
         """Compute the orbit family (and the selected members, when the selection is a
         subset) and save it as ``family.zarr`` (or ``family.nc``) in the output folder with the
         study and version as attributes. Returns ``(family, path)``.
 
         An existing family of the same ``[system]`` and ``[orbits]`` is reused (``say`` tells);
         one of other inputs raises :class:`~librate.app.results.ResultExists` naming the changed
-        keys, unless ``force`` (then it is replaced, after ``say`` names it)."""
+        keys, unless ``force`` (then it is replaced, after ``say`` names it). ``progress(done,
+        total)`` after each member of the continuation."""
         from .results import check_output, open_result, save_family
 
         path = self._result_path(out, "family")
@@ -839,7 +842,7 @@ class Study(BaseModel):
             if say is not None:
                 say(f"reused: {path} already holds this family (--force recomputes it)")
             return open_result(path), path
-        fam = self.build_family()
+        fam = self.build_family(progress=progress)
         sel = self.build_orbits(fam)
         if isinstance(sel, list):
             sel = _family_of(fam, sel)

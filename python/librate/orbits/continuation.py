@@ -167,10 +167,21 @@ def _result(problem: SymmetricFamilyProblem, branch: Branch, points: list[Point]
                               bifurcations=list(branch.bifurcations))
 
 
-def _stop(problem, stop):
-    if stop is None:
+def _stop(problem, stop, progress=None, total: int = 0):
+    """The driver's per-point hook: the family's ``stop(orbit, geometry)`` and ``progress(done,
+    total)`` after each accepted member (total: the requested members, or the most the run
+    may take)."""
+    if stop is None and progress is None:
         return None
-    return lambda pt: stop(pt.data, problem.geometries.get(id(pt.data)))
+    count = [1]
+
+    def hook(pt):
+        count[0] += 1
+        if progress is not None:
+            progress(min(count[0], total), total)
+        return stop(pt.data, problem.geometries.get(id(pt.data))) if stop is not None else None
+
+    return hook
 
 
 def continue_natural(
@@ -185,6 +196,7 @@ def continue_natural(
     check_geometry: bool = True,
     stop: Callable[[PeriodicOrbit, Geometry | None], str | None] | None = None,
     t_max: float = 50.0,
+    progress: Callable[[int, int], None] | None = None,
 ) -> ContinuationResult:
     """Natural-parameter continuation in ``var`` ("x0", "z0" or "vy0") through ``values``
     (thesis eq. 20-22), by the continuation driver (:func:`librate.solving.continuation.natural`):
@@ -195,7 +207,11 @@ def continue_natural(
     ``stop`` reason, or when the step falls below ``min_step`` (with the reason).
     """
     problem = SymmetricFamilyProblem(system, spatial=spatial, family=family, t_max=t_max, check_geometry=check_geometry, parameter=var)
-    br = natural(problem, problem.point(first), values, rules=StepRules(ds_min=min_step, ds_max=max(min_step, 1.0)), name=var, stop=_stop(problem, stop))
+    total = int(np.size(values))
+    br = natural(problem, problem.point(first), values, rules=StepRules(ds_min=min_step, ds_max=max(min_step, 1.0)), name=var,
+                 stop=_stop(problem, stop, progress, total))
+    if progress is not None:
+        progress(total, total)
     return _result(problem, br, br.points)
 
 
@@ -213,15 +229,19 @@ def continue_arclength(
     check_geometry: bool = True,
     stop: Callable[[PeriodicOrbit, Geometry | None], str | None] | None = None,
     t_max: float = 50.0,
+    progress: Callable[[int, int], None] | None = None,
 ) -> ContinuationResult:
     """Pseudo-arclength continuation in p = (x0, z0, vy0), through folds, by the continuation
     driver (:func:`librate.solving.continuation.arclength`): predictor along the tangent,
     corrector with the arclength condition, the driver's step rules (growth by 1.5 after an
     easy correction, halving on failure or a detected jump) and this family's guards; ends when
     the step falls below ``ds_min``, at ``max_members``, or when ``stop`` returns a reason.
+    ``progress(done, total)`` after each member (total: ``max_members``, the found count at the end).
     """
     problem = SymmetricFamilyProblem(system, spatial=spatial, family=family, t_max=t_max, check_geometry=check_geometry)
     rules = StepRules(ds=ds, ds_min=ds_min, ds_max=ds_max, jump=0.5, max_turn=0.5)
     br = arclength(problem, problem.point(first), direction=np.asarray(orient, dtype=float), rules=rules, max_points=max_members,
-                   name="x0", stop=_stop(problem, stop))
+                   name="x0", stop=_stop(problem, stop, progress, max_members))
+    if progress is not None:
+        progress(len(br.points), len(br.points))
     return _result(problem, br, br.points)

@@ -623,7 +623,8 @@ def _correct_dro_at(sys_, x0, ydot0, tol, max_iter, rtol, atol) -> PeriodicOrbit
     return correct_symmetric(sys_, (x0, 0.0, ydot0), fix="x0", family="dro", tol=tol, max_iter=max_iter, rtol=rtol, atol=atol)
 
 
-def dro_family(system: System | str = "earth-moon", x0=None, *, check_geometry: bool = True, allow_partial: bool = False) -> OrbitFamily:
+def dro_family(system: System | str = "earth-moon", x0=None, *, check_geometry: bool = True, allow_partial: bool = False,
+               progress=None) -> OrbitFamily:
     """The planar DRO family by natural-parameter continuation in x0 (thesis eq. 20-22).
 
     ``x0``: the members wanted (any order along the family; default the whole family from
@@ -635,7 +636,8 @@ def dro_family(system: System | str = "earth-moon", x0=None, *, check_geometry: 
     When ``x0`` is given, every requested member must be reached: otherwise
     :class:`librate.LibrateError` lists the missing x0 values and why the continuation ended
     (attributes ``missing``, ``found`` and ``end_reason``), unless ``allow_partial=True``, which
-    returns the members found (``parameters["missing_x0"]`` lists the others).
+    returns the members found (``parameters["missing_x0"]`` lists the others). ``progress(done,
+    total)`` is called after each member.
     """
     sys_ = resolve_system(system)
     mu = sys_.mu
@@ -650,7 +652,7 @@ def dro_family(system: System | str = "earth-moon", x0=None, *, check_geometry: 
         if len(lead.members) < 8:
             raise LibrateError(f"could not reach the first requested DRO at x0 = {xs[0]}: {lead.end_reason}")
         first = lead.members[-1]
-    res = continue_natural(sys_, first, "x0", xs, family="dro", check_geometry=check_geometry, stop=stop)
+    res = continue_natural(sys_, first, "x0", xs, family="dro", check_geometry=check_geometry, stop=stop, progress=progress)
     params: dict = {"rejected_jumps": res.rejected_jumps}
     if x0 is not None:
         got = np.array([m.x0 for m in res.members])
@@ -717,16 +719,17 @@ def _lyapunov_start(sys_: System, point: int, amplitude: float) -> PeriodicOrbit
 
 
 def lyapunov_family(system: System | str = "earth-moon", point: int = 1, *, max_members: int = 150,
-                    ds_max: float = 0.02, check_geometry: bool = True) -> OrbitFamily:
+                    ds_max: float = 0.02, check_geometry: bool = True, progress=None) -> OrbitFamily:
     """Planar Lyapunov family at L1 or L2 by pseudo-arclength continuation from a small
     orbit (x0 = L - 0.002, on the side of L toward the larger primary), growing in amplitude.
-    Ends at a collision with the Moon's surface, a step floor or ``max_members``."""
+    Ends at a collision with the Moon's surface, a step floor or ``max_members``. ``progress(done,
+    total)`` after each member (total: max_members until the end)."""
     sys_ = resolve_system(system)
     point = _check_point(point)
     first = _lyapunov_start(sys_, point, 2e-3)
     res = continue_arclength(
         sys_, first, spatial=False, orient=np.array([-1.0, 0.0, 0.0]), ds=2e-3, ds_max=ds_max, max_members=max_members,
-        family=f"lyapunov-L{point}", check_geometry=check_geometry, stop=_collision_stop(sys_, (sys_.r1_km, sys_.r2_km)),
+        family=f"lyapunov-L{point}", check_geometry=check_geometry, stop=_collision_stop(sys_, (sys_.r1_km, sys_.r2_km)), progress=progress,
     )
     return OrbitFamily.from_members(sys_, f"lyapunov-L{point}", False, res.members, res.end_reason, {"point": point},
                                     bifurcations=res.bifurcations)
@@ -754,7 +757,7 @@ def _check_branch(branch) -> float:
 
 
 def halo_family(system: System | str = "earth-moon", point: int = 2, branch: str = "south", *, max_members: int = 400,
-                ds_max: float = 0.02, check_geometry: bool = True) -> OrbitFamily:
+                ds_max: float = 0.02, check_geometry: bool = True, progress=None) -> OrbitFamily:
     """Halo family at L1/L2, started at its bifurcation from the planar Lyapunov family (where
     the out-of-plane stability index crosses +1) and continued by pseudo-arclength in
     (x0, z0, vy0) into the near-rectilinear halo orbits (NRHOs), until the orbit reaches the
@@ -765,7 +768,8 @@ def halo_family(system: System | str = "earth-moon", point: int = 2, branch: str
     above. The two are mirror images under z -> -z, so one is computed and mirrored. ``state0``
     is each member's x-z-plane crossing in the branch's hemisphere (the one with the smaller z
     for south, the larger for north), as the JPL catalog lists them; ``state_half`` the other
-    one. Neither x0 nor z0 is monotonic along the family; the period is, for L2.
+    one. Neither x0 nor z0 is monotonic along the family; the period is, for L2. ``progress(done,
+    total)`` after each member (total: max_members until the end).
     """
     sys_ = resolve_system(system)
     point = _check_point(point)
@@ -783,7 +787,7 @@ def halo_family(system: System | str = "earth-moon", point: int = 2, branch: str
     first = correct_symmetric(sys_, (planar.x0, 2e-3, planar.vy0), spatial=True, fix="z0", family=name)
     res = continue_arclength(
         sys_, first, spatial=True, orient=np.array([0.0, 1.0, 0.0]), ds=2e-3, ds_max=ds_max, max_members=max_members,
-        family=name, check_geometry=check_geometry, stop=_collision_stop(sys_, (sys_.r1_km, sys_.r2_km)),
+        family=name, check_geometry=check_geometry, stop=_collision_stop(sys_, (sys_.r1_km, sys_.r2_km)), progress=progress,
     )
     fam = OrbitFamily.from_members(sys_, name, True, res.members, res.end_reason,
                                    {"point": point, "branch": branch, "bifurcation_x0": bif["x0"]}, bifurcations=res.bifurcations)
