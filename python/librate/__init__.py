@@ -12,6 +12,7 @@ from ._errors import CollisionError, ConvergenceError, IntegrationError, Librate
 from .app import Study, StudyError, open_result, run_map
 from .attitude import (
     Appendage,
+    AttitudeEquilibrium,
     AttitudeTrajectory,
     Facet,
     FacetBody,
@@ -19,6 +20,8 @@ from .attitude import (
     FlexibleBody,
     RigidBody,
     Sun,
+    attitude_equilibrium,
+    equilibrium_stability,
     propagate_attitude,
     quasi_static,
     quaternion_from_euler,
@@ -92,6 +95,9 @@ __all__ = [
     "RigidBody",
     "AttitudeTrajectory",
     "propagate_attitude",
+    "AttitudeEquilibrium",
+    "attitude_equilibrium",
+    "equilibrium_stability",
     "quaternion_from_euler",
     "AttitudeSolution",
     "periodic_attitude",

@@ -274,3 +274,8 @@ def flexible_correct_periodic(
     mu: float, body_arg: Any, primaries: list[bool], orbit0: list[float], period: float, x0: list[float], turns: float,
     scale: list[float], *, options: Any, tol: float, max_iter: int, threads: int | None = None,
 ) -> tuple[_F64, float, int, str, _F64]: ...
+
+# --- 3-D attitude: equilibria and periodic motions (rust/py/src/attitude3d.rs) ---
+__all__ += ["attitude_equilibrium"]
+
+def attitude_equilibrium(mu: float, inertia: list[float], point: int, q0: list[float]) -> dict[str, Any]: ...
