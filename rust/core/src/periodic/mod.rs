@@ -5,6 +5,7 @@
 
 mod attitude;
 mod multiple;
+mod newton;
 mod stability;
 mod symmetric;
 
