@@ -23,10 +23,11 @@ def planar_n_minus_1(dro):
 
 
 def reciprocal_gap(m):
-    """Largest distance of a multiplier's reciprocal from the set (a symplectic monodromy's
-    multipliers come in pairs m, 1/m)."""
+    """A symplectic monodromy's multipliers come in pairs (m, 1/m): the largest, over the
+    multipliers z, of min over the others m of |z m - 1| (the product form, which stays meaningful
+    when |z| is large or small)."""
     m = np.asarray(m)
-    return max(np.min(np.abs(1 / z - m)) for z in m)
+    return max(np.min(np.abs(z * np.delete(m, i) - 1)) for i, z in enumerate(m))
 
 
 def test_planar_embedding_fig23(dro, planar_n_minus_1):
@@ -111,3 +112,53 @@ def test_invalid_arguments(dro, planar_n_minus_1):
         librate.periodic_attitude_3d(dro, body, guess=planar_n_minus_1, tol=-1)
     with pytest.raises(librate.ConvergenceError):
         librate.periodic_attitude_3d(dro, body, guess=([0, 0, 0, 1.0], [0.0, 0.0, 5.0]), max_iter=2)
+
+
+@pytest.fixture(scope="module")
+def dro_family(em):
+    return librate.dro_family(em)
+
+
+@pytest.mark.parametrize("n", [1, 0, -1])
+def test_out_of_plane_stability_across_the_dro_family(dro_family, n):
+    """Thesis Figs. 27-29 (N = 1, 0, -1, Kz = 0.8, across the DRO family from x0 = 0.9): every
+    member continued in the plane is a 3-D periodic motion of the Kz = 0.8 plate (re-propagated to
+    1e-9). Its in-plane multipliers are those of the planar family (trace to 1e-8), and all six
+    come in reciprocal pairs (1e-8). In every family some member is stable in the plane but
+    unstable out of it in the N = 0 and N = -1 families (the roll/yaw block has a multiplier off the
+    unit circle by more than 1e-3); along N = 1 the members stable in the plane are stable out of
+    it too (on this range, every other member)."""
+    from librate.periodicity import attitude_family, out_of_plane_family
+
+    fam = attitude_family(dro_family, kz=0.8, n=n, start=0.9, direction=-1, max_points=60)
+    ds = out_of_plane_family(dro_family, fam, every=2)
+    assert ds.sizes["member"] == len(range(0, len(fam), 2))
+    assert float(ds.residual.max()) < 1e-9
+    np.testing.assert_allclose(ds.in_plane.values.sum(axis=1).real, ds.trace.values, atol=1e-8)
+    for i in range(ds.sizes["member"]):
+        m = np.concatenate([ds.in_plane.values[i], ds.out_of_plane.values[i]])
+        assert reciprocal_gap(m) < 1e-8
+    new = ds.stable_in_plane.values & (ds.out_of_plane_modulus.values > 1 + 1e-3)
+    assert new.any() == (n != 1)
+    assert ds.attrs["n"] == n and ds.attrs["kz"] == 0.8
+
+
+def test_out_of_plane_figure(dro_family):
+    """The figure shows each member's class (gid class-<in>-<out>) and the roll/yaw modulus."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import librate.plotting as lp
+    import matplotlib.pyplot as plt
+    from librate.periodicity import attitude_family, out_of_plane_family
+
+    fam = attitude_family(dro_family, kz=0.8, n=0, start=0.9, direction=-1, max_points=12)
+    ds = out_of_plane_family(dro_family, fam)
+    fig = lp.plot_out_of_plane_stability([ds])
+    gids = {ln.get_gid() for a in fig.axes for ln in a.get_lines()}
+    assert "out-of-plane-modulus" in gids and any(g and g.startswith("class-") for g in gids)
+    plt.close(fig)
+    with pytest.raises(ValueError, match="datasets"):
+        lp.plot_out_of_plane_stability([object()])
+    with pytest.raises(ValueError, match="family"):
+        out_of_plane_family(dro_family, librate.periodicity.attitude_family(dro_family.member(x0=0.9), kz=0.8, n=0, max_points=3))

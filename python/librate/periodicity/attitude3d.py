@@ -37,7 +37,7 @@ from ..attitude.propagate import propagate_attitude
 from ..orbits.periodic import PeriodicOrbit
 from .solutions import AttitudeSolution
 
-__all__ = ["AttitudeSolution3D", "periodic_attitude_3d", "out_of_plane_stability", "STABILITY_TOL", "VERIFY_RTOL",
+__all__ = ["AttitudeSolution3D", "periodic_attitude_3d", "out_of_plane_stability", "out_of_plane_family", "STABILITY_TOL", "VERIFY_RTOL",
            "SOLVE_RTOL"]
 
 #: A multiplier lies on the unit circle when ||m| - 1| <= STABILITY_TOL. The monodromy is
@@ -213,3 +213,71 @@ def out_of_plane_stability(solution: AttitudeSolution) -> AttitudeSolution3D:
     if abs(solution.kz) >= 1:
         raise ValueError(f"invalid argument `solution`: Kz = {solution.kz:g} is a thin rod, which has no 3-D attitude dynamics")
     return periodic_attitude_3d(solution.orbit, RigidBody.from_kz(solution.kz), guess=solution, n_periods=solution.n_periods)
+
+
+def out_of_plane_family(orbits, family, *, body: RigidBody | None = None, every: int = 1):
+    """The 3-D stability of a planar attitude family across an orbit family (thesis Figs. 27-29).
+
+    ``family`` is an :class:`~librate.AttitudeFamily` continued in x0 across the planar orbit
+    family ``orbits`` (:func:`librate.attitude_family`). Every ``every``-th member is taken as a
+    3-D motion of ``body`` and corrected and verified by :func:`periodic_attitude_3d`, starting
+    from its planar (phi0 = 0, wz0). The out-of-plane stability depends on all three moments, not
+    only on Kz. The default body is the plate of the family's Kz, :meth:`RigidBody.from_kz`
+    (Ix + Iy = Iz).
+
+    Returns an xarray Dataset along ``member`` with:
+
+    - ``x0``, ``period_days``, ``wz0``, ``phidot0``;
+    - the planar ``trace`` and ``stable_in_plane``;
+    - ``in_plane`` multipliers (member, pair) and ``out_of_plane`` multipliers (member, k = 4),
+      both complex;
+    - ``out_of_plane_modulus``, the largest |multiplier| of the roll/yaw block;
+    - ``stable_out_of_plane`` and ``stable_3d``, all six multipliers on the unit circle to
+      :data:`STABILITY_TOL`;
+    - ``residual``, from the independent re-propagation.
+
+    Attributes: kz, n, kind, the body's moments.
+    """
+    import xarray as xr
+
+    from ..orbits.families import OrbitFamily
+    from .families import AttitudeFamily
+
+    if not isinstance(orbits, OrbitFamily):
+        raise ValueError(f"invalid argument `orbits`: must be a librate.OrbitFamily, got {type(orbits).__name__}")
+    if not isinstance(family, AttitudeFamily) or family.parameter_name != "x0":
+        raise ValueError("invalid argument `family`: must be a librate.AttitudeFamily continued in x0 (attitude_family(orbit_family, ...))")
+    if family.kind != "periodic":
+        raise ValueError("invalid argument `family`: half-turn motions repeat the attitude only up to a half turn; pass a periodic family")
+    every = as_count(every, "every", 1)
+    kz = float(family.kz)
+    if body is None:
+        if abs(kz) >= 1:
+            raise ValueError(f"invalid argument `body`: Kz = {kz:g} is a thin rod; pass a 3-D body")
+        body = RigidBody.from_kz(kz)
+    elif not isinstance(body, RigidBody) or abs(body.kz - kz) > 1e-9:
+        raise ValueError(f"invalid argument `body`: must be a librate.RigidBody with the family's Kz = {kz:g}, got {body!r}")
+    idx = np.arange(0, len(family), every)
+    rows = []
+    for i in idx:
+        orbit = orbits.member(x0=float(family.parameter[i]))
+        s = periodic_attitude_3d(orbit, body, guess=([0.0, 0.0, 0.0, 1.0], [0.0, 0.0, float(family.wz0[i])]))
+        rows.append((orbit, s))
+    inp = np.array([np.sort_complex(s.in_plane_multipliers) for _, s in rows]).reshape(len(rows), 2)
+    out = np.array([np.sort_complex(s.out_of_plane_multipliers) for _, s in rows]).reshape(len(rows), 4)
+    on_circle = lambda m: np.all(np.abs(np.abs(m) - 1) <= STABILITY_TOL, axis=-1)  # noqa: E731
+    dim = ("member",)
+    return xr.Dataset(
+        {"x0": (dim, family.parameter[idx]), "period_days": (dim, np.array([o.period_days for o, _ in rows])),
+         "wz0": (dim, np.array([s.w0[2] for _, s in rows]), {"units": "1/TU", "long_name": "inertial rate"}),
+         "phidot0": (dim, np.array([s.w0[2] - 1 for _, s in rows]), {"units": "1/TU"}),
+         "trace": (dim, family.trace[idx], {"long_name": "trace of the planar 2x2 monodromy"}),
+         "stable_in_plane": (dim, on_circle(inp)),
+         "in_plane": (("member", "pair"), inp),
+         "out_of_plane": (("member", "k"), out),
+         "out_of_plane_modulus": (dim, np.abs(out).max(axis=1)),
+         "stable_out_of_plane": (dim, on_circle(out)),
+         "stable_3d": (dim, np.array([s.stable for _, s in rows])),
+         "residual": (dim, np.array([s.residual for _, s in rows]))},
+        attrs={"kz": kz, "n": int(family.n), "kind": family.kind, "body_moments": list(body.moments), "stability_tol": STABILITY_TOL,
+               "system": orbits.system.name})

@@ -10,7 +10,7 @@ import numpy as np
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
-__all__ = ["plot_equilibrium_stability"]
+__all__ = ["plot_equilibrium_stability", "plot_out_of_plane_stability"]
 
 
 def plot_equilibrium_stability(ds, ax=None, *, boundaries: bool = True) -> Figure:
@@ -51,4 +51,60 @@ def plot_equilibrium_stability(ds, ax=None, *, boundaries: bool = True) -> Figur
     a.set_title(f"Equilibrium attitude at {point} (h = {ds.attrs.get('h', float('nan')):.2f})")
     labels = ["stable", "pitch unstable", "roll-yaw divergent", "roll-yaw flutter"]
     a.legend(handles=[Patch(color=col, label=lab) for col, lab in zip(colors, labels)], loc="lower left", fontsize="small", framealpha=0.9)
+    return fig
+
+
+#: Marker of each (in-plane stable, out-of-plane stable) class of plot_out_of_plane_stability.
+_CLASSES = {
+    (True, True): ("stable in 3-D", dict(marker="o", color="tab:green", linestyle="none")),
+    (True, False): ("stable in the plane, unstable out of it", dict(marker="^", color="tab:red", linestyle="none")),
+    (False, True): ("unstable in the plane only", dict(marker="o", color="0.45", markerfacecolor="none", linestyle="none")),
+    (False, False): ("unstable in and out of the plane", dict(marker="x", color="0.3", linestyle="none")),
+}
+
+
+def plot_out_of_plane_stability(datasets, ax=None, *, against: str = "period") -> Figure:
+    """The 3-D stability of planar attitude families across an orbit family, one column per
+    Dataset of :func:`librate.periodicity.out_of_plane_family` (e.g. N = 1, 0, -1 of thesis Figs.
+    27-29). The top row shows the initial rate phidot(0) = wz(0) - 1 against the orbit's period
+    (days) or x0 (``against``). Each member's marker shows whether it is stable in the plane and
+    out of it (gids ``"class-<in>-<out>"``, e.g. ``"class-1-0"``: stable in the plane, unstable
+    out of it). The bottom row shows the largest |roll/yaw multiplier| on a log scale (gid
+    ``"out-of-plane-modulus"``). Returns the Figure."""
+    from . import _axes
+
+    dss = [datasets] if hasattr(datasets, "data_vars") else list(datasets)
+    if not dss or not all("out_of_plane_modulus" in getattr(d, "data_vars", {}) for d in dss):
+        raise ValueError("invalid argument `datasets`: Datasets of librate.periodicity.out_of_plane_family")
+    if against not in ("period", "x0"):
+        raise ValueError(f"invalid argument `against`: must be 'period' or 'x0', got {against!r}")
+    ncol = len(dss)
+    if ax is None:
+        import matplotlib.pyplot as plt
+
+        fig = plt.figure(figsize=(4.8 * ncol, 7.0), layout="constrained")
+        axs = fig.subplots(2, ncol, sharex="col", squeeze=False)
+        top, bottom = list(axs[0]), list(axs[1])
+    else:
+        fig, flat = _axes(ax, 2 * ncol)
+        top, bottom = flat[:ncol], flat[ncol:]
+    for d, a, b in zip(dss, top, bottom):
+        x = d["period_days"].values if against == "period" else d["x0"].values
+        y = d["phidot0"].values
+        a.plot(x, y, color="0.8", linewidth=0.8, zorder=0)
+        for (sin, sout), (label, style) in _CLASSES.items():
+            m = (d["stable_in_plane"].values == sin) & (d["stable_out_of_plane"].values == sout)
+            if m.any():
+                (ln,) = a.plot(x[m], y[m], label=label, markersize=5, **style)
+                ln.set_gid(f"class-{int(sin)}-{int(sout)}")
+        a.set_title(f"N = {d.attrs.get('n')}, Kz = {d.attrs.get('kz'):g}")
+        a.set_ylabel(r"$\dot\phi(0) = w_z(0) - 1$ (1/TU)")
+        (ln,) = b.semilogy(x, d["out_of_plane_modulus"].values, ".-", color="tab:red", markersize=4)
+        ln.set_gid("out-of-plane-modulus")
+        b.axhline(1.0, color="k", linewidth=0.6)
+        b.set_ylabel("largest |roll/yaw multiplier|")
+        b.set_xlabel("orbit period (days)" if against == "period" else "$x_0$ (LU)")
+    from matplotlib.lines import Line2D
+
+    top[0].legend(handles=[Line2D([], [], label=label, **style) for label, style in _CLASSES.values()], fontsize="small", loc="best")
     return fig
