@@ -162,3 +162,29 @@ def test_out_of_plane_figure(dro_family):
         lp.plot_out_of_plane_stability([object()])
     with pytest.raises(ValueError, match="family"):
         out_of_plane_family(dro_family, librate.periodicity.attitude_family(dro_family.member(x0=0.9), kz=0.8, n=0, max_points=3))
+
+
+@pytest.mark.slow
+def test_family_along_the_l2_southern_halos_reaches_the_9_2_nrho(em):
+    """Issue 15 acceptance (family): the N = -1 motion of the body 0.8 : 0.9 : 1 on the 14-day L2
+    southern halo (started from the torque-free rate), continued along the halo family by natural
+    parameter in the period, reaches the 9:2 NRHO (6.56 days; Zimovan-Spreen et al. 2020). Every
+    member repeats to 1e-9 on independent re-propagation (tol = 1e-10 for the close lunar passes),
+    multipliers in reciprocal pairs (product form, 1e-7 at the NRHO's |m| ~ 50), and the
+    stability changes are listed (two Krein collisions between 13.25 and 11 days)."""
+    from librate.periodicity import attitude_family_3d
+
+    hf = librate.halo_family(em, 2, "south")
+    body = librate.RigidBody(0.8, 0.9, 1.0)
+    h = hf.member(period_days=14.0)
+    s = librate.periodic_attitude_3d(h, body, guess=([0, 0, 0, 1.0], [0, 0, 1 - 2 * math.pi / h.period]))
+    periods = np.r_[np.linspace(14.0, 6.75, 30), 6.7, 6.65, 6.6, 6.56]
+    ds = attitude_family_3d(hf, body, guess=(s.q0, s.w0), period_days=periods, tol=1e-10)
+    assert ds.attrs["end_reason"].startswith("completed")
+    assert ds.sizes["member"] == periods.size
+    assert ds.period_days.values[-1] == pytest.approx(6.56, abs=1e-9)
+    assert float(ds.residual.max()) < 1e-9
+    for m in ds.multipliers.values:
+        assert reciprocal_gap(m) < 1e-7
+    assert "krein" in ds.attrs["stability_changes"]
+    np.testing.assert_allclose(ds.turns.values, -1.0, atol=1e-9)

@@ -37,7 +37,8 @@ from ..attitude.propagate import propagate_attitude
 from ..orbits.periodic import PeriodicOrbit
 from .solutions import AttitudeSolution
 
-__all__ = ["AttitudeSolution3D", "periodic_attitude_3d", "out_of_plane_stability", "out_of_plane_family", "STABILITY_TOL", "VERIFY_RTOL",
+__all__ = ["AttitudeSolution3D", "periodic_attitude_3d", "out_of_plane_stability", "out_of_plane_family", "attitude_family_3d",
+           "OrbitFamilyBranch3D", "STABILITY_TOL", "VERIFY_RTOL",
            "SOLVE_RTOL"]
 
 #: A multiplier lies on the unit circle when ||m| - 1| <= STABILITY_TOL. The monodromy is
@@ -197,7 +198,7 @@ def periodic_attitude_3d(orbit: PeriodicOrbit, body: RigidBody, *, guess, n_peri
         raise ConvergenceError(f"periodic 3-D attitude: the corrector stopped ({r['reason'][0].replace('_', ' ')}) after {int(r['iterations'][0])} "
                                f"Newton steps, residual {float(r['residual_norm'][0]):.3e} (tolerance {tol:.1e})")
     q0, w0 = np.asarray(r["q0"][0]), np.asarray(r["w0"][0])
-    t = np.linspace(0.0, T, 64 * n_periods + 1)
+    t = np.linspace(0.0, T, 512 * n_periods + 1)
     tr = propagate_attitude(orbit.system, orbit.state0, (q0, w0), body, T, t_eval=t, rtol=VERIFY_RTOL, atol=VERIFY_RTOL)
     d_rot = float(np.linalg.norm(_rotvec(q0, tr.q[-1])))
     d_w = float(np.linalg.norm(tr.w[-1] - w0))
@@ -281,3 +282,111 @@ def out_of_plane_family(orbits, family, *, body: RigidBody | None = None, every:
          "residual": (dim, np.array([s.residual for _, s in rows]))},
         attrs={"kz": kz, "n": int(family.n), "kind": family.kind, "body_moments": list(body.moments), "stability_tol": STABILITY_TOL,
                "system": orbits.system.name})
+
+
+class OrbitFamilyBranch3D:
+    """A periodic 3-D attitude motion continued along a family of periodic orbits, for the
+    continuation driver (:func:`librate.solving.continuation.natural`). The vector is x = (orbit
+    period in days, the rotation vector of q0, w0). Every point corrects the family member with
+    that period (:meth:`OrbitFamily.member`) and then the attitude with
+    :func:`periodic_attitude_3d`, starting from the predicted (q0, w0). The tangent is the
+    driver's secant."""
+
+    parameter_index = 0
+    scale = np.ones(7)
+
+    def __init__(self, orbits, body: RigidBody, n_periods: int = 1, tol: float = 1e-12):
+        self.orbits, self.body, self.n_periods, self.tol = orbits, body, n_periods, tol
+
+    def correct(self, guess, c):
+        from scipy.spatial.transform import Rotation
+
+        from ..solving.continuation import CorrectionFailed, Point
+
+        if not (c.a[0] == 1 and not np.any(c.a[1:])):
+            raise CorrectionFailed("the 3-D attitude family across an orbit family is continued in the period only (natural parameter)")
+        try:
+            orbit = self.orbits.member(period_days=float(c.b))
+        except ValueError as e:
+            raise CorrectionFailed(str(e)) from None
+        q = Rotation.from_rotvec(np.asarray(guess[1:4], dtype=float)).as_quat()
+        s = periodic_attitude_3d(orbit, self.body, guess=(q, np.asarray(guess[4:7], dtype=float)), n_periods=self.n_periods, tol=self.tol)
+        if not s.residual <= 1e-9:
+            raise CorrectionFailed(f"re-propagation residual {s.residual:.2e} above 1e-9")
+        x = np.concatenate([[orbit.period_days], Rotation.from_quat(s.q0).as_rotvec(), s.w0])
+        return Point(x, s, s.iterations)
+
+    def tangent(self, point):
+        return None
+
+
+def attitude_family_3d(orbits, body: RigidBody, *, guess, period_days, n_periods: int = 1, tol: float = 1e-12, ds_min: float = 1e-4):
+    """A periodic 3-D attitude motion of ``body`` continued along the orbit family ``orbits``
+    (e.g. the L2 southern halos into the NRHOs) through the orbit periods ``period_days`` (days,
+    in order), by natural-parameter continuation (:func:`librate.solving.continuation.natural`)
+    from ``guess`` ((q0, w0) or a planar solution) at the first period. ``tol``: the corrector's
+    tolerance (NRHOs pass within a few thousand km of the Moon, where the tidal torque is some
+    1e4 times the Earth's at the Moon's distance; their attitude closure is reached to ~1e-11, so
+    pass tol=1e-10 there). Every member is re-propagated independently to 1e-9.
+
+    Returns an xarray Dataset along ``member``:
+
+    - ``period_days``, ``x0``, ``z0``;
+    - ``q0`` and ``w0``;
+    - the six ``multipliers`` (complex), ``stable`` and ``residual`` (from the re-propagation);
+    - ``turns``, NaN where it is undefined.
+
+    Attributes:
+
+    - ``stability_changes``: the consecutive members between which the number of multipliers on
+      the unit circle changes, with the kind of the crossing. A real pair leaving through +1 or
+      -1 is "+1" or "-1"; two pairs colliding on the circle and leaving it is "krein". These are
+      detected between members, not located.
+    - ``end_reason``: why the continuation stopped; a fold in the period shows as the step
+      collapsing there.
+    """
+    import xarray as xr
+
+    from ..orbits.families import OrbitFamily
+    from ..solving.continuation import Point, StepRules, natural
+
+    if not isinstance(orbits, OrbitFamily):
+        raise ValueError(f"invalid argument `orbits`: must be a librate.OrbitFamily, got {type(orbits).__name__}")
+    targets = np.asarray(period_days, dtype=float).ravel()
+    if targets.size < 2 or not np.all(np.isfinite(targets)):
+        raise ValueError(f"invalid argument `period_days`: need at least two finite periods, got {period_days!r}")
+    n_periods = as_count(n_periods, "n_periods", 1)
+    first_orbit = orbits.member(period_days=float(targets[0]))
+    tol = as_number(tol, "tol", positive=True)
+    s0 = periodic_attitude_3d(first_orbit, body, guess=guess, n_periods=n_periods, tol=tol)
+    problem = OrbitFamilyBranch3D(orbits, body, n_periods, tol)
+    from scipy.spatial.transform import Rotation
+
+    first = Point(np.concatenate([[first_orbit.period_days], Rotation.from_quat(s0.q0).as_rotvec(), s0.w0]), s0, s0.iterations)
+    br = natural(problem, first, targets[1:], rules=StepRules(ds=abs(targets[1] - targets[0]), ds_min=ds_min), name="period_days")
+    sols = [s0] + [p.data for p in br.points]
+    mult = np.array([_sorted_multipliers(s.multipliers) for s in sols])
+    on = np.abs(np.abs(mult) - 1) <= STABILITY_TOL
+    changes = []
+    for i in range(len(sols) - 1):
+        a, b = int(on[i].sum()), int(on[i + 1].sum())
+        if a != b:
+            left = mult[i + 1][~on[i + 1]] if a > b else mult[i][~on[i]]
+            kind = "krein" if np.any(np.abs(left.imag) > 1e-6) else ("+1" if np.all(left.real > 0) else "-1")
+            changes.append({"between_period_days": (float(sols[i].orbit.period_days), float(sols[i + 1].orbit.period_days)), "kind": kind,
+                            "on_unit_circle": (a, b)})
+    dim = ("member",)
+    return xr.Dataset(
+        {"period_days": (dim, np.array([s.orbit.period_days for s in sols])), "x0": (dim, np.array([s.orbit.state0[0] for s in sols])),
+         "z0": (dim, np.array([s.orbit.state0[2] for s in sols])),
+         "q0": (("member", "quaternion"), np.array([s.q0 for s in sols])), "w0": (("member", "axis"), np.array([s.w0 for s in sols])),
+         "multipliers": (("member", "k"), mult), "stable": (dim, np.array([s.stable for s in sols])),
+         "residual": (dim, np.array([s.residual for s in sols])),
+         "turns": (dim, np.array([np.nan if s.turns is None else s.turns for s in sols]))},
+        attrs={"body_moments": list(body.moments), "n_periods": n_periods, "end_reason": br.end_reason, "stability_changes": repr(changes),
+               "system": orbits.system.name})
+
+
+def _sorted_multipliers(m) -> np.ndarray:
+    m = np.asarray(m, dtype=complex)
+    return m[np.lexsort((m.imag, np.abs(m)))]
