@@ -351,4 +351,43 @@ mod tests {
         let (r, dl) = qlog(&q);
         assert!((r[0] - 1e-9).abs() < 1e-22 && (dl[0][0] - 2.0).abs() < 1e-12);
     }
+
+    /// The torque-free sphere (no gravity-gradient torque for equal moments): from a tilted
+    /// guess the corrector finds a spin (1 + 2 pi N / T) e_Z (inertial) in a few steps, and the
+    /// monodromy is expm([[-[w x] T, T I], [0, 0]]) to 1e-10 (docs/physics/periodic-attitude-3d.md).
+    #[test]
+    fn torque_free_sphere_monodromy_is_the_closed_form() {
+        use nalgebra::DMatrix;
+        let mu = 0.012150585609624;
+        let body = RigidBody::new(1.0, 1.0, 1.0).unwrap();
+        let t = 2.5;
+        let wz = 1.0 - 2.0 * std::f64::consts::PI / t;
+        let (q, _) = qexp(&[0.1, -0.05, 0.2]);
+        let a = crate::attitude::dcm(&q);
+        let w: [f64; 3] = std::array::from_fn(|i| a[i][2] * wz + if i == 0 { 1e-3 } else { 0.0 });
+        let out = correct_attitudes_3d(mu, body, &[0.8, 0.0, 0.0, 0.0, 0.5, 0.0], t, &[Start3d { q, w }], &Options3d::default()).unwrap();
+        let c = &out[0];
+        assert_eq!(c.reason, StopReason::Converged, "{c:?}");
+        let w = c.w0;
+        let mut m = DMatrix::<f64>::zeros(6, 6);
+        let wx = [[0.0, -w[2], w[1]], [w[2], 0.0, -w[0]], [-w[1], w[0], 0.0]];
+        for i in 0..3 {
+            for j in 0..3 {
+                m[(i, j)] = -wx[i][j] * t;
+            }
+            m[(i, 3 + i)] = t;
+        }
+        let e = m.exp();
+        for i in 0..6 {
+            for j in 0..6 {
+                assert!((e[(i, j)] - c.monodromy[i][j]).abs() < 1e-10, "({i}, {j}): {} vs {}", c.monodromy[i][j], e[(i, j)]);
+            }
+        }
+        // the converged spin is inertial-Z: A(q0)' w0 = wz e_Z
+        let a = crate::attitude::dcm(&c.q0);
+        for k in 0..3 {
+            let v: f64 = (0..3).map(|i| a[i][k] * w[i]).sum();
+            assert!((v - if k == 2 { wz } else { 0.0 }).abs() < 1e-12);
+        }
+    }
 }
