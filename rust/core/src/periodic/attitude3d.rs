@@ -356,6 +356,7 @@ mod tests {
     /// guess the corrector finds a spin (1 + 2 pi N / T) e_Z (inertial) in a few steps, and the
     /// monodromy is expm([[-[w x] T, T I], [0, 0]]) to 1e-10 (docs/physics/periodic-attitude-3d.md).
     #[test]
+    #[allow(clippy::needless_range_loop)]
     fn torque_free_sphere_monodromy_is_the_closed_form() {
         use nalgebra::DMatrix;
         let mu = 0.012150585609624;
