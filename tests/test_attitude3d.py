@@ -188,3 +188,31 @@ def test_family_along_the_l2_southern_halos_reaches_the_9_2_nrho(em):
         assert reciprocal_gap(m) < 1e-7
     assert "krein" in ds.attrs["stability_changes"]
     np.testing.assert_allclose(ds.turns.values, -1.0, atol=1e-9)
+
+
+def test_half_period_symmetric_form(em, dro, planar_n_minus_1):
+    """The mirror-symmetric half-period form (3 unknowns, closure at T/2) finds the same
+    solutions as the full form: on the Fig. 23 DRO (wz0 to 1e-10, full-period multipliers to
+    1e-8) and on the 13-day L2 southern halo from a perturbed symmetric guess (q0, w0 to 1e-9,
+    monodromy to 1e-8); both re-propagate to 1e-9. A guess that is not symmetric is refused."""
+    body = librate.RigidBody.from_kz(0.8)
+    p = planar_n_minus_1
+    full = librate.periodic_attitude_3d(dro, body, guess=p)
+    half = librate.periodic_attitude_3d(dro, body, guess=([0, 0, 0, 1.0], [0, 0, p.wz0 + 0.01]), symmetric=True)
+    assert half.w0[2] == pytest.approx(p.wz0, abs=1e-10)
+    assert np.max(np.abs(half.monodromy - full.monodromy)) < 1e-8
+    assert half.residual < 1e-9
+
+    h = librate.halo(em, 2, "south", period_days=13.0)
+    b2 = librate.RigidBody(0.8, 0.9, 1.0)
+    full = librate.periodic_attitude_3d(h, b2, guess=([0, 0, 0, 1.0], [0, 0, 1 - 2 * math.pi / h.period]))
+    a = Rotation.from_quat(full.q0).as_matrix().T
+    assert abs(a[1, 0]) < 1e-9 and abs(a[1, 2]) < 1e-9 and abs(full.w0[1]) < 1e-9  # the full form's solution is mirror symmetric
+    tilt = Rotation.from_quat(full.q0).as_rotvec()[1] + 0.05
+    half = librate.periodic_attitude_3d(h, b2, guess=(Rotation.from_rotvec([0, tilt, 0]).as_quat(), [full.w0[0] + 0.02, 0, full.w0[2] - 0.02]),
+                                        symmetric=True)
+    assert np.max(np.abs(half.q0 - full.q0)) < 1e-9 and np.max(np.abs(half.w0 - full.w0)) < 1e-9
+    assert np.max(np.abs(half.monodromy - full.monodromy)) < 1e-8
+    assert half.residual < 1e-9 and full.residual < 1e-9
+    with pytest.raises(ValueError, match="symmetric"):
+        librate.periodic_attitude_3d(h, b2, guess=(Rotation.from_rotvec([0.1, 0, 0]).as_quat(), [0, 0, 1.0]), symmetric=True)

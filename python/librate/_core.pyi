@@ -281,5 +281,5 @@ __all__ += ["attitude_equilibrium", "attitude_correct_3d"]
 def attitude_equilibrium(mu: float, inertia: list[float], point: int, q0: list[float]) -> dict[str, Any]: ...
 def attitude_correct_3d(
     mu: float, inertia: list[float], orbit0: list[float], t_final: float, q: _F64, w: _F64, *, tol: float, max_iter: int,
-    rtol: float, atol: float, max_halvings: int = 10, primaries: list[bool] = ..., threads: int | None = None,
+    rtol: float, atol: float, max_halvings: int = 10, primaries: list[bool] = ..., threads: int | None = None, half: bool = False,
 ) -> dict[str, Any]: ...

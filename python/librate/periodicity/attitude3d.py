@@ -37,7 +37,7 @@ from ..attitude.propagate import propagate_attitude
 from ..orbits.periodic import PeriodicOrbit
 from .solutions import AttitudeSolution
 
-__all__ = ["AttitudeSolution3D", "periodic_attitude_3d", "out_of_plane_stability", "out_of_plane_family", "attitude_family_3d",
+__all__ = ["AttitudeSolution3D", "periodic_attitude_3d", "is_mirror_symmetric", "out_of_plane_stability", "out_of_plane_family", "attitude_family_3d",
            "OrbitFamilyBranch3D", "STABILITY_TOL", "VERIFY_RTOL",
            "SOLVE_RTOL"]
 
@@ -172,8 +172,19 @@ def _turns(q: np.ndarray) -> float | None:
     return float((ang[-1] - ang[0]) / (2 * math.pi))
 
 
+def is_mirror_symmetric(orbit: PeriodicOrbit, q0, w0) -> bool:
+    """Whether the half-period symmetric form applies. The orbit must start on the x-z plane
+    perpendicularly (y = xdot = zdot = 0), and the attitude must be mirror symmetric: body y on
+    synodic +-Y and w_y = 0, to 1e-12."""
+    from scipy.spatial.transform import Rotation
+
+    s = np.asarray(orbit.state0)
+    a = Rotation.from_quat(q0).as_matrix().T
+    return bool(s[1] == 0 and s[3] == 0 and s[5] == 0 and abs(a[1, 0]) <= 1e-12 and abs(a[1, 2]) <= 1e-12 and abs(w0[1]) <= 1e-12)
+
+
 def periodic_attitude_3d(orbit: PeriodicOrbit, body: RigidBody, *, guess, n_periods: int = 1, tol: float = 1e-12,
-                         max_iter: int = 40) -> AttitudeSolution3D:
+                         max_iter: int = 40, symmetric: bool = False) -> AttitudeSolution3D:
     """The periodic 3-D attitude motion of ``body`` along ``orbit`` (planar or spatial) over
     ``n_periods`` revolutions, corrected from ``guess``.
 
@@ -182,6 +193,12 @@ def periodic_attitude_3d(orbit: PeriodicOrbit, body: RigidBody, *, guess, n_peri
     stops when the residual max-norm is <= ``tol``. The solution is then re-propagated
     independently, at a tighter tolerance, and ``residual`` reports that check. Raises
     :class:`librate.ConvergenceError` when the corrector stops without converging.
+
+    ``symmetric`` selects the formulation. True uses the half-period form: the orbit and the
+    guess must be mirror symmetric (:func:`is_mirror_symmetric`), and the solution then is
+    too, with three unknowns and three equations at KT/2. It is cheaper, but from a poor guess
+    its Newton basin can be smaller than the full form's. False (the default) uses the full
+    period, with six unknowns. The monodromy is always the full-period one.
     """
     if not isinstance(orbit, PeriodicOrbit):
         raise ValueError(f"invalid argument `orbit`: must be a librate.PeriodicOrbit, got {type(orbit).__name__}")
@@ -191,9 +208,18 @@ def periodic_attitude_3d(orbit: PeriodicOrbit, body: RigidBody, *, guess, n_peri
     tol = as_number(tol, "tol", positive=True)
     max_iter = as_count(max_iter, "max_iter", 1)
     q, w = _guess(guess, n_periods)
+    if not isinstance(symmetric, (bool, np.bool_)):
+        raise ValueError(f"invalid argument `symmetric`: must be True or False, got {symmetric!r}")
+    half = bool(symmetric)
+    if half and not is_mirror_symmetric(orbit, q, w):
+        raise ValueError("invalid argument `symmetric`: the half-period form needs an orbit started on the x-z plane perpendicularly and a "
+                         "mirror-symmetric guess (body y on synodic +-Y, w_y = 0)")
+    if half:
+        w = w.copy()
+        w[1] = 0.0  # symmetric to 1e-12: exactly so
     T = n_periods * float(orbit.period)
     r = _core.attitude_correct_3d(orbit.system.mu, list(body.moments), [float(v) for v in orbit.state0], T, q[None, :], w[None, :],
-                                  tol=float(tol), max_iter=int(max_iter), rtol=SOLVE_RTOL, atol=SOLVE_RTOL)
+                                  tol=float(tol), max_iter=int(max_iter), rtol=SOLVE_RTOL, atol=SOLVE_RTOL, half=half)
     if r["reason"][0] != "converged":
         raise ConvergenceError(f"periodic 3-D attitude: the corrector stopped ({r['reason'][0].replace('_', ' ')}) after {int(r['iterations'][0])} "
                                f"Newton steps, residual {float(r['residual_norm'][0]):.3e} (tolerance {tol:.1e})")

@@ -30,10 +30,11 @@ fn attitude_equilibrium<'py>(py: Python<'py>, mu: f64, inertia: [f64; 3], point:
 }
 
 /// Batched 3-D periodic-attitude corrector: guesses q (n x 4, scalar last) and w (n x 3) along
-/// the orbit started at `orbit0`, closure over `t_final`. dict of arrays (q0, w0, residual,
+/// the orbit started at `orbit0`, closure over `t_final` (K T; `half`: the mirror-symmetric
+/// half-period form). dict of arrays (q0, w0, residual,
 /// residual_norm, iterations, reason, monodromy n x 6 x 6).
 #[pyfunction]
-#[pyo3(signature = (mu, inertia, orbit0, t_final, q, w, *, tol, max_iter, rtol, atol, max_halvings=10, primaries=[true, true], threads=None))]
+#[pyo3(signature = (mu, inertia, orbit0, t_final, q, w, *, tol, max_iter, rtol, atol, max_halvings=10, primaries=[true, true], threads=None, half=false))]
 fn attitude_correct_3d<'py>(
     py: Python<'py>,
     mu: f64,
@@ -49,6 +50,7 @@ fn attitude_correct_3d<'py>(
     max_halvings: u32,
     primaries: [bool; 2],
     threads: Option<usize>,
+    half: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let body = RigidBody::new(inertia[0], inertia[1], inertia[2]).map_err(to_py)?;
     let (qa, wa) = (q.as_array(), w.as_array());
@@ -56,7 +58,7 @@ fn attitude_correct_3d<'py>(
         return Err(PyValueError::new_err(format!("invalid argument `guess`: need q of shape (n, 4) and w of shape (n, 3), got {:?} and {:?}", qa.shape(), wa.shape())));
     }
     let starts: Vec<Start3d> = (0..qa.nrows()).map(|i| Start3d { q: std::array::from_fn(|k| qa[(i, k)]), w: std::array::from_fn(|k| wa[(i, k)]) }).collect();
-    let opts = Options3d { tol, max_iter, max_halvings, rtol, atol, threads, primaries, ..Options3d::default() };
+    let opts = Options3d { tol, max_iter, max_halvings, rtol, atol, threads, primaries, half, ..Options3d::default() };
     let out = py.detach(|| correct_attitudes_3d(mu, body, &orbit0, t_final, &starts, &opts)).map_err(to_py)?;
     let n = out.len();
     let d = PyDict::new(py);

@@ -9,6 +9,14 @@
 //! Unknowns x = (theta, w0): theta (3) a rotation in body axes in a chart about the candidate's
 //! guess q_ref, q0 = q_ref (x) Exp(theta), and w0 (3). The Jacobian is exact: from the 13x13
 //! STM of the coupled model (dual numbers), the derivative of Exp and of Log in closed form.
+//! Half-period symmetric form ([`Options3d::half`]): the CR3BP is symmetric under the reflection
+//! S = diag(1, -1, 1) of the synodic frame with time reversal, and so is the attitude (R(t) ->
+//! S R(-t) S, any principal-axis inertia). On an orbit started on the x-z plane perpendicularly
+//! (y = xdot = zdot = 0), a motion with R(0) e_y = +-e_y and w_y(0) = 0 is mirror symmetric, and
+//! it is periodic when the same holds at T/2: (A[1][0], A[1][2], w_y)(KT/2) = 0, three equations
+//! in the unknowns (theta_y, w_x, w_z) (theta about body y keeps R(0) e_y = +-e_y). The
+//! full-period monodromy comes from one more batch over KT at the solutions.
+//!
 //! Newton runs on the one batched driver ([`super::newton`]); each iteration integrates the
 //! pending points of every candidate in parallel (rayon). The 6x6 attitude monodromy is the
 //! STM in the coordinates (theta, dw) of [`crate::attitude::linear`].
@@ -120,11 +128,13 @@ pub struct Options3d {
     pub threads: Option<usize>,
     /// Enabled primaries of the gravity gradient [larger, smaller].
     pub primaries: [bool; 2],
+    /// The half-period symmetric form (see the module docs): `t_final` is still K T.
+    pub half: bool,
 }
 
 impl Default for Options3d {
     fn default() -> Self {
-        Self { tol: 1e-12, max_iter: 40, max_halvings: 10, rtol: 1e-13, atol: 1e-13, max_angle_step: 0.5, max_rate_step: 0.5, threads: None, primaries: [true, true] }
+        Self { tol: 1e-12, max_iter: 40, max_halvings: 10, rtol: 1e-13, atol: 1e-13, max_angle_step: 0.5, max_rate_step: 0.5, threads: None, primaries: [true, true], half: false }
     }
 }
 
@@ -134,7 +144,8 @@ pub struct Correction3d {
     /// Final attitude (unit, scalar last) and inertial rate in body axes.
     pub q0: Quat,
     pub w0: [f64; 3],
-    /// (rotation vector of R(0)' R(T) in body axes, w(T) - w0); NaN when not integrated.
+    /// (rotation vector of R(0)' R(T) in body axes, w(T) - w0); the half form: (A[1][0], A[1][2],
+    /// w_y) at T/2, then NaN. NaN when not integrated.
     pub residual: [f64; 6],
     pub residual_norm: f64,
     pub iterations: usize,
@@ -150,6 +161,17 @@ struct Form3d<'a> {
 }
 
 const ROWS: [usize; 6] = [0, 1, 2, 3, 4, 5];
+const HALF_ROWS: [usize; 3] = [0, 1, 2];
+/// (theta_y, w_x, w_z).
+const HALF_COLS: [usize; 3] = [1, 3, 5];
+
+/// The attitude matrix A(q) and its derivative d A[i][j] / d q_k (dual numbers).
+fn dcm_and_derivative(q: &Quat) -> ([[f64; 3]; 3], [[[f64; 4]; 3]; 3]) {
+    use crate::scalar::Dual;
+    let qd: [Dual<4>; 4] = std::array::from_fn(|k| Dual::var(q[k], k));
+    let a = crate::attitude::dcm(&qd);
+    (a.map(|r| r.map(|v| v.re)), a.map(|r| r.map(|v| v.eps)))
+}
 
 impl Form3d<'_> {
     fn q0(&self, c: usize, x: &[f64; 6]) -> (Quat, [[f64; 3]; 4]) {
@@ -211,6 +233,19 @@ impl Problem<6> for Form3d<'_> {
                 }
             }
         }
+        if self.opts.half {
+            // (A[1][0], A[1][2], w_y)(T/2) and their derivatives
+            let (a, da) = dcm_and_derivative(&qt);
+            let mut f = [f64::NAN; 6];
+            let mut jac = [[f64::NAN; 6]; 6];
+            for (row, (i, j)) in [(1usize, 0usize), (1, 2)].into_iter().enumerate() {
+                f[row] = a[i][j];
+                jac[row] = std::array::from_fn(|c| (0..4).map(|k| da[i][j][k] * dqt[k][c]).sum());
+            }
+            f[2] = yt[11];
+            jac[2] = dwt[1];
+            return Some(Eval { f, jac, keep: Vec::new() });
+        }
         // d delta = R(qT) conj(d q0) + L(conj q0) d qT, times the sign (and 1/|delta|)
         let (rq, lc) = (rmat(&qt), lmat(&conj(&q0)));
         let mut ddelta = [[0.0; 6]; 4];
@@ -236,10 +271,18 @@ impl Problem<6> for Form3d<'_> {
         Some(Eval { f, jac, keep: mono.iter().flatten().copied().collect() })
     }
     fn rows(&self) -> &[usize] {
-        &ROWS
+        if self.opts.half {
+            &HALF_ROWS
+        } else {
+            &ROWS
+        }
     }
     fn cols(&self) -> &[usize] {
-        &ROWS
+        if self.opts.half {
+            &HALF_COLS
+        } else {
+            &ROWS
+        }
     }
     fn step_scale(&self, d: &[f64; 6]) -> f64 {
         let na = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
@@ -280,29 +323,69 @@ pub fn correct_attitudes_3d(mu: f64, body: RigidBody, orbit0: &[f64; 6], t_final
             return Err(invalid("guess", format!("start {i}: q must be a unit quaternion (scalar last), |q| = {n}")));
         }
     }
+    if opts.half {
+        if orbit0[1] != 0.0 || orbit0[3] != 0.0 || orbit0[5] != 0.0 {
+            return Err(invalid("closure", format!("the half-period form needs an orbit started on the x-z plane perpendicularly (y = xdot = zdot = 0), got {orbit0:?}")));
+        }
+        for (i, s) in starts.iter().enumerate() {
+            let a = crate::attitude::dcm(&s.q);
+            if a[1][0].abs() > 1e-12 || a[1][2].abs() > 1e-12 || s.w[1].abs() > 1e-12 {
+                return Err(invalid("guess", format!("start {i}: the half-period form needs a mirror-symmetric guess, body y on synodic +-Y and w_y = 0 (got A[1] = {:?}, w_y = {})", a[1], s.w[1])));
+            }
+        }
+    }
     let starts: Vec<Start3d> = starts.iter().map(|s| Start3d { q: s.q.map(|v| v / s.q.iter().map(|u| u * u).sum::<f64>().sqrt()), w: s.w }).collect();
     let form = Form3d { starts: &starts, opts: *opts };
     let gg = GravityGradient { primaries: opts.primaries };
     let integ = Options::with_tolerances(opts.rtol, opts.atol);
-    let one = |y: &Traj| -> Out {
+    let run = |y: &Traj, tf: f64| -> Out {
         let mut s = *y;
         s[..6].copy_from_slice(orbit0);
         let torques: [&dyn Torque; 1] = [&gg];
-        let r = propagate_attitude(mu, body, &torques, OrbitMode::Integrate, &s, 0.0, t_final, &integ, true, Output::Final, None, None).ok()?;
+        let r = propagate_attitude(mu, body, &torques, OrbitMode::Integrate, &s, 0.0, tf, &integ, true, Output::Final, None, None).ok()?;
         let yt = r.states[r.states.len() - 13..].to_vec();
         Some((yt, r.stm_final?))
     };
+    let t_solve = if opts.half { 0.5 * t_final } else { t_final };
+    let one = |y: &Traj| run(y, t_solve);
     let settings = Settings { tol: opts.tol, max_iter: opts.max_iter, max_halvings: opts.max_halvings };
     let cands: Vec<usize> = (0..starts.len()).collect();
-    let tracks = with_threads(opts.threads, || newton::solve(&form, &cands, &settings, &|b: &[Traj]| Ok(b.par_iter().map(one).collect())))??;
+    let (tracks, full) = with_threads(opts.threads, || -> Result<_> {
+        let tracks = newton::solve(&form, &cands, &settings, &|b: &[Traj]| Ok(b.par_iter().map(one).collect()))?;
+        // the half form's full-period monodromy: one more batch over K T at the final points
+        let full: Vec<Option<[[f64; 6]; 6]>> = if opts.half {
+            (0..tracks.len())
+                .into_par_iter()
+                .map(|c| {
+                    tracks[c].cur.as_ref()?;
+                    let x = tracks[c].x();
+                    let mut y = [0.0; 13];
+                    let (q0, _) = form.q0(c, &x);
+                    y[6..10].copy_from_slice(&q0);
+                    y[10..13].copy_from_slice(&x[3..6]);
+                    let (yt, stm) = run(&y, t_final)?;
+                    let m13: [[f64; 13]; 13] = std::array::from_fn(|i| std::array::from_fn(|j| stm[i * 13 + j]));
+                    Some(reduce(&m13, &q0, &[yt[6], yt[7], yt[8], yt[9]]))
+                })
+                .collect()
+        } else {
+            vec![None; tracks.len()]
+        };
+        Ok((tracks, full))
+    })??;
     Ok(tracks
         .iter()
+        .zip(full)
         .enumerate()
-        .map(|(c, t)| {
+        .map(|(c, (t, full))| {
             let x = t.x();
             let (q0, _) = form.q0(c, &x);
             let p = t.cur.as_ref();
-            let mono = p.map_or([[f64::NAN; 6]; 6], |p| std::array::from_fn(|i| std::array::from_fn(|j| p.keep[6 * i + j])));
+            let mono = match (full, p) {
+                (Some(m), _) => m,
+                (None, Some(p)) if !p.keep.is_empty() => std::array::from_fn(|i| std::array::from_fn(|j| p.keep[6 * i + j])),
+                _ => [[f64::NAN; 6]; 6],
+            };
             Correction3d {
                 q0,
                 w0: [x[3], x[4], x[5]],
