@@ -216,3 +216,28 @@ def test_half_period_symmetric_form(em, dro, planar_n_minus_1):
     assert half.residual < 1e-9 and full.residual < 1e-9
     with pytest.raises(ValueError, match="symmetric"):
         librate.periodic_attitude_3d(h, b2, guess=(Rotation.from_rotvec([0.1, 0, 0]).as_quat(), [0, 0, 1.0]), symmetric=True)
+
+
+def test_family_multipliers_figure(em):
+    """A short 3-D family along the L2 southern halos (14 to 12.5 days) and its Floquet figure:
+    the six moduli and the complex-plane panel, with the Krein collision near 13.1 days shaded."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import librate.plotting as lp
+    import matplotlib.pyplot as plt
+    from librate.periodicity import attitude_family_3d
+
+    hf = librate.halo_family(em, 2, "south")
+    body = librate.RigidBody(0.8, 0.9, 1.0)
+    h = hf.member(period_days=14.0)
+    s = librate.periodic_attitude_3d(h, body, guess=([0, 0, 0, 1.0], [0, 0, 1 - 2 * math.pi / h.period]))
+    ds = attitude_family_3d(hf, body, guess=(s.q0, s.w0), period_days=np.linspace(14.0, 12.5, 7))
+    assert ds.sizes["member"] == 7 and float(ds.residual.max()) < 1e-9
+    assert "krein" in ds.attrs["stability_changes"]
+    fig = lp.plot_family_multipliers(ds)
+    gids = {c.get_gid() for a in fig.axes for c in a.get_children()}
+    assert {"modulus", "multipliers", "stability-change"} <= gids
+    plt.close(fig)
+    with pytest.raises(ValueError, match="ds"):
+        lp.plot_family_multipliers(object())

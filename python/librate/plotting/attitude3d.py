@@ -10,7 +10,7 @@ import numpy as np
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
-__all__ = ["plot_equilibrium_stability", "plot_out_of_plane_stability"]
+__all__ = ["plot_equilibrium_stability", "plot_out_of_plane_stability", "plot_family_multipliers"]
 
 
 def plot_equilibrium_stability(ds, ax=None, *, boundaries: bool = True) -> Figure:
@@ -107,4 +107,47 @@ def plot_out_of_plane_stability(datasets, ax=None, *, against: str = "period") -
     from matplotlib.lines import Line2D
 
     top[0].legend(handles=[Line2D([], [], label=label, **style) for label, style in _CLASSES.values()], fontsize="small", loc="best")
+    return fig
+
+
+def plot_family_multipliers(ds, ax=None, *, against: str = "period") -> Figure:
+    """Floquet multipliers along a 3-D attitude family (:func:`librate.attitude_family_3d`).
+    The left panel shows |multiplier| of the six against the orbit period in days (or x0, z0)
+    on a log scale (gid ``"modulus"``), with the unit circle as a line. The right panel shows the
+    multipliers in the complex plane, coloured along the family (gid ``"multipliers"``). The
+    stability changes listed in the Dataset are shaded (gid ``"stability-change"``). Returns the
+    Figure."""
+    import ast
+
+    from matplotlib.patches import Circle
+
+    from . import _axes
+
+    if "multipliers" not in getattr(ds, "data_vars", {}) or "period_days" not in getattr(ds, "data_vars", {}):
+        raise ValueError("invalid argument `ds`: must be the Dataset of librate.attitude_family_3d")
+    if against not in ("period", "x0", "z0"):
+        raise ValueError(f"invalid argument `against`: must be 'period', 'x0' or 'z0', got {against!r}")
+    fig, (a, b) = _axes(ax, 2)
+    x = ds["period_days" if against == "period" else against].values
+    m = ds["multipliers"].values
+    for k in range(m.shape[1]):
+        (ln,) = a.semilogy(x, np.abs(m[:, k]), ".-", markersize=3, linewidth=0.8)
+        ln.set_gid("modulus")
+    a.axhline(1.0, color="k", linewidth=0.6)
+    for ch in ast.literal_eval(ds.attrs.get("stability_changes", "[]")):
+        lo, hi = ch["between_period_days"]
+        if against == "period":
+            a.axvspan(min(lo, hi), max(lo, hi), color="tab:orange", alpha=0.3, gid="stability-change")
+    a.set_xlabel({"period": "orbit period (days)", "x0": "$x_0$ (LU)", "z0": "$z_0$ (LU)"}[against])
+    a.set_ylabel("|Floquet multiplier|")
+    moments = ds.attrs.get("body_moments")
+    a.set_title(f"body {moments}" if moments is not None else "")
+    colors = np.broadcast_to(np.arange(m.shape[0])[:, None], m.shape)
+    sc = b.scatter(m.real.ravel(), m.imag.ravel(), c=colors.ravel(), cmap="viridis", s=8)
+    sc.set_gid("multipliers")
+    b.add_patch(Circle((0, 0), 1.0, fill=False, color="k", linewidth=0.6))
+    b.set_aspect("equal", adjustable="datalim")
+    b.set_xlabel("Re")
+    b.set_ylabel("Im")
+    fig.colorbar(sc, ax=b, label="member (along the family)")
     return fig
