@@ -241,3 +241,25 @@ def test_family_multipliers_figure(em):
     plt.close(fig)
     with pytest.raises(ValueError, match="ds"):
         lp.plot_family_multipliers(object())
+
+
+def test_continuation_in_the_inertia_from_the_sphere(em):
+    """Continued in the inertia from the torque-free sphere (where the spin 1 - 2 pi / T about
+    Z is periodic at any attitude) to the body 0.8 : 0.9 : 1 along the 13-day L2 southern halo:
+    the run completes, every member re-propagates to 1e-9 with reciprocal multipliers (1e-8),
+    the sphere's six unit multipliers split at once (a +1 crossing right after s = 0), and the last
+    member is a solution of the target body (re-corrected from itself: same q0, w0 to 1e-9)."""
+    from librate.periodicity import attitude_family_3d_inertia
+
+    h = librate.halo(em, 2, "south", period_days=13.0)
+    target = librate.RigidBody(0.8, 0.9, 1.0)
+    ds = attitude_family_3d_inertia(h, (librate.RigidBody(1.0, 1.0, 1.0), target), guess=([0, 0, 0, 1.0], [0, 0, 1 - 2 * math.pi / h.period]),
+                                    steps=6)
+    assert ds.attrs["end_reason"].startswith("completed") and ds.sizes["member"] == 7
+    np.testing.assert_allclose(ds.moments.values[-1], target.moments)
+    assert float(ds.residual.max()) < 1e-9
+    for m in ds.multipliers.values:
+        assert reciprocal_gap(m) < 1e-8
+    assert "'between': (0.0," in ds.attrs["stability_changes"]
+    again = librate.periodic_attitude_3d(h, target, guess=(ds.q0.values[-1], ds.w0.values[-1]))
+    assert np.max(np.abs(again.q0 - ds.q0.values[-1])) < 1e-9 and np.max(np.abs(again.w0 - ds.w0.values[-1])) < 1e-9

@@ -2,7 +2,14 @@
 solar radiation pressure continuation and maps, and the effect of flexibility on periodic
 motion."""
 
-from .attitude3d import AttitudeSolution3D, attitude_family_3d, out_of_plane_family, out_of_plane_stability, periodic_attitude_3d
+from .attitude3d import (
+    AttitudeSolution3D,
+    attitude_family_3d,
+    attitude_family_3d_inertia,
+    out_of_plane_family,
+    out_of_plane_stability,
+    periodic_attitude_3d,
+)
 from .branches import SrpContinuation, continue_srp, periodic_attitude
 from .families import AttitudeFamily, attitude_family
 from .flexible import FlexiblePeriodic, FrequencyScan, flexible_periodic, frequency_scan
@@ -25,6 +32,7 @@ __all__ = [
     "out_of_plane_stability",
     "out_of_plane_family",
     "attitude_family_3d",
+    "attitude_family_3d_inertia",
     "periodic_attitude",
     "find_periodic_attitudes",
     "orbit_forcing",

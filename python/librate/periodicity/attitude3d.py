@@ -38,7 +38,7 @@ from ..orbits.periodic import PeriodicOrbit
 from .solutions import AttitudeSolution
 
 __all__ = ["AttitudeSolution3D", "periodic_attitude_3d", "is_mirror_symmetric", "out_of_plane_stability", "out_of_plane_family", "attitude_family_3d",
-           "OrbitFamilyBranch3D", "STABILITY_TOL", "VERIFY_RTOL",
+           "attitude_family_3d_inertia", "OrbitFamilyBranch3D", "InertiaBranch3D", "STABILITY_TOL", "VERIFY_RTOL",
            "SOLVE_RTOL"]
 
 #: A multiplier lies on the unit circle when ||m| - 1| <= STABILITY_TOL. The monodromy is
@@ -355,7 +355,7 @@ def attitude_family_3d(orbits, body: RigidBody, *, guess, period_days, n_periods
     1e4 times the Earth's at the Moon's distance; their attitude closure is reached to ~1e-11, so
     pass tol=1e-10 there). Every member is re-propagated independently to 1e-9.
 
-    Returns an xarray Dataset along ``member``:
+    Returns an xarray Dataset along ``member`` (attribute ``parameter`` = "period_days"):
 
     - ``period_days``, ``x0``, ``z0``;
     - ``q0`` and ``w0``;
@@ -364,14 +364,14 @@ def attitude_family_3d(orbits, body: RigidBody, *, guess, period_days, n_periods
 
     Attributes:
 
-    - ``stability_changes``: the consecutive members between which the number of multipliers on
-      the unit circle changes, with the kind of the crossing. A real pair leaving through +1 or
+    - ``stability_changes``: the consecutive members (``between``: their two parameter values)
+      between which the number of multipliers on the unit circle changes, with the kind of the
+      crossing. A real pair leaving through +1 or
       -1 is "+1" or "-1"; two pairs colliding on the circle and leaving it is "krein". These are
       detected between members, not located.
     - ``end_reason``: why the continuation stopped; a fold in the period shows as the step
       collapsing there.
     """
-    import xarray as xr
 
     from ..orbits.families import OrbitFamily
     from ..solving.continuation import Point, StepRules, natural
@@ -391,6 +391,20 @@ def attitude_family_3d(orbits, body: RigidBody, *, guess, period_days, n_periods
     first = Point(np.concatenate([[first_orbit.period_days], Rotation.from_quat(s0.q0).as_rotvec(), s0.w0]), s0, s0.iterations)
     br = natural(problem, first, targets[1:], rules=StepRules(ds=abs(targets[1] - targets[0]), ds_min=ds_min), name="period_days")
     sols = [s0] + [p.data for p in br.points]
+    dim = ("member",)
+    extra = {"period_days": (dim, np.array([s.orbit.period_days for s in sols])), "x0": (dim, np.array([s.orbit.state0[0] for s in sols])),
+             "z0": (dim, np.array([s.orbit.state0[2] for s in sols]))}
+    return _family_dataset(sols, "period_days", extra, br.end_reason, {"body_moments": list(body.moments), "n_periods": n_periods,
+                                                                      "system": orbits.system.name})
+
+
+def _family_dataset(sols, parameter: str, extra: dict, end_reason: str, attrs: dict):
+    """The Dataset of a 3-D family: ``extra`` variables (the parameter among them), the
+    solutions' q0, w0, multipliers, stable, residual, turns, and the stability changes between
+    consecutive members (attribute, keyed ``between`` = the two parameter values)."""
+    import xarray as xr
+
+    p = np.asarray(extra[parameter][1], dtype=float)
     mult = np.array([_sorted_multipliers(s.multipliers) for s in sols])
     on = np.abs(np.abs(mult) - 1) <= STABILITY_TOL
     changes = []
@@ -399,18 +413,89 @@ def attitude_family_3d(orbits, body: RigidBody, *, guess, period_days, n_periods
         if a != b:
             left = mult[i + 1][~on[i + 1]] if a > b else mult[i][~on[i]]
             kind = "krein" if np.any(np.abs(left.imag) > 1e-6) else ("+1" if np.all(left.real > 0) else "-1")
-            changes.append({"between_period_days": (float(sols[i].orbit.period_days), float(sols[i + 1].orbit.period_days)), "kind": kind,
-                            "on_unit_circle": (a, b)})
+            changes.append({"between": (float(p[i]), float(p[i + 1])), "kind": kind, "on_unit_circle": (a, b)})
     dim = ("member",)
     return xr.Dataset(
-        {"period_days": (dim, np.array([s.orbit.period_days for s in sols])), "x0": (dim, np.array([s.orbit.state0[0] for s in sols])),
-         "z0": (dim, np.array([s.orbit.state0[2] for s in sols])),
+        {**extra,
          "q0": (("member", "quaternion"), np.array([s.q0 for s in sols])), "w0": (("member", "axis"), np.array([s.w0 for s in sols])),
          "multipliers": (("member", "k"), mult), "stable": (dim, np.array([s.stable for s in sols])),
          "residual": (dim, np.array([s.residual for s in sols])),
          "turns": (dim, np.array([np.nan if s.turns is None else s.turns for s in sols]))},
-        attrs={"body_moments": list(body.moments), "n_periods": n_periods, "end_reason": br.end_reason, "stability_changes": repr(changes),
-               "system": orbits.system.name})
+        attrs={**attrs, "parameter": parameter, "end_reason": end_reason, "stability_changes": repr(changes)})
+
+
+class InertiaBranch3D:
+    """A periodic 3-D attitude motion along one orbit, continued in the inertia along the
+    straight path between two bodies, I(s) = (1 - s) I_a + s I_b, s in [0, 1], for the
+    continuation driver. The vector is x = (s, the rotation vector of q0, w0); the tangent is
+    the driver's secant."""
+
+    parameter_index = 0
+    scale = np.ones(7)
+
+    def __init__(self, orbit, bodies, n_periods: int = 1, tol: float = 1e-12):
+        self.orbit, self.n_periods, self.tol = orbit, n_periods, tol
+        self.ia, self.ib = (np.asarray(b.moments, dtype=float) for b in bodies)
+
+    def body(self, s: float) -> RigidBody:
+        return RigidBody(*((1 - s) * self.ia + s * self.ib))
+
+    def correct(self, guess, c):
+        from scipy.spatial.transform import Rotation
+
+        from ..solving.continuation import CorrectionFailed, Point
+
+        if not (c.a[0] == 1 and not np.any(c.a[1:])) or not (0 <= c.b <= 1):
+            raise CorrectionFailed("the inertia path is continued in s in [0, 1] only (natural parameter)")
+        q = Rotation.from_rotvec(np.asarray(guess[1:4], dtype=float)).as_quat()
+        sol = periodic_attitude_3d(self.orbit, self.body(float(c.b)), guess=(q, np.asarray(guess[4:7], dtype=float)), n_periods=self.n_periods,
+                                   tol=self.tol)
+        if not sol.residual <= 1e-9:
+            raise CorrectionFailed(f"re-propagation residual {sol.residual:.2e} above 1e-9")
+        return Point(np.concatenate([[float(c.b)], Rotation.from_quat(sol.q0).as_rotvec(), sol.w0]), sol, sol.iterations)
+
+    def tangent(self, point):
+        return None
+
+
+def attitude_family_3d_inertia(orbit: PeriodicOrbit, bodies, *, guess, steps: int = 20, n_periods: int = 1, tol: float = 1e-12,
+                               ds_min: float = 1e-5):
+    """A periodic 3-D attitude motion along ``orbit`` continued in the inertia, from
+    ``bodies[0]`` to ``bodies[1]`` along I(s) = (1 - s) I_a + s I_b (``steps`` equal steps in
+    s), by natural-parameter continuation (:func:`librate.solving.continuation.natural`) from
+    ``guess`` ((q0, w0) or a planar solution) for the first body.
+
+    A common start is the torque-free sphere: with equal moments, the spin
+    (1 + 2 pi N / T) e_Z is periodic at any attitude. The Dataset is that of
+    :func:`attitude_family_3d`, along ``s``, with the ``moments`` (member, axis) of each body.
+    """
+    from ..solving.continuation import Point, StepRules, natural
+
+    if not isinstance(orbit, PeriodicOrbit):
+        raise ValueError(f"invalid argument `orbit`: must be a librate.PeriodicOrbit, got {type(orbit).__name__}")
+    try:
+        b0, b1 = bodies
+    except (TypeError, ValueError):
+        raise ValueError(f"invalid argument `bodies`: must be two librate.RigidBody, got {bodies!r}") from None
+    for b in (b0, b1):
+        if not isinstance(b, RigidBody) or b.is_rod:
+            raise ValueError(f"invalid argument `bodies`: must be two librate.RigidBody with every moment > 0, got {b!r}")
+    steps = as_count(steps, "steps", 1)
+    n_periods = as_count(n_periods, "n_periods", 1)
+    tol = as_number(tol, "tol", positive=True)
+    problem = InertiaBranch3D(orbit, (b0, b1), n_periods, tol)
+    from scipy.spatial.transform import Rotation
+
+    s0 = periodic_attitude_3d(orbit, b0, guess=guess, n_periods=n_periods, tol=tol)
+    first = Point(np.concatenate([[0.0], Rotation.from_quat(s0.q0).as_rotvec(), s0.w0]), s0, s0.iterations)
+    targets = np.linspace(0.0, 1.0, steps + 1)[1:]
+    br = natural(problem, first, targets, rules=StepRules(ds=1.0 / steps, ds_min=ds_min), name="s")
+    sols = [s0] + [p.data for p in br.points]
+    s_values = np.array([0.0] + [float(p.x[0]) for p in br.points])
+    dim = ("member",)
+    extra = {"s": (dim, s_values), "moments": (("member", "axis"), np.array([problem.body(v).moments for v in s_values]))}
+    return _family_dataset(sols, "s", extra, br.end_reason, {"orbit_period_days": float(orbit.period_days), "n_periods": n_periods,
+                                                            "system": orbit.system.name})
 
 
 def _sorted_multipliers(m) -> np.ndarray:

@@ -134,10 +134,10 @@ def plot_family_multipliers(ds, ax=None, *, against: str = "period") -> Figure:
         (ln,) = a.semilogy(x, np.abs(m[:, k]), ".-", markersize=3, linewidth=0.8)
         ln.set_gid("modulus")
     a.axhline(1.0, color="k", linewidth=0.6)
-    for ch in ast.literal_eval(ds.attrs.get("stability_changes", "[]")):
-        lo, hi = ch["between_period_days"]
-        if against == "period":
-            a.axvspan(min(lo, hi), max(lo, hi), color="tab:orange", alpha=0.3, gid="stability-change")
+    along_period = ds.attrs.get("parameter") == "period_days" and against == "period"
+    for ch in ast.literal_eval(ds.attrs.get("stability_changes", "[]")) if along_period else []:
+        lo, hi = ch["between"]
+        a.axvspan(min(lo, hi), max(lo, hi), color="tab:orange", alpha=0.3, gid="stability-change")
     a.set_xlabel({"period": "orbit period (days)", "x0": "$x_0$ (LU)", "z0": "$z_0$ (LU)"}[against])
     a.set_ylabel("|Floquet multiplier|")
     moments = ds.attrs.get("body_moments")
