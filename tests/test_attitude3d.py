@@ -263,3 +263,15 @@ def test_continuation_in_the_inertia_from_the_sphere(em):
     assert "'between': (0.0," in ds.attrs["stability_changes"]
     again = librate.periodic_attitude_3d(h, target, guess=(ds.q0.values[-1], ds.w0.values[-1]))
     assert np.max(np.abs(again.q0 - ds.q0.values[-1])) < 1e-9 and np.max(np.abs(again.w0 - ds.w0.values[-1])) < 1e-9
+
+
+def test_two_periods(dro, planar_n_minus_1):
+    """A one-period solution is a two-period one: corrected over K = 2 from its own (q0, w0) it
+    stays (wz0 to 1e-10) and its monodromy is the square of the one-period monodromy (1e-8),
+    with two turns backwards."""
+    body = librate.RigidBody.from_kz(0.8)
+    one = librate.periodic_attitude_3d(dro, body, guess=planar_n_minus_1)
+    two = librate.periodic_attitude_3d(dro, body, guess=(one.q0, one.w0), n_periods=2)
+    assert two.w0[2] == pytest.approx(one.w0[2], abs=1e-10)
+    assert np.max(np.abs(two.monodromy - one.monodromy @ one.monodromy)) < 1e-8 * np.max(np.abs(two.monodromy))
+    assert two.turns == pytest.approx(-2.0, abs=1e-9) and two.residual < 1e-9
