@@ -1,6 +1,15 @@
 """Periodic 3-D attitude motions along any periodic orbit (issue 15), and the out-of-plane
 stability of the planar ones.
 
+- :func:`periodic_attitude_3d`: one motion from a guess. The full-period form is the default;
+  ``symmetric=True`` uses the mirror-symmetric half-period form.
+- :func:`out_of_plane_stability` and :func:`out_of_plane_family`: the roll/yaw multipliers of a
+  planar solution, or across a planar family (thesis Figs. 27-29).
+- :func:`attitude_family_3d` and :func:`attitude_family_3d_inertia`: motions continued along an
+  orbit family (in the period) or in the inertia, on the shared continuation driver.
+
+The equations and checks are derived in docs/physics/periodic-attitude-3d.md.
+
 A 3-D motion (q0, w0) along an orbit of period T is periodic over K = ``n_periods`` revolutions
 when the attitude relative to the synodic frame repeats, R(KT) = R(0) (q and -q are one
 attitude), and the inertial rate repeats, w(KT) = w0. The Rust corrector
