@@ -275,3 +275,12 @@ def flexible_correct_periodic(
     mu: float, body_arg: Any, primaries: list[bool], orbit0: list[float], period: float, x0: list[float], turns: float,
     scale: list[float], *, options: Any, tol: float, max_iter: int, threads: int | None = None,
 ) -> tuple[_F64, float, int, str, _F64]: ...
+
+# --- 3-D attitude: equilibria and periodic motions (rust/py/src/attitude3d.rs) ---
+__all__ += ["attitude_equilibrium", "attitude_correct_3d"]
+
+def attitude_equilibrium(mu: float, inertia: list[float], point: int, q0: list[float]) -> dict[str, Any]: ...
+def attitude_correct_3d(
+    mu: float, inertia: list[float], orbit0: list[float], t_final: float, q: _F64, w: _F64, *, tol: float, max_iter: int,
+    rtol: float, atol: float, max_halvings: int = 10, primaries: list[bool] = ..., threads: int | None = None, half: bool = False,
+) -> dict[str, Any]: ...

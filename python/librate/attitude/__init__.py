@@ -2,6 +2,7 @@
 propagation of the attitude along a CR3BP orbit."""
 
 from .body import TORQUES, RigidBody, quaternion_from_euler
+from .equilibria import AttitudeEquilibrium, attitude_equilibrium, equilibrium_stability
 from .flexible import Appendage, FlexibleBody, FlexibleModes, FlexibleResponse, QuasiStaticResponse, quasi_static
 from .propagate import AttitudeTrajectory, propagate_attitude
 from .srp import Facet, FacetBody, FlatPlate, Sun
@@ -12,6 +13,9 @@ __all__ = [
     "TORQUES",
     "AttitudeTrajectory",
     "propagate_attitude",
+    "AttitudeEquilibrium",
+    "attitude_equilibrium",
+    "equilibrium_stability",
     "Sun",
     "Facet",
     "FacetBody",

@@ -2,6 +2,14 @@
 solar radiation pressure continuation and maps, and the effect of flexibility on periodic
 motion."""
 
+from .attitude3d import (
+    AttitudeSolution3D,
+    attitude_family_3d,
+    attitude_family_3d_inertia,
+    out_of_plane_family,
+    out_of_plane_stability,
+    periodic_attitude_3d,
+)
 from .branches import SrpContinuation, continue_srp, periodic_attitude
 from .families import AttitudeFamily, attitude_family
 from .flexible import FlexiblePeriodic, FrequencyScan, flexible_periodic, frequency_scan
@@ -19,6 +27,12 @@ from .srp import srp_map, sun_pointing_accelerations
 
 __all__ = [
     "AttitudeSolution",
+    "AttitudeSolution3D",
+    "periodic_attitude_3d",
+    "out_of_plane_stability",
+    "out_of_plane_family",
+    "attitude_family_3d",
+    "attitude_family_3d_inertia",
     "periodic_attitude",
     "find_periodic_attitudes",
     "orbit_forcing",

@@ -18,6 +18,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 mod attitude;
+mod attitude3d;
 mod flexible;
 mod fourier;
 mod map;
@@ -434,6 +435,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     attitude::register(m)?;
     map::register(m)?;
     flexible::register(m)?;
+    attitude3d::register(m)?;
     // Physical constants, read from the core (one definition: librate_core::constants).
     m.add("N_SUN", librate_core::constants::N_SUN)?;
     m.add("OMEGA_SUN", librate_core::constants::OMEGA_SUN)?;

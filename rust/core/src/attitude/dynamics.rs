@@ -59,7 +59,7 @@ pub fn dcm<R: Real>(q: &[R; 4]) -> [[R; 3]; 3] {
 impl Coupled<'_> {
     /// The right-hand side over any [`Real`] scalar.
     #[inline(always)]
-    fn rhs<R: Real>(&self, t: f64, y: &[R; DIM], dy: &mut [R; DIM], torque: impl Fn(&dyn Torque, &TorqueInput<R>) -> [R; 3]) {
+    pub(crate) fn rhs<R: Real>(&self, t: f64, y: &[R; DIM], dy: &mut [R; DIM], torque: impl Fn(&dyn Torque, &TorqueInput<R>) -> [R; 3]) {
         let mu = self.mu;
         let pos = [y[0], y[1], y[2]];
         let vel = [y[3], y[4], y[5]];

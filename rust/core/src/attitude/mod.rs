@@ -5,6 +5,7 @@
 pub mod body;
 pub mod dual;
 pub mod dynamics;
+pub mod linear;
 pub mod planar;
 pub mod propagate;
 pub mod srp;
@@ -12,6 +13,7 @@ pub mod torque;
 
 pub use body::RigidBody;
 pub use dynamics::{dcm, Coupled, CoupledStm, OrbitMode};
+pub use linear::{collinear_equilibrium, Equilibrium};
 pub use planar::{forcing_sc, forcing_scp, gravity_gradient_wzdot, planar_gravity_gradient, Forcing, PlanarAlongOrbit, PlanarForced};
 pub use propagate::{evaluate_torques, propagate_attitude, propagate_planar, AttitudeTrajectory, PlanarTrajectory};
 pub use srp::{flat_plate_wzdot, Facet, FacetBody, FlatPlate, Sun, N_SUN, OMEGA_SUN, P0, SOLAR_PRESSURE_1AU};

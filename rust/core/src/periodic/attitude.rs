@@ -1,4 +1,4 @@
-//! Periodic planar attitude motions along a periodic orbit (thesis sec. 3.3, docs/physics.md, periodic attitude motions
+//! Periodic planar attitude motions along a periodic orbit (thesis sec. 3.3, PHYSICS.md sec. 5
 //! and 6): a batched, globalised Newton corrector on the periodicity-map engine, and a batched
 //! independent verifier on the scalar model.
 //!
@@ -21,7 +21,8 @@
 //! [`map::sweep`] call with the STM (SIMD lanes, all cores). Newton is globalised per candidate:
 //! the steps in wz0 and in the angle unknown are capped, and a backtracking line search (Armijo-type sufficient decrease
 //! of the residual's 2-norm, step halved up to `max_halvings` times) evaluates the trial
-//! points of all candidates together in the next sweep. Each candidate reports why it stopped
+//! points of all candidates together in the next sweep (the driver, [`super::newton`], is shared
+//! with the 3-D corrector, [`super::attitude3d`]). Each candidate reports why it stopped
 //! ([`StopReason`]); nothing panics and a non-finite result is never labelled converged.
 //!
 //! Determinism: candidates keep their order; the sweep of each iteration is bit-identical for
@@ -30,12 +31,12 @@
 //! (~1e-14 relative, the integration tolerance's noise) can depend on its batch companions:
 //! correcting it alone, or in another batch, can differ at that level (never in the outcome).
 
-use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
 
 use std::collections::HashMap;
 use std::sync::{Arc, Mutex};
 
+use super::newton::{self, Eval, Problem, Settings, Track};
 use super::symmetric::{Constraint, SymmetricOrbit, SymmetricShooting, Var};
 use crate::attitude::{propagate_planar, FlatPlate, OMEGA_SUN};
 use crate::cr3bp::check_mu;
@@ -66,38 +67,7 @@ pub enum Free {
     SunPhase,
 }
 
-/// Why the corrector stopped on a candidate.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum StopReason {
-    /// Residual max-norm <= tol; or, where no Newton step descends any more, <= tol times the
-    /// largest |d F / d x| (at least 1): the integration's noise floor amplified by the
-    /// motion's instability (|trace| of the monodromy ~ 1e3 for some SRP-dominated motions),
-    /// the unknowns then being known to about tol.
-    Converged,
-    /// `max_iter` Newton steps taken without convergence.
-    MaxIterations,
-    /// The Jacobian is zero or non-finite, or rank-deficient with no decrease along its
-    /// minimum-norm step (e.g. a fold: trace of the monodromy = 2).
-    SingularJacobian,
-    /// The line search found no sufficient decrease after `max_halvings` halvings.
-    NoDescent,
-    /// The integration failed (lane status not Ok, or non-finite results) at the starting
-    /// point, or at every trial point of the last line search.
-    IntegrationFailed,
-}
-
-impl StopReason {
-    /// "converged", "max_iterations", "singular_jacobian", "no_descent", "integration_failed".
-    pub fn as_str(&self) -> &'static str {
-        match self {
-            Self::Converged => "converged",
-            Self::MaxIterations => "max_iterations",
-            Self::SingularJacobian => "singular_jacobian",
-            Self::NoDescent => "no_descent",
-            Self::IntegrationFailed => "integration_failed",
-        }
-    }
-}
+pub use super::newton::StopReason;
 
 /// One starting point: the trajectory's parameters (its `phi0`, `wz0`, `theta_sun0` are the
 /// initial guesses of the unknowns) and its target number of turns per `t_final` closure
@@ -258,41 +228,6 @@ impl Correction {
     }
 }
 
-/// Residual, Jacobian and STM at one point of the unknowns x = (angle, wz0, parameter): the
-/// angle (phi0, or theta_sun0 for [`Free::SunPhase`]) is unused by Half, the parameter by
-/// corrections that are not bordered.
-#[derive(Debug, Clone, Copy)]
-struct Point {
-    x: [f64; 3],
-    /// Residual rows (phi closure, wz closure, linear condition); NaN for unused rows.
-    f: [f64; 3],
-    norm: f64,
-    /// Line-search merit: the 2-norm of the used rows.
-    merit: f64,
-    /// d f / d x, row-major 3x3 (unused rows and columns NaN or 0).
-    jac: [f64; 9],
-    stm: [f64; 4],
-}
-
-#[derive(Debug, Clone, Copy)]
-enum Phase {
-    Start,
-    Trial { lambda: f64, halvings: u32, any_integrated: bool },
-    Done(StopReason),
-}
-
-struct Track {
-    cand: Candidate,
-    start: [f64; 3],
-    cur: Option<Point>,
-    /// Newton direction, already scaled to the step caps; `scale` is that factor (<= 1).
-    dir: [f64; 3],
-    scale: f64,
-    rank_deficient: bool,
-    phase: Phase,
-    iterations: usize,
-}
-
 #[derive(Clone, Copy)]
 struct Form {
     closure: Closure,
@@ -301,6 +236,9 @@ struct Form {
     bordered: Option<Bordered>,
     /// The freed parameter's range (Kz: [-1, 1]; the orbit's x0: the family's members).
     bounds: (f64, f64),
+    /// Step caps in wz0 and in the angle unknown (from the options).
+    max_wz_step: f64,
+    max_angle_step: f64,
 }
 
 const ANGLE: usize = 0;
@@ -401,8 +339,9 @@ impl Form {
         }
     }
 
-    /// The point from its trajectories; None when any failed or is non-finite.
-    fn point(&self, c: &Candidate, x: [f64; 3], o: &[Outcome]) -> Option<Point> {
+    /// The residual and Jacobian from the point's trajectories; None when any failed or is
+    /// non-finite.
+    fn eval(&self, c: &Candidate, x: [f64; 3], o: &[Outcome]) -> Option<Eval<3>> {
         let ok = |o: &Outcome| o.status == LaneStatus::Ok && o.phi_t.is_finite() && o.wz_t.is_finite() && o.stm.iter().all(|v| v.is_finite());
         if o.len() != self.cases_per_point() || !o.iter().all(ok) {
             return None;
@@ -410,184 +349,105 @@ impl Form {
         let m = o[0].stm;
         let r = self.closure_residual(c, x, &o[0]);
         let mut f = [r[0], r[1], f64::NAN];
-        let mut jac = [f64::NAN; 9];
+        let mut jac = [[f64::NAN; 3]; 3];
         match self.closure {
             Closure::Half => {
-                jac[ANGLE] = 0.0;
-                jac[WZ] = m[1];
+                jac[0][ANGLE] = 0.0;
+                jac[0][WZ] = m[1];
             }
             Closure::Full => {
                 if self.free == Free::Phi0 {
-                    jac[ANGLE] = m[0] - 1.0;
-                    jac[3 + ANGLE] = m[2];
+                    jac[0][ANGLE] = m[0] - 1.0;
+                    jac[1][ANGLE] = m[2];
                 } else {
                     let k = 0.5 / self.h;
-                    jac[ANGLE] = (o[1].phi_t - o[2].phi_t) * k;
-                    jac[3 + ANGLE] = (o[1].wz_t - o[2].wz_t) * k;
+                    jac[0][ANGLE] = (o[1].phi_t - o[2].phi_t) * k;
+                    jac[1][ANGLE] = (o[1].wz_t - o[2].wz_t) * k;
                 }
-                jac[WZ] = m[1];
-                jac[3 + WZ] = m[3] - 1.0;
+                jac[0][WZ] = m[1];
+                jac[1][WZ] = m[3] - 1.0;
             }
         }
         if let Some(b) = self.bordered {
             let j = self.cases_per_point() - 2;
             let (pp, pm) = self.parameter_pair(x[PARAM]);
             let (rp, rm) = (self.closure_residual(c, x, &o[j]), self.closure_residual(c, x, &o[j + 1]));
-            jac[PARAM] = (rp[0] - rm[0]) / (pp - pm);
-            jac[3 + PARAM] = (rp[1] - rm[1]) / (pp - pm);
+            jac[0][PARAM] = (rp[0] - rm[0]) / (pp - pm);
+            jac[1][PARAM] = (rp[1] - rm[1]) / (pp - pm);
             let (a, rhs) = c.condition.unwrap_or((b.a, b.b));
             f[2] = a[0] * x[0] + a[1] * x[1] + a[2] * x[2] - rhs;
-            jac[6..9].copy_from_slice(&a);
+            jac[2] = a;
         }
-        let rows = self.rows();
-        let norm = rows.iter().fold(0.0f64, |a, &i| a.max(f[i].abs()));
-        let merit = rows.iter().map(|&i| f[i] * f[i]).sum::<f64>().sqrt();
-        let used = rows.iter().all(|&i| self.cols().iter().all(|&j| jac[3 * i + j].is_finite()));
-        (norm.is_finite() && merit.is_finite() && used).then_some(Point { x, f, norm, merit, jac, stm: m })
-    }
-
-    /// The largest |d F / d x| of the closure rows in use (at least 1): the factor by which
-    /// errors in the unknowns, and the integration's own, show in the residual.
-    fn conditioning(&self, p: &Point) -> f64 {
-        let rows = self.rows().iter().filter(|&&r| r < PARAM);
-        rows.flat_map(|&r| self.cols().iter().map(move |&c| p.jac[3 * r + c].abs())).fold(1.0, f64::max)
-    }
-
-    /// Newton direction at p (minimum-norm step when J is rank-deficient) and whether J was;
-    /// None when J is zero or non-finite.
-    fn direction(&self, p: &Point) -> Option<([f64; 3], bool)> {
-        let (rows, cols) = (self.rows(), self.cols());
-        let n = rows.len();
-        let j = DMatrix::from_fn(n, n, |r, c| p.jac[3 * rows[r] + cols[c]]);
-        let rhs = DVector::from_fn(n, |r, _| -p.f[rows[r]]);
-        let svd = j.try_svd(true, true, f64::EPSILON, 200)?;
-        let s1 = svd.singular_values.max();
-        let s2 = svd.singular_values.min();
-        if !(s1 > 0.0 && s1.is_finite()) {
-            return None;
-        }
-        let deficient = s2 <= RANK_TOL * s1;
-        let d = svd.solve(&rhs, RANK_TOL * s1).ok()?;
-        let mut out = [0.0; 3];
-        for (k, &c) in cols.iter().enumerate() {
-            out[c] = d[k];
-        }
-        out.iter().all(|v| v.is_finite()).then_some((out, deficient))
+        Some(Eval { f, jac, keep: m.to_vec() })
     }
 }
 
-/// Singular values below this fraction of the largest are treated as zero (minimum-norm step).
-const RANK_TOL: f64 = 1e-11;
-/// Armijo constant of the sufficient-decrease test |F(x + l d)|_2 <= (1 - C l) |F(x)|_2.
-const ARMIJO: f64 = 1e-4;
-
-impl Track {
-    /// The point to integrate in the next sweep, if still active.
-    fn pending(&self) -> Option<[f64; 3]> {
-        match self.phase {
-            Phase::Start => Some(self.start),
-            Phase::Trial { lambda, .. } => {
-                let x = self.cur.as_ref()?.x;
-                Some(std::array::from_fn(|i| x[i] + lambda * self.dir[i]))
-            }
-            Phase::Done(_) => None,
+impl Problem<3> for Form {
+    type Cand = Candidate;
+    type Traj = (Case, f64);
+    type Out = Outcome;
+    fn initial(&self, c: &Candidate) -> [f64; 3] {
+        Form::initial(self, c)
+    }
+    fn push(&self, c: &Candidate, x: &[f64; 3], out: &mut Vec<(Case, f64)>) -> bool {
+        self.push_cases(c, *x, out)
+    }
+    fn per_point(&self) -> usize {
+        self.cases_per_point()
+    }
+    fn evaluate(&self, c: &Candidate, x: &[f64; 3], o: &[Outcome]) -> Option<Eval<3>> {
+        self.eval(c, *x, o)
+    }
+    fn rows(&self) -> &[usize] {
+        Form::rows(self)
+    }
+    fn closure_rows(&self) -> &[usize] {
+        let r = Form::rows(self);
+        if self.bordered.is_some() {
+            &r[..r.len() - 1]
+        } else {
+            r
         }
     }
-
-    fn advance(&mut self, form: &Form, x: [f64; 3], o: &[Outcome], opts: &CorrectorOptions) {
-        let p = form.point(&self.cand, x, o);
-        match self.phase {
-            Phase::Start => match p {
-                None => self.phase = Phase::Done(StopReason::IntegrationFailed),
-                Some(p) => {
-                    self.cur = Some(p);
-                    self.next_step(form, opts);
-                }
-            },
-            Phase::Trial { lambda, halvings, any_integrated } => {
-                let Some(cur) = self.cur else { return };
-                let integrated = any_integrated || p.is_some();
-                match p.filter(|p| p.merit <= (1.0 - ARMIJO * lambda * self.scale) * cur.merit) {
-                    Some(p) => {
-                        self.cur = Some(p);
-                        self.iterations += 1;
-                        self.next_step(form, opts);
-                    }
-                    None if halvings >= opts.max_halvings => {
-                        self.phase = Phase::Done(if integrated && cur.norm <= opts.tol * form.conditioning(&cur) {
-                            StopReason::Converged
-                        } else if !integrated {
-                            StopReason::IntegrationFailed
-                        } else if self.rank_deficient {
-                            StopReason::SingularJacobian
-                        } else {
-                            StopReason::NoDescent
-                        })
-                    }
-                    None => self.phase = Phase::Trial { lambda: 0.5 * lambda, halvings: halvings + 1, any_integrated: integrated },
-                }
-            }
-            Phase::Done(_) => {}
-        }
+    fn cols(&self) -> &[usize] {
+        Form::cols(self)
     }
-
-    /// After accepting a point: stop, or set up the line search along the Newton direction.
-    fn next_step(&mut self, form: &Form, opts: &CorrectorOptions) {
-        let Some(p) = self.cur else { return };
-        if p.norm <= opts.tol {
-            self.phase = Phase::Done(StopReason::Converged);
-            return;
+    fn step_scale(&self, d: &[f64; 3]) -> f64 {
+        let cap = |v: f64, m: f64| if v.abs() > m { m / v.abs() } else { 1.0 };
+        let mut scale = cap(d[WZ], self.max_wz_step).min(cap(d[ANGLE], self.max_angle_step));
+        if let Some(b) = self.bordered {
+            scale = scale.min(cap(d[PARAM], b.max_step));
         }
-        if self.iterations >= opts.max_iter {
-            self.phase = Phase::Done(StopReason::MaxIterations);
-            return;
-        }
-        match form.direction(&p) {
-            None => self.phase = Phase::Done(StopReason::SingularJacobian),
-            Some((d, deficient)) => {
-                let cap = |v: f64, m: f64| if v.abs() > m { m / v.abs() } else { 1.0 };
-                let mut scale = cap(d[WZ], opts.max_wz_step).min(cap(d[ANGLE], opts.max_angle_step));
-                if let Some(b) = form.bordered {
-                    scale = scale.min(cap(d[PARAM], b.max_step));
-                }
-                self.dir = d.map(|v| v * scale);
-                self.scale = scale;
-                self.rank_deficient = deficient;
-                self.phase = Phase::Trial { lambda: 1.0, halvings: 0, any_integrated: false };
-            }
-        }
+        scale
     }
+}
 
-    fn result(&self, form: &Form, monodromy: [f64; 4]) -> Correction {
-        let reason = match self.phase {
-            Phase::Done(r) => r,
-            _ => StopReason::MaxIterations,
-        };
-        let x = self.cur.map_or(self.start, |p| p.x);
-        let c = &self.cand.case;
-        let (phi0, theta_sun0) = match (form.closure, form.free) {
-            (Closure::Half, _) => (c.phi0, c.theta_sun0),
-            (Closure::Full, Free::Phi0) => (x[ANGLE], c.theta_sun0),
-            (Closure::Full, Free::SunPhase) => (c.phi0, x[ANGLE]),
-        };
-        let jac = self.cur.map_or([f64::NAN; 9], |p| p.jac);
-        let mut jacobian = [[jac[0], jac[1], jac[2]], [jac[3], jac[4], jac[5]]];
-        if form.closure == Closure::Half {
-            jacobian[0][ANGLE] = f64::NAN;
-            jacobian[1] = [f64::NAN; 3];
-        }
-        Correction {
-            phi0,
-            wz0: x[WZ],
-            theta_sun0,
-            residual: self.cur.map_or([f64::NAN; 2], |p| [p.f[0], p.f[1]]),
-            residual_norm: self.cur.map_or(f64::NAN, |p| p.norm),
-            iterations: self.iterations,
-            reason,
-            monodromy,
-            parameter: x[PARAM],
-            jacobian,
-        }
+/// The [`Correction`] of a candidate's track.
+fn result(form: &Form, cand: &Candidate, track: &Track<3>, monodromy: [f64; 4]) -> Correction {
+    let x = track.x();
+    let c = &cand.case;
+    let (phi0, theta_sun0) = match (form.closure, form.free) {
+        (Closure::Half, _) => (c.phi0, c.theta_sun0),
+        (Closure::Full, Free::Phi0) => (x[ANGLE], c.theta_sun0),
+        (Closure::Full, Free::SunPhase) => (c.phi0, x[ANGLE]),
+    };
+    let jac = track.cur.as_ref().map_or([[f64::NAN; 3]; 3], |p| p.jac);
+    let mut jacobian = [jac[0], jac[1]];
+    if form.closure == Closure::Half {
+        jacobian[0][ANGLE] = f64::NAN;
+        jacobian[1] = [f64::NAN; 3];
+    }
+    Correction {
+        phi0,
+        wz0: x[WZ],
+        theta_sun0,
+        residual: track.cur.as_ref().map_or([f64::NAN; 2], |p| [p.f[0], p.f[1]]),
+        residual_norm: track.cur.as_ref().map_or(f64::NAN, |p| p.norm),
+        iterations: track.iterations,
+        reason: track.reason(),
+        monodromy,
+        parameter: x[PARAM],
+        jacobian,
     }
 }
 
@@ -716,7 +576,7 @@ pub fn correct_planar_attitudes(
     opts: &CorrectorOptions,
 ) -> Result<Vec<Correction>> {
     validate(forcing, t_final, closure, free, candidates, opts)?;
-    let form = Form { closure, free, h: opts.phase_step, bordered: None, bounds: (f64::NEG_INFINITY, f64::INFINITY) };
+    let form = Form { closure, free, h: opts.phase_step, bordered: None, bounds: (f64::NEG_INFINITY, f64::INFINITY), max_wz_step: opts.max_wz_step, max_angle_step: opts.max_angle_step };
     run(form, candidates, opts, &on_table(forcing, t_final, opts))
 }
 
@@ -741,7 +601,7 @@ pub fn correct_bordered(
     }
     validate(forcing, t_final, closure, free, candidates, opts)?;
     let bounds = if bordered.parameter == Parameter::Kz { (-1.0, 1.0) } else { (f64::NEG_INFINITY, f64::INFINITY) };
-    let form = Form { closure, free, h: opts.phase_step, bordered: Some(*bordered), bounds };
+    let form = Form { closure, free, h: opts.phase_step, bordered: Some(*bordered), bounds, max_wz_step: opts.max_wz_step, max_angle_step: opts.max_angle_step };
     run(form, candidates, opts, &on_table(forcing, t_final, opts))
 }
 
@@ -795,50 +655,29 @@ fn on_table<'a>(forcing: &'a OrbitForcing, t_final: f64, opts: &CorrectorOptions
 
 const FAILED: Outcome = Outcome { phi_t: f64::NAN, wz_t: f64::NAN, stm: [f64::NAN; 4], accepted: 0, rejected: 0, status: LaneStatus::Failed };
 
-/// The one Newton driver of every form: all pending points of all candidates integrated in one
-/// call of `integrate` per iteration, a line search per candidate.
+/// The planar forms on the one Newton driver ([`super::newton::solve`]): all pending points of
+/// all candidates integrated in one call of `integrate` per iteration, a line search per
+/// candidate; then the full-period monodromy of half-closure corrections.
 fn run(form: Form, candidates: &[Candidate], opts: &CorrectorOptions, integrate: &Integrate<'_>) -> Result<Vec<Correction>> {
-    let per = form.cases_per_point();
-    let mut tracks: Vec<Track> = candidates
-        .iter()
-        .map(|c| Track { cand: *c, start: form.initial(c), cur: None, dir: [0.0; 3], scale: 1.0, rank_deficient: false, phase: Phase::Start, iterations: 0 })
-        .collect();
+    let settings = Settings { tol: opts.tol, max_iter: opts.max_iter, max_halvings: opts.max_halvings };
     with_threads(opts.threads, || -> Result<Vec<Correction>> {
-        let mut batch: Vec<(Case, f64)> = Vec::with_capacity(per * tracks.len());
-        let mut active: Vec<(usize, [f64; 3], Option<usize>)> = Vec::with_capacity(tracks.len());
-        loop {
-            batch.clear();
-            active.clear();
-            for (i, t) in tracks.iter().enumerate() {
-                if let Some(x) = t.pending() {
-                    let at = batch.len();
-                    let pushed = form.push_cases(&t.cand, x, &mut batch);
-                    active.push((i, x, pushed.then_some(at)));
-                }
-            }
-            if active.is_empty() {
-                break;
-            }
-            let out = integrate_batch(integrate, &batch, false)?;
-            for &(i, x, at) in &active {
-                let o = at.map_or(&out[0..0], |k| &out[k..k + per]);
-                tracks[i].advance(&form, x, o, opts);
-            }
-        }
-        let mut mono: Vec<[f64; 4]> = tracks.iter().map(|t| t.cur.map_or([f64::NAN; 4], |p| p.stm)).collect();
+        let tracks = newton::solve(&form, candidates, &settings, &|b: &[(Case, f64)]| integrate_batch(integrate, b, false))?;
+        let stm = |t: &Track<3>| t.cur.as_ref().map_or([f64::NAN; 4], |p| [p.keep[0], p.keep[1], p.keep[2], p.keep[3]]);
+        let mut mono: Vec<[f64; 4]> = tracks.iter().map(stm).collect();
         if form.closure == Closure::Half && !opts.monodromy {
             mono.fill([f64::NAN; 4]);
         } else if form.closure == Closure::Half {
             // The full-period monodromy: one more batch over K T at the final points.
-            let full: Vec<(usize, (Case, f64))> =
-                (0..tracks.len()).filter_map(|i| tracks[i].cur.and_then(|p| form.case_at(&tracks[i].cand, p.x).map(|k| (i, (k, p.x[PARAM]))))).collect();
+            let full: Vec<(usize, (Case, f64))> = (0..tracks.len())
+                .filter_map(|i| tracks[i].cur.as_ref().and_then(|p| form.case_at(&candidates[i], p.x).map(|k| (i, (k, p.x[PARAM])))))
+                .collect();
             let cases: Vec<(Case, f64)> = full.iter().map(|&(_, k)| k).collect();
             let out = integrate_batch(integrate, &cases, true)?;
             for (&(i, _), o) in full.iter().zip(&out) {
                 mono[i] = if o.status == LaneStatus::Ok { o.stm } else { [f64::NAN; 4] };
             }
         }
-        Ok(tracks.iter().zip(mono).map(|(t, m)| t.result(&form, m)).collect())
+        Ok(tracks.iter().zip(candidates).zip(mono).map(|((t, c), m)| result(&form, c, t, m)).collect())
     })?
 }
 
@@ -925,7 +764,7 @@ pub fn correct_across_family(family: &PlanarFamily, bordered: &Bordered, candida
     validate_bordered(bordered, Closure::Half, candidates)?;
     validate_options(opts)?;
     validate_candidates(Closure::Half, Free::Phi0, candidates)?;
-    let form = Form { closure: Closure::Half, free: Free::Phi0, h: opts.phase_step, bordered: Some(*bordered), bounds: family.range() };
+    let form = Form { closure: Closure::Half, free: Free::Phi0, h: opts.phase_step, bordered: Some(*bordered), bounds: family.range(), max_wz_step: opts.max_wz_step, max_angle_step: opts.max_angle_step };
     let lane = LaneOptions { rtol: opts.rtol, atol: opts.atol, max_steps: opts.max_steps, sun_omega: opts.sun_omega };
     let integrate = |cases: &[Case], values: &[f64], full: bool| -> Result<Vec<Outcome>> {
         // distinct orbits, in parallel; then each orbit's trajectories in one sweep

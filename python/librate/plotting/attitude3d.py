@@ -1,0 +1,153 @@
+"""Figures of the 3-D attitude: the stability diagram of the equilibrium attitudes at a collinear
+Lagrange point (thesis Fig. 19, after Robinson 1974). Re-exported by :mod:`librate.plotting`."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
+
+__all__ = ["plot_equilibrium_stability", "plot_out_of_plane_stability", "plot_family_multipliers"]
+
+
+def plot_equilibrium_stability(ds, ax=None, *, boundaries: bool = True) -> Figure:
+    """The stability diagram of :func:`librate.equilibrium_stability` over Robinson's inertia
+    ratios k_x = (Iy - Iz)/Ix (horizontal) and k_y = (Iz - Ix)/Iy (vertical): the stable regions
+    filled (gid "stable"), the rest shaded by why it is unstable (pitch, roll-yaw divergence or
+    flutter; gid "unstable"), and with ``boundaries`` the curves K1 K2 = 0, K3 = 0 and the
+    flutter boundary b^2 = 4c (gids "boundary-*"). Returns the Figure."""
+    from matplotlib.colors import ListedColormap
+    from matplotlib.patches import Patch
+
+    from . import _axes
+
+    if not all(v in getattr(ds, "data_vars", {}) for v in ("stable", "pitch_stable", "roll_yaw", "b", "c")):
+        raise ValueError("invalid argument `ds`: must be the Dataset of librate.equilibrium_stability")
+    fig, (a,) = _axes(ax, 1)
+    kx, ky = ds["k_x"].values, ds["k_y"].values
+    # 0 stable, 1 pitch unstable, 2 roll-yaw divergent, 3 roll-yaw flutter (pitch stable)
+    code = np.where(ds["stable"].values, 0, np.where(~ds["pitch_stable"].values, 1, np.where(ds["roll_yaw"].values == 1, 2, 3)))
+    colors = ["tab:red", "0.88", "0.72", "0.55"]
+    mesh = a.pcolormesh(kx, ky, code, cmap=ListedColormap(colors), vmin=-0.5, vmax=3.5, shading="nearest")
+    mesh.set_gid("stable")
+    if boundaries:
+        b, c = ds["b"].values, ds["c"].values
+        for field, gid, style in ((c, "boundary-k1k2", "-"), (b * b - 4 * c, "boundary-flutter", "--")):
+            cs = a.contour(kx, ky, field, levels=[0.0], colors="k", linewidths=0.8, linestyles=style)
+            for art in getattr(cs, "collections", [cs]):
+                art.set_gid(gid)
+        # K3 = 0 (pitch): Iy = Ix, the line k_y = -k_x
+        (line,) = a.plot(kx, -kx, color="k", linewidth=0.8, linestyle=":")
+        line.set_gid("boundary-pitch")
+    a.set_xlim(kx[0], kx[-1])
+    a.set_ylim(ky[0], ky[-1])
+    a.set_xlabel("$(I_y - I_z) / I_x$")
+    a.set_ylabel("$(I_z - I_x) / I_y$")
+    a.set_aspect("equal")
+    point = ds.attrs.get("point", "")
+    a.set_title(f"Equilibrium attitude at {point} (h = {ds.attrs.get('h', float('nan')):.2f})")
+    labels = ["stable", "pitch unstable", "roll-yaw divergent", "roll-yaw flutter"]
+    a.legend(handles=[Patch(color=col, label=lab) for col, lab in zip(colors, labels)], loc="lower left", fontsize="small", framealpha=0.9)
+    return fig
+
+
+#: Marker of each (in-plane stable, out-of-plane stable) class of plot_out_of_plane_stability.
+_CLASSES = {
+    (True, True): ("stable in 3-D", dict(marker="o", color="tab:green", linestyle="none")),
+    (True, False): ("stable in the plane, unstable out of it", dict(marker="^", color="tab:red", linestyle="none")),
+    (False, True): ("unstable in the plane only", dict(marker="o", color="0.45", markerfacecolor="none", linestyle="none")),
+    (False, False): ("unstable in and out of the plane", dict(marker="x", color="0.3", linestyle="none")),
+}
+
+
+def plot_out_of_plane_stability(datasets, ax=None, *, against: str = "period") -> Figure:
+    """The 3-D stability of planar attitude families across an orbit family, one column per
+    Dataset of :func:`librate.periodicity.out_of_plane_family` (e.g. N = 1, 0, -1 of thesis Figs.
+    27-29). The top row shows the initial rate phidot(0) = wz(0) - 1 against the orbit's period
+    (days) or x0 (``against``). Each member's marker shows whether it is stable in the plane and
+    out of it (gids ``"class-<in>-<out>"``, e.g. ``"class-1-0"``: stable in the plane, unstable
+    out of it). The bottom row shows the largest |roll/yaw multiplier| on a log scale (gid
+    ``"out-of-plane-modulus"``). Returns the Figure."""
+    from . import _axes
+
+    dss = [datasets] if hasattr(datasets, "data_vars") else list(datasets)
+    if not dss or not all("out_of_plane_modulus" in getattr(d, "data_vars", {}) for d in dss):
+        raise ValueError("invalid argument `datasets`: Datasets of librate.periodicity.out_of_plane_family")
+    if against not in ("period", "x0"):
+        raise ValueError(f"invalid argument `against`: must be 'period' or 'x0', got {against!r}")
+    ncol = len(dss)
+    if ax is None:
+        import matplotlib.pyplot as plt
+
+        fig = plt.figure(figsize=(4.8 * ncol, 7.0), layout="constrained")
+        axs = fig.subplots(2, ncol, sharex="col", squeeze=False)
+        top, bottom = list(axs[0]), list(axs[1])
+    else:
+        fig, flat = _axes(ax, 2 * ncol)
+        top, bottom = flat[:ncol], flat[ncol:]
+    for d, a, b in zip(dss, top, bottom):
+        x = d["period_days"].values if against == "period" else d["x0"].values
+        y = d["phidot0"].values
+        a.plot(x, y, color="0.8", linewidth=0.8, zorder=0)
+        for (sin, sout), (label, style) in _CLASSES.items():
+            m = (d["stable_in_plane"].values == sin) & (d["stable_out_of_plane"].values == sout)
+            if m.any():
+                (ln,) = a.plot(x[m], y[m], label=label, markersize=5, **style)
+                ln.set_gid(f"class-{int(sin)}-{int(sout)}")
+        a.set_title(f"N = {d.attrs.get('n')}, Kz = {d.attrs.get('kz'):g}")
+        a.set_ylabel(r"$\dot\phi(0) = w_z(0) - 1$ (1/TU)")
+        (ln,) = b.semilogy(x, d["out_of_plane_modulus"].values, ".-", color="tab:red", markersize=4)
+        ln.set_gid("out-of-plane-modulus")
+        b.axhline(1.0, color="k", linewidth=0.6)
+        b.set_ylabel("largest |roll/yaw multiplier|")
+        b.set_xlabel("orbit period (days)" if against == "period" else "$x_0$ (LU)")
+    from matplotlib.lines import Line2D
+
+    top[0].legend(handles=[Line2D([], [], label=label, **style) for label, style in _CLASSES.values()], fontsize="small", loc="best")
+    return fig
+
+
+def plot_family_multipliers(ds, ax=None, *, against: str = "period") -> Figure:
+    """Floquet multipliers along a 3-D attitude family (:func:`librate.attitude_family_3d`).
+    The left panel shows |multiplier| of the six against the orbit period in days (or x0, z0)
+    on a log scale (gid ``"modulus"``), with the unit circle as a line. The right panel shows the
+    multipliers in the complex plane, coloured along the family (gid ``"multipliers"``). The
+    stability changes listed in the Dataset are shaded (gid ``"stability-change"``). Returns the
+    Figure."""
+    import ast
+
+    from matplotlib.patches import Circle
+
+    from . import _axes
+
+    if "multipliers" not in getattr(ds, "data_vars", {}) or "period_days" not in getattr(ds, "data_vars", {}):
+        raise ValueError("invalid argument `ds`: must be the Dataset of librate.attitude_family_3d")
+    if against not in ("period", "x0", "z0"):
+        raise ValueError(f"invalid argument `against`: must be 'period', 'x0' or 'z0', got {against!r}")
+    fig, (a, b) = _axes(ax, 2)
+    x = ds["period_days" if against == "period" else against].values
+    m = ds["multipliers"].values
+    for k in range(m.shape[1]):
+        (ln,) = a.semilogy(x, np.abs(m[:, k]), ".-", markersize=3, linewidth=0.8)
+        ln.set_gid("modulus")
+    a.axhline(1.0, color="k", linewidth=0.6)
+    along_period = ds.attrs.get("parameter") == "period_days" and against == "period"
+    for ch in ast.literal_eval(ds.attrs.get("stability_changes", "[]")) if along_period else []:
+        lo, hi = ch["between"]
+        a.axvspan(min(lo, hi), max(lo, hi), color="tab:orange", alpha=0.3, gid="stability-change")
+    a.set_xlabel({"period": "orbit period (days)", "x0": "$x_0$ (LU)", "z0": "$z_0$ (LU)"}[against])
+    a.set_ylabel("|Floquet multiplier|")
+    moments = ds.attrs.get("body_moments")
+    a.set_title(f"body {moments}" if moments is not None else "")
+    colors = np.broadcast_to(np.arange(m.shape[0])[:, None], m.shape)
+    sc = b.scatter(m.real.ravel(), m.imag.ravel(), c=colors.ravel(), cmap="viridis", s=8)
+    sc.set_gid("multipliers")
+    b.add_patch(Circle((0, 0), 1.0, fill=False, color="k", linewidth=0.6))
+    b.set_aspect("equal", adjustable="datalim")
+    b.set_xlabel("Re")
+    b.set_ylabel("Im")
+    fig.colorbar(sc, ax=b, label="member (along the family)")
+    return fig

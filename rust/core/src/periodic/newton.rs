@@ -1,0 +1,288 @@
+//! The one batched, globalised Newton driver of the attitude correctors (planar: [`super::attitude`];
+//! 3-D: [`super::attitude3d`]). A problem form ([`Problem`]) says which trajectories a point of
+//! the unknowns needs and how its residual and Jacobian follow from their outcomes; the driver
+//! integrates the pending points of every candidate in ONE call per iteration and runs, per
+//! candidate, capped Newton steps (minimum-norm when the Jacobian is rank-deficient) with a
+//! backtracking line search (Armijo-type sufficient decrease of the residual's 2-norm, step
+//! halved up to `max_halvings` times). Each candidate reports why it stopped ([`StopReason`]);
+//! nothing panics and a non-finite result is never labelled converged.
+
+use nalgebra::{DMatrix, DVector};
+
+use crate::error::Result;
+
+/// Why the corrector stopped on a candidate.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum StopReason {
+    /// Residual max-norm <= tol; or, where no Newton step descends any more, <= tol times the
+    /// largest |d F / d x| of the closure rows (at least 1): the integration's noise floor
+    /// amplified by the motion's instability (|trace| of the monodromy ~ 1e3 for some
+    /// SRP-dominated motions), the unknowns then being known to about tol.
+    Converged,
+    /// `max_iter` Newton steps taken without convergence.
+    MaxIterations,
+    /// The Jacobian is zero or non-finite, or rank-deficient with no decrease along its
+    /// minimum-norm step (e.g. a fold: trace of the monodromy = 2).
+    SingularJacobian,
+    /// The line search found no sufficient decrease after `max_halvings` halvings.
+    NoDescent,
+    /// The integration failed (lane status not Ok, or non-finite results) at the starting
+    /// point, or at every trial point of the last line search.
+    IntegrationFailed,
+}
+
+impl StopReason {
+    /// "converged", "max_iterations", "singular_jacobian", "no_descent", "integration_failed".
+    pub fn as_str(&self) -> &'static str {
+        match self {
+            Self::Converged => "converged",
+            Self::MaxIterations => "max_iterations",
+            Self::SingularJacobian => "singular_jacobian",
+            Self::NoDescent => "no_descent",
+            Self::IntegrationFailed => "integration_failed",
+        }
+    }
+}
+
+/// The residual rows and Jacobian of one point, and what the form keeps of its trajectories
+/// (e.g. the monodromy).
+#[derive(Debug, Clone)]
+pub(crate) struct Eval<const N: usize> {
+    /// Residual rows; unused rows NaN.
+    pub f: [f64; N],
+    /// d f / d x; unused rows and columns NaN or 0.
+    pub jac: [[f64; N]; N],
+    pub keep: Vec<f64>,
+}
+
+/// An evaluated point of the unknowns.
+#[derive(Debug, Clone)]
+pub(crate) struct Point<const N: usize> {
+    pub x: [f64; N],
+    pub f: [f64; N],
+    pub norm: f64,
+    /// Line-search merit: the 2-norm of the used rows.
+    pub merit: f64,
+    pub jac: [[f64; N]; N],
+    pub keep: Vec<f64>,
+}
+
+/// One problem form of the driver over N unknowns.
+pub(crate) trait Problem<const N: usize>: Sync {
+    type Cand;
+    /// One trajectory to integrate.
+    type Traj;
+    /// Its outcome.
+    type Out;
+    fn initial(&self, c: &Self::Cand) -> [f64; N];
+    /// Push the trajectories of the point x (always [`Problem::per_point`] of them); false when x
+    /// cannot be integrated (outside the domain of a parameter).
+    fn push(&self, c: &Self::Cand, x: &[f64; N], out: &mut Vec<Self::Traj>) -> bool;
+    fn per_point(&self) -> usize;
+    /// Residual and Jacobian from the point's outcomes; None when any failed or is non-finite.
+    fn evaluate(&self, c: &Self::Cand, x: &[f64; N], o: &[Self::Out]) -> Option<Eval<N>>;
+    /// The residual rows and unknown columns in use (square).
+    fn rows(&self) -> &[usize];
+    fn cols(&self) -> &[usize];
+    /// The factor (<= 1) scaling the Newton step `d` to the step caps (direction kept).
+    fn step_scale(&self, d: &[f64; N]) -> f64;
+    /// The closure rows (the rows in use but a continuation's linear condition).
+    fn closure_rows(&self) -> &[usize] {
+        self.rows()
+    }
+}
+
+/// The largest |d F / d x| of the closure rows at a point (at least 1): the factor by which
+/// errors in the unknowns, and the integration's own, show in the residual.
+fn conditioning<const N: usize, P: Problem<N>>(p: &P, pt: &Point<N>) -> f64 {
+    p.closure_rows().iter().flat_map(|&r| p.cols().iter().map(move |&c| pt.jac[r][c].abs())).fold(1.0, f64::max)
+}
+
+/// Settings of the driver.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Settings {
+    pub tol: f64,
+    pub max_iter: usize,
+    pub max_halvings: u32,
+}
+
+#[derive(Debug, Clone, Copy)]
+enum Phase {
+    Start,
+    Trial { lambda: f64, halvings: u32, any_integrated: bool },
+    Done(StopReason),
+}
+
+/// One candidate's state, and its outcome when the driver returns.
+pub(crate) struct Track<const N: usize> {
+    pub start: [f64; N],
+    pub cur: Option<Point<N>>,
+    /// Newton direction, already scaled to the step caps; `scale` is that factor (<= 1).
+    dir: [f64; N],
+    scale: f64,
+    rank_deficient: bool,
+    phase: Phase,
+    pub iterations: usize,
+}
+
+/// Singular values below this fraction of the largest are treated as zero (minimum-norm step).
+const RANK_TOL: f64 = 1e-11;
+/// Armijo constant of the sufficient-decrease test |F(x + l d)|_2 <= (1 - C l) |F(x)|_2.
+const ARMIJO: f64 = 1e-4;
+
+fn point<const N: usize, P: Problem<N>>(p: &P, x: [f64; N], e: Eval<N>) -> Option<Point<N>> {
+    let rows = p.rows();
+    let norm = rows.iter().fold(0.0f64, |a, &i| a.max(e.f[i].abs()));
+    let merit = rows.iter().map(|&i| e.f[i] * e.f[i]).sum::<f64>().sqrt();
+    let used = rows.iter().all(|&i| p.cols().iter().all(|&j| e.jac[i][j].is_finite()));
+    (norm.is_finite() && merit.is_finite() && used).then_some(Point { x, f: e.f, norm, merit, jac: e.jac, keep: e.keep })
+}
+
+/// Newton direction at pt (minimum-norm step when J is rank-deficient) and whether J was;
+/// None when J is zero or non-finite.
+fn direction<const N: usize, P: Problem<N>>(p: &P, pt: &Point<N>) -> Option<([f64; N], bool)> {
+    let (rows, cols) = (p.rows(), p.cols());
+    let n = rows.len();
+    let j = DMatrix::from_fn(n, n, |r, c| pt.jac[rows[r]][cols[c]]);
+    let rhs = DVector::from_fn(n, |r, _| -pt.f[rows[r]]);
+    let svd = j.try_svd(true, true, f64::EPSILON, 200)?;
+    let s1 = svd.singular_values.max();
+    let s2 = svd.singular_values.min();
+    if !(s1 > 0.0 && s1.is_finite()) {
+        return None;
+    }
+    let deficient = s2 <= RANK_TOL * s1;
+    let d = svd.solve(&rhs, RANK_TOL * s1).ok()?;
+    let mut out = [0.0; N];
+    for (k, &c) in cols.iter().enumerate() {
+        out[c] = d[k];
+    }
+    out.iter().all(|v| v.is_finite()).then_some((out, deficient))
+}
+
+impl<const N: usize> Track<N> {
+    /// Why it stopped (MaxIterations if it had not).
+    pub fn reason(&self) -> StopReason {
+        match self.phase {
+            Phase::Done(r) => r,
+            _ => StopReason::MaxIterations,
+        }
+    }
+
+    /// The final unknowns (the last accepted point; the start when nothing was accepted).
+    pub fn x(&self) -> [f64; N] {
+        self.cur.as_ref().map_or(self.start, |p| p.x)
+    }
+
+    fn pending(&self) -> Option<[f64; N]> {
+        match self.phase {
+            Phase::Start => Some(self.start),
+            Phase::Trial { lambda, .. } => {
+                let x = self.cur.as_ref()?.x;
+                Some(std::array::from_fn(|i| x[i] + lambda * self.dir[i]))
+            }
+            Phase::Done(_) => None,
+        }
+    }
+
+    fn advance<P: Problem<N>>(&mut self, p: &P, pt: Option<Point<N>>, s: &Settings) {
+        match self.phase {
+            Phase::Start => match pt {
+                None => self.phase = Phase::Done(StopReason::IntegrationFailed),
+                Some(pt) => {
+                    self.cur = Some(pt);
+                    self.next_step(p, s);
+                }
+            },
+            Phase::Trial { lambda, halvings, any_integrated } => {
+                let Some(cur_merit) = self.cur.as_ref().map(|c| c.merit) else { return };
+                let floor = self.cur.as_ref().is_some_and(|c| c.norm <= s.tol * conditioning(p, c));
+                let integrated = any_integrated || pt.is_some();
+                match pt.filter(|pt| pt.merit <= (1.0 - ARMIJO * lambda * self.scale) * cur_merit) {
+                    Some(pt) => {
+                        self.cur = Some(pt);
+                        self.iterations += 1;
+                        self.next_step(p, s);
+                    }
+                    None if halvings >= s.max_halvings => {
+                        self.phase = Phase::Done(if integrated && floor {
+                            StopReason::Converged
+                        } else if !integrated {
+                            StopReason::IntegrationFailed
+                        } else if self.rank_deficient {
+                            StopReason::SingularJacobian
+                        } else {
+                            StopReason::NoDescent
+                        })
+                    }
+                    None => self.phase = Phase::Trial { lambda: 0.5 * lambda, halvings: halvings + 1, any_integrated: integrated },
+                }
+            }
+            Phase::Done(_) => {}
+        }
+    }
+
+    /// After accepting a point: stop, or set up the line search along the Newton direction.
+    fn next_step<P: Problem<N>>(&mut self, p: &P, s: &Settings) {
+        let Some(cur) = self.cur.as_ref() else { return };
+        if cur.norm <= s.tol {
+            self.phase = Phase::Done(StopReason::Converged);
+            return;
+        }
+        if self.iterations >= s.max_iter {
+            self.phase = Phase::Done(StopReason::MaxIterations);
+            return;
+        }
+        match direction(p, cur) {
+            None => self.phase = Phase::Done(StopReason::SingularJacobian),
+            Some((d, deficient)) => {
+                let scale = p.step_scale(&d).min(1.0);
+                self.dir = d.map(|v| v * scale);
+                self.scale = scale;
+                self.rank_deficient = deficient;
+                self.phase = Phase::Trial { lambda: 1.0, halvings: 0, any_integrated: false };
+            }
+        }
+    }
+}
+
+/// Run the driver on every candidate: all pending points integrated in one call of
+/// `integrate` per iteration (trajectories in order, outcomes in the same order), a line
+/// search per candidate. Returns the tracks in the candidates' order.
+pub(crate) fn solve<const N: usize, P: Problem<N>>(
+    problem: &P,
+    candidates: &[P::Cand],
+    settings: &Settings,
+    integrate: &dyn Fn(&[P::Traj]) -> Result<Vec<P::Out>>,
+) -> Result<Vec<Track<N>>> {
+    let per = problem.per_point();
+    let mut tracks: Vec<Track<N>> = candidates
+        .iter()
+        .map(|c| Track { start: problem.initial(c), cur: None, dir: [0.0; N], scale: 1.0, rank_deficient: false, phase: Phase::Start, iterations: 0 })
+        .collect();
+    let mut batch: Vec<P::Traj> = Vec::with_capacity(per * tracks.len());
+    let mut active: Vec<(usize, [f64; N], Option<usize>)> = Vec::with_capacity(tracks.len());
+    loop {
+        batch.clear();
+        active.clear();
+        for (i, t) in tracks.iter().enumerate() {
+            if let Some(x) = t.pending() {
+                let at = batch.len();
+                let pushed = problem.push(&candidates[i], &x, &mut batch);
+                if !pushed {
+                    batch.truncate(at);
+                }
+                active.push((i, x, pushed.then_some(at)));
+            }
+        }
+        if active.is_empty() {
+            break;
+        }
+        let out = if batch.is_empty() { Vec::new() } else { integrate(&batch)? };
+        for &(i, x, at) in &active {
+            let pt = at.and_then(|k| out.get(k..k + per)).and_then(|o| problem.evaluate(&candidates[i], &x, o)).and_then(|e| point(problem, x, e));
+            tracks[i].advance(problem, pt, settings);
+        }
+    }
+    Ok(tracks)
+}
