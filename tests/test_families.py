@@ -241,7 +241,11 @@ def test_family_progress(em):
     Lyapunov: the members found, total max_members until the end)."""
     for build in (lambda cb: librate.dro_family(em, x0=np.linspace(0.9, 0.5, 9), progress=cb),
                   lambda cb: librate.lyapunov_family(em, 1, max_members=30, progress=cb)):
-        calls = []
-        fam = build(lambda d, t: calls.append((d, t)))
+        calls: list = []
+
+        def record(d, t, calls=calls):
+            calls.append((d, t))
+
+        fam = build(record)
         assert calls and all(d <= t for d, t in calls) and all(a[0] <= b[0] for a, b in zip(calls, calls[1:]))
         assert calls[-1] == (len(fam), len(fam))
