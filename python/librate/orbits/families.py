@@ -57,8 +57,11 @@ class OrbitFamily:
         if not members:
             raise LibrateError(f"the {kind} family has no member ({end_reason})")
         state0 = np.array([m.state0 for m in members])
-        half = np.array([m._evaluation["crossing"] for m in members])
         period = np.array([m.period for m in members])
+        half = np.array([np.full(6, np.nan) if m._evaluation is None else m._evaluation.crossing for m in members])
+        missing = np.flatnonzero(np.isnan(half[:, 0]))
+        if missing.size:  # members not from the symmetric corrector: their half-period states
+            half[missing] = propagate_many(system, state0[missing], 0.5 * period[missing], rtol=SHOOT_RTOL, atol=SHOOT_ATOL, collision="point").y
         batch = propagate_many(system, state0, period, stm=True, rtol=SHOOT_RTOL, atol=SHOOT_ATOL, on_error="mask", collision="point")
         eig = np.full((len(members), 6), np.nan + 0j)
         nu = np.full((len(members), 2), np.nan + 0j)

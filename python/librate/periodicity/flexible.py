@@ -135,8 +135,8 @@ def flexible_periodic(
 
     x = np.concatenate([[phi0, wz0], qs.q[0], qs.qdot[0]])
     r = flow(x, te)
-    out.update(full_drift=np.array([r["phi"][-1] - phi0 - 2 * math.pi * turns, r["wz"][-1] - wz0]),
-               full_max_dphi=float(np.max(np.abs(r["phi"] - qs.phi))), full_max_dwz=float(np.max(np.abs(r["wz"] - qs.wz))))
+    out.update(full_drift=np.array([r.phi[-1] - phi0 - 2 * math.pi * turns, r.wz[-1] - wz0]),
+               full_max_dphi=float(np.max(np.abs(r.phi - qs.phi))), full_max_dwz=float(np.max(np.abs(r.wz - qs.wz))))
     if not resolve:
         return FlexiblePeriodic(**out)
 
