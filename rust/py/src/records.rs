@@ -104,7 +104,7 @@ pub struct PyBatchResult {
     pub ok: Py<PyAny>,
     /// Per member: 0 completed, 1 / 2 collision with primary 1 / 2, 3 another error; uint8 (n,).
     pub status: Py<PyAny>,
-    /// The error of each failed member, by index.
+    /// The error of each failed member (IntegrationError, CollisionError, ...), by index.
     pub errors: Py<pyo3::types::PyDict>,
     /// Accepted, rejected steps and RHS evaluations per member, uint64 (n, 3).
     pub stats: Py<PyAny>,
