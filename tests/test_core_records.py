@@ -101,5 +101,8 @@ def test_attitude_and_flexible_records(em, dro_085):
     q = _core.flexible_quasi_static(em.mu, body, [True, True], False, list(dro_085.state0), 0.1, -1.0, 0.0, 0.5,
                                     options=OPTS, t_eval=np.linspace(0.0, 0.5, 4))
     assert isinstance(q, _core.QuasiStaticTrajectory) and q.qddot.shape == (4, 2) and q.dtau.shape == (4,)
-    for r in (p, a, c, f, e, q):
+    pt = _core.flexible_quasi_static_point(em.mu, body, [True, True], False, list(dro_085.state0), 0.1, -1.0)
+    assert isinstance(pt, _core.QuasiStaticPoint)
+    np.testing.assert_array_equal(pt.q, q.q[0])  # the closed form at the start of the solution
+    for r in (p, a, c, f, e, q, pt):
         _frozen(r, "t")

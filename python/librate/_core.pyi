@@ -20,6 +20,7 @@ __all__ = [
     "EventHit",
     "FlexibleBodyConstants",
     "FlexibleEnergies",
+    "FlexiblePeriodicCorrection",
     "FlexibleTrajectory",
     "IntegrationError",
     "LibrateError",
@@ -30,6 +31,7 @@ __all__ = [
     "PlanarFamily",
     "PlanarTrajectory",
     "PlanarVerification",
+    "QuasiStaticPoint",
     "QuasiStaticTrajectory",
     "SOLAR_PRESSURE_1AU",
     "SUN_SYNODIC_PERIOD",
@@ -487,9 +489,22 @@ def flexible_quasi_static(
     mu: float, body_arg: _FlexBody, primaries: list[bool], held: bool, orbit0: list[float], phi0: float, wz0: float,
     t0: float, tf: float, *, options: _Options, t_eval: _F64 | None
 ) -> QuasiStaticTrajectory: ...
+@final
+class QuasiStaticPoint:
+    @property
+    def q(self) -> list[float]: ...
+    @property
+    def qdot(self) -> list[float]: ...
+    @property
+    def qddot(self) -> list[float]: ...
+    @property
+    def wzdot(self) -> float: ...
+    @property
+    def dtau(self) -> float: ...
+
 def flexible_quasi_static_point(
     mu: float, body_arg: _FlexBody, primaries: list[bool], held: bool, orbit: list[float], phi: float, wz: float
-) -> tuple[list[float], list[float], list[float], float, float]: ...
+) -> QuasiStaticPoint: ...
 def flexible_energies(
     mu: float, body_arg: _FlexBody, primaries: list[bool], orbit: _F64, phi: _F64, wz: _F64, q: _F64, qdot: _F64
 ) -> FlexibleEnergies: ...
@@ -500,7 +515,20 @@ def flexible_rates(
 def planar_gravity_gradient(kz: float, s: _F64, c: _F64, phi: _F64) -> _F64: ...
 def flat_plate_wzdot(eps: float, cs: float, cd: float, theta_sun0: float, t: _F64, phi: _F64) -> _F64: ...
 def sun_angle(theta_sun0: float, t: _F64) -> _F64: ...
+@final
+class FlexiblePeriodicCorrection:
+    @property
+    def x(self) -> _F64: ...
+    @property
+    def residual(self) -> float: ...
+    @property
+    def iterations(self) -> int: ...
+    @property
+    def reason(self) -> str: ...
+    @property
+    def monodromy(self) -> _F64: ...
+
 def flexible_correct_periodic(
-    mu: float, body_arg: Any, primaries: list[bool], orbit0: list[float], period: float, x0: list[float], turns: float,
-    scale: list[float], *, options: Any, tol: float, max_iter: int, threads: int | None = None,
-) -> tuple[_F64, float, int, str, _F64]: ...
+    mu: float, body_arg: _FlexBody, primaries: list[bool], orbit0: list[float], period: float, x0: list[float], turns: float,
+    scale: list[float], *, options: _Options, tol: float, max_iter: int, threads: int | None = None,
+) -> FlexiblePeriodicCorrection: ...

@@ -515,8 +515,8 @@ def initial_deflection(deflection, sys_, body, primaries, held, s, phi0, wz0):
     if isinstance(deflection, str):
         if deflection != "quasi-static":
             raise ValueError(f"invalid argument `deflection`: must be None/'rest', 'quasi-static' or (q0, qdot0), got {deflection!r}")
-        q, qd, *_ = _core.flexible_quasi_static_point(sys_.mu, body._core_arg(sys_.tu_s), primaries, held, [float(v) for v in s], phi0, wz0)
-        return list(q), list(qd)
+        p = _core.flexible_quasi_static_point(sys_.mu, body._core_arg(sys_.tu_s), primaries, held, [float(v) for v in s], phi0, wz0)
+        return p.q, p.qdot
     try:
         q0, qd0 = deflection
         q0 = np.asarray(q0, dtype=np.float64).ravel()

@@ -145,11 +145,11 @@ def flexible_periodic(
     omega = body.frequencies_nd(sys_)
     qscale = np.maximum(np.max(np.abs(qs.q), axis=0), 1e-12)
     scale = np.concatenate([[1.0, 1.0], qscale, qscale * omega])
-    x, res, it, reason, mono = _core.flexible_correct_periodic(sys_.mu, arg, [True, True], s0, T, [float(v) for v in x], float(turns),
-                                                               [float(v) for v in scale], options=opts, tol=float(tol), max_iter=int(max_iter))
-    x = np.asarray(x)
-    out.update(phi0=float(x[0]), wz0=float(x[1]), q0=x[2:2 + n].copy(), qdot0=x[2 + n:].copy(), residual=float(res),
-               iterations=int(it), multipliers=np.linalg.eigvals(mono) if np.all(np.isfinite(mono)) else None, reason=reason)
+    c = _core.flexible_correct_periodic(sys_.mu, arg, [True, True], s0, T, [float(v) for v in x], float(turns),
+                                        [float(v) for v in scale], options=opts, tol=float(tol), max_iter=int(max_iter))
+    x, mono = c.x, c.monodromy
+    out.update(phi0=float(x[0]), wz0=float(x[1]), q0=x[2:2 + n].copy(), qdot0=x[2 + n:].copy(), residual=c.residual,
+               iterations=c.iterations, multipliers=np.linalg.eigvals(mono) if np.all(np.isfinite(mono)) else None, reason=c.reason)
     return FlexiblePeriodic(**out)
 
 

@@ -256,14 +256,35 @@ fn flexible_quasi_static<'py>(
     })
 }
 
-/// The closed form at one state: (q, qdot, qddot, wzdot, dtau).
+/// The outcome of `flexible_quasi_static_point`: the closed form at one state.
+#[pyclass(frozen, get_all, name = "QuasiStaticPoint", module = "librate._core")]
+pub struct PyQuasiStaticPoint {
+    /// Quasi-static deflections, (n,).
+    q: Vec<f64>,
+    /// Their rates, (n,).
+    qdot: Vec<f64>,
+    /// Their accelerations, (n,).
+    qddot: Vec<f64>,
+    /// wzdot of the rigid composite model.
+    wzdot: f64,
+    /// The first-order torque perturbation.
+    dtau: f64,
+}
+
+#[pymethods]
+impl PyQuasiStaticPoint {
+    fn __repr__(&self) -> String {
+        format!("QuasiStaticPoint(n={}, wzdot={}, dtau={})", self.q.len(), self.wzdot, self.dtau)
+    }
+}
+
+/// The closed form at one state.
 #[pyfunction]
 #[allow(clippy::too_many_arguments)]
-#[allow(clippy::type_complexity)]
-fn flexible_quasi_static_point(mu: f64, body_arg: BodyArg, primaries: [bool; 2], held: bool, orbit: [f64; 6], phi: f64, wz: f64) -> PyResult<(Vec<f64>, Vec<f64>, Vec<f64>, f64, f64)> {
+fn flexible_quasi_static_point(mu: f64, body_arg: BodyArg, primaries: [bool; 2], held: bool, orbit: [f64; 6], phi: f64, wz: f64) -> PyResult<PyQuasiStaticPoint> {
     let b = body(body_arg)?;
     let p = flexible::quasi_static_point(mu, &b, primaries, held, &orbit, phi, wz).map_err(to_py)?;
-    Ok((p.q, p.qdot, p.qddot, p.wzdot, p.dtau))
+    Ok(PyQuasiStaticPoint { q: p.q, qdot: p.qdot, qddot: p.qddot, wzdot: p.wzdot, dtau: p.dtau })
 }
 
 /// Energies, momentum, torque and inertia of states (orbit (m, 6), phi, wz (m,), q, qdot (m, n)).
@@ -309,12 +330,33 @@ fn flexible_rates(mu: f64, body_arg: BodyArg, primaries: [bool; 2], orbit: [f64;
     Ok(flexible::flexible_rates(mu, &b, primaries, &orbit, phi, wz, &q, &qdot))
 }
 
+/// The outcome of `flexible_correct_periodic`.
+#[pyclass(frozen, get_all, name = "FlexiblePeriodicCorrection", module = "librate._core")]
+pub struct PyFlexiblePeriodicCorrection {
+    /// (phi0, wz0, q0 (n), qdot0 (n)) at the last accepted point, (m,) with m = 2 + 2n.
+    x: Py<PyAny>,
+    /// Max-norm of the scaled residual there.
+    residual: f64,
+    /// Newton iterations taken.
+    iterations: usize,
+    /// Why the corrector stopped ("converged", "max_iterations", ...).
+    reason: &'static str,
+    /// d y(T) / d x from the last Jacobian, (m, m).
+    monodromy: Py<PyAny>,
+}
+
+#[pymethods]
+impl PyFlexiblePeriodicCorrection {
+    fn __repr__(&self) -> String {
+        format!("FlexiblePeriodicCorrection(reason='{}', iterations={}, residual={:e})", self.reason, self.iterations, self.residual)
+    }
+}
+
 /// Correct (phi0, wz0, q0, qdot0) to a periodic motion of the coupled flexible model over one
-/// orbit period (librate_core::flexible::correct_flexible_periodic): returns (x, scaled residual
-/// max-norm, iterations, stop reason, monodromy (m, m)).
+/// orbit period (librate_core::flexible::correct_flexible_periodic).
 #[pyfunction]
 #[pyo3(signature = (mu, body_arg, primaries, orbit0, period, x0, turns, scale, *, options, tol, max_iter, threads=None))]
-#[allow(clippy::too_many_arguments, clippy::type_complexity)]
+#[allow(clippy::too_many_arguments)]
 fn flexible_correct_periodic<'py>(
     py: Python<'py>,
     mu: f64,
@@ -329,14 +371,14 @@ fn flexible_correct_periodic<'py>(
     tol: f64,
     max_iter: usize,
     threads: Option<usize>,
-) -> PyResult<(Bound<'py, PyAny>, f64, usize, &'static str, Bound<'py, PyAny>)> {
+) -> PyResult<PyFlexiblePeriodicCorrection> {
     let b = body(body_arg)?;
     let opts = Options::from(options);
     let r = py
         .detach(|| flexible::correct_flexible_periodic(mu, &b, primaries, &orbit0, period, &x0, turns, &scale, &opts, tol, max_iter, threads))
         .map_err(to_py)?;
     let m = r.x.len();
-    Ok((r.x.into_pyarray(py).into_any(), r.residual, r.iterations, r.reason.as_str(), r.monodromy.into_pyarray(py).reshape([m, m])?.into_any()))
+    Ok(PyFlexiblePeriodicCorrection { x: array(py, r.x), residual: r.residual, iterations: r.iterations, reason: r.reason.as_str(), monodromy: rows(py, r.monodromy, m, m)? })
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -344,6 +386,8 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyFlexibleTrajectory>()?;
     m.add_class::<PyQuasiStaticTrajectory>()?;
     m.add_class::<PyFlexibleEnergies>()?;
+    m.add_class::<PyQuasiStaticPoint>()?;
+    m.add_class::<PyFlexiblePeriodicCorrection>()?;
     m.add_function(wrap_pyfunction!(flexible_correct_periodic, m)?)?;
     m.add_function(wrap_pyfunction!(flexible_body_check, m)?)?;
     m.add_function(wrap_pyfunction!(flexible_propagate, m)?)?;
