@@ -106,3 +106,14 @@ def test_attitude_and_flexible_records(em, dro_085):
     np.testing.assert_array_equal(pt.q, q.q[0])  # the closed form at the start of the solution
     for r in (p, a, c, f, e, q, pt):
         _frozen(r, "t")
+
+
+def test_system_constants_record(em):
+    """The preset's constants come back as a record (thesis: mu = 0.01215 for the Earth-Moon
+    system), and the validation names the offending constant."""
+    c = _core.system_preset("earth-moon")
+    assert isinstance(c, _core.SystemConstants) and c.name == "earth-moon" and c.mu == 0.01215
+    assert (c.mu, c.lu_km, c.tu_s, c.r1_km, c.r2_km) == (em.mu, em.lu_km, em.tu_s, em.r1_km, em.r2_km)
+    with pytest.raises(ValueError, match="mu"):
+        _core.system_validate("bad", 0.7, c.lu_km, c.tu_s, 0.0, 0.0)
+    _frozen(c, "mu")

@@ -23,7 +23,7 @@ mod fourier;
 mod map;
 mod records;
 
-use records::{PyBatchResult, PyEventHit, PyMultipleShooting, PyShootingEvaluation, PyStats, PySymmetricOrbit, PyTrajectory};
+use records::{PyBatchResult, PyEventHit, PyMultipleShooting, PyShootingEvaluation, PyStats, PySymmetricOrbit, PySystemConstants, PyTrajectory};
 
 create_exception!(librate, LibrateError, PyException, "Base class of librate's errors.");
 create_exception!(
@@ -269,22 +269,16 @@ fn lagrange_points<'py>(py: Python<'py>, mu: f64) -> PyResult<Bound<'py, PyAny>>
     Ok(Array2::from_shape_fn((5, 3), |(i, j)| lp[i][j]).into_pyarray(py).into_any())
 }
 
-type SystemTuple = (String, f64, f64, f64, f64, f64);
-
-fn system_tuple(s: SystemConstants) -> SystemTuple {
-    (s.name, s.mu, s.lu_km, s.tu_s, s.r1_km, s.r2_km)
-}
-
-/// (name, mu, lu_km, tu_s, r1_km, r2_km) of a preset.
+/// The constants of a preset.
 #[pyfunction]
-fn system_preset(name: &str) -> PyResult<SystemTuple> {
-    SystemConstants::preset(name).map(system_tuple).map_err(to_py)
+fn system_preset(name: &str) -> PyResult<PySystemConstants> {
+    SystemConstants::preset(name).map(PySystemConstants::from).map_err(to_py)
 }
 
 /// Validate user-defined system constants (raises ValueError naming the bad one).
 #[pyfunction]
-fn system_validate(name: String, mu: f64, lu_km: f64, tu_s: f64, r1_km: f64, r2_km: f64) -> PyResult<SystemTuple> {
-    SystemConstants::new(name, mu, lu_km, tu_s, r1_km, r2_km).map(system_tuple).map_err(to_py)
+fn system_validate(name: String, mu: f64, lu_km: f64, tu_s: f64, r1_km: f64, r2_km: f64) -> PyResult<PySystemConstants> {
+    SystemConstants::new(name, mu, lu_km, tu_s, r1_km, r2_km).map(PySystemConstants::from).map_err(to_py)
 }
 
 /// Names of the system presets.

@@ -223,6 +223,36 @@ impl PyMultipleShooting {
     }
 }
 
+/// The constants of a CR3BP system (`system_preset`, `system_validate`), validated by the core.
+#[pyclass(frozen, get_all, name = "SystemConstants", module = "librate._core")]
+pub struct PySystemConstants {
+    /// The system's name.
+    pub name: String,
+    /// Mass ratio m2 / (m1 + m2).
+    pub mu: f64,
+    /// Length unit (km): the primaries' distance.
+    pub lu_km: f64,
+    /// Time unit (s): 1 / mean motion.
+    pub tu_s: f64,
+    /// Radius of the larger primary (km; 0 for a point).
+    pub r1_km: f64,
+    /// Radius of the smaller primary (km; 0 for a point).
+    pub r2_km: f64,
+}
+
+impl From<librate_core::cr3bp::SystemConstants> for PySystemConstants {
+    fn from(s: librate_core::cr3bp::SystemConstants) -> Self {
+        Self { name: s.name, mu: s.mu, lu_km: s.lu_km, tu_s: s.tu_s, r1_km: s.r1_km, r2_km: s.r2_km }
+    }
+}
+
+#[pymethods]
+impl PySystemConstants {
+    fn __repr__(&self) -> String {
+        format!("SystemConstants(name='{}', mu={}, lu_km={}, tu_s={}, r1_km={}, r2_km={})", self.name, self.mu, self.lu_km, self.tu_s, self.r1_km, self.r2_km)
+    }
+}
+
 /// Add the record classes to `librate._core`.
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyStats>()?;
@@ -232,5 +262,6 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyShootingEvaluation>()?;
     m.add_class::<PySymmetricOrbit>()?;
     m.add_class::<PyMultipleShooting>()?;
+    m.add_class::<PySystemConstants>()?;
     Ok(())
 }
