@@ -949,20 +949,8 @@ def _family_of(fam, orbits):
     """An OrbitFamily holding the corrected members ``orbits`` of ``fam`` (for saving)."""
     from ..orbits.families import OrbitFamily
 
-    return OrbitFamily.from_members(fam.system, fam.kind, fam.spatial, [_with_crossing(o) for o in orbits], fam.end_reason,
+    return OrbitFamily.from_members(fam.system, fam.kind, fam.spatial, orbits, fam.end_reason,
                                     {**fam.parameters, "selected": True})
-
-
-def _with_crossing(o):
-    """A PeriodicOrbit with its half-period crossing state (needed by OrbitFamily)."""
-    if o._evaluation is not None and "crossing" in o._evaluation:
-        return o
-    import dataclasses
-
-    from ..orbits.propagation import propagate
-
-    half = propagate(o.system, o.state0, 0.5 * o.period, rtol=1e-13, atol=1e-13, collision="point").y[-1]
-    return dataclasses.replace(o, _evaluation={"crossing": half})
 
 
 def parse_value(text: str) -> Any:

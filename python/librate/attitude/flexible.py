@@ -213,7 +213,7 @@ class FlexibleBody:
     hub: RigidBody
     appendages: tuple[Appendage, ...]
     name: str = "custom"
-    _derived: dict = field(init=False, repr=False, compare=False)
+    _derived: _core.FlexibleBodyConstants = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "hub", _hub(self.hub))
@@ -226,7 +226,7 @@ class FlexibleBody:
                 raise ValueError(f"invalid argument `appendages`: item {j} must be a librate.Appendage, got {a!r}")
         object.__setattr__(self, "appendages", apps)
         object.__setattr__(self, "name", str(self.name))
-        object.__setattr__(self, "_derived", dict(_core.flexible_body_check(self._core_arg(1.0))))
+        object.__setattr__(self, "_derived", _core.flexible_body_check(self._core_arg(1.0)))
 
     # --- conversion ---------------------------------------------------------------------------
     def _core_arg(self, tu_s: float):
@@ -242,33 +242,34 @@ class FlexibleBody:
 
     @property
     def total_mass(self) -> float:
-        return float(self._derived["total_mass"])
+        return self._derived.total_mass
 
     @property
     def hub_position(self) -> tuple[float, float]:
         """Hub centre relative to the undeformed system's centre of mass (m)."""
-        return tuple(self._derived["hub_position"])
+        x, y = self._derived.hub_position
+        return (x, y)
 
     @property
     def inertia(self) -> float:
         """I0: the composite moment of inertia about z of the undeformed body (kg m^2)."""
-        return float(self._derived["inertia"])
+        return self._derived.inertia
 
     @property
     def kz(self) -> float:
         """Kz = (Iy - Ix) / Iz of the rigid composite body (principal axes)."""
-        return float(self._derived["kz"])
+        return self._derived.kz
 
     @property
     def principal_angle(self) -> float:
         """Angle (rad) of the composite principal x axis from the body x axis: the rigid
         composite model's phi is the flexible model's phi plus this angle."""
-        return float(self._derived["principal_angle"])
+        return self._derived.principal_angle
 
     @property
     def mass_matrix(self) -> np.ndarray:
         """(n, n) mass matrix of the deflections, M_qq = diag(m) - m_j m_k t_j . t_k / M (kg)."""
-        return np.array(self._derived["mass_matrix"], dtype=float).reshape(self.n, self.n)
+        return self._derived.mass_matrix.copy()
 
     @property
     def frequencies(self) -> np.ndarray:
@@ -282,8 +283,7 @@ class FlexibleBody:
     def rigid_body(self) -> RigidBody:
         """The rigid composite body (undeformed): principal moments (kg m^2) and mass; its x axis
         is at :attr:`principal_angle` from the body x axis."""
-        re, im = self._derived["asymmetry"]
-        delta = math.hypot(re, im)
+        delta = abs(self._derived.asymmetry)
         s = self.hub.ix + self.hub.iy + (self.inertia - self.hub.iz)
         return RigidBody(0.5 * (s - delta), 0.5 * (s + delta), self.inertia, mass_kg=self.total_mass)
 
@@ -483,11 +483,8 @@ class FlexibleResponse:
                                     np.ascontiguousarray(self.orbit), np.ascontiguousarray(self.phi), np.ascontiguousarray(self.wz),
                                     np.ascontiguousarray(self.q), np.ascontiguousarray(self.qdot))
         tu = self.system.tu_s
-        out = {k: np.asarray(v) for k, v in e.items()}
-        for k in ("kinetic", "elastic", "tidal", "structural", "torque"):
-            out[k] = out[k] / tu**2
-        out["momentum"] = out["momentum"] / tu
-        return out
+        return {"kinetic": e.kinetic / tu**2, "elastic": e.elastic / tu**2, "tidal": e.tidal / tu**2, "momentum": e.momentum / tu,
+                "structural": e.structural / tu**2, "torque": e.torque / tu**2, "inertia": e.inertia}
 
     def jacobi_energy(self, mean_motion: float) -> np.ndarray:
         """E_J = T + V_el + V_tidal - n h_z (J) for a circular orbit of inertial mean motion
@@ -518,8 +515,8 @@ def initial_deflection(deflection, sys_, body, primaries, held, s, phi0, wz0):
     if isinstance(deflection, str):
         if deflection != "quasi-static":
             raise ValueError(f"invalid argument `deflection`: must be None/'rest', 'quasi-static' or (q0, qdot0), got {deflection!r}")
-        q, qd, *_ = _core.flexible_quasi_static_point(sys_.mu, body._core_arg(sys_.tu_s), primaries, held, [float(v) for v in s], phi0, wz0)
-        return list(q), list(qd)
+        p = _core.flexible_quasi_static_point(sys_.mu, body._core_arg(sys_.tu_s), primaries, held, [float(v) for v in s], phi0, wz0)
+        return p.q, p.qdot
     try:
         q0, qd0 = deflection
         q0 = np.asarray(q0, dtype=np.float64).ravel()
@@ -607,5 +604,5 @@ def quasi_static(
     r = _core.flexible_quasi_static(sys_.mu, body._core_arg(sys_.tu_s), enabled_primaries(names), orbit == "held", [float(v) for v in s],
                                     phi0, wz0, t0, tf, options=opts, t_eval=te)
     tu2 = sys_.tu_s**2
-    return QuasiStaticResponse(sys_, body, r["t"], r["orbit"], r["phi"], r["wz"], r["dphi"], r["dwz"], r["q"], r["qdot"], r["qddot"],
-                               r["dtau"] / tu2, Stats(*r["stats"]))
+    return QuasiStaticResponse(sys_, body, r.t, r.orbit, r.phi, r.wz, r.dphi, r.dwz, r.q, r.qdot, r.qddot,
+                               r.dtau / tu2, Stats.from_core(r.stats))

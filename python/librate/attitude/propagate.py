@@ -179,11 +179,11 @@ def propagate_attitude(
                      any(n in ("gravity_gradient", "gravity_gradient_moon") for n in names)]
         r = _core.planar_propagate(sys_.mu, body.kz, primaries, orbit == "held", [float(v) for v in s], phi0, wz0, t0, tf,
                                    options=opts, stm=bool(stm), t_eval=te, plate=None if srp is None else srp._plate())
-        phi, wz = r["phi"], r["wz"]
+        phi, wz = r.phi, r.wz
         zero = np.zeros_like(phi)
         q = np.stack([zero, zero, np.sin(0.5 * phi), np.cos(0.5 * phi)], axis=1)
         w = np.stack([zero, zero, wz], axis=1)
-        return AttitudeTrajectory(sys_, body, names, True, r["t"], r["orbit"], q, w, phi, wz, r["stm"], Stats(*r["stats"]))
+        return AttitudeTrajectory(sys_, body, names, True, r.t, r.orbit, q, w, phi, wz, r.stm, Stats.from_core(r.stats))
 
     if isinstance(body, RigidBody) and body.is_rod:
         raise ValueError(f"invalid argument `body`: a body with a zero principal moment (Kz = {body.kz:g}, a thin rod) has no 3-D attitude "
@@ -206,8 +206,8 @@ def propagate_attitude(
             extra["srp_force"] = (float(body.mass_kg), sys_.lu_km * 1e3)
     r = _core.attitude_propagate(sys_.mu, list(body.moments), list(names), orbit, state0, t0, tf,
                                  options=opts, stm=bool(stm), t_eval=te, inertia_nd=inertia_nd, **extra)
-    st = r["states"]
-    return AttitudeTrajectory(sys_, body, names, False, r["t"], st[:, :6], st[:, 6:10], st[:, 10:], None, None, r["stm"], Stats(*r["stats"]))
+    st = r.states
+    return AttitudeTrajectory(sys_, body, names, False, r.t, st[:, :6], st[:, 6:10], st[:, 10:], None, None, r.stm, Stats.from_core(r.stats))
 
 
 def _pair(attitude) -> tuple[float, float]:
@@ -247,9 +247,9 @@ def _propagate_flexible(sys_, s, attitude, body, t0, tf, names, orbit, opts, te,
     q0, qd0 = initial_deflection(deflection, sys_, body, primaries, held, s, phi0, wz0)
     r = _core.flexible_propagate(sys_.mu, body._core_arg(sys_.tu_s), primaries, held, [float(v) for v in s], phi0, wz0, q0, qd0,
                                  t0, tf, options=opts, t_eval=te)
-    phi, wz = r["phi"], r["wz"]
+    phi, wz = r.phi, r.wz
     zero = np.zeros_like(phi)
     quat = np.stack([zero, zero, np.sin(0.5 * phi), np.cos(0.5 * phi)], axis=1)
     w = np.stack([zero, zero, wz], axis=1)
-    flex = FlexibleResponse(sys_, body, tuple(primaries), r["t"], r["orbit"], phi, wz, r["q"], r["qdot"])
-    return AttitudeTrajectory(sys_, body, tuple(names), True, r["t"], r["orbit"], quat, w, phi, wz, None, Stats(*r["stats"]), flex=flex)
+    flex = FlexibleResponse(sys_, body, tuple(primaries), r.t, r.orbit, phi, wz, r.q, r.qdot)
+    return AttitudeTrajectory(sys_, body, tuple(names), True, r.t, r.orbit, quat, w, phi, wz, None, Stats.from_core(r.stats), flex=flex)

@@ -91,7 +91,9 @@ def tangent(orbit: PeriodicOrbit, spatial: bool, previous: np.ndarray | None = N
     """Unit tangent of the family at ``orbit`` in p = (x0, z0, vy0): the null vector of the
     symmetric conditions' Jacobian, oriented along ``previous`` (or ``orient``)."""
     e = orbit._evaluation
-    d = np.array(e["dcond"], dtype=float)
+    if e is None:
+        raise LibrateError("family tangent undefined: the orbit was not corrected by the symmetric shooting")
+    d = e.dcond
     if spatial:
         t = np.cross(d[0], d[1])
     else:

@@ -38,7 +38,7 @@ def _bifurcation_record(b) -> dict:
     its level, and the located orbit's two x-z-plane crossings (x0, z0 and x0_half, z0_half)."""
     index, level, kind = INDEX_TESTS[b.name]
     orbit = b.point.data
-    half = orbit._evaluation["crossing"] if orbit._evaluation is not None else orbit.state0
+    half = orbit._evaluation.crossing if orbit._evaluation is not None else orbit.state0
     return {"member": int(b.after), "index": index, "type": kind, "level": level, "x0": float(b.parameter), "z0": float(orbit.state0[2]),
             "x0_half": float(half[0]), "z0_half": float(half[2]), "located": bool(b.located)}
 
@@ -86,8 +86,11 @@ class OrbitFamily:
         if not members:
             raise LibrateError(f"the {kind} family has no member ({end_reason})")
         state0 = np.array([m.state0 for m in members])
-        half = np.array([m._evaluation["crossing"] for m in members])
         period = np.array([m.period for m in members])
+        half = np.array([np.full(6, np.nan) if m._evaluation is None else m._evaluation.crossing for m in members])
+        missing = np.flatnonzero(np.isnan(half[:, 0]))
+        if missing.size:  # members not from the symmetric corrector: their half-period states
+            half[missing] = propagate_many(system, state0[missing], 0.5 * period[missing], rtol=SHOOT_RTOL, atol=SHOOT_ATOL, collision="point").y
         batch = propagate_many(system, state0, period, stm=True, rtol=SHOOT_RTOL, atol=SHOOT_ATOL, on_error="mask", collision="point")
         eig = np.full((len(members), 6), np.nan + 0j)
         nu = np.full((len(members), 2), np.nan + 0j)

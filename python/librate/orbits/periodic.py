@@ -52,7 +52,7 @@ class PeriodicOrbit:
     family: str = "symmetric"
     iterations: int = 0
     residual: float = 0.0
-    _evaluation: dict | None = field(default=None, repr=False, compare=False)
+    _evaluation: _core.ShootingEvaluation | None = field(default=None, repr=False, compare=False)
 
     @property
     def x0(self) -> float:
@@ -140,7 +140,7 @@ def index_tests(stability_indices, spatial: bool) -> dict[str, float]:
 def symmetric_monodromy(orbit: PeriodicOrbit) -> np.ndarray | None:
     """The monodromy of a symmetric orbit from its half-period STM (the core's correction
     carries it: Phi(T) = S Phi(T/2)^-1 S Phi(T/2)), or None when the orbit has none."""
-    m = None if orbit._evaluation is None else orbit._evaluation.get("monodromy")
+    m = None if orbit._evaluation is None else orbit._evaluation.monodromy
     return None if m is None else np.asarray(m, dtype=float)
 
 
@@ -206,8 +206,8 @@ def correct_symmetric(
     return orbit_from_core(sys_, r, family)
 
 
-def orbit_from_core(system: System, r: dict, family: str) -> PeriodicOrbit:
-    return PeriodicOrbit(system, r["state0"], r["period"], r["jacobi"], family, r["iterations"], r["residual"], r["evaluation"])
+def orbit_from_core(system: System, r: _core.SymmetricOrbit, family: str) -> PeriodicOrbit:
+    return PeriodicOrbit(system, r.state0, r.period, r.jacobi, family, r.iterations, r.residual, r.evaluation)
 
 
 def correct_periodic(
@@ -256,4 +256,4 @@ def correct_periodic(
         cond, value = "jacobi", float(sys_.jacobi(patches[0]) if jacobi is None else jacobi)
     r = _core.multiple_shooting(sys_.mu, patches, float(period), condition=cond, value=value, tol=float(tol),
                                 max_iter=int(max_iter), rtol=float(rtol), atol=float(atol))
-    return PeriodicOrbit(sys_, r["patches"][0].copy(), r["period"], r["jacobi"], family, r["iterations"], r["residual"])
+    return PeriodicOrbit(sys_, r.patches[0].copy(), r.period, r.jacobi, family, r.iterations, r.residual)

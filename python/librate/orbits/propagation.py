@@ -89,6 +89,11 @@ class Stats:
     rejected: int
     rhs_evals: int
 
+    @classmethod
+    def from_core(cls, stats: _core.Stats) -> Stats:
+        """The counters of a run of the Rust core."""
+        return cls(stats.accepted, stats.rejected, stats.rhs_evals)
+
 
 @dataclass(frozen=True)
 class Trajectory:
@@ -239,18 +244,18 @@ def propagate(
         sys_.mu, s, t0, tf, stm=bool(stm), t_eval=te, events=[e._spec(sys_) for e in evs],
         options=integration_options(rtol, atol, h0, h_min, h_max, max_steps, safety, fixed_step), collision=radii,
     )
-    err = r.get("collision")
+    err = r.collision
     tr = Trajectory(
         system=sys_,
-        t=r["t"],
-        y=r["y"],
-        t_final=r["t_final"],
-        y_final=r["y_final"],
-        stm=r["stm"],
-        events=[EventHit(i, t, y, m) for (i, t, y, m) in r["events"]],
-        status=r["status"],
-        event_index=r["event_index"],
-        stats=Stats(*r["stats"]),
+        t=r.t,
+        y=r.y,
+        t_final=r.t_final,
+        y_final=r.y_final,
+        stm=r.stm,
+        events=[EventHit(e.index, e.t, e.y, e.stm) for e in r.events],
+        status=r.status,
+        event_index=r.event_index,
+        stats=Stats.from_core(r.stats),
         collision_primary=None if err is None else int(err.primary),
     )
     if err is not None:
@@ -317,9 +322,9 @@ def propagate_many(
         sys_.mu, arr, float(t0), tf, stm=bool(stm), threads=None if threads is None else int(threads),
         options=integration_options(rtol, atol, h0, h_min, h_max, max_steps, safety, fixed_step), collision=radii,
     )
-    errors = {i: (_collision(sys_, e, None) if isinstance(e, CollisionError) else e) for i, e in r["errors"]}
-    status = np.array(["completed", "collision_primary1", "collision_primary2", "failed"])[np.asarray(r["status"], dtype=np.intp)]
-    result = BatchResult(y=r["y"], stm=r["stm"], ok=r["ok"], errors=errors, stats=r["stats"], status=status)
+    errors = {i: (_collision(sys_, e, None) if isinstance(e, CollisionError) else e) for i, e in r.errors.items()}
+    status = np.array(["completed", "collision_primary1", "collision_primary2", "failed"])[np.asarray(r.status, dtype=np.intp)]
+    result = BatchResult(y=r.y, stm=r.stm, ok=r.ok, errors=errors, stats=r.stats, status=status)
     if result.errors and on_error == "raise":
         index, err = next(iter(result.errors.items()))
         err.add_note(f"in member {index} of propagate_many ({len(result.errors)} of {arr.shape[0]} members failed)") if hasattr(err, "add_note") else None

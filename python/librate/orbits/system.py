@@ -37,16 +37,16 @@ class System:
         if not isinstance(self.name, str):
             raise ValueError(f"invalid argument `name`: must be a string, got {self.name!r}")
         nums = [as_real(getattr(self, k), k, allow_inf=True) for k in ("mu", "lu_km", "tu_s", "r1_km", "r2_km")]
-        name, mu, lu, tu, r1, r2 = _core.system_validate(self.name, *nums)
-        for field, value in (("mu", mu), ("lu_km", lu), ("tu_s", tu), ("r1_km", r1), ("r2_km", r2)):
-            object.__setattr__(self, field, value)
+        c = _core.system_validate(self.name, *nums)
+        for field in ("mu", "lu_km", "tu_s", "r1_km", "r2_km"):
+            object.__setattr__(self, field, getattr(c, field))
 
     @classmethod
     def preset(cls, name: str = "earth-moon") -> System:
         """A named system: ``"earth-moon"`` (the thesis's, mu = 0.01215) or ``"earth-moon-jpl"``
         (the JPL periodic-orbit catalog's constants)."""
-        n, mu, lu, tu, r1, r2 = _core.system_preset(name)
-        return cls(mu=mu, lu_km=lu, tu_s=tu, r1_km=r1, r2_km=r2, name=n)
+        c = _core.system_preset(name)
+        return cls(mu=c.mu, lu_km=c.lu_km, tu_s=c.tu_s, r1_km=c.r1_km, r2_km=c.r2_km, name=c.name)
 
     @staticmethod
     def presets() -> list[str]:

@@ -140,8 +140,8 @@ def flexible_periodic(
 
     x = np.concatenate([[phi0, wz0], qs.q[0], qs.qdot[0]])
     r = flow(x, te)
-    out.update(full_drift=np.array([r["phi"][-1] - phi0 - 2 * math.pi * turns, r["wz"][-1] - wz0]),
-               full_max_dphi=float(np.max(np.abs(r["phi"] - qs.phi))), full_max_dwz=float(np.max(np.abs(r["wz"] - qs.wz))))
+    out.update(full_drift=np.array([r.phi[-1] - phi0 - 2 * math.pi * turns, r.wz[-1] - wz0]),
+               full_max_dphi=float(np.max(np.abs(r.phi - qs.phi))), full_max_dwz=float(np.max(np.abs(r.wz - qs.wz))))
     if not resolve:
         return FlexiblePeriodic(**out)
 
@@ -200,12 +200,13 @@ class CompliancePath:
         f = 1.0 / math.sqrt(s)
         b = self.body if s == 1.0 else self.body.scaled(f)
         scale = np.concatenate([[1.0, 1.0], self.qscale * s, self.qscale * s * self.omega * f])
-        x, res, it, reason, mono = _core.flexible_correct_periodic(self.sys.mu, b._core_arg(self.sys.tu_s), [True, True], self.s0, self.T,
-                                                                   [float(v) for v in guess[1:]], float(self.turns), [float(v) for v in scale],
-                                                                   options=self.opts, tol=float(self.tol), max_iter=int(self.max_iter))
-        if reason != "converged":
-            raise CorrectionFailed(f"flexible re-solve at compliance {s:.6g}: {reason}")
-        return Point(np.concatenate([[s], x]), {"residual": float(res), "reason": reason, "monodromy": np.asarray(mono)}, int(it))
+        r = _core.flexible_correct_periodic(self.sys.mu, b._core_arg(self.sys.tu_s), [True, True], self.s0, self.T,
+                                            [float(v) for v in guess[1:]], float(self.turns), [float(v) for v in scale],
+                                            options=self.opts, tol=float(self.tol), max_iter=int(self.max_iter))
+        if r.reason != "converged":
+            raise CorrectionFailed(f"flexible re-solve at compliance {s:.6g}: {r.reason}")
+        return Point(np.concatenate([[s], r.x]), {"residual": float(r.residual), "reason": r.reason, "monodromy": np.asarray(r.monodromy)},
+                     int(r.iterations))
 
     def tangent(self, pt):
         return None

@@ -5,8 +5,8 @@ use librate_core::integrate::{Options, Output};
 use numpy::{IntoPyArray, PyArrayMethods, PyReadonlyArray1};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
 
+use crate::records::PyStats;
 use crate::{to_py, OptionsArg};
 
 fn output<'a>(t_eval: &'a Option<Vec<f64>>) -> Output<'a> {
@@ -31,6 +31,56 @@ fn facets_force_torque(facets: Vec<FacetTuple>, s_body: [f64; 3]) -> PyResult<([
     Ok(m.force_torque(&s_body))
 }
 
+/// The outcome of `attitude_propagate`.
+#[pyclass(frozen, get_all, name = "AttitudeTrajectory", module = "librate._core")]
+pub struct PyAttitudeTrajectory {
+    /// Output times, (n,).
+    t: Py<PyAny>,
+    /// Coupled states (x, y, z, xd, yd, zd, q1, q2, q3, q4, wx, wy, wz), (n, 13); q scalar last.
+    states: Py<PyAny>,
+    /// The 13x13 STM from t0 to the final time, or None when not asked.
+    stm: Option<Py<PyAny>>,
+    /// Integrator counters.
+    stats: PyStats,
+}
+
+#[pymethods]
+impl PyAttitudeTrajectory {
+    fn __len__(&self, py: Python<'_>) -> PyResult<usize> {
+        self.t.bind(py).len()
+    }
+    fn __repr__(&self, py: Python<'_>) -> PyResult<String> {
+        Ok(format!("AttitudeTrajectory(n={}, stm={})", self.__len__(py)?, if self.stm.is_some() { "True" } else { "False" }))
+    }
+}
+
+/// The outcome of `planar_propagate`.
+#[pyclass(frozen, get_all, name = "PlanarTrajectory", module = "librate._core")]
+pub struct PyPlanarTrajectory {
+    /// Output times, (n,).
+    t: Py<PyAny>,
+    /// Orbit states, (n, 6).
+    orbit: Py<PyAny>,
+    /// Attitude angle (unwrapped), (n,).
+    phi: Py<PyAny>,
+    /// Inertial angular rate, (n,).
+    wz: Py<PyAny>,
+    /// The 2x2 STM d(phi, wz)(tf) / d(phi0, wz0), or None when not asked.
+    stm: Option<Py<PyAny>>,
+    /// Integrator counters.
+    stats: PyStats,
+}
+
+#[pymethods]
+impl PyPlanarTrajectory {
+    fn __len__(&self, py: Python<'_>) -> PyResult<usize> {
+        self.t.bind(py).len()
+    }
+    fn __repr__(&self, py: Python<'_>) -> PyResult<String> {
+        Ok(format!("PlanarTrajectory(n={}, stm={})", self.__len__(py)?, if self.stm.is_some() { "True" } else { "False" }))
+    }
+}
+
 /// Coupled 3-D orbit-attitude propagation.
 #[pyfunction]
 #[pyo3(signature = (mu, inertia, torques, orbit_mode, state0, t0, tf, *, options, stm, t_eval, inertia_nd=None, facets=None, sun=(0.0, librate_core::constants::OMEGA_SUN, librate_core::constants::SOLAR_PRESSURE_1AU), tu_s=1.0, srp_force=None))]
@@ -52,7 +102,7 @@ fn attitude_propagate<'py>(
     sun: (f64, f64, f64),
     tu_s: f64,
     srp_force: Option<(f64, f64)>,
-) -> PyResult<Bound<'py, PyDict>> {
+) -> PyResult<PyAttitudeTrajectory> {
     let body = RigidBody::new(inertia[0], inertia[1], inertia[2]).map_err(to_py)?;
     let gg_names: Vec<&String> = torques.iter().filter(|n| n.as_str() != "srp").collect();
     let models: Vec<GravityGradient> = gg_names.iter().map(|n| gravity_gradient_by_name(n)).collect::<Result<_, _>>().map_err(to_py)?;
@@ -86,12 +136,15 @@ fn attitude_propagate<'py>(
         })
         .map_err(to_py)?;
     let n = tr.t.len();
-    let d = PyDict::new(py);
-    d.set_item("t", tr.t.into_pyarray(py))?;
-    d.set_item("states", tr.states.into_pyarray(py).reshape([n, 13])?)?;
-    d.set_item("stm", match tr.stm_final { Some(m) => Some(m.into_pyarray(py).reshape([13, 13])?), None => None })?;
-    d.set_item("stats", (tr.stats.accepted, tr.stats.rejected, tr.stats.rhs_evals))?;
-    Ok(d)
+    Ok(PyAttitudeTrajectory {
+        t: tr.t.into_pyarray(py).into_any().unbind(),
+        states: tr.states.into_pyarray(py).reshape([n, 13])?.into_any().unbind(),
+        stm: match tr.stm_final {
+            Some(m) => Some(m.into_pyarray(py).reshape([13, 13])?.into_any().unbind()),
+            None => None,
+        },
+        stats: PyStats::from(tr.stats),
+    })
 }
 
 /// Planar reduced attitude model along an integrated (or held) orbit.
@@ -113,7 +166,7 @@ fn planar_propagate<'py>(
     stm: bool,
     t_eval: Option<PyReadonlyArray1<'py, f64>>,
     plate: Option<(f64, f64, f64, f64, f64)>,
-) -> PyResult<Bound<'py, PyDict>> {
+) -> PyResult<PyPlanarTrajectory> {
     let opts = Options::from(options);
     let times = t_eval.map(|a| a.as_array().to_vec());
     let srp = match plate {
@@ -124,14 +177,17 @@ fn planar_propagate<'py>(
         .detach(|| attitude::propagate_planar(mu, kz, primaries, held, &orbit0, phi0, wz0, t0, tf, &opts, stm, output(&times), srp))
         .map_err(to_py)?;
     let n = tr.t.len();
-    let d = PyDict::new(py);
-    d.set_item("t", tr.t.into_pyarray(py))?;
-    d.set_item("orbit", tr.orbit.into_pyarray(py).reshape([n, 6])?)?;
-    d.set_item("phi", tr.phi.into_pyarray(py))?;
-    d.set_item("wz", tr.wz.into_pyarray(py))?;
-    d.set_item("stm", match tr.stm_final { Some(m) => Some(m.to_vec().into_pyarray(py).reshape([2, 2])?), None => None })?;
-    d.set_item("stats", (tr.stats.accepted, tr.stats.rejected, tr.stats.rhs_evals))?;
-    Ok(d)
+    Ok(PyPlanarTrajectory {
+        t: tr.t.into_pyarray(py).into_any().unbind(),
+        orbit: tr.orbit.into_pyarray(py).reshape([n, 6])?.into_any().unbind(),
+        phi: tr.phi.into_pyarray(py).into_any().unbind(),
+        wz: tr.wz.into_pyarray(py).into_any().unbind(),
+        stm: match tr.stm_final {
+            Some(m) => Some(m.to_vec().into_pyarray(py).reshape([2, 2])?.into_any().unbind()),
+            None => None,
+        },
+        stats: PyStats::from(tr.stats),
+    })
 }
 
 /// Total torque (body axes, inertia units / TU^2) at coupled states (n, 13).
@@ -206,6 +262,8 @@ fn sun_angle<'py>(py: Python<'py>, theta_sun0: f64, t: PyReadonlyArray1<'py, f64
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<PyAttitudeTrajectory>()?;
+    m.add_class::<PyPlanarTrajectory>()?;
     m.add_function(wrap_pyfunction!(planar_gravity_gradient, m)?)?;
     m.add_function(wrap_pyfunction!(flat_plate_wzdot, m)?)?;
     m.add_function(wrap_pyfunction!(sun_angle, m)?)?;

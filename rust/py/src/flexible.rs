@@ -7,8 +7,9 @@ use librate_core::integrate::{Options, Output};
 use numpy::{IntoPyArray, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
+use pyo3::types::PyComplex;
 
+use crate::records::PyStats;
 use crate::{to_py, OptionsArg};
 
 type AppendageArg = (f64, [f64; 2], [f64; 2], f64, f64);
@@ -26,25 +27,155 @@ fn output<'a>(t_eval: &'a Option<Vec<f64>>) -> Output<'a> {
     }
 }
 
-fn rows<'py>(py: Python<'py>, v: Vec<f64>, m: usize, n: usize) -> PyResult<Bound<'py, PyAny>> {
-    Ok(v.into_pyarray(py).reshape([m, n])?.into_any())
+fn rows(py: Python<'_>, v: Vec<f64>, m: usize, n: usize) -> PyResult<Py<PyAny>> {
+    Ok(v.into_pyarray(py).reshape([m, n])?.into_any().unbind())
+}
+
+fn array(py: Python<'_>, v: Vec<f64>) -> Py<PyAny> {
+    v.into_pyarray(py).into_any().unbind()
+}
+
+/// The derived constants of a validated flexible body (`flexible_body_check`), in the units of
+/// its arguments.
+#[pyclass(frozen, get_all, name = "FlexibleBodyConstants", module = "librate._core")]
+pub struct PyFlexibleBodyConstants {
+    /// Hub plus appendage masses.
+    total_mass: f64,
+    /// Hub centre relative to the undeformed system's centre of mass, [x, y].
+    hub_position: [f64; 2],
+    /// Composite moment of inertia about z of the undeformed body.
+    inertia: f64,
+    /// Z0 = (Qxx - Qyy) + 2i Qxy (Q the in-plane second moments of mass): |Z0| = Iy - Ix about
+    /// the composite principal axes, arg(Z0) / 2 the principal x axis from the body x axis.
+    asymmetry: Py<PyComplex>,
+    /// Kz = (Iy - Ix) / Iz of the rigid composite body (principal axes).
+    kz: f64,
+    /// Angle of the composite principal x axis from the body x axis (rad).
+    principal_angle: f64,
+    /// Mass matrix of the deflections, (n, n).
+    mass_matrix: Py<PyAny>,
+    /// Unit deflection direction of each appendage, [tx, ty].
+    directions: Vec<[f64; 2]>,
+}
+
+#[pymethods]
+impl PyFlexibleBodyConstants {
+    fn __repr__(&self) -> String {
+        format!("FlexibleBodyConstants(n={}, total_mass={}, inertia={}, kz={})", self.directions.len(), self.total_mass, self.inertia, self.kz)
+    }
+}
+
+/// The outcome of `flexible_propagate`.
+#[pyclass(frozen, get_all, name = "FlexibleTrajectory", module = "librate._core")]
+pub struct PyFlexibleTrajectory {
+    /// Output times, (m,).
+    t: Py<PyAny>,
+    /// Orbit states, (m, 6).
+    orbit: Py<PyAny>,
+    /// Attitude angle of the body axes (unwrapped), (m,).
+    phi: Py<PyAny>,
+    /// Inertial angular rate, (m,).
+    wz: Py<PyAny>,
+    /// Deflections, (m, n).
+    q: Py<PyAny>,
+    /// Deflection rates, (m, n).
+    qdot: Py<PyAny>,
+    /// Integrator counters.
+    stats: PyStats,
+}
+
+#[pymethods]
+impl PyFlexibleTrajectory {
+    fn __len__(&self, py: Python<'_>) -> PyResult<usize> {
+        self.t.bind(py).len()
+    }
+    fn __repr__(&self, py: Python<'_>) -> PyResult<String> {
+        Ok(format!("FlexibleTrajectory(m={})", self.__len__(py)?))
+    }
+}
+
+/// The outcome of `flexible_quasi_static`: the rigid composite solution, the closed-form
+/// deflections along it and the first-order attitude perturbation.
+#[pyclass(frozen, get_all, name = "QuasiStaticTrajectory", module = "librate._core")]
+pub struct PyQuasiStaticTrajectory {
+    /// Output times, (m,).
+    t: Py<PyAny>,
+    /// Orbit states, (m, 6).
+    orbit: Py<PyAny>,
+    /// Rigid composite attitude angle of the body axes (unwrapped), (m,).
+    phi: Py<PyAny>,
+    /// Rigid composite inertial angular rate, (m,).
+    wz: Py<PyAny>,
+    /// First-order attitude perturbation, (m,).
+    dphi: Py<PyAny>,
+    /// First-order rate perturbation, (m,).
+    dwz: Py<PyAny>,
+    /// Quasi-static deflections, (m, n).
+    q: Py<PyAny>,
+    /// Their rates, (m, n).
+    qdot: Py<PyAny>,
+    /// Their accelerations, (m, n).
+    qddot: Py<PyAny>,
+    /// Torque perturbation (mass LU^2 / TU^2), (m,).
+    dtau: Py<PyAny>,
+    /// Integrator counters.
+    stats: PyStats,
+}
+
+#[pymethods]
+impl PyQuasiStaticTrajectory {
+    fn __len__(&self, py: Python<'_>) -> PyResult<usize> {
+        self.t.bind(py).len()
+    }
+    fn __repr__(&self, py: Python<'_>) -> PyResult<String> {
+        Ok(format!("QuasiStaticTrajectory(m={})", self.__len__(py)?))
+    }
+}
+
+/// The outcome of `flexible_energies`: per state, in the units of the body argument and TU.
+#[pyclass(frozen, get_all, name = "FlexibleEnergies", module = "librate._core")]
+pub struct PyFlexibleEnergies {
+    /// Kinetic energy of the motion relative to the centre of mass (inertial rates), (m,).
+    kinetic: Py<PyAny>,
+    /// Elastic energy sum k_j q_j^2 / 2, (m,).
+    elastic: Py<PyAny>,
+    /// Second-order gravity potential of the enabled primaries, (m,).
+    tidal: Py<PyAny>,
+    /// Inertial angular momentum about the centre of mass, (m,).
+    momentum: Py<PyAny>,
+    /// kinetic + elastic - momentum^2 / (2 I(q)), (m,).
+    structural: Py<PyAny>,
+    /// Tidal torque on the deformed body, (m,).
+    torque: Py<PyAny>,
+    /// Moment of inertia I(q), (m,).
+    inertia: Py<PyAny>,
+}
+
+#[pymethods]
+impl PyFlexibleEnergies {
+    fn __len__(&self, py: Python<'_>) -> PyResult<usize> {
+        self.kinetic.bind(py).len()
+    }
+    fn __repr__(&self, py: Python<'_>) -> PyResult<String> {
+        Ok(format!("FlexibleEnergies(m={})", self.__len__(py)?))
+    }
 }
 
 /// Validate a body; its derived constants.
 #[pyfunction]
-fn flexible_body_check<'py>(py: Python<'py>, body_arg: BodyArg) -> PyResult<Bound<'py, PyDict>> {
+fn flexible_body_check(py: Python<'_>, body_arg: BodyArg) -> PyResult<PyFlexibleBodyConstants> {
     let b = body(body_arg)?;
     let n = b.n();
-    let d = PyDict::new(py);
-    d.set_item("total_mass", b.total_mass())?;
-    d.set_item("hub_position", b.hub_position().to_vec())?;
-    d.set_item("inertia", b.inertia())?;
-    d.set_item("asymmetry", (b.asymmetry().re, b.asymmetry().im))?;
-    d.set_item("kz", b.kz())?;
-    d.set_item("principal_angle", b.principal_angle())?;
-    d.set_item("mass_matrix", rows(py, b.mass_matrix(), n, n)?)?;
-    d.set_item("directions", b.appendages().iter().map(|a| a.direction.to_vec()).collect::<Vec<_>>())?;
-    Ok(d)
+    Ok(PyFlexibleBodyConstants {
+        total_mass: b.total_mass(),
+        hub_position: b.hub_position(),
+        inertia: b.inertia(),
+        asymmetry: PyComplex::from_doubles(py, b.asymmetry().re, b.asymmetry().im).unbind(),
+        kz: b.kz(),
+        principal_angle: b.principal_angle(),
+        mass_matrix: rows(py, b.mass_matrix(), n, n)?,
+        directions: b.appendages().iter().map(|a| a.direction).collect(),
+    })
 }
 
 /// Coupled flexible propagation along an integrated (or held) orbit.
@@ -66,7 +197,7 @@ fn flexible_propagate<'py>(
     tf: f64,
     options: OptionsArg,
     t_eval: Option<PyReadonlyArray1<'py, f64>>,
-) -> PyResult<Bound<'py, PyDict>> {
+) -> PyResult<PyFlexibleTrajectory> {
     let b = body(body_arg)?;
     let opts = Options::from(options);
     let times = t_eval.map(|a| a.as_array().to_vec());
@@ -74,15 +205,15 @@ fn flexible_propagate<'py>(
         .detach(|| flexible::propagate_flexible(mu, &b, primaries, held, &orbit0, phi0, wz0, &q0, &qdot0, t0, tf, &opts, output(&times)))
         .map_err(to_py)?;
     let (m, n) = (tr.t.len(), b.n());
-    let d = PyDict::new(py);
-    d.set_item("t", tr.t.into_pyarray(py))?;
-    d.set_item("orbit", rows(py, tr.orbit, m, 6)?)?;
-    d.set_item("phi", tr.phi.into_pyarray(py))?;
-    d.set_item("wz", tr.wz.into_pyarray(py))?;
-    d.set_item("q", rows(py, tr.q, m, n)?)?;
-    d.set_item("qdot", rows(py, tr.qdot, m, n)?)?;
-    d.set_item("stats", (tr.stats.accepted, tr.stats.rejected, tr.stats.rhs_evals))?;
-    Ok(d)
+    Ok(PyFlexibleTrajectory {
+        t: array(py, tr.t),
+        orbit: rows(py, tr.orbit, m, 6)?,
+        phi: array(py, tr.phi),
+        wz: array(py, tr.wz),
+        q: rows(py, tr.q, m, n)?,
+        qdot: rows(py, tr.qdot, m, n)?,
+        stats: PyStats::from(tr.stats),
+    })
 }
 
 /// Rigid composite solution, closed-form deflections along it and the first-order attitude perturbation.
@@ -102,7 +233,7 @@ fn flexible_quasi_static<'py>(
     tf: f64,
     options: OptionsArg,
     t_eval: Option<PyReadonlyArray1<'py, f64>>,
-) -> PyResult<Bound<'py, PyDict>> {
+) -> PyResult<PyQuasiStaticTrajectory> {
     let b = body(body_arg)?;
     let opts = Options::from(options);
     let times = t_eval.map(|a| a.as_array().to_vec());
@@ -110,29 +241,50 @@ fn flexible_quasi_static<'py>(
         .detach(|| flexible::propagate_quasi_static(mu, &b, primaries, held, &orbit0, phi0, wz0, t0, tf, &opts, output(&times)))
         .map_err(to_py)?;
     let (m, n) = (tr.t.len(), b.n());
-    let d = PyDict::new(py);
-    d.set_item("t", tr.t.into_pyarray(py))?;
-    d.set_item("orbit", rows(py, tr.orbit, m, 6)?)?;
-    d.set_item("phi", tr.phi.into_pyarray(py))?;
-    d.set_item("wz", tr.wz.into_pyarray(py))?;
-    d.set_item("dphi", tr.dphi.into_pyarray(py))?;
-    d.set_item("dwz", tr.dwz.into_pyarray(py))?;
-    d.set_item("q", rows(py, tr.q, m, n)?)?;
-    d.set_item("qdot", rows(py, tr.qdot, m, n)?)?;
-    d.set_item("qddot", rows(py, tr.qddot, m, n)?)?;
-    d.set_item("dtau", tr.dtau.into_pyarray(py))?;
-    d.set_item("stats", (tr.stats.accepted, tr.stats.rejected, tr.stats.rhs_evals))?;
-    Ok(d)
+    Ok(PyQuasiStaticTrajectory {
+        t: array(py, tr.t),
+        orbit: rows(py, tr.orbit, m, 6)?,
+        phi: array(py, tr.phi),
+        wz: array(py, tr.wz),
+        dphi: array(py, tr.dphi),
+        dwz: array(py, tr.dwz),
+        q: rows(py, tr.q, m, n)?,
+        qdot: rows(py, tr.qdot, m, n)?,
+        qddot: rows(py, tr.qddot, m, n)?,
+        dtau: array(py, tr.dtau),
+        stats: PyStats::from(tr.stats),
+    })
 }
 
-/// The closed form at one state: (q, qdot, qddot, wzdot, dtau).
+/// The outcome of `flexible_quasi_static_point`: the closed form at one state.
+#[pyclass(frozen, get_all, name = "QuasiStaticPoint", module = "librate._core")]
+pub struct PyQuasiStaticPoint {
+    /// Quasi-static deflections, (n,).
+    q: Vec<f64>,
+    /// Their rates, (n,).
+    qdot: Vec<f64>,
+    /// Their accelerations, (n,).
+    qddot: Vec<f64>,
+    /// wzdot of the rigid composite model.
+    wzdot: f64,
+    /// The first-order torque perturbation.
+    dtau: f64,
+}
+
+#[pymethods]
+impl PyQuasiStaticPoint {
+    fn __repr__(&self) -> String {
+        format!("QuasiStaticPoint(n={}, wzdot={}, dtau={})", self.q.len(), self.wzdot, self.dtau)
+    }
+}
+
+/// The closed form at one state.
 #[pyfunction]
 #[allow(clippy::too_many_arguments)]
-#[allow(clippy::type_complexity)]
-fn flexible_quasi_static_point(mu: f64, body_arg: BodyArg, primaries: [bool; 2], held: bool, orbit: [f64; 6], phi: f64, wz: f64) -> PyResult<(Vec<f64>, Vec<f64>, Vec<f64>, f64, f64)> {
+fn flexible_quasi_static_point(mu: f64, body_arg: BodyArg, primaries: [bool; 2], held: bool, orbit: [f64; 6], phi: f64, wz: f64) -> PyResult<PyQuasiStaticPoint> {
     let b = body(body_arg)?;
     let p = flexible::quasi_static_point(mu, &b, primaries, held, &orbit, phi, wz).map_err(to_py)?;
-    Ok((p.q, p.qdot, p.qddot, p.wzdot, p.dtau))
+    Ok(PyQuasiStaticPoint { q: p.q, qdot: p.qdot, qddot: p.qddot, wzdot: p.wzdot, dtau: p.dtau })
 }
 
 /// Energies, momentum, torque and inertia of states (orbit (m, 6), phi, wz (m,), q, qdot (m, n)).
@@ -148,22 +300,23 @@ fn flexible_energies<'py>(
     wz: PyReadonlyArray1<'py, f64>,
     q: PyReadonlyArray2<'py, f64>,
     qdot: PyReadonlyArray2<'py, f64>,
-) -> PyResult<Bound<'py, PyDict>> {
+) -> PyResult<PyFlexibleEnergies> {
     let b = body(body_arg)?;
     let flat = |a: &PyReadonlyArray2<'py, f64>| -> Vec<f64> { a.as_array().iter().copied().collect() };
     if q.shape()[1] != b.n() || qdot.shape()[1] != b.n() || orbit.shape()[1] != 6 {
         return Err(PyValueError::new_err(format!("invalid argument `states`: orbit must be (m, 6) and q, qdot (m, {})", b.n())));
     }
     let e = flexible::evaluate_energies(mu, &b, primaries, &flat(&orbit), phi.as_slice()?, wz.as_slice()?, &flat(&q), &flat(&qdot)).map_err(to_py)?;
-    let d = PyDict::new(py);
-    d.set_item("kinetic", e.iter().map(|e| e.kinetic).collect::<Vec<_>>().into_pyarray(py))?;
-    d.set_item("elastic", e.iter().map(|e| e.elastic).collect::<Vec<_>>().into_pyarray(py))?;
-    d.set_item("tidal", e.iter().map(|e| e.tidal).collect::<Vec<_>>().into_pyarray(py))?;
-    d.set_item("momentum", e.iter().map(|e| e.momentum).collect::<Vec<_>>().into_pyarray(py))?;
-    d.set_item("structural", e.iter().map(|e| e.structural).collect::<Vec<_>>().into_pyarray(py))?;
-    d.set_item("torque", e.iter().map(|e| e.torque).collect::<Vec<_>>().into_pyarray(py))?;
-    d.set_item("inertia", e.iter().map(|e| e.inertia).collect::<Vec<_>>().into_pyarray(py))?;
-    Ok(d)
+    let col = |f: fn(&flexible::Energies) -> f64| array(py, e.iter().map(f).collect());
+    Ok(PyFlexibleEnergies {
+        kinetic: col(|e| e.kinetic),
+        elastic: col(|e| e.elastic),
+        tidal: col(|e| e.tidal),
+        momentum: col(|e| e.momentum),
+        structural: col(|e| e.structural),
+        torque: col(|e| e.torque),
+        inertia: col(|e| e.inertia),
+    })
 }
 
 /// The right-hand side at one state (orbit held): (wzdot, qddot).
@@ -177,12 +330,33 @@ fn flexible_rates(mu: f64, body_arg: BodyArg, primaries: [bool; 2], orbit: [f64;
     Ok(flexible::flexible_rates(mu, &b, primaries, &orbit, phi, wz, &q, &qdot))
 }
 
+/// The outcome of `flexible_correct_periodic`.
+#[pyclass(frozen, get_all, name = "FlexiblePeriodicCorrection", module = "librate._core")]
+pub struct PyFlexiblePeriodicCorrection {
+    /// (phi0, wz0, q0 (n), qdot0 (n)) at the last accepted point, (m,) with m = 2 + 2n.
+    x: Py<PyAny>,
+    /// Max-norm of the scaled residual there.
+    residual: f64,
+    /// Newton iterations taken.
+    iterations: usize,
+    /// Why the corrector stopped ("converged", "max_iterations", ...).
+    reason: &'static str,
+    /// d y(T) / d x from the last Jacobian, (m, m).
+    monodromy: Py<PyAny>,
+}
+
+#[pymethods]
+impl PyFlexiblePeriodicCorrection {
+    fn __repr__(&self) -> String {
+        format!("FlexiblePeriodicCorrection(reason='{}', iterations={}, residual={:e})", self.reason, self.iterations, self.residual)
+    }
+}
+
 /// Correct (phi0, wz0, q0, qdot0) to a periodic motion of the coupled flexible model over one
-/// orbit period (librate_core::flexible::correct_flexible_periodic): returns (x, scaled residual
-/// max-norm, iterations, stop reason, monodromy (m, m)).
+/// orbit period (librate_core::flexible::correct_flexible_periodic).
 #[pyfunction]
 #[pyo3(signature = (mu, body_arg, primaries, orbit0, period, x0, turns, scale, *, options, tol, max_iter, threads=None))]
-#[allow(clippy::too_many_arguments, clippy::type_complexity)]
+#[allow(clippy::too_many_arguments)]
 fn flexible_correct_periodic<'py>(
     py: Python<'py>,
     mu: f64,
@@ -197,17 +371,23 @@ fn flexible_correct_periodic<'py>(
     tol: f64,
     max_iter: usize,
     threads: Option<usize>,
-) -> PyResult<(Bound<'py, PyAny>, f64, usize, &'static str, Bound<'py, PyAny>)> {
+) -> PyResult<PyFlexiblePeriodicCorrection> {
     let b = body(body_arg)?;
     let opts = Options::from(options);
     let r = py
         .detach(|| flexible::correct_flexible_periodic(mu, &b, primaries, &orbit0, period, &x0, turns, &scale, &opts, tol, max_iter, threads))
         .map_err(to_py)?;
     let m = r.x.len();
-    Ok((r.x.into_pyarray(py).into_any(), r.residual, r.iterations, r.reason.as_str(), r.monodromy.into_pyarray(py).reshape([m, m])?.into_any()))
+    Ok(PyFlexiblePeriodicCorrection { x: array(py, r.x), residual: r.residual, iterations: r.iterations, reason: r.reason.as_str(), monodromy: rows(py, r.monodromy, m, m)? })
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<PyFlexibleBodyConstants>()?;
+    m.add_class::<PyFlexibleTrajectory>()?;
+    m.add_class::<PyQuasiStaticTrajectory>()?;
+    m.add_class::<PyFlexibleEnergies>()?;
+    m.add_class::<PyQuasiStaticPoint>()?;
+    m.add_class::<PyFlexiblePeriodicCorrection>()?;
     m.add_function(wrap_pyfunction!(flexible_correct_periodic, m)?)?;
     m.add_function(wrap_pyfunction!(flexible_body_check, m)?)?;
     m.add_function(wrap_pyfunction!(flexible_propagate, m)?)?;

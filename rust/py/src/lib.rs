@@ -7,7 +7,7 @@
 use librate_core::cr3bp::{self, SystemConstants, PRESETS};
 use librate_core::error::Error;
 use librate_core::integrate::{Options, Output, Status};
-use librate_core::periodic::{correct_multiple_shooting, MemberCondition, Constraint, Evaluation, Stability, SymmetricShooting, Var};
+use librate_core::periodic::{correct_multiple_shooting, MemberCondition, Constraint, Stability, SymmetricShooting, Var};
 use numpy::Complex64;
 use librate_core::propagation::{self, Collision, EventKind, EventSpec};
 use numpy::ndarray::Array2;
@@ -15,13 +15,16 @@ use numpy::{IntoPyArray, PyArray1, PyArrayMethods, PyReadonlyArray1, PyReadonlyA
 use pyo3::create_exception;
 use pyo3::exceptions::{PyException, PyValueError};
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
+use pyo3::types::{PyDict, PyTuple};
 
 mod attitude;
 mod attitude3d;
 mod flexible;
 mod fourier;
 mod map;
+mod records;
+
+use records::{PyBatchResult, PyEventHit, PyMultipleShooting, PyShootingEvaluation, PyStats, PySymmetricOrbit, PySystemConstants, PyTrajectory};
 
 create_exception!(librate, LibrateError, PyException, "Base class of librate's errors.");
 create_exception!(
@@ -123,7 +126,7 @@ fn event_specs(events: Vec<(String, Vec<f64>, i8, bool)>) -> PyResult<Vec<EventS
         .collect()
 }
 
-/// Propagate one CR3BP state; returns a dict of arrays (see `librate.propagate`).
+/// Propagate one CR3BP state (see `librate.propagate`).
 #[pyfunction]
 #[pyo3(signature = (mu, state, t0, tf, *, options, stm, t_eval, events, collision=None))]
 #[allow(clippy::too_many_arguments)]
@@ -138,7 +141,7 @@ fn propagate<'py>(
     t_eval: Option<PyReadonlyArray1<'py, f64>>,
     events: Vec<(String, Vec<f64>, i8, bool)>,
     collision: Option<(f64, f64)>,
-) -> PyResult<Bound<'py, PyDict>> {
+) -> PyResult<PyTrajectory> {
     let s = state6("state", state.as_slice()?)?;
     let opts = Options::from(options);
     let specs = event_specs(events)?;
@@ -157,28 +160,28 @@ fn propagate<'py>(
         })
         .map_err(to_py)?;
     let n = tr.t.len();
-    let out = PyDict::new(py);
-    out.set_item("t", tr.t.into_pyarray(py))?;
-    out.set_item("y", tr.states.into_pyarray(py).reshape([n, 6])?)?;
-    out.set_item("t_final", tr.t_final)?;
-    out.set_item("y_final", tr.state_final.to_vec().into_pyarray(py))?;
-    out.set_item("stm", tr.stm_final.as_ref().map(|m| mat6(py, m)))?;
-    let evs: Vec<(usize, f64, Bound<'py, PyArray1<f64>>, Option<Bound<'py, PyAny>>)> = tr
+    let events = tr
         .events
         .iter()
-        .map(|e| (e.index, e.t, e.state.to_vec().into_pyarray(py), e.stm.as_ref().map(|m| mat6(py, m))))
-        .collect();
-    out.set_item("events", evs)?;
+        .map(|e| Py::new(py, PyEventHit { index: e.index, t: e.t, y: e.state.to_vec().into_pyarray(py).into_any().unbind(), stm: e.stm.as_ref().map(|m| mat6(py, m).unbind()) }))
+        .collect::<PyResult<Vec<_>>>()?;
     let (status, event_index) = match (tr.status, tr.collision) {
         (_, Some(_)) => ("collision", None),
         (Status::Completed, None) => ("completed", None),
         (Status::Terminated { event }, None) => ("event", Some(event)),
     };
-    out.set_item("collision", tr.collision.map(|h| to_py(h.error(tr.stats.steps())).into_value(py)))?;
-    out.set_item("status", status)?;
-    out.set_item("event_index", event_index)?;
-    out.set_item("stats", (tr.stats.accepted, tr.stats.rejected, tr.stats.rhs_evals))?;
-    Ok(out)
+    Ok(PyTrajectory {
+        t: tr.t.into_pyarray(py).into_any().unbind(),
+        y: tr.states.into_pyarray(py).reshape([n, 6])?.into_any().unbind(),
+        t_final: tr.t_final,
+        y_final: tr.state_final.to_vec().into_pyarray(py).into_any().unbind(),
+        stm: tr.stm_final.as_ref().map(|m| mat6(py, m).unbind()),
+        events: PyTuple::new(py, events)?.unbind(),
+        status,
+        event_index,
+        collision: tr.collision.map(|h| to_py(h.error(tr.stats.steps())).into_value(py).into_any()),
+        stats: PyStats::from(tr.stats),
+    })
 }
 
 /// Propagate many states to their final times on all cores; failed members are reported, not raised.
@@ -195,7 +198,7 @@ fn propagate_many<'py>(
     stm: bool,
     threads: Option<usize>,
     collision: Option<(f64, f64)>,
-) -> PyResult<Bound<'py, PyDict>> {
+) -> PyResult<PyBatchResult> {
     let spheres = collision.map(|(a, b)| Collision::new([a, b])).transpose().map_err(to_py)?;
     if states.shape()[1] != 6 {
         return Err(PyValueError::new_err(format!("invalid argument `states`: must have shape (n, 6), got {:?}", states.shape())));
@@ -211,7 +214,7 @@ fn propagate_many<'py>(
     let mut stats = Vec::with_capacity(n * 3);
     // per member: 0 completed, 1 / 2 collision with primary 1 / 2, 3 another integration error
     let mut status: Vec<u8> = Vec::with_capacity(n);
-    let errors = pyo3::types::PyList::empty(py);
+    let errors = PyDict::new(py);
     for (i, r) in results.iter().enumerate() {
         match r {
             Ok(f) => {
@@ -234,18 +237,18 @@ fn propagate_many<'py>(
                     _ => 3,
                 });
                 stats.extend([0u64; 3]);
-                errors.append((i, to_py(e.clone()).into_value(py)))?;
+                errors.set_item(i, to_py(e.clone()).into_value(py))?;
             }
         }
     }
-    let out = PyDict::new(py);
-    out.set_item("y", y.into_pyarray(py).reshape([n, 6])?)?;
-    out.set_item("stm", if stm { Some(m.into_pyarray(py).reshape([n, 6, 6])?) } else { None })?;
-    out.set_item("ok", ok.into_pyarray(py))?;
-    out.set_item("status", status.into_pyarray(py))?;
-    out.set_item("errors", errors)?;
-    out.set_item("stats", stats.into_pyarray(py).reshape([n, 3])?)?;
-    Ok(out)
+    Ok(PyBatchResult {
+        y: y.into_pyarray(py).reshape([n, 6])?.into_any().unbind(),
+        stm: if stm { Some(m.into_pyarray(py).reshape([n, 6, 6])?.into_any().unbind()) } else { None },
+        ok: ok.into_pyarray(py).into_any().unbind(),
+        status: status.into_pyarray(py).into_any().unbind(),
+        errors: errors.unbind(),
+        stats: stats.into_pyarray(py).reshape([n, 3])?.into_any().unbind(),
+    })
 }
 
 /// Jacobi constant of each row of an (n, 6) array.
@@ -267,22 +270,16 @@ fn lagrange_points<'py>(py: Python<'py>, mu: f64) -> PyResult<Bound<'py, PyAny>>
     Ok(Array2::from_shape_fn((5, 3), |(i, j)| lp[i][j]).into_pyarray(py).into_any())
 }
 
-type SystemTuple = (String, f64, f64, f64, f64, f64);
-
-fn system_tuple(s: SystemConstants) -> SystemTuple {
-    (s.name, s.mu, s.lu_km, s.tu_s, s.r1_km, s.r2_km)
-}
-
-/// (name, mu, lu_km, tu_s, r1_km, r2_km) of a preset.
+/// The constants of a preset.
 #[pyfunction]
-fn system_preset(name: &str) -> PyResult<SystemTuple> {
-    SystemConstants::preset(name).map(system_tuple).map_err(to_py)
+fn system_preset(name: &str) -> PyResult<PySystemConstants> {
+    SystemConstants::preset(name).map(PySystemConstants::from).map_err(to_py)
 }
 
 /// Validate user-defined system constants (raises ValueError naming the bad one).
 #[pyfunction]
-fn system_validate(name: String, mu: f64, lu_km: f64, tu_s: f64, r1_km: f64, r2_km: f64) -> PyResult<SystemTuple> {
-    SystemConstants::new(name, mu, lu_km, tu_s, r1_km, r2_km).map(system_tuple).map_err(to_py)
+fn system_validate(name: String, mu: f64, lu_km: f64, tu_s: f64, r1_km: f64, r2_km: f64) -> PyResult<PySystemConstants> {
+    SystemConstants::new(name, mu, lu_km, tu_s, r1_km, r2_km).map(PySystemConstants::from).map_err(to_py)
 }
 
 /// Names of the system presets.
@@ -309,20 +306,6 @@ fn constraint(kind: &str, v: &[f64]) -> PyResult<Constraint> {
     })
 }
 
-fn evaluation_dict<'py>(py: Python<'py>, e: &Evaluation) -> PyResult<Bound<'py, PyDict>> {
-    let d = PyDict::new(py);
-    d.set_item("p", e.p.to_vec())?;
-    d.set_item("cond", e.cond.to_vec())?;
-    d.set_item("dcond", e.dcond.iter().map(|r| r.to_vec()).collect::<Vec<_>>())?;
-    d.set_item("half_period", e.half_period)?;
-    d.set_item("dhalf", e.dhalf.to_vec())?;
-    d.set_item("jacobi", e.jacobi)?;
-    d.set_item("djacobi", e.djacobi.to_vec())?;
-    d.set_item("crossing", e.crossing.to_vec())?;
-    d.set_item("monodromy", e.monodromy().map(|m| m.iter().map(|r| r.to_vec()).collect::<Vec<_>>()))?;
-    Ok(d)
-}
-
 fn shooting(mu: f64, spatial: bool, tol: f64, max_iter: usize, t_max: f64, rtol: f64, atol: f64) -> SymmetricShooting {
     let mut sh = SymmetricShooting::new(mu, spatial, Options::with_tolerances(rtol, atol));
     sh.tol = tol;
@@ -347,18 +330,18 @@ fn symmetric_correct<'py>(
     t_max: f64,
     rtol: f64,
     atol: f64,
-) -> PyResult<Bound<'py, PyDict>> {
+) -> PyResult<PySymmetricOrbit> {
     let c = self::constraint(constraint, &values)?;
     let sh = shooting(mu, spatial, tol, max_iter, t_max, rtol, atol);
     let o = py.detach(|| sh.correct(p, c)).map_err(to_py)?;
-    let d = PyDict::new(py);
-    d.set_item("state0", o.state0.to_vec().into_pyarray(py))?;
-    d.set_item("period", o.period)?;
-    d.set_item("jacobi", o.jacobi)?;
-    d.set_item("iterations", o.iterations)?;
-    d.set_item("residual", o.residual)?;
-    d.set_item("evaluation", evaluation_dict(py, &o.evaluation)?)?;
-    Ok(d)
+    Ok(PySymmetricOrbit {
+        state0: o.state0.to_vec().into_pyarray(py).into_any().unbind(),
+        period: o.period,
+        jacobi: o.jacobi,
+        iterations: o.iterations,
+        residual: o.residual,
+        evaluation: Py::new(py, PyShootingEvaluation::new(py, &o.evaluation))?,
+    })
 }
 
 /// Eigenvalues (6,) and the two stability indices (2,) of a monodromy matrix, both complex.
@@ -391,7 +374,7 @@ fn multiple_shooting<'py>(
     max_iter: usize,
     rtol: f64,
     atol: f64,
-) -> PyResult<Bound<'py, PyDict>> {
+) -> PyResult<PyMultipleShooting> {
     if patches.shape()[1] != 6 || patches.shape()[0] == 0 {
         return Err(PyValueError::new_err(format!("invalid argument `states`: must have shape (n, 6) with n >= 1, got {:?}", patches.shape())));
     }
@@ -405,13 +388,7 @@ fn multiple_shooting<'py>(
     let o = py.detach(|| correct_multiple_shooting(mu, &rows, period, cond, tol, max_iter, &opts)).map_err(to_py)?;
     let n = o.patches.len();
     let flat: Vec<f64> = o.patches.iter().flatten().copied().collect();
-    let d = PyDict::new(py);
-    d.set_item("patches", flat.into_pyarray(py).reshape([n, 6])?)?;
-    d.set_item("period", o.period)?;
-    d.set_item("jacobi", o.jacobi)?;
-    d.set_item("iterations", o.iterations)?;
-    d.set_item("residual", o.residual)?;
-    Ok(d)
+    Ok(PyMultipleShooting { patches: flat.into_pyarray(py).reshape([n, 6])?.into_any().unbind(), period: o.period, jacobi: o.jacobi, iterations: o.iterations, residual: o.residual })
 }
 
 #[pymodule]
@@ -436,6 +413,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     map::register(m)?;
     flexible::register(m)?;
     attitude3d::register(m)?;
+    records::register(m)?;
     // Physical constants, read from the core (one definition: librate_core::constants).
     m.add("N_SUN", librate_core::constants::N_SUN)?;
     m.add("OMEGA_SUN", librate_core::constants::OMEGA_SUN)?;
