@@ -139,12 +139,12 @@ def attitude_equilibrium(system: System | str, point, body: RigidBody, q0=None) 
     if q.shape != (4,) or not np.all(np.isfinite(q)):
         raise ValueError(f"invalid argument `q0`: must be 4 finite numbers (a scalar-last quaternion), got {q0!r}")
     r = _core.attitude_equilibrium(sys_.mu, list(body.moments), k, [float(v) for v in q])
-    state = np.asarray(r["state"])
+    state = np.asarray(r.state)
     a = _dcm(state[6:10])
     moments = tuple(float(v) for v in (a * a).T @ np.asarray(body.moments))
-    m = np.asarray(r["matrix"])
-    return AttitudeEquilibrium(sys_, k, body, state[6:10], state[10:], state[:3], float(r["sigma"]), moments, m, np.linalg.eigvals(m),
-                               float(r["residual"]))
+    m = np.asarray(r.matrix)
+    return AttitudeEquilibrium(sys_, k, body, state[6:10], state[10:], state[:3], float(r.sigma), moments, m, np.linalg.eigvals(m),
+                               float(r.residual))
 
 
 def _dcm(q) -> np.ndarray:

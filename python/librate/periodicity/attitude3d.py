@@ -229,15 +229,15 @@ def periodic_attitude_3d(orbit: PeriodicOrbit, body: RigidBody, *, guess, n_peri
     T = n_periods * float(orbit.period)
     r = _core.attitude_correct_3d(orbit.system.mu, list(body.moments), [float(v) for v in orbit.state0], T, q[None, :], w[None, :],
                                   tol=float(tol), max_iter=int(max_iter), rtol=SOLVE_RTOL, atol=SOLVE_RTOL, half=half)
-    if r["reason"][0] != "converged":
-        raise ConvergenceError(f"periodic 3-D attitude: the corrector stopped ({r['reason'][0].replace('_', ' ')}) after {int(r['iterations'][0])} "
-                               f"Newton steps, residual {float(r['residual_norm'][0]):.3e} (tolerance {tol:.1e})")
-    q0, w0 = np.asarray(r["q0"][0]), np.asarray(r["w0"][0])
+    if r.reason[0] != "converged":
+        raise ConvergenceError(f"periodic 3-D attitude: the corrector stopped ({r.reason[0].replace('_', ' ')}) after {int(r.iterations[0])} "
+                               f"Newton steps, residual {float(r.residual_norm[0]):.3e} (tolerance {tol:.1e})")
+    q0, w0 = np.asarray(r.q0[0]), np.asarray(r.w0[0])
     t = np.linspace(0.0, T, 512 * n_periods + 1)
     tr = propagate_attitude(orbit.system, orbit.state0, (q0, w0), body, T, t_eval=t, rtol=VERIFY_RTOL, atol=VERIFY_RTOL)
     d_rot = float(np.linalg.norm(_rotvec(q0, tr.q[-1])))
     d_w = float(np.linalg.norm(tr.w[-1] - w0))
-    return AttitudeSolution3D(orbit, body, n_periods, q0, w0, np.asarray(r["monodromy"][0]), d_rot, d_w, _turns(tr.q), int(r["iterations"][0]))
+    return AttitudeSolution3D(orbit, body, n_periods, q0, w0, np.asarray(r.monodromy[0]), d_rot, d_w, _turns(tr.q), int(r.iterations[0]))
 
 
 def out_of_plane_stability(solution: AttitudeSolution) -> AttitudeSolution3D:

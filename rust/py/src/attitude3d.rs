@@ -7,32 +7,79 @@ use numpy::ndarray::{Array2, Array3};
 use numpy::{IntoPyArray, PyReadonlyArray2};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
 
 use crate::to_py;
+
+/// The linearised attitude at a collinear point (librate_core::attitude::collinear_equilibrium).
+#[pyclass(frozen, get_all, name = "LinearisedEquilibrium", module = "librate._core")]
+pub struct PyLinearisedEquilibrium {
+    /// The 13-state equilibrium (orbit, quaternion scalar last, rate), (13,).
+    pub state: Py<PyAny>,
+    /// d(theta, dw)/dt of the small rotation theta and the rate change dw, (6, 6).
+    pub matrix: Py<PyAny>,
+    /// The tidal coefficient sigma = (1 - mu)/r1^3 + mu/r2^3 at the point.
+    pub sigma: f64,
+    /// Max |d state / dt| at the equilibrium (zero up to rounding).
+    pub residual: f64,
+}
+
+#[pymethods]
+impl PyLinearisedEquilibrium {
+    fn __repr__(&self) -> String {
+        format!("LinearisedEquilibrium(sigma={}, residual={:e})", self.sigma, self.residual)
+    }
+}
+
+/// The outcome of a batch of 3-D periodic-attitude corrections, one row per candidate
+/// (librate_core::periodic::correct_attitudes_3d).
+#[pyclass(frozen, get_all, name = "CorrectionBatch3D", module = "librate._core")]
+pub struct PyCorrectionBatch3D {
+    /// Initial attitude relative to the synodic frame, scalar last, (n, 4).
+    pub q0: Py<PyAny>,
+    /// Initial inertial rate in body axes (rad/TU), (n, 3).
+    pub w0: Py<PyAny>,
+    /// (rotation vector of R(0)^T R(KT), w(KT) - w0), (n, 6).
+    pub residual: Py<PyAny>,
+    pub residual_norm: Py<PyAny>,
+    pub iterations: Py<PyAny>,
+    /// Why each candidate stopped ("converged", "max_iterations", ...).
+    pub reason: Vec<&'static str>,
+    /// The 6x6 attitude monodromy, (n, 6, 6).
+    pub monodromy: Py<PyAny>,
+}
+
+#[pymethods]
+impl PyCorrectionBatch3D {
+    fn __len__(&self) -> usize {
+        self.reason.len()
+    }
+    fn __repr__(&self) -> String {
+        let c = self.reason.iter().filter(|r| **r == "converged").count();
+        format!("CorrectionBatch3D(n={}, converged={c})", self.reason.len())
+    }
+}
 
 fn mat<'py, const R: usize, const C: usize>(py: Python<'py>, m: &[[f64; C]; R]) -> Bound<'py, PyAny> {
     Array2::from_shape_fn((R, C), |(i, j)| m[i][j]).into_pyarray(py).into_any()
 }
 
 /// The linearised attitude of a body held at a collinear point with its principal axes on the
-/// synodic axes: dict(state (13), matrix (6x6, d(theta, dw)/dt), sigma, residual).
+/// synodic axes.
 #[pyfunction]
-fn attitude_equilibrium<'py>(py: Python<'py>, mu: f64, inertia: [f64; 3], point: u8, q0: [f64; 4]) -> PyResult<Bound<'py, PyDict>> {
+fn attitude_equilibrium(py: Python<'_>, mu: f64, inertia: [f64; 3], point: u8, q0: [f64; 4]) -> PyResult<PyLinearisedEquilibrium> {
     let body = RigidBody::new(inertia[0], inertia[1], inertia[2]).map_err(to_py)?;
     let e = py.detach(|| collinear_equilibrium(mu, body, point, &q0)).map_err(to_py)?;
-    let d = PyDict::new(py);
-    d.set_item("state", e.state.to_vec().into_pyarray(py))?;
-    d.set_item("matrix", mat(py, &e.matrix))?;
-    d.set_item("sigma", e.sigma)?;
-    d.set_item("residual", e.residual)?;
-    Ok(d)
+    Ok(PyLinearisedEquilibrium {
+        state: e.state.to_vec().into_pyarray(py).into_any().unbind(),
+        matrix: mat(py, &e.matrix).unbind(),
+        sigma: e.sigma,
+        residual: e.residual,
+    })
 }
 
 /// Batched 3-D periodic-attitude corrector: guesses q (n x 4, scalar last) and w (n x 3) along
 /// the orbit started at `orbit0`, closure over `t_final` (K T; `half`: the mirror-symmetric
-/// half-period form). dict of arrays (q0, w0, residual,
-/// residual_norm, iterations, reason, monodromy n x 6 x 6).
+/// half-period form).
 #[pyfunction]
 #[pyo3(signature = (mu, inertia, orbit0, t_final, q, w, *, tol, max_iter, rtol, atol, max_halvings=10, primaries=[true, true], threads=None, half=false))]
 fn attitude_correct_3d<'py>(
@@ -51,7 +98,7 @@ fn attitude_correct_3d<'py>(
     primaries: [bool; 2],
     threads: Option<usize>,
     half: bool,
-) -> PyResult<Bound<'py, PyDict>> {
+) -> PyResult<PyCorrectionBatch3D> {
     let body = RigidBody::new(inertia[0], inertia[1], inertia[2]).map_err(to_py)?;
     let (qa, wa) = (q.as_array(), w.as_array());
     if qa.ncols() != 4 || wa.ncols() != 3 || qa.nrows() != wa.nrows() {
@@ -61,18 +108,20 @@ fn attitude_correct_3d<'py>(
     let opts = Options3d { tol, max_iter, max_halvings, rtol, atol, threads, primaries, half, ..Options3d::default() };
     let out = py.detach(|| correct_attitudes_3d(mu, body, &orbit0, t_final, &starts, &opts)).map_err(to_py)?;
     let n = out.len();
-    let d = PyDict::new(py);
-    d.set_item("q0", Array2::from_shape_fn((n, 4), |(i, k)| out[i].q0[k]).into_pyarray(py))?;
-    d.set_item("w0", Array2::from_shape_fn((n, 3), |(i, k)| out[i].w0[k]).into_pyarray(py))?;
-    d.set_item("residual", Array2::from_shape_fn((n, 6), |(i, k)| out[i].residual[k]).into_pyarray(py))?;
-    d.set_item("residual_norm", out.iter().map(|c| c.residual_norm).collect::<Vec<_>>().into_pyarray(py))?;
-    d.set_item("iterations", out.iter().map(|c| c.iterations as i64).collect::<Vec<_>>().into_pyarray(py))?;
-    d.set_item("reason", out.iter().map(|c| c.reason.as_str()).collect::<Vec<_>>())?;
-    d.set_item("monodromy", Array3::from_shape_fn((n, 6, 6), |(i, r, c)| out[i].monodromy[r][c]).into_pyarray(py))?;
-    Ok(d)
+    Ok(PyCorrectionBatch3D {
+        q0: Array2::from_shape_fn((n, 4), |(i, k)| out[i].q0[k]).into_pyarray(py).into_any().unbind(),
+        w0: Array2::from_shape_fn((n, 3), |(i, k)| out[i].w0[k]).into_pyarray(py).into_any().unbind(),
+        residual: Array2::from_shape_fn((n, 6), |(i, k)| out[i].residual[k]).into_pyarray(py).into_any().unbind(),
+        residual_norm: out.iter().map(|c| c.residual_norm).collect::<Vec<_>>().into_pyarray(py).into_any().unbind(),
+        iterations: out.iter().map(|c| c.iterations as i64).collect::<Vec<_>>().into_pyarray(py).into_any().unbind(),
+        reason: out.iter().map(|c| c.reason.as_str()).collect(),
+        monodromy: Array3::from_shape_fn((n, 6, 6), |(i, r, c)| out[i].monodromy[r][c]).into_pyarray(py).into_any().unbind(),
+    })
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<PyLinearisedEquilibrium>()?;
+    m.add_class::<PyCorrectionBatch3D>()?;
     m.add_function(wrap_pyfunction!(attitude_correct_3d, m)?)?;
     m.add_function(wrap_pyfunction!(attitude_equilibrium, m)?)?;
     Ok(())
