@@ -197,6 +197,7 @@ def test_family_along_the_l2_southern_halos_reaches_the_9_2_nrho(em):
     for c in changes:
         a, b = (round(float(p), 9) for p in c["between"])
         assert (on_circle[a], on_circle[b]) == tuple(c["on_unit_circle"])
+        assert c["located"] and min(a, b) < c["at"] < max(a, b)
     # turns of the body x axis about synodic Z: whole numbers wherever defined (this family's
     # motions are tilted: the count depends on the tilt, 0, -1 or -2 along it)
     t = ds.turns.values[np.isfinite(ds.turns.values)]
@@ -294,3 +295,28 @@ def test_two_periods(dro, planar_n_minus_1):
     assert two.w0[2] == pytest.approx(one.w0[2], abs=1e-10)
     assert np.max(np.abs(two.monodromy - one.monodromy @ one.monodromy)) < 1e-8 * np.max(np.abs(two.monodromy))
     assert two.turns == pytest.approx(-2.0, abs=1e-9) and two.residual < 1e-9
+
+
+def test_floquet_test_functions():
+    """The test functions of the 3-D families' stability changes, against the multipliers they
+    come from (a 6x6 matrix built with three reciprocal pairs: a real pair lambda = 3, a pair
+    e^(+-0.7i) on the unit circle and a real pair through -1 at lambda = -2): Q(u) at u = +-2
+    equals prod_k (+-2 - u_k) with u_k = lambda_k + 1/lambda_k, and the discriminant of Q equals
+    prod_{j<k} (u_j - u_k)^2; to 1e-10 relative (the traces of M^3 lose a few digits)."""
+    from librate.periodicity.attitude3d import floquet_tests
+
+    rng = np.random.default_rng(7)
+    lam = np.array([3.0, 1 / 3.0, np.exp(0.7j), np.exp(-0.7j), -2.0, -0.5])
+    v = rng.normal(size=(6, 6))
+    # a real matrix with these eigenvalues: the complex pair as a 2x2 rotation block
+    d = np.zeros((6, 6))
+    d[0, 0], d[1, 1], d[4, 4], d[5, 5] = 3.0, 1 / 3.0, -2.0, -0.5
+    d[2:4, 2:4] = [[np.cos(0.7), -np.sin(0.7)], [np.sin(0.7), np.cos(0.7)]]
+    m = v @ d @ np.linalg.inv(v)
+    u = np.array([3 + 1 / 3, 2 * np.cos(0.7), -2.5])
+    t = floquet_tests(m)
+    assert t["Q(2)"] == pytest.approx(np.prod(2 - u), rel=1e-10)
+    assert t["Q(-2)"] == pytest.approx(np.prod(-2 - u), rel=1e-10)
+    disc = ((u[0] - u[1]) * (u[0] - u[2]) * (u[1] - u[2])) ** 2
+    assert t["discriminant"] == pytest.approx(disc, rel=1e-10)
+    assert np.allclose(np.sort_complex(np.linalg.eigvals(m)), np.sort_complex(lam))

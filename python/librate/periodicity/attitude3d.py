@@ -47,7 +47,7 @@ from ..orbits.periodic import PeriodicOrbit
 from .solutions import AttitudeSolution
 
 __all__ = ["AttitudeSolution3D", "periodic_attitude_3d", "is_mirror_symmetric", "out_of_plane_stability", "out_of_plane_family", "attitude_family_3d",
-           "attitude_family_3d_inertia", "OrbitFamilyBranch3D", "InertiaBranch3D", "STABILITY_TOL", "VERIFY_RTOL",
+           "attitude_family_3d_inertia", "OrbitFamilyBranch3D", "InertiaBranch3D", "STABILITY_TOL", "VERIFY_RTOL", "floquet_tests",
            "SOLVE_RTOL"]
 
 #: A multiplier lies on the unit circle when ||m| - 1| <= STABILITY_TOL. The monodromy is
@@ -354,6 +354,9 @@ class OrbitFamilyBranch3D:
     def tangent(self, point):
         return None
 
+    def tests(self, point):
+        return floquet_tests(point.data.monodromy)
+
 
 def attitude_family_3d(orbits, body: RigidBody, *, guess, period_days, n_periods: int = 1, tol: float = 1e-12, ds_min: float = 1e-4):
     """A periodic 3-D attitude motion of ``body`` continued along the orbit family ``orbits``
@@ -373,11 +376,11 @@ def attitude_family_3d(orbits, body: RigidBody, *, guess, period_days, n_periods
 
     Attributes:
 
-    - ``stability_changes``: the consecutive members (``between``: their two parameter values)
-      between which the number of multipliers on the unit circle changes, with the kind of the
-      crossing. A real pair leaving through +1 or
-      -1 is "+1" or "-1"; two pairs colliding on the circle and leaving it is "krein". These are
-      detected between members, not located.
+    - ``stability_changes``: where a pair of multipliers passes +1 or -1 ("+1", "-1") or two
+      pairs collide ("krein": on the unit circle, or two real pairs meeting off it), located by
+      the continuation driver on the test functions :func:`floquet_tests` to 1e-8 in the
+      parameter (``at``, ``located``), with the two members around it (``between``) and their
+      counts of multipliers on the unit circle (``on_unit_circle``).
     - ``end_reason``: why the continuation stopped; a fold in the period shows as the step
       collapsing there.
     """
@@ -403,26 +406,25 @@ def attitude_family_3d(orbits, body: RigidBody, *, guess, period_days, n_periods
     dim = ("member",)
     extra = {"period_days": (dim, np.array([s.orbit.period_days for s in sols])), "x0": (dim, np.array([s.orbit.state0[0] for s in sols])),
              "z0": (dim, np.array([s.orbit.state0[2] for s in sols]))}
-    return _family_dataset(sols, "period_days", extra, br.end_reason, {"body_moments": list(body.moments), "n_periods": n_periods,
-                                                                      "system": orbits.system.name})
+    return _family_dataset(sols, "period_days", extra, br, {"body_moments": list(body.moments), "n_periods": n_periods,
+                                                            "system": orbits.system.name})
 
 
-def _family_dataset(sols, parameter: str, extra: dict, end_reason: str, attrs: dict):
+def _family_dataset(sols, parameter: str, extra: dict, branch, attrs: dict):
     """The Dataset of a 3-D family: ``extra`` variables (the parameter among them), the
-    solutions' q0, w0, multipliers, stable, residual, turns, and the stability changes between
-    consecutive members (attribute, keyed ``between`` = the two parameter values)."""
+    solutions' q0, w0, multipliers, stable, residual, turns, and the stability changes the
+    continuation driver located (the zeros of :func:`floquet_tests`; attribute)."""
     import xarray as xr
 
     p = np.asarray(extra[parameter][1], dtype=float)
     mult = np.array([_sorted_multipliers(s.multipliers) for s in sols])
     on = np.abs(np.abs(mult) - 1) <= STABILITY_TOL
     changes = []
-    for i in range(len(sols) - 1):
-        a, b = int(on[i].sum()), int(on[i + 1].sum())
-        if a != b:
-            left = mult[i + 1][~on[i + 1]] if a > b else mult[i][~on[i]]
-            kind = "krein" if np.any(np.abs(left.imag) > 1e-6) else ("+1" if np.all(left.real > 0) else "-1")
-            changes.append({"between": (float(p[i]), float(p[i + 1])), "kind": kind, "on_unit_circle": (a, b)})
+    for b in branch.bifurcations:
+        i = b.after + 1  # the member before it (the first member is the start, not a returned point)
+        changes.append({"at": float(b.parameter), "located": bool(b.located), "kind": FLOQUET_TESTS[b.name],
+                        "between": (float(p[i]), float(p[i + 1])), "on_unit_circle": (int(on[i].sum()), int(on[i + 1].sum()))})
+    end_reason = branch.end_reason
     dim = ("member",)
     return xr.Dataset(
         {**extra,
@@ -466,6 +468,9 @@ class InertiaBranch3D:
     def tangent(self, point):
         return None
 
+    def tests(self, point):
+        return floquet_tests(point.data.monodromy)
+
 
 def attitude_family_3d_inertia(orbit: PeriodicOrbit, bodies, *, guess, steps: int = 20, n_periods: int = 1, tol: float = 1e-12,
                                ds_min: float = 1e-5):
@@ -503,8 +508,31 @@ def attitude_family_3d_inertia(orbit: PeriodicOrbit, bodies, *, guess, steps: in
     s_values = np.array([0.0] + [float(p.x[0]) for p in br.points])
     dim = ("member",)
     extra = {"s": (dim, s_values), "moments": (("member", "axis"), np.array([problem.body(v).moments for v in s_values]))}
-    return _family_dataset(sols, "s", extra, br.end_reason, {"orbit_period_days": float(orbit.period_days), "n_periods": n_periods,
-                                                            "system": orbit.system.name})
+    return _family_dataset(sols, "s", extra, br, {"orbit_period_days": float(orbit.period_days), "n_periods": n_periods,
+                                                  "system": orbit.system.name})
+
+
+FLOQUET_TESTS = {"Q(2)": "+1", "Q(-2)": "-1", "discriminant": "krein"}
+
+
+def floquet_tests(monodromy) -> dict[str, float]:
+    """Bifurcation test functions of a 6x6 attitude monodromy, whose multipliers come in
+    reciprocal pairs (lambda, 1/lambda): with u = lambda + 1/lambda, the three pairs are the roots
+    of the cubic Q(u) = u^3 + a u^2 + (b - 3) u + (c - 2a), where lambda^6 + a lambda^5 + b lambda^4
+    + c lambda^3 + b lambda^2 + a lambda + 1 is the (palindromic) characteristic polynomial (a, b,
+    c from the traces of M, M^2, M^3). Q(2) changes sign where a real pair passes +1, Q(-2) where
+    one passes -1 (a complex pair adds |2 -+ u|^2 > 0 and never changes them), and the
+    discriminant of Q where two pairs collide: a Krein collision on the unit circle, or two
+    real pairs meeting off it. Smooth in the family's parameter, so the continuation driver
+    locates their zeros."""
+    m = np.asarray(monodromy, dtype=float)
+    t1, t2, t3 = np.trace(m), np.trace(m @ m), np.trace(m @ m @ m)
+    e1, e2, e3 = t1, (t1 * t1 - t2) / 2, (t1**3 - 3 * t1 * t2 + 2 * t3) / 6
+    a, b, c = -e1, e2, -e3
+    B, C, D = a, b - 3.0, c - 2.0 * a
+    q = lambda u: u**3 + B * u * u + C * u + D  # noqa: E731
+    disc = 18 * B * C * D - 4 * B**3 * D + B * B * C * C - 4 * C**3 - 27 * D * D
+    return {"Q(2)": float(q(2.0)), "Q(-2)": float(q(-2.0)), "discriminant": float(disc)}
 
 
 def _sorted_multipliers(m) -> np.ndarray:
