@@ -18,6 +18,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 mod attitude;
+mod build;
 mod flexible;
 mod fourier;
 mod map;
@@ -433,6 +434,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     attitude::register(m)?;
     map::register(m)?;
     flexible::register(m)?;
+    build::register(m)?;
     // Physical constants, read from the core (one definition: librate_core::constants).
     m.add("N_SUN", librate_core::constants::N_SUN)?;
     m.add("OMEGA_SUN", librate_core::constants::OMEGA_SUN)?;
