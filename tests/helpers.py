@@ -16,7 +16,7 @@ def continue_dros(system, xs):
 
 
 def cr3bp_rhs(mu):
-    """Independent CR3BP right-hand side for scipy (written from PHYSICS.md section 2)."""
+    """Independent CR3BP right-hand side for scipy (written from docs/physics.md, the CR3BP)."""
 
     def f(t, s):
         x, y, z, vx, vy, vz = s

@@ -99,7 +99,7 @@ def test_eccentricity_resonance_beats(em):
 
 @pytest.mark.parametrize("point, h_table", [(1, 15.44), (2, 9.57), (3, 3.03)])
 def test_yaw_frequency_at_collinear_points(em, point, h_table):
-    """Thesis Table 4 / eq. 43 (with its sign restored, PHYSICS.md): a body held at L1, L2, L3
+    """Thesis Table 4 / eq. 43 (with its sign restored, docs/physics.md): a body held at L1, L2, L3
     librates in yaw as psi'' = -h Kz psi. The measured frequency squared over Kz equals the
     tabulated h to its two decimals (tolerance 0.006)."""
     lp = em.lagrange_points()[point - 1]
@@ -148,7 +148,7 @@ def test_roll_pitch_at_l1_against_linearised_equations(em, ix, iy):
 
 def test_planar_and_3d_agree_and_outputs(em):
     """The facade's planar run and the 3-D run started planar agree to 1e-10 (3-D started planar
-    stays planar, PHYSICS.md sec. 4); Euler angles, local-vertical angles and torques are
+    stays planar, docs/physics.md, attitude); Euler angles, local-vertical angles and torques are
     consistent: the z torque equals Iz * dwz/dt from the planar equation."""
     d = librate.dro(em, x0=0.8)
     body = librate.RigidBody(12.12e6, 89.68e6, IZ)

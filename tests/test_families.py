@@ -1,4 +1,4 @@
-"""Periodic-orbit families against the thesis (ch. 2), PHYSICS.md section 3 and the JPL catalog."""
+"""Periodic-orbit families against the thesis (ch. 2), docs/physics.md, periodic orbits and the JPL catalog."""
 
 import math
 
@@ -24,7 +24,7 @@ def test_dro_family_spans_moon_to_earth(dros, em):
 
 
 def test_dro_stability_facts(dros):
-    """PHYSICS.md sec. 3 / thesis Fig. 5: the planar (in-plane) family is linearly stable for
+    """docs/physics.md, periodic orbits / thesis Fig. 5: the planar (in-plane) family is linearly stable for
     0.02 <= x0 <= 0.985; the out-of-plane index crosses +1 near x0 = 0.27 (bifurcation to 3-D
     DROs), detected and reported. Tolerance on the crossing: 0.01 (the thesis reads it off a plot)."""
     sel = (dros.x0 >= 0.02) & (dros.x0 <= 0.985)
@@ -37,7 +37,7 @@ def test_dro_stability_facts(dros):
 
 
 def test_dro_period_tends_to_the_limit_near_the_earth(dros, em):
-    """PHYSICS.md: the period tends to 2 pi / sqrt(1 - mu) (27.45 d) as x0 -> -mu; at x0 = 0.005
+    """docs/physics.md: the period tends to 2 pi / sqrt(1 - mu) (27.45 d) as x0 -> -mu; at x0 = 0.005
     it is within 0.5 % and still increasing towards it."""
     limit = 2 * math.pi / math.sqrt(1 - em.mu)
     assert em.period_days(limit) == pytest.approx(27.45, abs=0.01)

@@ -1,4 +1,4 @@
-"""Flexible spacecraft (thesis ch. 5, PHYSICS.md sec. 7): the lumped-parameter model against an
+"""Flexible spacecraft (thesis ch. 5, docs/physics.md, flexible spacecraft): the lumped-parameter model against an
 independently coded Lagrangian, the rigid limit, the energy integral, the quasi-static closed
 form, modal damping, the low-frequency coupled response against a hand-derived two-degree-of-
 freedom model, the effect on periodic orbit-attitude solutions, the presets and bad input. Each
@@ -135,7 +135,7 @@ def test_equations_of_motion_match_an_independent_lagrangian():
 
 # --- acceptance: rigid limit ---------------------------------------------------------------------
 def test_stiffness_to_infinity_recovers_the_rigid_composite_body(dro, low, stable):
-    """PHYSICS.md sec. 7: as every k_j -> infinity (the low-frequency station stiffened 100, 1000
+    """docs/physics.md, flexible spacecraft: as every k_j -> infinity (the low-frequency station stiffened 100, 1000
     and 10000 times) the flexible attitude along the stable N = 0 solution of the 12.66-day DRO
     (one period, started on the quasi-static deflection) converges to the rigid planar model
     with the composite inertia (FlexibleBody.rigid_body(), Kz = 0.8) at the predicted rate 1/k:
@@ -195,7 +195,7 @@ def test_energy_integral_conserved_in_circular_two_body_orbit():
 
 # --- acceptance: quasi-static closed form --------------------------------------------------------
 def test_quasi_static_closed_form_error_falls_like_rate_over_omega_squared(dro, low, stable):
-    """PHYSICS.md sec. 7: for Omega_j >> the orbital and attitude rates, the closed form
+    """docs/physics.md, flexible spacecraft: for Omega_j >> the orbital and attitude rates, the closed form
     q_j = L_j / (m_j Omega_j^2) along the rigid solution matches the full model (started on it)
     with a relative error shrinking like (rate / Omega)^2. The low-frequency station stiffened so
     that the arrays' Omega spans 68 to 6821 rad/TU (two decades; modules 5x higher), along the

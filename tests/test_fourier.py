@@ -1,4 +1,4 @@
-"""Fourier-series orbits (thesis eq. 44-45, Fig. 22; PHYSICS.md section 3) against the integrated
+"""Fourier-series orbits (thesis eq. 44-45, Fig. 22; docs/physics.md, periodic orbits) against the integrated
 orbit, an independent integrator and the CR3BP equations of motion."""
 
 import math
@@ -11,7 +11,7 @@ from scipy.integrate import solve_ivp
 
 
 def jacobi_numpy(mu, states):
-    """C = 2U - |v|^2 written from PHYSICS.md section 2 (independent of the core's jacobi)."""
+    """C = 2U - |v|^2 written from docs/physics.md, the CR3BP (independent of the core's jacobi)."""
     x, y, z = states[:, 0], states[:, 1], states[:, 2]
     r1 = np.sqrt((x + mu) ** 2 + y**2 + z**2)
     r2 = np.sqrt((x - 1 + mu) ** 2 + y**2 + z**2)
@@ -98,7 +98,7 @@ def test_twenty_term_series_of_21_day_dro_position_error(em, dro_21):
 def test_series_derivatives_follow_the_cr3bp_vector_field(em, dro_1992):
     """Velocity and acceleration from the series are the exact derivatives of the series, so on
     a converged series they must satisfy the equations of motion: the series' acceleration
-    against the CR3BP right-hand side (helpers.cr3bp_rhs, written from PHYSICS.md) evaluated at
+    against the CR3BP right-hand side (helpers.cr3bp_rhs, written from docs/physics.md) evaluated at
     the series' own position and velocity, at 777 times. Measured max residual: 3.7e-6 at Nf = 20,
     1.6e-8 at 30, 7e-11 at 40; velocity against the integrated orbit 1.4e-12 at 40.
     Tolerances: 1e-5 at 20, 1e-9 at 40, velocity 1e-10 at 40."""

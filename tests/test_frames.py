@@ -1,5 +1,5 @@
 """ECI conversion and osculating elements: analytic two-body states, round trips, and the
-near-1:1 DROs of thesis Table 1 (PHYSICS.md section 3)."""
+near-1:1 DROs of thesis Table 1 (docs/physics.md, periodic orbits)."""
 
 import math
 
@@ -37,7 +37,7 @@ def eci_to_synodic_by_hand(mu, t, r_i, v_i, theta0=0.0):
 
 @pytest.fixture(scope="module")
 def dro_1to1(em):
-    """The 1:1 synodic-resonant DRO (T = 2 pi), x0 = 0.15213 (PHYSICS.md: 0.1521)."""
+    """The 1:1 synodic-resonant DRO (T = 2 pi), x0 = 0.15213 (docs/physics.md: 0.1521)."""
     return dro_with_period(em, 2 * math.pi, np.arange(0.95, 0.14, -0.02))
 
 
@@ -120,7 +120,7 @@ def test_eci_round_trip_and_known_values(em):
 
 
 def test_one_to_one_dro_mean_elements_table1(em, dro_1to1):
-    """Thesis Table 1 / PHYSICS.md section 3: the 1:1 resonant DRO (x0 = 0.1521) has mean
+    """Thesis Table 1 / docs/physics.md, periodic orbits: the 1:1 resonant DRO (x0 = 0.1521) has mean
     osculating a = 392070 km and e = 0.8312 in the ECI frame, and no apsidal drift.
 
     Measured (time average over 2000 uniform samples per period, 3 periods): a = 392065.1 km

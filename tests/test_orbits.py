@@ -1,4 +1,4 @@
-"""DRO correction against the thesis/PHYSICS.md facts and an independent integrator."""
+"""DRO correction against the thesis/docs/physics.md facts and an independent integrator."""
 
 import math
 
@@ -21,7 +21,7 @@ def test_corrected_dro_closes_in_scipy(em, x0):
 
 
 def test_one_to_one_resonant_dro_starts_at_x0_0_1521(em):
-    """PHYSICS.md / thesis Fig. 7: the DRO whose period is the synodic 2 pi starts at x0 = 0.1521
+    """docs/physics.md / thesis Fig. 7: the DRO whose period is the synodic 2 pi starts at x0 = 0.1521
     (4 digits). Continue the family from the Moon, root-find T(x0) = 2 pi by the secant method,
     and compare at the printed precision."""
     orbits = continue_dros(em, np.arange(0.95, 0.14, -0.02))

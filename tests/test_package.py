@@ -39,7 +39,7 @@ def test_cli_info_dros_and_demo(tmp_path):
     assert "4 orbits x 200 rates" in demo.output
     import xarray as xr
 
-    ds = xr.open_dataset(tmp_path / "dro_map_kz0.8.nc", engine="scipy")
+    ds = xr.open_dataset(tmp_path / "demo.nc", engine="scipy")
     assert ds.dwz.shape == (4, 1, 200) and ds.sizes["solution"] > 0
     assert float(ds.sol_residual.max()) < 1e-9
     bad = runner.invoke(main, ["demo", "--kz", "2"])

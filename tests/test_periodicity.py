@@ -1,4 +1,4 @@
-"""Periodic orbit-attitude solutions and periodicity maps: thesis sec. 3.3 / PHYSICS.md sec. 5."""
+"""Periodic orbit-attitude solutions and periodicity maps: thesis sec. 3.3 / docs/physics.md, periodic attitude motions."""
 
 import math
 
@@ -13,7 +13,7 @@ def dro1266(em):
 
 
 def test_thesis_fig23_n_minus_one(dro1266):
-    """Thesis Fig. 23 (PHYSICS.md sec. 5): on the 12.66-day DRO with Kz = 0.8 the N = -1 solution
+    """Thesis Fig. 23 (docs/physics.md, periodic attitude motions): on the 12.66-day DRO with Kz = 0.8 the N = -1 solution
     sits at phidot0 = -2.4545 (inertial wz0 = -1.4545; 4 digits), and both residual curves cross
     zero there with slopes of opposite sign, staying within +-0.15 over [-2.55, -2.35]."""
     sol = librate.periodic_attitude(dro1266, kz=0.8, n=-1)
@@ -60,7 +60,7 @@ def test_solutions_repeat_when_repropagated(dro1266, em):
 
 
 def test_newton_matches_half_period_method(dro1266):
-    """PHYSICS.md: the correct Newton step [Phi(T) - I] d = -F on (phi0, wz0) converges for N = -1
+    """docs/physics.md: the correct Newton step [Phi(T) - I] d = -F on (phi0, wz0) converges for N = -1
     and N = -2, where the thesis's eq. 53 fails, and agrees with the half-period method (1e-9);
     phi0 stays at the symmetric 0."""
     for n in (-1, -2):

@@ -1,4 +1,4 @@
-"""Solar radiation pressure: the facet and flat-plate models (PHYSICS.md sec. 6), Sun-resonant
+"""Solar radiation pressure: the facet and flat-plate models (docs/physics.md, solar radiation pressure), Sun-resonant
 periodic solutions, continuation in the SRP amplitude with folds."""
 
 import math
@@ -152,7 +152,7 @@ def test_srp_needs_a_facet_body(em):
 
 
 def test_free_sun_phase_finds_the_symmetric_phases(sun12, gravity_solution):
-    """PHYSICS.md sec. 6: with phi0 = 0 kept, solutions survive only for special Sun phases (a
+    """docs/physics.md, solar radiation pressure: with phi0 = 0 kept, solutions survive only for special Sun phases (a
     multiple of pi/K for this plate). Freeing the Sun phase from 0.3 converges to such a phase
     (K = 2: a multiple of pi/2, to 1e-9), and the solution repeats (1e-9)."""
     plate = librate.FlatPlate(0.05, cs=0.4, cd=0.1, sun=librate.Sun(theta0=0.3))

@@ -88,7 +88,7 @@ def test_inertia_custom_system_and_srp_geometry():
     body = st.build_body()
     assert body.moments == (12.12e6, 89.68e6, 96.95e6) and body.mass_kg == 4.0e5
     plate = st.build_srp()
-    # eps = P A d TU^2 / Iz (PHYSICS.md sec. 6)
+    # eps = P A d TU^2 / Iz (docs/physics.md, solar radiation pressure)
     assert plate.eps == pytest.approx(4.56e-6 * 100.0 * 2.0 * 375190.25852**2 / 96.95e6, rel=1e-12)
     assert (plate.cs, plate.cd, plate.sun.theta0) == (0.4, 0.0, 0.3)
     assert st.n_periods() == 2  # the 1:2 Sun-resonant orbit: one Sun period
@@ -360,7 +360,7 @@ def _flex_study(tmp_path, flexible, purpose="solve"):
 def test_flexible_body_in_a_study(tmp_path):
     """Issue 8: studies accept a flexible body (preset or TOML file). `solve` finds the rigid
     solutions of the composite body and reports each one's first-order shift from flexibility
-    (PHYSICS.md sec. 7): negligible for the real-scale station (0.1 Hz arrays: < 1e-9), large for
+    (docs/physics.md, flexible spacecraft): negligible for the real-scale station (0.1 Hz arrays: < 1e-9), large for
     its low-frequency variant (> 1e-4 rad/TU somewhere)."""
     real, _ = _flex_study(tmp_path, "sample-station").run_solve(out=tmp_path / "real")
     low, _ = _flex_study(tmp_path, "sample-station-low-frequency").run_solve(out=tmp_path / "low")

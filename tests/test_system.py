@@ -8,7 +8,7 @@ import pytest
 
 
 def test_presets_constants(em):
-    # PHYSICS.md table 1.
+    # docs/physics.md table 1.
     assert (em.mu, em.lu_km, em.tu_s) == (0.01215, 384400.0, 375190.0)
     assert em.tu_days == pytest.approx(4.342477, abs=1e-6)
     jpl = librate.System.preset("earth-moon-jpl")
@@ -47,7 +47,7 @@ def test_lagrange_points_against_quintic_roots(mu):
 
 
 def test_lagrange_points_physics_md_values(em):
-    # PHYSICS.md section 2: L1 0.83692, L2 1.15568, L3 -1.00506 (5 decimals printed).
+    # docs/physics.md, the CR3BP: L1 0.83692, L2 1.15568, L3 -1.00506 (5 decimals printed).
     np.testing.assert_allclose(em.lagrange_points()[:3, 0], [0.83692, 1.15568, -1.00506], atol=5e-6)
 
 

@@ -7,6 +7,7 @@ All quantities are nondimensional (CR3BP units) unless a name says otherwise
 
 import warnings as _warnings
 
+from ._build import build_info
 from ._core import __version__
 from ._errors import CollisionError, ConvergenceError, IntegrationError, LibrateError
 from .app import Study, StudyError, open_result, run_map
@@ -78,6 +79,7 @@ from .periodicity import (
 
 __all__ = [
     "__version__",
+    "build_info",
     "srp_map",
     "sun_pointing_accelerations",
     "zero_contours",

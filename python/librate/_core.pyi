@@ -44,6 +44,7 @@ __all__ = [
     "__version__",
     "attitude_correct",
     "attitude_correct_across",
+    "build_info",
     "attitude_propagate",
     "attitude_torques",
     "facets_force_torque",
@@ -72,6 +73,7 @@ __all__ = [
     "symmetric_correct",
     "system_preset",
     "system_validate",
+    "simd_set_active",
 ]
 
 class LibrateError(Exception): ...
@@ -92,6 +94,17 @@ class ConvergenceError(LibrateError):
     tolerance: float
 
 _F64 = npt.NDArray[np.float64]
+
+class _BuildInfo(TypedDict):
+    simd_known: list[str]
+    simd_available: list[str]
+    simd_active: str
+    version: str
+    profile: str
+    target_arch: str
+
+def build_info() -> _BuildInfo: ...
+def simd_set_active(level: str) -> str: ...
 
 class _Options(TypedDict):
     rtol: float

@@ -71,15 +71,22 @@ def main() -> None:
 
 @main.command(context_settings=_CONTEXT, short_help="Version, system presets and their constants, optional parts.")
 def info() -> None:
-    """Show the version, the system presets with their constants, and the optional parts.
+    """Show the version, the build (SIMD levels), the system presets with their constants, and
+    the optional parts.
 
-    For each preset: the mass ratio mu, the length unit LU (km), the time unit TU (s and
-    days) and the x coordinate of L1 (LU). Parts: matplotlib (figures, required), the chunked
-    map runner (resumable and distributed maps) and Dask (optional).
+    Build: the Rust profile, the SIMD levels this CPU supports and the one the kernels run at
+    (``LIBRATE_SIMD`` forces one). For each preset: the mass ratio mu, the length unit LU (km),
+    the time unit TU (s and days) and the x coordinate of L1 (LU). Parts: matplotlib (figures,
+    required), the chunked map runner (resumable and distributed maps) and Dask (optional).
     """
     import importlib.util
 
+    from .._build import build_info
+
     click.echo(f"librate {__version__}")
+    b = build_info()
+    click.echo(f"  build: {b['profile']} ({b['target_arch']}); SIMD level {b['simd_active']} "
+               f"(this CPU supports: {', '.join(b['simd_available'])}; LIBRATE_SIMD forces one)")
     for name in System.presets():
         s = System.preset(name)
         l1 = s.lagrange_points()[0, 0]

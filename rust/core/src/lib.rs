@@ -7,6 +7,7 @@
 //! - [`constants`]: physical constants (the Sun's motion, solar pressure).
 //! - [`scalar`]: the scalar traits equations are written over (f64, dual numbers, SIMD lanes).
 //! - [`fourier`]: periodic orbits as truncated Fourier series, with analytic derivatives.
+//! - [`simd`]: runtime CPU dispatch of the hot kernels (baseline, AVX2, AVX-512, NEON).
 
 // Intentional patterns: `!(x <= tol)` is the NaN-safe test (a NaN must fail it); numerical
 // kernels take many scalar arguments; dual-number products contain sums by definition.
@@ -23,5 +24,6 @@ pub mod map;
 pub mod periodic;
 pub mod propagation;
 pub mod scalar;
+pub mod simd;
 
 pub use error::{Error, IntegrationError, Result};

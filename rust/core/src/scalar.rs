@@ -3,14 +3,15 @@
 //! - [`Real`]: f64 and forward-mode dual numbers [`Dual`] carrying N partial derivatives, so one
 //!   generic right-hand side gives both the values (f64) and the exact Jacobian (`Dual<N>`) used
 //!   by the variational equations (the CR3BP acceleration, the 3-D attitude model);
-//! - [`Lane`]: f64 and the SIMD vector `wide::f64x8`, so the scalar planar model and the map
+//! - [`Lane`]: f64 and the eight-lane vector [`F8`], so the scalar planar model and the map
 //!   engine's lanes evaluate the same torque laws (gravity gradient, flat-plate SRP).
 //!
-//! This module depends on nothing else in the crate (cr3bp and attitude both build on it).
+//! This module depends on nothing else in the crate but [`crate::simd`]'s instruction-set
+//! markers (cr3bp and attitude both build on it).
 
-use std::ops::{Add, Div, Mul, Neg, Sub};
+use std::ops::{Add, AddAssign, Div, Mul, Neg, Sub};
 
-use wide::f64x8;
+use crate::simd::Isa;
 
 /// Scalar arithmetic needed by the dynamics.
 pub trait Real:
@@ -117,35 +118,30 @@ impl<const N: usize> Real for Dual<N> {
     }
 }
 
-/// Fused multiply-add `a * b + c` where the target has a hardware FMA (one rounding, faster),
-/// otherwise the plain expression (a software `fma` call would be far slower).
+/// Fused multiply-add `a * b + c` where the build's baseline target has a hardware FMA (aarch64;
+/// x86-64 built for a CPU with FMA), otherwise the plain expression (a software `fma` call would
+/// be far slower). The portable x86-64 build does not fuse here: the dispatched kernels
+/// ([`crate::simd`]) fuse on their FMA levels through [`Isa::mul_add`].
 #[inline(always)]
 pub(crate) fn fmadd(a: f64, b: f64, c: f64) -> f64 {
-    #[cfg(target_feature = "fma")]
+    #[cfg(any(target_feature = "fma", target_arch = "aarch64"))]
     {
         a.mul_add(b, c)
     }
-    #[cfg(not(target_feature = "fma"))]
+    #[cfg(not(any(target_feature = "fma", target_arch = "aarch64")))]
     {
         a * b + c
     }
 }
 
-/// Lane-wise arithmetic shared by f64 and `wide::f64x8`.
+/// Lane-wise arithmetic shared by f64 and [`F8`].
 pub trait Lane: Copy + Add<Output = Self> + Sub<Output = Self> + Mul<Output = Self> + Neg<Output = Self> {
-    /// The value in every lane.
-    fn splat(x: f64) -> Self;
-    /// self * a + b, fused where the target has FMA (as `wide` does for f64x8, so that the
-    /// scalar and lane evaluations round alike).
+    /// self * a + b: fused where the level (F8) or the build (f64, [`fmadd`]) has FMA.
     fn mul_add(self, a: Self, b: Self) -> Self;
     fn abs(self) -> Self;
 }
 
 impl Lane for f64 {
-    #[inline(always)]
-    fn splat(x: f64) -> Self {
-        x
-    }
     #[inline(always)]
     fn mul_add(self, a: Self, b: Self) -> Self {
         fmadd(self, a, b)
@@ -156,18 +152,100 @@ impl Lane for f64 {
     }
 }
 
-impl Lane for f64x8 {
+/// Eight f64 lanes computed with the instruction set `I` ([`crate::simd`]): each operation is
+/// one call of the level's eight-lane primitive ([`Isa`]: 4 x SSE2, 2 x AVX or 1 x AVX-512
+/// instructions); `mul_add` fuses on FMA levels. A vector carries its level's token (zero-sized;
+/// for AVX2 and AVX-512 it exists only once the CPU's support is detected), so the only way to
+/// compute with one is inside that level's dispatched code.
+#[derive(Debug, Clone, Copy)]
+#[repr(C, align(64))]
+pub struct F8<I> {
+    v: [f64; 8],
+    isa: I,
+}
+
+impl<I: Isa> F8<I> {
     #[inline(always)]
-    fn splat(x: f64) -> Self {
-        f64x8::splat(x)
+    pub fn new(isa: I, v: [f64; 8]) -> Self {
+        Self { v, isa }
     }
     #[inline(always)]
+    pub fn splat(isa: I, x: f64) -> Self {
+        Self { v: [x; 8], isa }
+    }
+    /// The instruction-set token.
+    #[inline(always)]
+    pub fn isa(self) -> I {
+        self.isa
+    }
+    #[inline(always)]
+    pub fn to_array(self) -> [f64; 8] {
+        self.v
+    }
+    #[inline(always)]
+    fn with(self, v: [f64; 8]) -> Self {
+        Self { v, isa: self.isa }
+    }
+    /// Lane-wise `if self > o { self } else { o }` (x86 `maxpd`: o where either is NaN).
+    #[inline(always)]
+    pub fn max(self, o: Self) -> Self {
+        self.with(self.isa.max8(self.v, o.v))
+    }
+    /// Lane-wise `if self <= o { if_le } else { if_not }` (NaN compares false).
+    #[inline(always)]
+    pub fn le_select(self, o: Self, if_le: Self, if_not: Self) -> Self {
+        self.with(self.isa.le_select8(self.v, o.v, if_le.v, if_not.v))
+    }
+    #[inline(always)]
+    pub fn abs(self) -> Self {
+        self.with(self.isa.abs8(self.v))
+    }
+    /// self * a + b, fused on FMA levels.
+    #[inline(always)]
+    pub fn mul_add(self, a: Self, b: Self) -> Self {
+        self.with(self.isa.mul_add8(self.v, a.v, b.v))
+    }
+}
+
+macro_rules! f8_binop {
+    ($tr:ident, $f:ident, $op:ident) => {
+        impl<I: Isa> $tr for F8<I> {
+            type Output = Self;
+            #[inline(always)]
+            fn $f(self, o: Self) -> Self {
+                self.with(self.isa.$op(self.v, o.v))
+            }
+        }
+    };
+}
+f8_binop!(Add, add, add8);
+f8_binop!(Sub, sub, sub8);
+f8_binop!(Mul, mul, mul8);
+f8_binop!(Div, div, div8);
+
+impl<I: Isa> Neg for F8<I> {
+    type Output = Self;
+    #[inline(always)]
+    fn neg(self) -> Self {
+        self.with(self.isa.neg8(self.v))
+    }
+}
+
+impl<I: Isa> AddAssign for F8<I> {
+    #[inline(always)]
+    fn add_assign(&mut self, o: Self) {
+        *self = *self + o;
+    }
+}
+
+impl<I: Isa> Lane for F8<I> {
+    #[inline(always)]
     fn mul_add(self, a: Self, b: Self) -> Self {
-        f64x8::mul_add(self, a, b)
+        F8::mul_add(self, a, b)
     }
     #[inline(always)]
     fn abs(self) -> Self {
-        f64x8::abs(self)
+        F8::abs(self)
     }
 }
 

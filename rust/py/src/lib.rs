@@ -19,6 +19,7 @@ use pyo3::types::{PyDict, PyTuple};
 
 mod attitude;
 mod attitude3d;
+mod build;
 mod flexible;
 mod fourier;
 mod map;
@@ -414,6 +415,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     flexible::register(m)?;
     attitude3d::register(m)?;
     records::register(m)?;
+    build::register(m)?;
     // Physical constants, read from the core (one definition: librate_core::constants).
     m.add("N_SUN", librate_core::constants::N_SUN)?;
     m.add("OMEGA_SUN", librate_core::constants::OMEGA_SUN)?;

@@ -14,6 +14,7 @@ use crate::cr3bp::check_mu;
 use crate::error::{check_finite, check_positive, invalid, Error, Result};
 use crate::integrate::{Options, Output};
 use crate::propagation::{propagate_checked, Collision};
+use crate::simd::Isa;
 
 /// Chebyshev degree per segment.
 pub const DEGREE: usize = 12;
@@ -140,19 +141,30 @@ impl OrbitForcing {
     /// S(t), C(t).
     #[inline]
     pub fn sc(&self, t: f64) -> (f64, f64) {
+        self.sc_with(t, crate::scalar::fmadd)
+    }
+
+    /// S(t), C(t) with the multiply-adds of the instruction set `I` (the dispatched lane engine).
+    #[inline(always)]
+    pub fn sc_at<I: Isa>(&self, t: f64) -> (f64, f64) {
+        self.sc_with(t, I::mul_add)
+    }
+
+    #[inline(always)]
+    fn sc_with(&self, t: f64, fma: impl Fn(f64, f64, f64) -> f64) -> (f64, f64) {
         let (s, x) = self.locate(t);
         let c = &self.coef[s * NC * 2..(s + 1) * NC * 2];
         let (mut b1s, mut b2s, mut b1c, mut b2c) = (0.0, 0.0, 0.0, 0.0);
         let x2 = 2.0 * x;
         for k in (1..NC).rev() {
-            let ts = x2.mul_add(b1s, c[2 * k] - b2s);
-            let tc = x2.mul_add(b1c, c[2 * k + 1] - b2c);
+            let ts = fma(x2, b1s, c[2 * k] - b2s);
+            let tc = fma(x2, b1c, c[2 * k + 1] - b2c);
             b2s = b1s;
             b1s = ts;
             b2c = b1c;
             b1c = tc;
         }
-        (x.mul_add(b1s, c[0] - b2s), x.mul_add(b1c, c[1] - b2c))
+        (fma(x, b1s, c[0] - b2s), fma(x, b1c, c[1] - b2c))
     }
 }
 

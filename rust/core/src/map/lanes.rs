@@ -24,18 +24,18 @@
 //! scalar planar model calls ([`gravity_gradient_wzdot`], [`flat_plate_wzdot`], [`Sun::angle`],
 //! generic over the lane type) and step with the scalar driver's [`Controller`] and tableau.
 
-use wide::f64x8;
-
 use super::forcing::OrbitForcing;
 use crate::attitude::{flat_plate_wzdot, gravity_gradient_wzdot, FlatPlate, Sun};
 use crate::constants::SOLAR_PRESSURE_1AU;
 use crate::integrate::tableau::{A, B8, C, ERR};
 use crate::integrate::Controller;
+use crate::scalar::F8;
+use crate::error::Result;
+use crate::simd::{Isa, Kernel, Level};
 
 /// The scalar driver's step-size controller with its default settings.
 const CONTROLLER: Controller = Controller::RKF78;
 
-type V = f64x8;
 /// Trajectories per lock-step group (SIMD width).
 pub const LANES: usize = 8;
 
@@ -106,28 +106,28 @@ impl Default for LaneOptions {
 
 /// Per-lane parameters and the stage's shared forcing.
 #[derive(Clone, Copy)]
-struct Params {
-    kz15: V,
+struct Params<I> {
+    kz15: F8<I>,
     /// The plate law's coefficients (FlatPlate::coefficients), cos and sin of the Sun phase
     /// at t = 0.
-    a1: V,
-    a2: V,
-    c0: V,
-    s0: V,
+    a1: F8<I>,
+    a2: F8<I>,
+    c0: F8<I>,
+    s0: F8<I>,
     /// The Sun with phase zero: its angle at the shared time, turned by each lane's phase.
     sun: Sun,
 }
 
-impl Params {
+impl<I: Isa> Params<I> {
     /// The lanes' parameters and their cases' plates.
-    fn new(pick: impl Fn(usize) -> Case, sun_omega: f64) -> (Self, [FlatPlate; LANES]) {
+    fn new(isa: I, pick: impl Fn(usize) -> Case, sun_omega: f64) -> (Self, [FlatPlate; LANES]) {
         let plates: [FlatPlate; LANES] = std::array::from_fn(|l| pick(l).plate(sun_omega));
         let p = Params {
-            kz15: V::new(std::array::from_fn(|l| 1.5 * pick(l).kz)),
-            a1: V::new(std::array::from_fn(|l| plates[l].coefficients().0)),
-            a2: V::new(std::array::from_fn(|l| plates[l].coefficients().1)),
-            c0: V::new(std::array::from_fn(|l| plates[l].sun.theta0.cos())),
-            s0: V::new(std::array::from_fn(|l| plates[l].sun.theta0.sin())),
+            kz15: F8::new(isa, std::array::from_fn(|l| 1.5 * pick(l).kz)),
+            a1: F8::new(isa, std::array::from_fn(|l| plates[l].coefficients().0)),
+            a2: F8::new(isa, std::array::from_fn(|l| plates[l].coefficients().1)),
+            c0: F8::new(isa, std::array::from_fn(|l| plates[l].sun.theta0.cos())),
+            s0: F8::new(isa, std::array::from_fn(|l| plates[l].sun.theta0.sin())),
             sun: Sun { theta0: 0.0, ..plates[0].sun },
         };
         (p, plates)
@@ -135,21 +135,23 @@ impl Params {
 }
 
 #[inline(always)]
-fn lincomb<const D: usize, const M: usize>(out: &mut [V; D], y: &[V; D], h: V, coef: [f64; M], ks: [&[V; D]; M]) {
+fn lincomb<I: Isa, const D: usize, const M: usize>(out: &mut [F8<I>; D], y: &[F8<I>; D], h: F8<I>, coef: [f64; M], ks: [&[F8<I>; D]; M]) {
+    let isa = h.isa();
     for i in 0..D {
-        let mut acc = V::ZERO;
+        let mut acc = F8::splat(isa, 0.0);
         for m in 0..M {
-            acc = V::splat(coef[m]).mul_add(ks[m][i], acc);
+            acc = F8::splat(isa, coef[m]).mul_add(ks[m][i], acc);
         }
         out[i] = h.mul_add(acc, y[i]);
     }
 }
 
 #[inline(always)]
-fn rhs<const D: usize, const SRP: bool>(f: &OrbitForcing, t: f64, y: &[V; D], p: &Params, dy: &mut [V; D]) {
-    let (s, c) = f.sc(t);
-    let (s, c) = (V::splat(s), V::splat(c));
-    let w = y[1] - V::ONE;
+fn rhs<I: Isa, const D: usize, const SRP: bool>(f: &OrbitForcing, t: f64, y: &[F8<I>; D], p: &Params<I>, dy: &mut [F8<I>; D]) {
+    let isa = y[0].isa();
+    let (s, c) = f.sc_at::<I>(t);
+    let (s, c) = (F8::splat(isa, s), F8::splat(isa, c));
+    let w = y[1] - F8::splat(isa, 1.0);
     let (cp, sp) = (y[2], y[3]);
     let c2 = cp * cp - sp * sp;
     let s2 = (cp + cp) * sp;
@@ -162,7 +164,7 @@ fn rhs<const D: usize, const SRP: bool>(f: &OrbitForcing, t: f64, y: &[V; D], p:
         // Sun angle theta = w t + theta0_l: (cos, sin)(w t) turned by each lane's theta0_l;
         // alpha = theta - phi (sin alpha, like k, is compiled away without the STM)
         let (swt, cwt) = p.sun.angle(t).sin_cos();
-        let (swt, cwt) = (V::splat(swt), V::splat(cwt));
+        let (swt, cwt) = (F8::splat(isa, swt), F8::splat(isa, cwt));
         let ct = cwt * p.c0 - swt * p.s0;
         let st = swt * p.c0 + cwt * p.s0;
         let ca = ct.mul_add(cp, st * sp);
@@ -180,24 +182,25 @@ fn rhs<const D: usize, const SRP: bool>(f: &OrbitForcing, t: f64, y: &[V; D], p:
     }
 }
 
-struct Stages<const D: usize> {
-    k: [[V; D]; 13],
-    tmp: [V; D],
+struct Stages<I, const D: usize> {
+    k: [[F8<I>; D]; 13],
+    tmp: [F8<I>; D],
 }
 
 macro_rules! stage {
     ($st:ident, $f:ident, $t:ident, $y:ident, $h:ident, $p:ident, $s:literal; $($j:literal),+) => {{
-        lincomb(&mut $st.tmp, $y, V::splat($h), [$(A[$s][$j]),+], [$(&$st.k[$j]),+]);
-        rhs::<D, SRP>($f, C[$s].mul_add($h, $t), &$st.tmp, $p, &mut $st.k[$s]);
+        lincomb(&mut $st.tmp, $y, F8::splat($y[0].isa(), $h), [$(A[$s][$j]),+], [$(&$st.k[$j]),+]);
+        rhs::<I, D, SRP>($f, C[$s].mul_add($h, $t), &$st.tmp, $p, &mut $st.k[$s]);
     }};
 }
 
-impl<const D: usize> Stages<D> {
+impl<I: Isa, const D: usize> Stages<I, D> {
     /// One step of size h from (t, y), all lanes: writes the 8th-order solution and returns the
     /// scaled max-norm error per lane.
     #[inline(always)]
-    fn step<const SRP: bool>(&mut self, f: &OrbitForcing, t: f64, y: &[V; D], h: f64, p: &Params, out: &mut [V; D], rtol: V, atol: V) -> V {
-        rhs::<D, SRP>(f, t, y, p, &mut self.k[0]);
+    fn step<const SRP: bool>(&mut self, f: &OrbitForcing, t: f64, y: &[F8<I>; D], h: f64, p: &Params<I>, out: &mut [F8<I>; D], rtol: F8<I>, atol: F8<I>) -> F8<I> {
+        let isa = y[0].isa();
+        rhs::<I, D, SRP>(f, t, y, p, &mut self.k[0]);
         stage!(self, f, t, y, h, p, 1; 0);
         stage!(self, f, t, y, h, p, 2; 0, 1);
         stage!(self, f, t, y, h, p, 3; 0, 2);
@@ -211,43 +214,44 @@ impl<const D: usize> Stages<D> {
         stage!(self, f, t, y, h, p, 11; 0, 5, 6, 7, 8, 9);
         stage!(self, f, t, y, h, p, 12; 0, 3, 4, 5, 6, 7, 8, 9, 11);
         let k = &self.k;
-        let hv = V::splat(h);
+        let hv = F8::splat(isa, h);
         lincomb(out, y, hv, [B8[5], B8[6], B8[7], B8[8], B8[9], B8[11], B8[12]], [&k[5], &k[6], &k[7], &k[8], &k[9], &k[11], &k[12]]);
-        let he = hv * V::splat(ERR);
-        let mut err = V::ZERO;
+        let he = hv * F8::splat(isa, ERR);
+        let mut err = F8::splat(isa, 0.0);
         for i in 0..D {
             let e = (he * ((k[0][i] + k[10][i]) - (k[11][i] + k[12][i]))).abs();
             let sc = rtol.mul_add(y[i].abs().max(out[i].abs()), atol);
             let r = e / sc;
             // keep NaN: a NaN ratio fails the `<=` test and becomes the lane's error
-            err = r.simd_le(err).select(err, r);
+            err = r.le_select(err, err, r);
         }
         err
     }
 }
 
-fn lane(v: &V, l: usize) -> f64 {
+fn lane<I: Isa>(v: &F8<I>, l: usize) -> f64 {
     v.to_array()[l]
 }
 
 /// Integrate one group of up to LANES trajectories in lock step; missing lanes repeat the last.
-fn integrate_group<const D: usize, const SRP: bool>(f: &OrbitForcing, t_final: f64, group: &[Case], opts: &LaneOptions, st: &mut Stages<D>) -> [Outcome; LANES] {
+#[inline(always)]
+fn integrate_group<I: Isa, const D: usize, const SRP: bool>(isa: I, f: &OrbitForcing, t_final: f64, group: &[Case], opts: &LaneOptions, st: &mut Stages<I, D>) -> [Outcome; LANES] {
     let n = group.len();
     let pick = |l: usize| group[l.min(n - 1)];
-    let mut y = [V::ZERO; D];
-    y[0] = V::new(std::array::from_fn(|l| pick(l).phi0));
-    y[1] = V::new(std::array::from_fn(|l| pick(l).wz0));
-    y[2] = V::new(std::array::from_fn(|l| pick(l).phi0.cos()));
-    y[3] = V::new(std::array::from_fn(|l| pick(l).phi0.sin()));
+    let mut y = [F8::splat(isa, 0.0); D];
+    y[0] = F8::new(isa, std::array::from_fn(|l| pick(l).phi0));
+    y[1] = F8::new(isa, std::array::from_fn(|l| pick(l).wz0));
+    y[2] = F8::new(isa, std::array::from_fn(|l| pick(l).phi0.cos()));
+    y[3] = F8::new(isa, std::array::from_fn(|l| pick(l).phi0.sin()));
     if D == 8 {
-        y[4] = V::ONE;
-        y[7] = V::ONE;
+        y[4] = F8::splat(isa, 1.0);
+        y[7] = F8::splat(isa, 1.0);
     }
-    let (p, plates) = Params::new(pick, opts.sun_omega);
+    let (p, plates) = Params::new(isa, pick, opts.sun_omega);
     let plate: [bool; LANES] = std::array::from_fn(|l| plates[l].eps != 0.0);
-    let (rtol, atol) = (V::splat(opts.rtol), V::splat(opts.atol));
-    let mut ynew = [V::ZERO; D];
-    let mut yc = [V::ZERO; D];
+    let (rtol, atol) = (F8::splat(isa, opts.rtol), F8::splat(isa, opts.atol));
+    let mut ynew = [F8::splat(isa, 0.0); D];
+    let mut yc = [F8::splat(isa, 0.0); D];
     let (mut t, mut h) = (0.0f64, t_final / 100.0);
     let (mut accepted, mut rejected) = (0u32, 0u32);
     let mut after_reject = false;
@@ -343,16 +347,33 @@ fn integrate_group<const D: usize, const SRP: bool>(f: &OrbitForcing, t_final: f
 }
 
 /// Integrate `cases` from t = 0 to `t_final` along the orbit forcing, in lock-step groups of LANES
-/// taken in order from the start of the slice. `D` is 4 (no STM) or 8 (with the 2x2 STM); `SRP`
-/// compiles the flat-plate term in (lanes with eps = 0 add exact zeros and never cut steps).
-pub fn integrate_cases<const D: usize, const SRP: bool>(f: &OrbitForcing, t_final: f64, cases: &[Case], opts: &LaneOptions) -> Vec<Outcome> {
-    let mut st = Stages::<D> { k: [[V::ZERO; D]; 13], tmp: [V::ZERO; D] };
-    let mut out = Vec::with_capacity(cases.len());
-    for group in cases.chunks(LANES) {
-        let r = integrate_group::<D, SRP>(f, t_final, group, opts, &mut st);
-        out.extend_from_slice(&r[..group.len()]);
+/// taken in order from the start of the slice, at the SIMD `level` ([`crate::simd`]; an error
+/// only if the CPU lacks it). `D` is 4 (no STM) or 8 (with the 2x2 STM); `SRP` compiles the
+/// flat-plate term in (lanes with eps = 0 add exact zeros and never cut steps).
+pub fn integrate_cases<const D: usize, const SRP: bool>(level: Level, f: &OrbitForcing, t_final: f64, cases: &[Case], opts: &LaneOptions) -> Result<Vec<Outcome>> {
+    crate::simd::run_at(level, Groups::<D, SRP> { f, t_final, cases, opts })
+}
+
+/// The lane engine as a dispatched kernel: everything below `run` is inlined into it.
+struct Groups<'a, const D: usize, const SRP: bool> {
+    f: &'a OrbitForcing,
+    t_final: f64,
+    cases: &'a [Case],
+    opts: &'a LaneOptions,
+}
+
+impl<const D: usize, const SRP: bool> Kernel for Groups<'_, D, SRP> {
+    type Output = Vec<Outcome>;
+    #[inline(always)]
+    fn run<I: Isa>(self, isa: I) -> Vec<Outcome> {
+        let mut st = Stages::<I, D> { k: [[F8::splat(isa, 0.0); D]; 13], tmp: [F8::splat(isa, 0.0); D] };
+        let mut out = Vec::with_capacity(self.cases.len());
+        for group in self.cases.chunks(LANES) {
+            let r = integrate_group::<I, D, SRP>(isa, self.f, self.t_final, group, self.opts, &mut st);
+            out.extend_from_slice(&r[..group.len()]);
+        }
+        out
     }
-    out
 }
 
 #[cfg(test)]
@@ -361,6 +382,11 @@ mod tests {
     use crate::attitude::PlanarForced;
     use crate::integrate::{Options, System};
     use crate::periodic::correct_planar_symmetric;
+    use crate::simd::Baseline;
+
+    type I = Baseline;
+    type V = F8<I>;
+    const ISA: I = Baseline;
 
     /// The lanes' right-hand side (gravity gradient and flat plate through the shared generic
     /// laws, cos 2phi and sin 2phi from the (cos phi, sin phi) states, the Sun turned per lane)
@@ -377,19 +403,19 @@ mod tests {
             let x = l as f64;
             Case { phi0: -2.9 + 0.8 * x, wz0: -2.0 + 0.6 * x, kz: 0.9 - 0.25 * x, eps: [0.0, 0.05, 0.3, -0.2][l % 4], cs: 0.1 * (l % 3) as f64, cd: 0.2, theta_sun0: 0.9 * x - 3.0 }
         });
-        let (p, plates) = Params::new(|l| cases[l], LaneOptions::default().sun_omega);
+        let (p, plates) = Params::new(ISA, |l| cases[l], LaneOptions::default().sun_omega);
         let stm = [0.7, -1.3, 2.1, 0.4];
         for t in [0.0, 0.37 * o.period, 0.81 * o.period, 3.3 * o.period] {
-            let mut y = [V::ZERO; 8];
-            y[0] = V::new(cases.map(|c| c.phi0));
-            y[1] = V::new(cases.map(|c| c.wz0));
-            y[2] = V::new(cases.map(|c| c.phi0.cos()));
-            y[3] = V::new(cases.map(|c| c.phi0.sin()));
+            let mut y = [V::splat(ISA, 0.0); 8];
+            y[0] = V::new(ISA, cases.map(|c| c.phi0));
+            y[1] = V::new(ISA, cases.map(|c| c.wz0));
+            y[2] = V::new(ISA, cases.map(|c| c.phi0.cos()));
+            y[3] = V::new(ISA, cases.map(|c| c.phi0.sin()));
             for i in 0..4 {
-                y[4 + i] = V::splat(stm[i]);
+                y[4 + i] = V::splat(ISA, stm[i]);
             }
-            let mut dy = [V::ZERO; 8];
-            rhs::<8, true>(&f, t, &y, &p, &mut dy);
+            let mut dy = [V::splat(ISA, 0.0); 8];
+            rhs::<I, 8, true>(&f, t, &y, &p, &mut dy);
             let (s, c) = f.sc(t);
             for (l, case) in cases.iter().enumerate() {
                 let scalar = PlanarForced { kz: case.kz, forcing: &f, srp: if case.eps != 0.0 { Some(plates[l]) } else { None } };

@@ -12,6 +12,7 @@ use rayon::prelude::*;
 
 use crate::error::{check_positive, invalid, Result};
 use crate::propagation::with_threads;
+use crate::simd::Level;
 
 /// Residuals of one trajectory: Dwz = wz(T) - wz0, Dphi = phi(T) - phi0 wrapped to (-pi, pi].
 pub fn residuals(case: &Case, o: &Outcome) -> (f64, f64) {
@@ -25,8 +26,25 @@ pub fn residuals(case: &Case, o: &Outcome) -> (f64, f64) {
 }
 
 /// Integrate every case over `t_final` on `threads` workers (None: all cores), `chunk` cases
-/// per task. Results are in case order and bit-identical for any `chunk` and thread count.
+/// per task, at the active SIMD level ([`crate::simd::active`]). Results are in case order and
+/// bit-identical for any `chunk` and thread count.
 pub fn sweep(
+    forcing: &OrbitForcing,
+    t_final: f64,
+    cases: &[Case],
+    opts: &LaneOptions,
+    with_stm: bool,
+    chunk: usize,
+    threads: Option<usize>,
+) -> Result<Vec<Outcome>> {
+    sweep_at(crate::simd::active()?, forcing, t_final, cases, opts, with_stm, chunk, threads)
+}
+
+/// [`sweep`] at a given SIMD level (an error naming `LIBRATE_SIMD` if the CPU lacks it).
+/// Bit-identical for any `chunk` and thread count on one level; between levels, equal to the
+/// rounding of fused against unfused multiply-adds ([`crate::simd`]).
+pub fn sweep_at(
+    level: Level,
     forcing: &OrbitForcing,
     t_final: f64,
     cases: &[Case],
@@ -59,14 +77,18 @@ pub fn sweep(
     // Lock-step groups are taken from the start of each chunk: chunks are multiples of the group
     // size so that the groups, and so the results, are the same for any chunk size.
     let chunk = chunk.div_ceil(lanes::LANES) * lanes::LANES;
-    let run = |part: &[Case]| -> Vec<Outcome> {
+    if !level.is_available() {
+        crate::simd::parse(Some(level.name()))?;
+    }
+    let run = |part: &[Case]| -> Result<Vec<Outcome>> {
         let srp = part.chunks(lanes::LANES).any(|g| g.iter().any(|c| c.eps != 0.0));
         match (with_stm, srp) {
-            (true, false) => integrate_cases::<8, false>(forcing, t_final, part, opts),
-            (false, false) => integrate_cases::<4, false>(forcing, t_final, part, opts),
-            (true, true) => integrate_cases::<8, true>(forcing, t_final, part, opts),
-            (false, true) => integrate_cases::<4, true>(forcing, t_final, part, opts),
+            (true, false) => integrate_cases::<8, false>(level, forcing, t_final, part, opts),
+            (false, false) => integrate_cases::<4, false>(level, forcing, t_final, part, opts),
+            (true, true) => integrate_cases::<8, true>(level, forcing, t_final, part, opts),
+            (false, true) => integrate_cases::<4, true>(level, forcing, t_final, part, opts),
         }
     };
-    with_threads(threads, || cases.par_chunks(chunk).map(run).collect::<Vec<_>>().concat())
+    let parts = with_threads(threads, || cases.par_chunks(chunk).map(run).collect::<Result<Vec<_>>>())??;
+    Ok(parts.concat())
 }

@@ -1,6 +1,7 @@
-//! Periodic planar attitude motions along a periodic orbit (thesis sec. 3.3, PHYSICS.md sec. 5
-//! and 6): a batched, globalised Newton corrector on the periodicity-map engine, and a batched
-//! independent verifier on the scalar model.
+//! Periodic planar attitude motions along a periodic orbit (thesis sec. 3.3; docs/physics.md,
+//! "Periodic attitude motions" and "Solar radiation pressure"): a batched, globalised Newton
+//! corrector on the periodicity-map engine, and a batched independent verifier on the scalar
+//! model.
 //!
 //! Along an orbit of period T, the planar motion (phi0, wz0) is periodic over K revolutions
 //! when phi(KT) = phi0 + 2 pi N and wz(KT) = wz0 (N net body turns; N + 1/2 for the half-turn
