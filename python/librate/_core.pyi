@@ -357,6 +357,7 @@ def map_sweep(
     forcing: OrbitForcing, t_final: float, phi0: _F64, wz0: _F64, kz: _F64, *,
     rtol: float, atol: float, max_steps: int, stm: bool, chunk: int, threads: int | None,
     eps: _F64 | None = None, cs: _F64 | None = None, cd: _F64 | None = None, theta_sun0: _F64 | None = None,
+    method: str = "rkf78",
 ) -> SweepResult: ...
 
 @final

@@ -29,10 +29,13 @@ from ..orbits.periodic import PeriodicOrbit
 
 __all__ = ["AttitudeSolution", "find_periodic_attitudes", "orbit_forcing", "clear_forcing_cache", "sweep", "candidates",
            "check_orbit", "check_kz", "check_kinds", "KINDS", "check_srp", "is_symmetric", "MAP_RTOL", "MAP_ATOL", "correct", "verified", "refine",
-           "turns_of", "n_total_of", "per_period", "SOLVE_RTOL", "SOLVE_ATOL", "STEP_MAX_ITER",
+           "turns_of", "n_total_of", "per_period", "SOLVE_RTOL", "SOLVE_ATOL", "STEP_MAX_ITER", "MAP_METHOD",
            "STEP_MAX_HALVINGS"]
 
 MAP_RTOL = 1e-12
+#: The lanes' method of the maps: RKF7(8); RKN8(6) is within 0.9-1.0x of its time at equal
+#: accuracy (bench/bench_lanes.py), not enough to change the defaults' results.
+MAP_METHOD = "rkf78"
 MAP_ATOL = 1e-12
 #: A continuation step's corrector: a good prediction converges in a few Newton steps; one that
 #: does not is a step too long (the driver halves it), not worth forty iterations.
@@ -61,9 +64,13 @@ def clear_forcing_cache() -> None:
     _FORCINGS.clear()
 
 
-def sweep(forcing, t_final, phi0, wz0, kz, *, stm=False, rtol=MAP_RTOL, atol=MAP_ATOL, chunk=64, threads=None, srp=None, eps=None):
+def sweep(forcing, t_final, phi0, wz0, kz, *, stm=False, rtol=MAP_RTOL, atol=MAP_ATOL, chunk=64, threads=None, srp=None, eps=None,
+          method=MAP_METHOD):
     """The engine over broadcast (phi0, wz0, kz[, eps]) arrays; ``srp`` a FlatPlate (its eps
-    overridden per case by ``eps`` when given)."""
+    overridden per case by ``eps`` when given); ``method`` "rkf78" (Runge-Kutta-Fehlberg 7(8),
+    the default) or "rkn86" (Runge-Kutta-Nyström 8(6) on phi'' = wzdot(t, phi); its embedded
+    error estimate is of sixth order, so the same accuracy comes at a looser rtol: see
+    bench/bench_lanes.py)."""
     chunk = as_count(chunk, "chunk", 1)
     threads = None if threads is None else as_count(threads, "threads", 1)
     rtol, atol = as_number(rtol, "rtol", positive=True), as_number(atol, "atol", positive=True)
@@ -74,7 +81,7 @@ def sweep(forcing, t_final, phi0, wz0, kz, *, stm=False, rtol=MAP_RTOL, atol=MAP
     if srp is not None:
         extra = dict(eps=flat(srp.eps if eps is None else eps), cs=flat(srp.cs), cd=flat(srp.cd), theta_sun0=flat(srp.sun.theta0))
     return _core.map_sweep(forcing, float(t_final), p, w, k, rtol=float(rtol), atol=float(atol), max_steps=200_000,
-                           stm=bool(stm), chunk=int(chunk), threads=threads, **extra)
+                           stm=bool(stm), chunk=int(chunk), threads=threads, method=str(method), **extra)
 
 
 def check_orbit(orbit) -> PeriodicOrbit:

@@ -204,6 +204,11 @@ pub trait Isa: Copy + Send + Sync + 'static {
     fn mul_add8(self, a: A8, b: A8, c: A8) -> A8 {
         std::array::from_fn(|l| Self::mul_add(a[l], b[l], c[l]))
     }
+    /// The largest integer <= a per lane (exact; vectorised in the level's dispatched code).
+    #[inline(always)]
+    fn floor8(self, a: A8) -> A8 {
+        a.map(f64::floor)
+    }
 }
 
 /// x86-64 baseline (SSE2, no FMA).

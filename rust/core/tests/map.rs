@@ -3,7 +3,7 @@
 
 use librate_core::attitude::{forcing_sc, propagate_planar};
 use librate_core::integrate::{Options, Output};
-use librate_core::map::{residuals, sweep, sweep_at, Case, LaneOptions, LaneStatus, OrbitForcing};
+use librate_core::map::{residuals, sweep, sweep_at, Case, LaneOptions, LaneStatus, Method, OrbitForcing};
 use librate_core::simd;
 use librate_core::periodic::correct_planar_symmetric;
 use librate_core::propagation::propagate;
@@ -167,7 +167,7 @@ fn val_engine_srp_matches_scalar_model() {
 /// x0 = 0.70, Kz = 0.8, rates in [-3, 2]; with and without the STM) and of SRP cases equal to
 /// 1e-12 relative to max(1, |value|) (they differ by fused against unfused multiply-adds only:
 /// a few ulps per step, grown along the trajectory); the two FMA levels (avx2, avx512) compute
-/// the same operations and agree bit for bit.
+/// the same operations and agree bit for bit. Both lane methods (RKF7(8) and RKN8(6)).
 #[test]
 fn val_engine_levels_agree() {
     let bits = |r: &[librate_core::map::Outcome]| -> Vec<_> { r.iter().map(|o| (o.phi_t.to_bits(), o.wz_t.to_bits(), o.stm.map(f64::to_bits), o.accepted, o.rejected)).collect() };
@@ -177,12 +177,12 @@ fn val_engine_levels_agree() {
     for (k, w) in [-2.0, -0.5, 1.3].into_iter().enumerate() {
         cases.push(Case { phi0: 0.3 * k as f64, wz0: w, kz: 0.6, eps: 0.2, cs: 0.4, cd: 0.1, theta_sun0: 1.1 * k as f64 });
     }
-    let opts = LaneOptions::default();
     let levels = simd::available();
     println!("levels available: {levels:?}");
-    // the trajectories' sensitivity: max(1, max |d(phi, wz)(T) / d(phi0, wz0)|)
-    let sens: Vec<f64> = sweep_at(levels[0], &f, period, &cases, &opts, true, 64, None).unwrap().iter().map(|o| o.stm.iter().fold(1f64, |m, v| m.max(v.abs()))).collect();
-    for stm in [false, true] {
+    for (method, stm) in [(Method::Rkf78, false), (Method::Rkf78, true), (Method::Rkn86, false), (Method::Rkn86, true)] {
+        let opts = LaneOptions { method, ..LaneOptions::default() };
+        // the trajectories' sensitivity: max(1, max |d(phi, wz)(T) / d(phi0, wz0)|)
+        let sens: Vec<f64> = sweep_at(levels[0], &f, period, &cases, &opts, true, 64, None).unwrap().iter().map(|o| o.stm.iter().fold(1f64, |m, v| m.max(v.abs()))).collect();
         let mut runs: Vec<(simd::Level, Vec<librate_core::map::Outcome>)> = Vec::new();
         for &level in &levels {
             let base = sweep_at(level, &f, period, &cases, &opts, stm, 64, Some(1)).unwrap();
@@ -203,14 +203,55 @@ fn val_engine_levels_agree() {
                     worst_scaled = worst_scaled.max(d / sens[k]);
                 }
             }
-            println!("stm {stm}: {level} vs {l0}: max relative difference {worst:.1e}, divided by the sensitivity {worst_scaled:.1e}");
-            assert!(worst_scaled <= 1e-12, "stm {stm}: {level} vs {l0}: {worst_scaled:e}");
+            println!("{method:?}, stm {stm}: {level} vs {l0}: max relative difference {worst:.1e}, divided by the sensitivity {worst_scaled:.1e}");
+            assert!(worst_scaled <= 1e-12, "{method:?}, stm {stm}: {level} vs {l0}: {worst_scaled:e}");
             if *level != simd::Level::Baseline {
-                assert!(bits(r0) == bits(r), "stm {stm}: the FMA levels {l0} and {level} differ");
+                assert!(bits(r0) == bits(r), "{method:?}, stm {stm}: the FMA levels {l0} and {level} differ");
             }
         }
     }
     // An unavailable or unknown level is an error naming the variable.
     let e = simd::parse(Some("avx3")).unwrap_err().to_string();
     assert!(e.contains("LIBRATE_SIMD") && e.contains("baseline"), "{e}");
+}
+
+/// The Runge-Kutta-Nyström lanes (Method::Rkn86: phi'' = wzdot(t, phi) and its variational
+/// equation, RKN8(6)) against the scalar planar model (RKF7(8), orbit integrated alongside,
+/// 1e-13): gravity gradient on the DRO x0 = 0.7 over one period and a flat plate over two
+/// periods of the DRO x0 = 0.8 (terminator crossings cut, as in the RKF7(8) lanes). References
+/// and tolerances as for the RKF7(8) lanes: 1e-9 relative in phi and wz, 1e-8 in the STM; the
+/// results bit-identical for any chunking and thread count.
+#[test]
+fn val_nystrom_lanes_match_scalar_model() {
+    use librate_core::attitude::{FlatPlate, Sun};
+    let opts = LaneOptions { rtol: 1e-12, atol: 1e-12, method: Method::Rkn86, ..LaneOptions::default() };
+    let tight = Options::with_tolerances(1e-13, 1e-13);
+    for (x0, k_periods, srp) in [(0.7, 1.0, false), (0.8, 2.0, true)] {
+        let (s0, period) = dro(x0);
+        let f = OrbitForcing::new(MU, &s0, period, [true, true], 1e-13).unwrap();
+        let tf = k_periods * period;
+        let mut cases = Vec::new();
+        for (k, (eps, cs, cd, th)) in [(0.05, 0.4, 0.1, 0.0), (0.3, 0.0, 0.5, 1.1), (-0.2, 0.9, 0.1, 2.5)].into_iter().enumerate() {
+            for w in [-2.6, -0.5, 1.3, 1.9] {
+                let plate = if srp { (eps, cs, cd, th) } else { (0.0, 0.0, 0.0, 0.0) };
+                cases.push(Case { phi0: 0.2 * k as f64, wz0: w, kz: 0.8 - 0.3 * k as f64, eps: plate.0, cs: plate.1, cd: plate.2, theta_sun0: plate.3 });
+            }
+        }
+        let out = sweep(&f, tf, &cases, &opts, true, 8, None).unwrap();
+        for (c, o) in cases.iter().zip(&out) {
+            assert_eq!(o.status, LaneStatus::Ok);
+            let plate = srp.then(|| FlatPlate::new(c.eps, c.cs, c.cd, Sun { theta0: c.theta_sun0, ..Sun::default() }).unwrap());
+            let r = propagate_planar(MU, c.kz, [true, true], false, &s0, c.phi0, c.wz0, 0.0, tf, &tight, true, Output::Final, plate).unwrap();
+            let scale = 1f64.max(r.phi[0].abs()).max(r.wz[0].abs());
+            assert!((o.phi_t - r.phi[0]).abs() / scale < 1e-9 && (o.wz_t - r.wz[0]).abs() / scale < 1e-9, "{c:?}: {} {} vs {} {}", o.phi_t, o.wz_t, r.phi[0], r.wz[0]);
+            let m = r.stm_final.unwrap();
+            let n = m.iter().map(|v| v * v).sum::<f64>().sqrt();
+            let e = (0..4).map(|i| (m[i] - o.stm[i]).powi(2)).sum::<f64>().sqrt() / n;
+            assert!(e < 1e-8, "{c:?}: STM relative difference {e:e}");
+        }
+        let key = |o: &librate_core::map::Outcome| (o.phi_t.to_bits(), o.wz_t.to_bits(), o.stm.map(f64::to_bits), o.accepted, o.rejected);
+        let a: Vec<_> = sweep(&f, tf, &cases, &opts, true, 1, Some(1)).unwrap().iter().map(key).collect();
+        let b: Vec<_> = sweep(&f, tf, &cases, &opts, true, 64, Some(2)).unwrap().iter().map(key).collect();
+        assert_eq!(a, b);
+    }
 }

@@ -132,7 +132,7 @@ fn per_case(a: &Option<PyReadonlyArray1<'_, f64>>, name: &str, n: usize) -> PyRe
 
 /// Integrate planar attitude trajectories (phi0, wz0, kz arrays of one length) over t_final.
 #[pyfunction]
-#[pyo3(signature = (forcing, t_final, phi0, wz0, kz, *, rtol, atol, max_steps, stm, chunk, threads, eps=None, cs=None, cd=None, theta_sun0=None))]
+#[pyo3(signature = (forcing, t_final, phi0, wz0, kz, *, rtol, atol, max_steps, stm, chunk, threads, eps=None, cs=None, cd=None, theta_sun0=None, method="rkf78"))]
 #[allow(clippy::too_many_arguments)]
 fn map_sweep<'py>(
     py: Python<'py>,
@@ -151,7 +151,9 @@ fn map_sweep<'py>(
     cs: Option<PyReadonlyArray1<'py, f64>>,
     cd: Option<PyReadonlyArray1<'py, f64>>,
     theta_sun0: Option<PyReadonlyArray1<'py, f64>>,
+    method: &str,
 ) -> PyResult<PySweepResult> {
+    let method = map::Method::parse(method).ok_or_else(|| PyValueError::new_err(format!("invalid argument `method`: must be 'rkf78' or 'rkn86', got {method:?}")))?;
     let (p, w, k) = (phi0.as_array(), wz0.as_array(), kz.as_array());
     if p.len() != w.len() || k.len() != w.len() {
         return Err(PyValueError::new_err(format!("invalid argument: phi0, wz0 and kz must have one length, got {}, {}, {}", p.len(), w.len(), k.len())));
@@ -159,7 +161,7 @@ fn map_sweep<'py>(
     let n = w.len();
     let (e, s, d, th) = (per_case(&eps, "eps", n)?, per_case(&cs, "cs", n)?, per_case(&cd, "cd", n)?, per_case(&theta_sun0, "theta_sun0", n)?);
     let cases: Vec<Case> = (0..n).map(|i| Case { eps: e[i], cs: s[i], cd: d[i], theta_sun0: th[i], ..Case::new(p[i], w[i], k[i]) }).collect();
-    let opts = LaneOptions { rtol, atol, max_steps, ..LaneOptions::default() };
+    let opts = LaneOptions { rtol, atol, max_steps, method, ..LaneOptions::default() };
     let f = &forcing.inner;
     let out = py.detach(|| map::sweep(f, t_final, &cases, &opts, stm, chunk, threads)).map_err(to_py)?;
     let (mut phi_t, mut wz_t, mut dwz, mut dphi) = (Vec::with_capacity(n), Vec::with_capacity(n), Vec::with_capacity(n), Vec::with_capacity(n));

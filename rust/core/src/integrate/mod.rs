@@ -12,6 +12,7 @@ pub mod controller;
 pub mod driver;
 pub mod events;
 pub mod stepper;
+pub mod rkn;
 pub mod tableau;
 
 pub use controller::{Controller, StepControl};

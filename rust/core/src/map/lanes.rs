@@ -27,6 +27,7 @@
 use super::forcing::OrbitForcing;
 use crate::attitude::{flat_plate_wzdot, gravity_gradient_wzdot, FlatPlate, Sun};
 use crate::constants::SOLAR_PRESSURE_1AU;
+use crate::integrate::rkn::{A as RKN_A, B as RKN_B, BP as RKN_BP, BPT as RKN_BPT, BT as RKN_BT, C as RKN_C, ERROR_ORDER as RKN_ERROR_ORDER, STAGES as RKN_STAGES};
 use crate::integrate::tableau::{A, B8, C, ERR};
 use crate::integrate::Controller;
 use crate::scalar::F8;
@@ -96,11 +97,33 @@ pub struct LaneOptions {
     pub max_steps: u32,
     /// Rate of the Sun direction in the synodic frame (1/TU), for SRP cases.
     pub sun_omega: f64,
+    pub method: Method,
 }
 
 impl Default for LaneOptions {
     fn default() -> Self {
-        Self { rtol: 1e-12, atol: 1e-12, max_steps: 200_000, sun_omega: crate::constants::OMEGA_SUN }
+        Self { rtol: 1e-12, atol: 1e-12, max_steps: 200_000, sun_omega: crate::constants::OMEGA_SUN, method: Method::default() }
+    }
+}
+
+/// The lanes' integration method.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Method {
+    /// Runge-Kutta-Fehlberg 7(8) on (phi, wz, cos phi, sin phi): the reference and the default.
+    #[default]
+    Rkf78,
+    /// Runge-Kutta-Nyström 8(6) on phi'' = wzdot(t, phi) ([`crate::integrate::rkn`]).
+    Rkn86,
+}
+
+impl Method {
+    /// "rkf78" or "rkn86".
+    pub fn parse(name: &str) -> Option<Self> {
+        match name {
+            "rkf78" => Some(Self::Rkf78),
+            "rkn86" => Some(Self::Rkn86),
+            _ => None,
+        }
     }
 }
 
@@ -146,20 +169,17 @@ fn lincomb<I: Isa, const D: usize, const M: usize>(out: &mut [F8<I>; D], y: &[F8
     }
 }
 
+/// The lanes' angular acceleration wzdot(t, phi) and its derivative k = d wzdot / d phi (only
+/// used with the STM: compiled away otherwise), from (cos phi, sin phi): gravity gradient and,
+/// with SRP, the flat plate.
 #[inline(always)]
-fn rhs<I: Isa, const D: usize, const SRP: bool>(f: &OrbitForcing, t: f64, y: &[F8<I>; D], p: &Params<I>, dy: &mut [F8<I>; D]) {
-    let isa = y[0].isa();
+fn accel<I: Isa, const SRP: bool>(f: &OrbitForcing, t: f64, cp: F8<I>, sp: F8<I>, p: &Params<I>) -> (F8<I>, F8<I>) {
+    let isa = cp.isa();
     let (s, c) = f.sc_at::<I>(t);
     let (s, c) = (F8::splat(isa, s), F8::splat(isa, c));
-    let w = y[1] - F8::splat(isa, 1.0);
-    let (cp, sp) = (y[2], y[3]);
     let c2 = cp * cp - sp * sp;
     let s2 = (cp + cp) * sp;
-    dy[0] = w;
-    // k (d wzdot / d phi) is only used with the STM: unused, it is compiled away
     let (mut dwz, mut k) = gravity_gradient_wzdot(p.kz15, s, c, c2, s2);
-    dy[2] = -(w * sp);
-    dy[3] = w * cp;
     if SRP {
         // Sun angle theta = w t + theta0_l: (cos, sin)(w t) turned by each lane's theta0_l;
         // alpha = theta - phi (sin alpha, like k, is compiled away without the STM)
@@ -173,6 +193,18 @@ fn rhs<I: Isa, const D: usize, const SRP: bool>(f: &OrbitForcing, t: f64, y: &[F
         dwz += v;
         k += d;
     }
+    (dwz, k)
+}
+
+#[inline(always)]
+fn rhs<I: Isa, const D: usize, const SRP: bool>(f: &OrbitForcing, t: f64, y: &[F8<I>; D], p: &Params<I>, dy: &mut [F8<I>; D]) {
+    let isa = y[0].isa();
+    let w = y[1] - F8::splat(isa, 1.0);
+    let (cp, sp) = (y[2], y[3]);
+    dy[0] = w;
+    dy[2] = -(w * sp);
+    dy[3] = w * cp;
+    let (dwz, k) = accel::<I, SRP>(f, t, cp, sp, p);
     dy[1] = dwz;
     if D == 8 {
         dy[4] = y[6];
@@ -194,9 +226,69 @@ macro_rules! stage {
     }};
 }
 
-impl<I: Isa, const D: usize> Stages<I, D> {
-    /// One step of size h from (t, y), all lanes: writes the 8th-order solution and returns the
-    /// scaled max-norm error per lane.
+/// A lane integration scheme: its state, one step, and how a trajectory starts and ends.
+trait Scheme<I: Isa> {
+    type Y: Copy;
+    /// The step-size controller (the scalar driver's, at this scheme's error order).
+    const CONTROLLER: Controller;
+    fn new(isa: I) -> Self;
+    /// Forget anything kept from the previous group (its cases differ).
+    fn begin(&mut self) {}
+    /// The state at t = 0 of the lanes' cases.
+    fn start(isa: I, pick: impl Fn(usize) -> Case) -> Self::Y;
+    /// One step of size h from (t, y), all lanes: writes the propagated solution and returns
+    /// the scaled max-norm error per lane.
+    fn step<const SRP: bool>(&mut self, f: &OrbitForcing, t: f64, y: &Self::Y, h: f64, p: &Params<I>, out: &mut Self::Y, rtol: F8<I>, atol: F8<I>) -> F8<I>;
+    /// The lanes' phi.
+    fn phi(y: &Self::Y) -> F8<I>;
+    fn finite(y: &Self::Y) -> bool;
+    /// Lane l's (phi, wz, 2x2 STM row-major or NaN).
+    fn end(y: &Self::Y, l: usize) -> (f64, f64, [f64; 4]);
+}
+
+/// The scaled error of one component, |e| / (rtol max(|y|, |y_new|) + atol), folded into the
+/// lanes' running maximum (a NaN ratio fails the `<=` test and becomes the lane's error).
+#[inline(always)]
+fn fold_error<I: Isa>(err: F8<I>, e: F8<I>, y: F8<I>, ynew: F8<I>, rtol: F8<I>, atol: F8<I>) -> F8<I> {
+    let r = e.abs() / rtol.mul_add(y.abs().max(ynew.abs()), atol);
+    r.le_select(err, err, r)
+}
+
+impl<I: Isa, const D: usize> Scheme<I> for Stages<I, D> {
+    type Y = [F8<I>; D];
+    const CONTROLLER: Controller = CONTROLLER;
+
+    fn new(isa: I) -> Self {
+        Stages { k: [[F8::splat(isa, 0.0); D]; 13], tmp: [F8::splat(isa, 0.0); D] }
+    }
+
+    fn start(isa: I, pick: impl Fn(usize) -> Case) -> [F8<I>; D] {
+        let mut y = [F8::splat(isa, 0.0); D];
+        y[0] = F8::new(isa, std::array::from_fn(|l| pick(l).phi0));
+        y[1] = F8::new(isa, std::array::from_fn(|l| pick(l).wz0));
+        y[2] = F8::new(isa, std::array::from_fn(|l| pick(l).phi0.cos()));
+        y[3] = F8::new(isa, std::array::from_fn(|l| pick(l).phi0.sin()));
+        if D == 8 {
+            y[4] = F8::splat(isa, 1.0);
+            y[7] = F8::splat(isa, 1.0);
+        }
+        y
+    }
+
+    fn phi(y: &[F8<I>; D]) -> F8<I> {
+        y[0]
+    }
+
+    fn finite(y: &[F8<I>; D]) -> bool {
+        (0..D).all(|i| y[i].to_array().iter().all(|v| v.is_finite()))
+    }
+
+    fn end(y: &[F8<I>; D], l: usize) -> (f64, f64, [f64; 4]) {
+        let stm = if D == 8 { [lane(&y[4], l), lane(&y[5], l), lane(&y[6], l), lane(&y[7], l)] } else { [f64::NAN; 4] };
+        (lane(&y[0], l), lane(&y[1], l), stm)
+    }
+
+    /// One RKF7(8) step: the 8th-order solution and the scaled max-norm error per lane.
     #[inline(always)]
     fn step<const SRP: bool>(&mut self, f: &OrbitForcing, t: f64, y: &[F8<I>; D], h: f64, p: &Params<I>, out: &mut [F8<I>; D], rtol: F8<I>, atol: F8<I>) -> F8<I> {
         let isa = y[0].isa();
@@ -219,11 +311,128 @@ impl<I: Isa, const D: usize> Stages<I, D> {
         let he = hv * F8::splat(isa, ERR);
         let mut err = F8::splat(isa, 0.0);
         for i in 0..D {
-            let e = (he * ((k[0][i] + k[10][i]) - (k[11][i] + k[12][i]))).abs();
-            let sc = rtol.mul_add(y[i].abs().max(out[i].abs()), atol);
-            let r = e / sc;
-            // keep NaN: a NaN ratio fails the `<=` test and becomes the lane's error
-            err = r.le_select(err, err, r);
+            err = fold_error(err, he * ((k[0][i] + k[10][i]) - (k[11][i] + k[12][i])), y[i], out[i], rtol, atol);
+        }
+        err
+    }
+}
+
+/// Runge-Kutta-Nyström RKN8(6) ([`crate::integrate::rkn`]) on the lanes: with the orbit
+/// tabulated, the planar attitude is a special second-order equation, phi'' = wzdot(t, phi)
+/// (phidot = wz - 1), and so is its variational equation, Y'' = k(t, phi) Y for the columns Y of
+/// d phi / d(phi0, wz0). Positions x = (phi[, Y1, Y2]) and velocities v = (phidot[, Y1', Y2'])
+/// with P = 1 (no STM) or 3 components; cos phi and sin phi from one vector sin_cos per stage
+/// (RKF7(8) carries them as states instead). Eight new evaluations per step (the last stage is
+/// the next step's first) against RKF7(8)'s thirteen.
+struct Nystrom<I, const P: usize> {
+    k: [[F8<I>; P]; RKN_STAGES],
+    tmp: [F8<I>; P],
+    /// First same as last: the last stage of the latest step and where it was evaluated (the
+    /// next step reuses it when it starts there, after an accepted step, not after a trial).
+    last: [F8<I>; P],
+    last_at: Option<(f64, [F8<I>; P])>,
+}
+
+/// Positions and velocities of the Nyström lanes.
+#[derive(Clone, Copy)]
+struct NyState<I, const P: usize> {
+    x: [F8<I>; P],
+    v: [F8<I>; P],
+}
+
+impl<I: Isa, const P: usize> Nystrom<I, P> {
+    #[inline(always)]
+    fn acc<const SRP: bool>(f: &OrbitForcing, t: f64, x: &[F8<I>; P], p: &Params<I>, out: &mut [F8<I>; P]) {
+        let (sp, cp) = x[0].sin_cos();
+        let (a, k) = accel::<I, SRP>(f, t, cp, sp, p);
+        out[0] = a;
+        for i in 1..P {
+            out[i] = k * x[i];
+        }
+    }
+}
+
+impl<I: Isa, const P: usize> Scheme<I> for Nystrom<I, P> {
+    type Y = NyState<I, P>;
+    const CONTROLLER: Controller = Controller::new(0.8, 0.2, 5.0, RKN_ERROR_ORDER);
+
+    fn new(isa: I) -> Self {
+        let z = [F8::splat(isa, 0.0); P];
+        Nystrom { k: [z; RKN_STAGES], tmp: z, last: z, last_at: None }
+    }
+
+    fn begin(&mut self) {
+        self.last_at = None;
+    }
+
+    fn start(isa: I, pick: impl Fn(usize) -> Case) -> NyState<I, P> {
+        let mut y = NyState { x: [F8::splat(isa, 0.0); P], v: [F8::splat(isa, 0.0); P] };
+        y.x[0] = F8::new(isa, std::array::from_fn(|l| pick(l).phi0));
+        y.v[0] = F8::new(isa, std::array::from_fn(|l| pick(l).wz0 - 1.0));
+        if P == 3 {
+            y.x[1] = F8::splat(isa, 1.0); // d phi / d phi0
+            y.v[2] = F8::splat(isa, 1.0); // d phidot / d wz0
+        }
+        y
+    }
+
+    fn phi(y: &NyState<I, P>) -> F8<I> {
+        y.x[0]
+    }
+
+    fn finite(y: &NyState<I, P>) -> bool {
+        (0..P).all(|i| y.x[i].to_array().iter().chain(y.v[i].to_array().iter()).all(|v| v.is_finite()))
+    }
+
+    fn end(y: &NyState<I, P>, l: usize) -> (f64, f64, [f64; 4]) {
+        // STM rows (phi, wz), columns (phi0, wz0): (Y1, Y2; Y1', Y2')
+        let stm = if P == 3 { [lane(&y.x[1], l), lane(&y.x[2], l), lane(&y.v[1], l), lane(&y.v[2], l)] } else { [f64::NAN; 4] };
+        (lane(&y.x[0], l), lane(&y.v[0], l) + 1.0, stm)
+    }
+
+    #[inline(always)]
+    fn step<const SRP: bool>(&mut self, f: &OrbitForcing, t: f64, y: &NyState<I, P>, h: f64, p: &Params<I>, out: &mut NyState<I, P>, rtol: F8<I>, atol: F8<I>) -> F8<I> {
+        let isa = y.x[0].isa();
+        let (hv, h2) = (F8::splat(isa, h), F8::splat(isa, h * h));
+        let same = |a: &[F8<I>; P], b: &[F8<I>; P]| (0..P).all(|i| a[i].to_array().iter().zip(b[i].to_array().iter()).all(|(u, v)| u.to_bits() == v.to_bits()));
+        match self.last_at {
+            Some((tl, ref xl)) if tl.to_bits() == t.to_bits() && same(xl, &y.x) => self.k[0] = self.last,
+            _ => Self::acc::<SRP>(f, t, &y.x, p, &mut self.k[0]),
+        }
+        for s in 1..RKN_STAGES - 1 {
+            for i in 0..P {
+                let mut acc = F8::splat(isa, 0.0);
+                for (a, k) in RKN_A[s][..s].iter().zip(&self.k) {
+                    acc = F8::splat(isa, *a).mul_add(k[i], acc);
+                }
+                self.tmp[i] = h2.mul_add(acc, (hv * F8::splat(isa, RKN_C[s])).mul_add(y.v[i], y.x[i]));
+            }
+            let tmp = self.tmp;
+            Self::acc::<SRP>(f, RKN_C[s].mul_add(h, t), &tmp, p, &mut self.k[s]);
+        }
+        // the new position (the last stage's: A's last row is B), then the last stage there
+        for i in 0..P {
+            let mut acc = F8::splat(isa, 0.0);
+            for (b, k) in RKN_B[..RKN_STAGES - 1].iter().zip(&self.k) {
+                acc = F8::splat(isa, *b).mul_add(k[i], acc);
+            }
+            out.x[i] = h2.mul_add(acc, hv.mul_add(y.v[i], y.x[i]));
+        }
+        let xnew = out.x;
+        Self::acc::<SRP>(f, t + h, &xnew, p, &mut self.k[RKN_STAGES - 1]);
+        self.last = self.k[RKN_STAGES - 1];
+        self.last_at = Some((t + h, xnew));
+        let mut err = F8::splat(isa, 0.0);
+        for i in 0..P {
+            let (mut dv, mut ex, mut ev) = (F8::splat(isa, 0.0), F8::splat(isa, 0.0), F8::splat(isa, 0.0));
+            for (j, k) in self.k.iter().enumerate() {
+                dv = F8::splat(isa, RKN_BP[j]).mul_add(k[i], dv);
+                ex = F8::splat(isa, RKN_BT[j]).mul_add(k[i], ex);
+                ev = F8::splat(isa, RKN_BPT[j]).mul_add(k[i], ev);
+            }
+            out.v[i] = hv.mul_add(dv, y.v[i]);
+            err = fold_error(err, h2 * ex, y.x[i], out.x[i], rtol, atol);
+            err = fold_error(err, hv * ev, y.v[i], out.v[i], rtol, atol);
         }
         err
     }
@@ -235,23 +444,16 @@ fn lane<I: Isa>(v: &F8<I>, l: usize) -> f64 {
 
 /// Integrate one group of up to LANES trajectories in lock step; missing lanes repeat the last.
 #[inline(always)]
-fn integrate_group<I: Isa, const D: usize, const SRP: bool>(isa: I, f: &OrbitForcing, t_final: f64, group: &[Case], opts: &LaneOptions, st: &mut Stages<I, D>) -> [Outcome; LANES] {
+fn integrate_group<I: Isa, S: Scheme<I>, const SRP: bool>(isa: I, f: &OrbitForcing, t_final: f64, group: &[Case], opts: &LaneOptions, st: &mut S) -> [Outcome; LANES] {
     let n = group.len();
     let pick = |l: usize| group[l.min(n - 1)];
-    let mut y = [F8::splat(isa, 0.0); D];
-    y[0] = F8::new(isa, std::array::from_fn(|l| pick(l).phi0));
-    y[1] = F8::new(isa, std::array::from_fn(|l| pick(l).wz0));
-    y[2] = F8::new(isa, std::array::from_fn(|l| pick(l).phi0.cos()));
-    y[3] = F8::new(isa, std::array::from_fn(|l| pick(l).phi0.sin()));
-    if D == 8 {
-        y[4] = F8::splat(isa, 1.0);
-        y[7] = F8::splat(isa, 1.0);
-    }
+    let mut y = S::start(isa, pick);
+    st.begin();
     let (p, plates) = Params::new(isa, pick, opts.sun_omega);
     let plate: [bool; LANES] = std::array::from_fn(|l| plates[l].eps != 0.0);
     let (rtol, atol) = (F8::splat(isa, opts.rtol), F8::splat(isa, opts.atol));
-    let mut ynew = [F8::splat(isa, 0.0); D];
-    let mut yc = [F8::splat(isa, 0.0); D];
+    let mut ynew = y;
+    let mut yc = y;
     let (mut t, mut h) = (0.0f64, t_final / 100.0);
     let (mut accepted, mut rejected) = (0u32, 0u32);
     let mut after_reject = false;
@@ -266,11 +468,11 @@ fn integrate_group<I: Isa, const D: usize, const SRP: bool>(isa: I, f: &OrbitFor
         let (mut heff, mut last) = if h >= rem { (rem, true) } else { (h, false) };
         let err = st.step::<SRP>(f, t, &y, heff, &p, &mut ynew, rtol, atol).to_array();
         let emax = err.iter().fold(0.0f64, |m, &e| if e.is_nan() || e > m { if e.is_nan() { f64::INFINITY } else { e } } else { m });
-        let finite = (0..D).all(|i| ynew[i].to_array().iter().all(|v| v.is_finite()));
+        let finite = S::finite(&ynew);
         if !(emax <= 1.0) || !finite {
             rejected += 1;
             after_reject = true;
-            h = heff * CONTROLLER.factor_rejected(emax);
+            h = heff * S::CONTROLLER.factor_rejected(emax);
             if h <= 1e-14 * t_final.max(1.0) {
                 status = LaneStatus::Failed;
                 break;
@@ -284,8 +486,8 @@ fn integrate_group<I: Isa, const D: usize, const SRP: bool>(isa: I, f: &OrbitFor
                 if !has_plate {
                     continue;
                 }
-                let g0 = g(l, t, lane(&y[0], l));
-                let g1 = g(l, t + heff, lane(&ynew[0], l));
+                let g0 = g(l, t, lane(&S::phi(&y), l));
+                let g1 = g(l, t + heff, lane(&S::phi(&ynew), l));
                 if !((g0 < 0.0 && g1 > 0.0) || (g0 > 0.0 && g1 < 0.0)) {
                     continue;
                 }
@@ -296,7 +498,7 @@ fn integrate_group<I: Isa, const D: usize, const SRP: bool>(isa: I, f: &OrbitFor
                     }
                     let tau = (tb - gb * (tb - ta) / (gb - ga)).clamp(ta.min(tb), ta.max(tb));
                     st.step::<SRP>(f, t, &y, tau, &p, &mut yc, rtol, atol);
-                    let gc = g(l, t + tau, lane(&yc[0], l));
+                    let gc = g(l, t + tau, lane(&S::phi(&yc), l));
                     if (gc > 0.0) == (gb > 0.0) {
                         tb = tau;
                         gb = gc;
@@ -327,7 +529,7 @@ fn integrate_group<I: Isa, const D: usize, const SRP: bool>(isa: I, f: &OrbitFor
         accepted += 1;
         y = ynew;
         t = if last { t_final } else { t + heff };
-        let fac = CONTROLLER.factor_accepted(emax, after_reject);
+        let fac = S::CONTROLLER.factor_accepted(emax, after_reject);
         after_reject = false;
         h = h.max(heff) * fac;
     }
@@ -335,21 +537,16 @@ fn integrate_group<I: Isa, const D: usize, const SRP: bool>(isa: I, f: &OrbitFor
         if status != LaneStatus::Ok {
             return Outcome { phi_t: f64::NAN, wz_t: f64::NAN, stm: [f64::NAN; 4], accepted, rejected, status };
         }
-        Outcome {
-            phi_t: lane(&y[0], l),
-            wz_t: lane(&y[1], l),
-            stm: if D == 8 { [lane(&y[4], l), lane(&y[5], l), lane(&y[6], l), lane(&y[7], l)] } else { [f64::NAN; 4] },
-            accepted,
-            rejected,
-            status,
-        }
+        let (phi_t, wz_t, stm) = S::end(&y, l);
+        Outcome { phi_t, wz_t, stm, accepted, rejected, status }
     })
 }
 
 /// Integrate `cases` from t = 0 to `t_final` along the orbit forcing, in lock-step groups of LANES
 /// taken in order from the start of the slice, at the SIMD `level` ([`crate::simd`]; an error
-/// only if the CPU lacks it). `D` is 4 (no STM) or 8 (with the 2x2 STM); `SRP` compiles the
-/// flat-plate term in (lanes with eps = 0 add exact zeros and never cut steps).
+/// only if the CPU lacks it), with `opts.method`. `D` is 4 (no STM) or 8 (with the 2x2 STM);
+/// `SRP` compiles the flat-plate term in (lanes with eps = 0 add exact zeros and never cut
+/// steps).
 pub fn integrate_cases<const D: usize, const SRP: bool>(level: Level, f: &OrbitForcing, t_final: f64, cases: &[Case], opts: &LaneOptions) -> Result<Vec<Outcome>> {
     crate::simd::run_at(level, Groups::<D, SRP> { f, t_final, cases, opts })
 }
@@ -366,10 +563,21 @@ impl<const D: usize, const SRP: bool> Kernel for Groups<'_, D, SRP> {
     type Output = Vec<Outcome>;
     #[inline(always)]
     fn run<I: Isa>(self, isa: I) -> Vec<Outcome> {
-        let mut st = Stages::<I, D> { k: [[F8::splat(isa, 0.0); D]; 13], tmp: [F8::splat(isa, 0.0); D] };
+        match (self.opts.method, D == 8) {
+            (Method::Rkf78, _) => self.with::<I, Stages<I, D>>(isa),
+            (Method::Rkn86, true) => self.with::<I, Nystrom<I, 3>>(isa),
+            (Method::Rkn86, false) => self.with::<I, Nystrom<I, 1>>(isa),
+        }
+    }
+}
+
+impl<const D: usize, const SRP: bool> Groups<'_, D, SRP> {
+    #[inline(always)]
+    fn with<I: Isa, S: Scheme<I>>(self, isa: I) -> Vec<Outcome> {
+        let mut st = S::new(isa);
         let mut out = Vec::with_capacity(self.cases.len());
         for group in self.cases.chunks(LANES) {
-            let r = integrate_group::<I, D, SRP>(isa, self.f, self.t_final, group, self.opts, &mut st);
+            let r = integrate_group::<I, S, SRP>(isa, self.f, self.t_final, group, self.opts, &mut st);
             out.extend_from_slice(&r[..group.len()]);
         }
         out

@@ -6,7 +6,7 @@ pub mod forcing;
 pub mod lanes;
 
 pub use forcing::OrbitForcing;
-pub use lanes::{integrate_cases, Case, LaneOptions, LaneStatus, Outcome};
+pub use lanes::{integrate_cases, Case, LaneOptions, LaneStatus, Method, Outcome};
 
 use rayon::prelude::*;
 

@@ -644,7 +644,7 @@ type Integrate<'a> = dyn Fn(&[Case], &[f64], bool) -> Result<Vec<Outcome>> + Syn
 /// All trajectories on one orbit's forcing table, in one sweep (over `t_final`, or twice it for
 /// the half closure's full-period monodromy).
 fn on_table<'a>(forcing: &'a OrbitForcing, t_final: f64, opts: &CorrectorOptions) -> impl Fn(&[Case], &[f64], bool) -> Result<Vec<Outcome>> + Sync + 'a {
-    let lane = LaneOptions { rtol: opts.rtol, atol: opts.atol, max_steps: opts.max_steps, sun_omega: opts.sun_omega };
+    let lane = LaneOptions { rtol: opts.rtol, atol: opts.atol, max_steps: opts.max_steps, sun_omega: opts.sun_omega, ..LaneOptions::default() };
     let chunk = opts.chunk;
     move |cases: &[Case], _: &[f64], full: bool| {
         // small batches (a few branches of a lock-step continuation) still spread over every
@@ -766,7 +766,7 @@ pub fn correct_across_family(family: &PlanarFamily, bordered: &Bordered, candida
     validate_options(opts)?;
     validate_candidates(Closure::Half, Free::Phi0, candidates)?;
     let form = Form { closure: Closure::Half, free: Free::Phi0, h: opts.phase_step, bordered: Some(*bordered), bounds: family.range(), max_wz_step: opts.max_wz_step, max_angle_step: opts.max_angle_step };
-    let lane = LaneOptions { rtol: opts.rtol, atol: opts.atol, max_steps: opts.max_steps, sun_omega: opts.sun_omega };
+    let lane = LaneOptions { rtol: opts.rtol, atol: opts.atol, max_steps: opts.max_steps, sun_omega: opts.sun_omega, ..LaneOptions::default() };
     let integrate = |cases: &[Case], values: &[f64], full: bool| -> Result<Vec<Outcome>> {
         // distinct orbits, in parallel; then each orbit's trajectories in one sweep
         let mut distinct: Vec<f64> = values.to_vec();
