@@ -1,5 +1,6 @@
-//! Runtime CPU dispatch of the hot kernels: one portable build runs on every x86-64 CPU and uses
-//! the widest instruction set the running CPU has.
+//! Runtime CPU dispatch of the hot kernels (the map engine's lanes, `map::lanes`; each step of the
+//! scalar RKF7(8) stepper, `integrate::Rkf78`): one portable build runs on every x86-64 CPU and
+//! uses the widest instruction set the running CPU has.
 //!
 //! Levels: on x86-64, `baseline` (SSE2, no fused multiply-add: every x86-64 CPU), `avx2`
 //! (x86-64-v3: AVX2 + FMA) and `avx512` (x86-64-v4: AVX-512 F/BW/CD/DQ/VL + FMA); on aarch64,

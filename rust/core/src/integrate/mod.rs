@@ -74,4 +74,3 @@ impl Stats {
     }
 }
 
-pub(crate) use crate::scalar::fmadd;
