@@ -7,10 +7,12 @@
 //! `neon` (part of the architecture's baseline, with FMA; compile time). The level is chosen once,
 //! at first use, from the running CPU (the highest it supports), or forced by the environment
 //! variable `LIBRATE_SIMD=auto|baseline|avx2|avx512` (an unknown or unavailable value is an
-//! [`Error::InvalidArgument`] naming the variable and the allowed values, at every use).
+//! [`crate::error::Error::InvalidArgument`] naming the variable and the allowed values, at every
+//! use); [`set_active`] switches levels within a process (tests, benchmarks).
 //!
-//! How: a kernel is written once, generic over an [`Isa`] marker ([`Kernel::run`]), with
-//! everything it calls in its hot loop `#[inline(always)]`. [`run`] calls it inside a function
+//! How: a kernel is written once, generic over an [`Isa`] token ([`Kernel::run`]; the AVX2 and
+//! AVX-512 tokens exist only once the CPU's support is detected), with everything it calls in its
+//! hot loop `#[inline(always)]`. [`run`] calls it inside a function
 //! compiled with the level's target features (`pulp`'s `V3` / `V4` `vectorize`, which also
 //! detect and cache the CPU's features), so LLVM generates the same generic code once per level.
 //! The marker's [`Isa::FMA`] decides `a * b + c` (two roundings) or a fused multiply-add (one):
