@@ -136,7 +136,7 @@ pub(crate) fn fmadd(a: f64, b: f64, c: f64) -> f64 {
 
 /// Lane-wise arithmetic shared by f64 and [`F8`].
 pub trait Lane: Copy + Add<Output = Self> + Sub<Output = Self> + Mul<Output = Self> + Neg<Output = Self> {
-    /// self * a + b: fused where the level (F8) or the build (f64, [`fmadd`]) has FMA.
+    /// self * a + b: fused where the level (F8) or the build (f64, `fmadd`) has FMA.
     fn mul_add(self, a: Self, b: Self) -> Self;
     fn abs(self) -> Self;
 }

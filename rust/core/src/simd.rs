@@ -1,15 +1,18 @@
-//! Runtime CPU dispatch of the hot kernels: one portable build runs on every x86-64 CPU and uses
-//! the widest instruction set the running CPU has.
+//! Runtime CPU dispatch of the hot kernels (the map engine's lanes, `map::lanes`; each step of the
+//! scalar RKF7(8) stepper, `integrate::Rkf78`): one portable build runs on every x86-64 CPU and
+//! uses the widest instruction set the running CPU has.
 //!
 //! Levels: on x86-64, `baseline` (SSE2, no fused multiply-add: every x86-64 CPU), `avx2`
 //! (x86-64-v3: AVX2 + FMA) and `avx512` (x86-64-v4: AVX-512 F/BW/CD/DQ/VL + FMA); on aarch64,
 //! `neon` (part of the architecture's baseline, with FMA; compile time). The level is chosen once,
 //! at first use, from the running CPU (the highest it supports), or forced by the environment
 //! variable `LIBRATE_SIMD=auto|baseline|avx2|avx512` (an unknown or unavailable value is an
-//! [`Error::InvalidArgument`] naming the variable and the allowed values, at every use).
+//! [`crate::error::Error::InvalidArgument`] naming the variable and the allowed values, at every
+//! use); [`set_active`] switches levels within a process (tests, benchmarks).
 //!
-//! How: a kernel is written once, generic over an [`Isa`] marker ([`Kernel::run`]), with
-//! everything it calls in its hot loop `#[inline(always)]`. [`run`] calls it inside a function
+//! How: a kernel is written once, generic over an [`Isa`] token ([`Kernel::run`]; the AVX2 and
+//! AVX-512 tokens exist only once the CPU's support is detected), with everything it calls in its
+//! hot loop `#[inline(always)]`. [`run`] calls it inside a function
 //! compiled with the level's target features (`pulp`'s `V3` / `V4` `vectorize`, which also
 //! detect and cache the CPU's features), so LLVM generates the same generic code once per level.
 //! The marker's [`Isa::FMA`] decides `a * b + c` (two roundings) or a fused multiply-add (one):

@@ -201,7 +201,7 @@ pub fn solve<S: State, Sys: System<S>>(
         Output::Final => {}
     }
 
-    let mut stepper = Rkf78::new(y0);
+    let mut stepper = Rkf78::new(y0, crate::simd::active()?);
     let mut stats = Stats::default();
     let mut t = t0;
     let mut y = y0.clone();

@@ -75,4 +75,3 @@ impl Stats {
     }
 }
 
-pub(crate) use crate::scalar::fmadd;

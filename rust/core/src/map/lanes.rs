@@ -1,5 +1,6 @@
 //! The attitude periodicity engine's integrator: RKF7(8) on eight trajectories at once in SIMD
-//! lanes (`wide::f64x8`, AVX-512 where the CPU has it), in lock step: the eight share the time
+//! lanes ([`F8`]: 4 x SSE2, 2 x AVX2 or 1 x AVX-512 registers, the level dispatched at run time by
+//! [`crate::simd`]), in lock step: the eight share the time
 //! and the step size (the smallest any of them needs), each with its own state, Kz and SRP
 //! parameters.
 //!
