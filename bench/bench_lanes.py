@@ -11,13 +11,14 @@ orbit integrated alongside at 1e-14 (an independent code path). For each method,
 rung meeting the target (2e-10) is timed on one thread (CPU time, best of --rounds, the two
 methods alternating round-robin) and the ratio is reported.
 
-Result and the default (Intel Xeon, AVX-512 build, 2 cores shared): at the 2e-10 target the
-Nyström lanes take 0.89x the RKF7(8) lanes' time without the STM (rtol 1e-9 against 2e-12: the
-RKN's sixth-order error estimate is conservative) and 1.02x with it. RKN8(6) needs about half
-the evaluations (8 per step with FSAL, against 13), but each needs a vector sin/cos of phi,
-which RKF7(8) avoids by carrying cos phi and sin phi as states. At this accuracy the gain is
-too small to change the default's tolerance and results: the maps keep RKF7(8) (MAP_METHOD),
-and `method="rkn86"` is there to select. Run:
+Result and the default (Intel Xeon, family 6 model 207, 2 vCPUs, AVX-512 level of the portable
+build): at the 2e-10 target the Nyström lanes take 0.80x the RKF7(8) lanes' time without the STM
+(rtol 1e-9 against 2e-12: the RKN's sixth-order error estimate is conservative) and 0.86x with
+it; at the maps' default accuracy (RKF7(8) at 1e-12 against RKN8(6) at 2e-10) 0.89x and 0.85x.
+RKN8(6) needs about half the evaluations (8 per step with FSAL, against 13), but each needs a
+vector sin/cos of phi, which RKF7(8) avoids by carrying cos phi and sin phi as states. The maps
+keep RKF7(8) (MAP_METHOD): every default and stored map was made with it and its tolerance, and
+a resumed store must not mix methods; `method="rkn86"` is there to select. Run:
 
     python bench/bench_lanes.py [--rounds N]
 """
