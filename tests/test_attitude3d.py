@@ -320,3 +320,40 @@ def test_floquet_test_functions():
     disc = ((u[0] - u[1]) * (u[0] - u[2]) * (u[1] - u[2])) ** 2
     assert t["discriminant"] == pytest.approx(disc, rel=1e-10)
     assert np.allclose(np.sort_complex(np.linalg.eigvals(m)), np.sort_complex(lam))
+
+
+def test_body_axes_figure(em, tmp_path):
+    """Issue 15's figure of the body axes over the orbit, on the thesis Fig. 23 motion embedded
+    in 3-D (12.66-day DRO, Kz = 0.8, N = -1): two panels (x-y, x-z); the orbit line is the
+    orbit's trajectory; the arrows sit on it, one per sample, their x-y projections are the body
+    axes (from the propagated attitude, 1e-12) scaled to 6 % of the orbit's extent, and the body
+    z axis stays on synodic Z (a planar motion: its x-y arrows have zero length, 1e-12)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import librate.plotting as lp
+    import matplotlib.pyplot as plt
+
+    d = librate.dro(em, period_days=12.66)
+    body = librate.RigidBody(12.12e6, 89.68e6, 96.95e6)
+    sol = librate.periodic_attitude_3d(d, body, guess=librate.periodic_attitude(d, kz=0.8, n=-1))
+    fig = lp.plot_body_axes(sol, samples=8)
+    assert len(fig.axes) == 2
+    a = fig.axes[0]
+    gid = lambda g: [c for c in a.get_children() if c.get_gid() == g]  # noqa: E731
+    (orbit,) = gid("orbit")
+    tr = sol.propagate(t_eval=np.linspace(0.0, d.period, 8, endpoint=False))
+    qx = gid("axis-x")[0]
+    np.testing.assert_allclose(qx.get_offsets(), tr.orbit[:, :2], atol=1e-12)
+    ext = float(np.max(np.ptp(orbit.get_xydata(), axis=0)))
+    length = np.hypot(qx.U, qx.V)
+    np.testing.assert_allclose(length, 0.06 * max(ext, float(np.ptp(sol.propagate(t_eval=np.linspace(0, d.period, 400)).orbit[:, 2]))), rtol=1e-9)
+    np.testing.assert_allclose(np.c_[qx.U, qx.V] / length[:, None], tr.dcm()[:, 0, :2] / np.linalg.norm(tr.dcm()[:, 0, :2], axis=1)[:, None], atol=1e-12)
+    qz = gid("axis-z")[0]
+    assert np.max(np.hypot(qz.U, qz.V)) < 1e-12
+    fig.savefig(tmp_path / "axes.png")
+    plt.close(fig)
+    with pytest.raises(ValueError, match="solution"):
+        lp.plot_body_axes(object())
+    with pytest.raises(ValueError, match="planes"):
+        lp.plot_body_axes(sol, planes=("xx",))

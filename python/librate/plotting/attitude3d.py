@@ -1,5 +1,7 @@
 """Figures of the 3-D attitude: the stability diagram of the equilibrium attitudes at a collinear
-Lagrange point (thesis Fig. 19, after Robinson 1974). Re-exported by :mod:`librate.plotting`."""
+Lagrange point (thesis Fig. 19, after Robinson 1974), the out-of-plane stability of planar
+families, Floquet multipliers along 3-D families and the body axes along the orbit.
+Re-exported by :mod:`librate.plotting`."""
 
 from __future__ import annotations
 
@@ -10,7 +12,7 @@ import numpy as np
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
-__all__ = ["plot_equilibrium_stability", "plot_out_of_plane_stability", "plot_family_multipliers"]
+__all__ = ["plot_equilibrium_stability", "plot_out_of_plane_stability", "plot_family_multipliers", "plot_body_axes"]
 
 
 def plot_equilibrium_stability(ds, ax=None, *, boundaries: bool = True) -> Figure:
@@ -138,6 +140,8 @@ def plot_family_multipliers(ds, ax=None, *, against: str = "period") -> Figure:
     for ch in ast.literal_eval(ds.attrs.get("stability_changes", "[]")) if along_period else []:
         lo, hi = ch["between"]
         a.axvspan(min(lo, hi), max(lo, hi), color="tab:orange", alpha=0.3, gid="stability-change")
+        if "at" in ch:  # located by the continuation driver
+            a.axvline(ch["at"], color="tab:orange", linewidth=1.0, gid="stability-change-at")
     a.set_xlabel({"period": "orbit period (days)", "x0": "$x_0$ (LU)", "z0": "$z_0$ (LU)"}[against])
     a.set_ylabel("|Floquet multiplier|")
     moments = ds.attrs.get("body_moments")
@@ -150,4 +154,46 @@ def plot_family_multipliers(ds, ax=None, *, against: str = "period") -> Figure:
     b.set_xlabel("Re")
     b.set_ylabel("Im")
     fig.colorbar(sc, ax=b, label="member (along the family)")
+    return fig
+
+
+def plot_body_axes(solution, ax=None, *, samples: int = 16, planes=("xy", "xz")) -> Figure:
+    """The body axes along the orbit of a periodic 3-D attitude motion
+    (:class:`librate.AttitudeSolution3D`): one panel per synodic plane of ``planes`` ("xy",
+    "xz" or "yz"), the orbit over the solution's K periods (gid ``"orbit"``) and, at ``samples``
+    evenly spaced times, the projections of the body x, y and z axes as arrows (gids
+    ``"axis-x"``, ``"axis-y"``, ``"axis-z"``; red, green, blue), scaled to 6 % of the orbit's
+    extent. Returns the Figure."""
+    from . import _axes
+
+    if not all(hasattr(solution, a) for a in ("q0", "w0", "orbit", "propagate", "n_periods")):
+        raise ValueError(f"invalid argument `solution`: must be a librate.AttitudeSolution3D, got {type(solution).__name__}")
+    samples = int(samples)
+    if samples < 1:
+        raise ValueError(f"invalid argument `samples`: must be an integer >= 1, got {samples!r}")
+    index = {"x": 0, "y": 1, "z": 2}
+    planes = tuple(planes)
+    if not planes or any(len(p) != 2 or p[0] not in index or p[1] not in index or p[0] == p[1] for p in planes):
+        raise ValueError(f"invalid argument `planes`: must be planes such as 'xy', 'xz', 'yz', got {planes!r}")
+    t_end = solution.n_periods * solution.orbit.period
+    dense = solution.propagate(t_eval=np.linspace(0.0, t_end, 400))
+    marks = solution.propagate(t_eval=np.linspace(0.0, t_end, samples, endpoint=False))
+    pos, at = dense.orbit[:, :3], marks.orbit[:, :3]
+    axes = marks.dcm()  # (n, 3, 3): row i is body axis i in synodic components
+    extent = float(np.max(np.ptp(pos, axis=0)))
+    length = 0.06 * (extent if extent > 0 else 1.0)
+    fig, panels = _axes(ax, len(planes))
+    for a, plane in zip(panels, planes):
+        i, j = index[plane[0]], index[plane[1]]
+        (ln,) = a.plot(pos[:, i], pos[:, j], color="0.5", linewidth=0.8)
+        ln.set_gid("orbit")
+        for k, (name, color) in enumerate((("x", "tab:red"), ("y", "tab:green"), ("z", "tab:blue"))):
+            q = a.quiver(at[:, i], at[:, j], length * axes[:, k, i], length * axes[:, k, j], color=color, angles="xy", scale_units="xy",
+                         scale=1.0, width=0.004, label=f"body {name}")
+            q.set_gid(f"axis-{name}")
+        a.set_aspect("equal", adjustable="datalim")
+        a.set_xlabel(f"{plane[0]} (LU)")
+        a.set_ylabel(f"{plane[1]} (LU)")
+    panels[0].legend(fontsize="small", loc="best")
+    panels[0].set_title(f"body axes along the orbit (T = {solution.orbit.period_days:.3f} d, K = {solution.n_periods})")
     return fig
