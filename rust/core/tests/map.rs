@@ -67,9 +67,13 @@ fn val_engine_is_deterministic() {
     let f = OrbitForcing::new(MU, &s0, period, [true, true], 1e-13).unwrap();
     let mut cases = grid(37, 0.8);
     cases.extend(grid(11, 0.3));
-    let base = sweep(&f, period, &cases, &LaneOptions::default(), true, 64, Some(1)).unwrap();
+    // bit for bit (NaN fields, such as dparam without a sensitivity, compare by their bits)
+    let bits = |r: &[librate_core::map::Outcome]| -> Vec<_> {
+        r.iter().map(|o| (o.phi_t.to_bits(), o.wz_t.to_bits(), o.stm.map(f64::to_bits), o.dparam.map(f64::to_bits), o.accepted, o.rejected, o.status)).collect()
+    };
+    let base = bits(&sweep(&f, period, &cases, &LaneOptions::default(), true, 64, Some(1)).unwrap());
     for (chunk, threads) in [(1, Some(2)), (3, Some(1)), (64, Some(2)), (5, None)] {
-        let other = sweep(&f, period, &cases, &LaneOptions::default(), true, chunk, threads).unwrap();
+        let other = bits(&sweep(&f, period, &cases, &LaneOptions::default(), true, chunk, threads).unwrap());
         assert_eq!(base, other, "chunk {chunk}, threads {threads:?}");
     }
 }
@@ -253,5 +257,46 @@ fn val_nystrom_lanes_match_scalar_model() {
         let a: Vec<_> = sweep(&f, tf, &cases, &opts, true, 1, Some(1)).unwrap().iter().map(key).collect();
         let b: Vec<_> = sweep(&f, tf, &cases, &opts, true, 64, Some(2)).unwrap().iter().map(key).collect();
         assert_eq!(a, b);
+    }
+}
+
+
+/// The parameter sensitivity of the lanes (LaneOptions::sensitivity): d(phi, wz)(T) / d Kz and
+/// d / d eps integrated with the trajectory (the torques are linear in both) against central
+/// differences of plain trajectories at the parameter +- 1e-5 (1e-7 relative to max(1, the
+/// derivative): second-order truncation and the integrations' noise at 1e-13); with a plate,
+/// terminator crossings included, on two periods of the DRO x0 = 0.8, and for eps from 0 (the
+/// continuation's start, where no plate acts yet).
+#[test]
+fn val_parameter_sensitivity_matches_differences() {
+    use librate_core::map::Sensitivity;
+    let (s0, period) = dro(0.8);
+    let f = OrbitForcing::new(MU, &s0, period, [true, true], 1e-13).unwrap();
+    let tf = 2.0 * period;
+    let plain = LaneOptions { rtol: 1e-13, atol: 1e-13, ..LaneOptions::default() };
+    let mut cases = Vec::new();
+    for (k, eps) in [0.0, 0.05, 0.3].into_iter().enumerate() {
+        for w in [-2.0, -0.5, 1.3] {
+            cases.push(Case { phi0: 0.2 * k as f64, wz0: w, kz: 0.6, eps, cs: 0.4, cd: 0.1, theta_sun0: 1.1 });
+        }
+    }
+    for sens in [Sensitivity::Kz, Sensitivity::Eps] {
+        let opts = LaneOptions { sensitivity: sens, ..plain };
+        let out = sweep(&f, tf, &cases, &opts, true, 8, None).unwrap();
+        let h = 1e-5;
+        let shifted = |d: f64| -> Vec<Case> {
+            cases.iter().map(|c| if sens == Sensitivity::Kz { Case { kz: c.kz + d, ..*c } } else { Case { eps: c.eps + d, ..*c } }).collect()
+        };
+        let (p, m) = (sweep(&f, tf, &shifted(h), &plain, false, 8, None).unwrap(), sweep(&f, tf, &shifted(-h), &plain, false, 8, None).unwrap());
+        for (i, o) in out.iter().enumerate() {
+            let fd = [(p[i].phi_t - m[i].phi_t) / (2.0 * h), (p[i].wz_t - m[i].wz_t) / (2.0 * h)];
+            for k in 0..2 {
+                let scale = 1f64.max(fd[k].abs());
+                assert!((o.dparam[k] - fd[k]).abs() <= 1e-7 * scale, "{sens:?}, case {i}, component {k}: {} vs {}", o.dparam[k], fd[k]);
+            }
+            // the trajectory itself is the plain one's to the integration's accuracy
+            let q = sweep(&f, tf, &cases[i..i + 1], &plain, true, 8, None).unwrap()[0];
+            assert!((q.phi_t - o.phi_t).abs() <= 1e-9 * 1f64.max(q.phi_t.abs()));
+        }
     }
 }

@@ -85,6 +85,8 @@ pub struct Outcome {
     pub wz_t: f64,
     /// d(phi, wz)(T) / d(phi0, wz0), row-major (NaN when not computed).
     pub stm: [f64; 4],
+    /// d(phi, wz)(T) / d parameter for [`LaneOptions::sensitivity`] (NaN when not computed).
+    pub dparam: [f64; 2],
     pub accepted: u32,
     pub rejected: u32,
     pub status: LaneStatus,
@@ -99,11 +101,25 @@ pub struct LaneOptions {
     /// Rate of the Sun direction in the synodic frame (1/TU), for SRP cases.
     pub sun_omega: f64,
     pub method: Method,
+    /// With the STM, also d(phi, wz)(T) / d parameter ([`Outcome::dparam`]) from the
+    /// variational equation: the torques are linear in Kz and in the plate amplitude eps, so
+    /// the sensitivity is integrated exactly (RKF7(8) lanes; the continuation's bordered
+    /// corrections use it instead of two finite-difference trajectories).
+    pub sensitivity: Sensitivity,
+}
+
+/// The parameter of [`Outcome::dparam`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Sensitivity {
+    #[default]
+    None,
+    Kz,
+    Eps,
 }
 
 impl Default for LaneOptions {
     fn default() -> Self {
-        Self { rtol: 1e-12, atol: 1e-12, max_steps: 200_000, sun_omega: crate::constants::OMEGA_SUN, method: Method::default() }
+        Self { rtol: 1e-12, atol: 1e-12, max_steps: 200_000, sun_omega: crate::constants::OMEGA_SUN, method: Method::default(), sensitivity: Sensitivity::None }
     }
 }
 
@@ -138,20 +154,30 @@ struct Params<I> {
     a2: F8<I>,
     c0: F8<I>,
     s0: F8<I>,
+    /// The parameter sensitivity's forcing, d wzdot / d parameter at fixed phi: 1.5 (S c2 - C s2)
+    /// times `gk` (1 for Kz) plus the plate law with the unit-amplitude coefficients (`u1`, `u2`;
+    /// zero unless eps).
+    gk: F8<I>,
+    u1: F8<I>,
+    u2: F8<I>,
     /// The Sun with phase zero: its angle at the shared time, turned by each lane's phase.
     sun: Sun,
 }
 
 impl<I: Isa> Params<I> {
     /// The lanes' parameters and their cases' plates.
-    fn new(isa: I, pick: impl Fn(usize) -> Case, sun_omega: f64) -> (Self, [FlatPlate; LANES]) {
+    fn new(isa: I, pick: impl Fn(usize) -> Case, sun_omega: f64, sensitivity: Sensitivity) -> (Self, [FlatPlate; LANES]) {
         let plates: [FlatPlate; LANES] = std::array::from_fn(|l| pick(l).plate(sun_omega));
+        let unit = |l: usize| if sensitivity == Sensitivity::Eps { FlatPlate { eps: 1.0, ..plates[l] }.coefficients() } else { (0.0, 0.0) };
         let p = Params {
             kz15: F8::new(isa, std::array::from_fn(|l| 1.5 * pick(l).kz)),
             a1: F8::new(isa, std::array::from_fn(|l| plates[l].coefficients().0)),
             a2: F8::new(isa, std::array::from_fn(|l| plates[l].coefficients().1)),
             c0: F8::new(isa, std::array::from_fn(|l| plates[l].sun.theta0.cos())),
             s0: F8::new(isa, std::array::from_fn(|l| plates[l].sun.theta0.sin())),
+            gk: F8::splat(isa, if sensitivity == Sensitivity::Kz { 1.5 } else { 0.0 }),
+            u1: F8::new(isa, std::array::from_fn(|l| unit(l).0)),
+            u2: F8::new(isa, std::array::from_fn(|l| unit(l).1)),
             sun: Sun { theta0: 0.0, ..plates[0].sun },
         };
         (p, plates)
@@ -175,12 +201,24 @@ fn lincomb<I: Isa, const D: usize, const M: usize>(out: &mut [F8<I>; D], y: &[F8
 /// with SRP, the flat plate.
 #[inline(always)]
 fn accel<I: Isa, const SRP: bool>(f: &OrbitForcing, t: f64, cp: F8<I>, sp: F8<I>, p: &Params<I>) -> (F8<I>, F8<I>) {
+    let (a, k, _) = accel_sens::<I, SRP, false>(f, t, cp, sp, p);
+    (a, k)
+}
+
+/// [`accel`] and, with `SENS`, d wzdot / d parameter at fixed phi (the torques are linear in Kz
+/// and in eps: the same laws at unit Kz or unit plate amplitude, weighted per the parameter).
+#[inline(always)]
+fn accel_sens<I: Isa, const SRP: bool, const SENS: bool>(f: &OrbitForcing, t: f64, cp: F8<I>, sp: F8<I>, p: &Params<I>) -> (F8<I>, F8<I>, F8<I>) {
     let isa = cp.isa();
     let (s, c) = f.sc_at::<I>(t);
     let (s, c) = (F8::splat(isa, s), F8::splat(isa, c));
     let c2 = cp * cp - sp * sp;
     let s2 = (cp + cp) * sp;
     let (mut dwz, mut k) = gravity_gradient_wzdot(p.kz15, s, c, c2, s2);
+    let mut dp = F8::splat(isa, 0.0);
+    if SENS {
+        dp = gravity_gradient_wzdot(p.gk, s, c, c2, s2).0;
+    }
     if SRP {
         // Sun angle theta = w t + theta0_l: (cos, sin)(w t) turned by each lane's theta0_l;
         // alpha = theta - phi (sin alpha, like k, is compiled away without the STM)
@@ -193,8 +231,11 @@ fn accel<I: Isa, const SRP: bool>(f: &OrbitForcing, t: f64, cp: F8<I>, sp: F8<I>
         let (v, d) = flat_plate_wzdot(p.a1, p.a2, ca, sa);
         dwz += v;
         k += d;
+        if SENS {
+            dp += flat_plate_wzdot(p.u1, p.u2, ca, sa).0;
+        }
     }
-    (dwz, k)
+    (dwz, k, dp)
 }
 
 #[inline(always)]
@@ -205,13 +246,18 @@ fn rhs<I: Isa, const D: usize, const SRP: bool>(f: &OrbitForcing, t: f64, y: &[F
     dy[0] = w;
     dy[2] = -(w * sp);
     dy[3] = w * cp;
-    let (dwz, k) = accel::<I, SRP>(f, t, cp, sp, p);
+    let (dwz, k, dp) = if D == 10 { accel_sens::<I, SRP, true>(f, t, cp, sp, p) } else { accel_sens::<I, SRP, false>(f, t, cp, sp, p) };
     dy[1] = dwz;
-    if D == 8 {
+    if D >= 8 {
         dy[4] = y[6];
         dy[5] = y[7];
         dy[6] = k * y[4];
         dy[7] = k * y[5];
+    }
+    if D == 10 {
+        // d(phi, wz)/d parameter: d/dt = (dwz/dp, k dphi/dp + d wzdot/dp)
+        dy[8] = y[9];
+        dy[9] = k.mul_add(y[8], dp);
     }
 }
 
@@ -243,8 +289,8 @@ trait Scheme<I: Isa> {
     /// The lanes' phi.
     fn phi(y: &Self::Y) -> F8<I>;
     fn finite(y: &Self::Y) -> bool;
-    /// Lane l's (phi, wz, 2x2 STM row-major or NaN).
-    fn end(y: &Self::Y, l: usize) -> (f64, f64, [f64; 4]);
+    /// Lane l's (phi, wz, 2x2 STM row-major or NaN, d(phi, wz)/d parameter or NaN).
+    fn end(y: &Self::Y, l: usize) -> (f64, f64, [f64; 4], [f64; 2]);
 }
 
 /// The scaled error of one component, |e| / (rtol max(|y|, |y_new|) + atol), folded into the
@@ -269,7 +315,7 @@ impl<I: Isa, const D: usize> Scheme<I> for Stages<I, D> {
         y[1] = F8::new(isa, std::array::from_fn(|l| pick(l).wz0));
         y[2] = F8::new(isa, std::array::from_fn(|l| pick(l).phi0.cos()));
         y[3] = F8::new(isa, std::array::from_fn(|l| pick(l).phi0.sin()));
-        if D == 8 {
+        if D >= 8 {
             y[4] = F8::splat(isa, 1.0);
             y[7] = F8::splat(isa, 1.0);
         }
@@ -284,9 +330,10 @@ impl<I: Isa, const D: usize> Scheme<I> for Stages<I, D> {
         (0..D).all(|i| y[i].to_array().iter().all(|v| v.is_finite()))
     }
 
-    fn end(y: &[F8<I>; D], l: usize) -> (f64, f64, [f64; 4]) {
-        let stm = if D == 8 { [lane(&y[4], l), lane(&y[5], l), lane(&y[6], l), lane(&y[7], l)] } else { [f64::NAN; 4] };
-        (lane(&y[0], l), lane(&y[1], l), stm)
+    fn end(y: &[F8<I>; D], l: usize) -> (f64, f64, [f64; 4], [f64; 2]) {
+        let stm = if D >= 8 { [lane(&y[4], l), lane(&y[5], l), lane(&y[6], l), lane(&y[7], l)] } else { [f64::NAN; 4] };
+        let dparam = if D == 10 { [lane(&y[8], l), lane(&y[9], l)] } else { [f64::NAN; 2] };
+        (lane(&y[0], l), lane(&y[1], l), stm, dparam)
     }
 
     /// One RKF7(8) step: the 8th-order solution and the scaled max-norm error per lane.
@@ -385,10 +432,10 @@ impl<I: Isa, const P: usize> Scheme<I> for Nystrom<I, P> {
         (0..P).all(|i| y.x[i].to_array().iter().chain(y.v[i].to_array().iter()).all(|v| v.is_finite()))
     }
 
-    fn end(y: &NyState<I, P>, l: usize) -> (f64, f64, [f64; 4]) {
+    fn end(y: &NyState<I, P>, l: usize) -> (f64, f64, [f64; 4], [f64; 2]) {
         // STM rows (phi, wz), columns (phi0, wz0): (Y1, Y2; Y1', Y2')
         let stm = if P == 3 { [lane(&y.x[1], l), lane(&y.x[2], l), lane(&y.v[1], l), lane(&y.v[2], l)] } else { [f64::NAN; 4] };
-        (lane(&y.x[0], l), lane(&y.v[0], l) + 1.0, stm)
+        (lane(&y.x[0], l), lane(&y.v[0], l) + 1.0, stm, [f64::NAN; 2])
     }
 
     #[inline(always)]
@@ -450,8 +497,10 @@ fn integrate_group<I: Isa, S: Scheme<I>, const SRP: bool>(isa: I, f: &OrbitForci
     let pick = |l: usize| group[l.min(n - 1)];
     let mut y = S::start(isa, pick);
     st.begin();
-    let (p, plates) = Params::new(isa, pick, opts.sun_omega);
-    let plate: [bool; LANES] = std::array::from_fn(|l| plates[l].eps != 0.0);
+    let (p, plates) = Params::new(isa, pick, opts.sun_omega, opts.sensitivity);
+    // the steps stop at a lane's terminator crossings where its plate acts, or where the
+    // sensitivity to eps does (the law's kink is there for any amplitude)
+    let plate: [bool; LANES] = std::array::from_fn(|l| plates[l].eps != 0.0 || opts.sensitivity == Sensitivity::Eps);
     let (rtol, atol) = (F8::splat(isa, opts.rtol), F8::splat(isa, opts.atol));
     let mut ynew = y;
     let mut yc = y;
@@ -536,10 +585,10 @@ fn integrate_group<I: Isa, S: Scheme<I>, const SRP: bool>(isa: I, f: &OrbitForci
     }
     std::array::from_fn(|l| {
         if status != LaneStatus::Ok {
-            return Outcome { phi_t: f64::NAN, wz_t: f64::NAN, stm: [f64::NAN; 4], accepted, rejected, status };
+            return Outcome { phi_t: f64::NAN, wz_t: f64::NAN, stm: [f64::NAN; 4], dparam: [f64::NAN; 2], accepted, rejected, status };
         }
-        let (phi_t, wz_t, stm) = S::end(&y, l);
-        Outcome { phi_t, wz_t, stm, accepted, rejected, status }
+        let (phi_t, wz_t, stm, dparam) = S::end(&y, l);
+        Outcome { phi_t, wz_t, stm, dparam, accepted, rejected, status }
     })
 }
 
@@ -565,6 +614,7 @@ impl<const D: usize, const SRP: bool> Kernel for Groups<'_, D, SRP> {
     #[inline(always)]
     fn run<I: Isa>(self, isa: I) -> Vec<Outcome> {
         match (self.opts.method, D == 8) {
+            (_, true) if self.opts.sensitivity != Sensitivity::None => self.with::<I, Stages<I, 10>>(isa),
             (Method::Rkf78, _) => self.with::<I, Stages<I, D>>(isa),
             (Method::Rkn86, true) => self.with::<I, Nystrom<I, 3>>(isa),
             (Method::Rkn86, false) => self.with::<I, Nystrom<I, 1>>(isa),
@@ -612,7 +662,7 @@ mod tests {
             let x = l as f64;
             Case { phi0: -2.9 + 0.8 * x, wz0: -2.0 + 0.6 * x, kz: 0.9 - 0.25 * x, eps: [0.0, 0.05, 0.3, -0.2][l % 4], cs: 0.1 * (l % 3) as f64, cd: 0.2, theta_sun0: 0.9 * x - 3.0 }
         });
-        let (p, plates) = Params::new(ISA, |l| cases[l], LaneOptions::default().sun_omega);
+        let (p, plates) = Params::new(ISA, |l| cases[l], LaneOptions::default().sun_omega, Sensitivity::None);
         let stm = [0.7, -1.3, 2.1, 0.4];
         for t in [0.0, 0.37 * o.period, 0.81 * o.period, 3.3 * o.period] {
             let mut y = [V::splat(ISA, 0.0); 8];

@@ -6,7 +6,7 @@ pub mod forcing;
 pub mod lanes;
 
 pub use forcing::OrbitForcing;
-pub use lanes::{integrate_cases, Case, LaneOptions, LaneStatus, Method, Outcome};
+pub use lanes::{integrate_cases, Case, LaneOptions, LaneStatus, Method, Outcome, Sensitivity};
 
 use rayon::prelude::*;
 
@@ -81,7 +81,7 @@ pub fn sweep_at(
         crate::simd::parse(Some(level.name()))?;
     }
     let run = |part: &[Case]| -> Result<Vec<Outcome>> {
-        let srp = part.chunks(lanes::LANES).any(|g| g.iter().any(|c| c.eps != 0.0));
+        let srp = opts.sensitivity == lanes::Sensitivity::Eps || part.chunks(lanes::LANES).any(|g| g.iter().any(|c| c.eps != 0.0));
         match (with_stm, srp) {
             (true, false) => integrate_cases::<8, false>(level, forcing, t_final, part, opts),
             (false, false) => integrate_cases::<4, false>(level, forcing, t_final, part, opts),

@@ -43,7 +43,7 @@ use crate::attitude::{propagate_planar, FlatPlate, OMEGA_SUN};
 use crate::cr3bp::check_mu;
 use crate::error::{check_finite, check_positive, invalid, Error, Result};
 use crate::integrate::{Options, Output};
-use crate::map::{self, Case, LaneOptions, LaneStatus, OrbitForcing, Outcome};
+use crate::map::{self, Case, LaneOptions, LaneStatus, OrbitForcing, Outcome, Sensitivity};
 use crate::propagation::with_threads;
 
 use std::f64::consts::{FRAC_PI_2, PI};
@@ -248,7 +248,23 @@ const PARAM: usize = 2;
 
 impl Form {
     fn cases_per_point(&self) -> usize {
-        1 + if self.closure == Closure::Full && self.free == Free::SunPhase { 2 } else { 0 } + if self.bordered.is_some() { 2 } else { 0 }
+        1 + if self.closure == Closure::Full && self.free == Free::SunPhase { 2 } else { 0 } + if self.differences() { 2 } else { 0 }
+    }
+
+    /// Whether d F / d parameter comes from central differences (two more trajectories per
+    /// point: the orbit's x0, each value its own orbit); Kz and eps enter the torques linearly,
+    /// and their derivative is integrated with the trajectory ([`Sensitivity`]).
+    fn differences(&self) -> bool {
+        self.bordered.is_some_and(|b| b.parameter == Parameter::OrbitX0)
+    }
+
+    /// The lanes' parameter sensitivity this form needs.
+    fn sensitivity(&self) -> Sensitivity {
+        match self.bordered.map(|b| b.parameter) {
+            Some(Parameter::Kz) => Sensitivity::Kz,
+            Some(Parameter::Eps) => Sensitivity::Eps,
+            _ => Sensitivity::None,
+        }
     }
 
     /// The residual rows and unknown columns in use.
@@ -316,14 +332,10 @@ impl Form {
                 out.push((Case { theta_sun0: th, ..k }, x[PARAM]));
             }
         }
-        if let Some(b) = self.bordered {
+        if self.differences() {
             let (pp, pm) = self.parameter_pair(x[PARAM]);
             for v in [pp, pm] {
-                out.push(match b.parameter {
-                    Parameter::Kz => (Case { kz: v, ..k }, v),
-                    Parameter::Eps => (Case { eps: v, ..k }, v),
-                    Parameter::OrbitX0 => (k, v),
-                });
+                out.push((k, v));
             }
         }
         true
@@ -370,11 +382,21 @@ impl Form {
             }
         }
         if let Some(b) = self.bordered {
-            let j = self.cases_per_point() - 2;
-            let (pp, pm) = self.parameter_pair(x[PARAM]);
-            let (rp, rm) = (self.closure_residual(c, x, &o[j]), self.closure_residual(c, x, &o[j + 1]));
-            jac[0][PARAM] = (rp[0] - rm[0]) / (pp - pm);
-            jac[1][PARAM] = (rp[1] - rm[1]) / (pp - pm);
+            if self.differences() {
+                let j = self.cases_per_point() - 2;
+                let (pp, pm) = self.parameter_pair(x[PARAM]);
+                let (rp, rm) = (self.closure_residual(c, x, &o[j]), self.closure_residual(c, x, &o[j + 1]));
+                jac[0][PARAM] = (rp[0] - rm[0]) / (pp - pm);
+                jac[1][PARAM] = (rp[1] - rm[1]) / (pp - pm);
+            } else {
+                // the closure residuals' derivatives are those of phi(T) and wz(T)
+                let d = o[0].dparam;
+                if !(d[0].is_finite() && d[1].is_finite()) {
+                    return None;
+                }
+                jac[0][PARAM] = d[0];
+                jac[1][PARAM] = if self.closure == Closure::Full { d[1] } else { f64::NAN };
+            }
             let (a, rhs) = c.condition.unwrap_or((b.a, b.b));
             f[2] = a[0] * x[0] + a[1] * x[1] + a[2] * x[2] - rhs;
             jac[2] = a;
@@ -578,7 +600,7 @@ pub fn correct_planar_attitudes(
 ) -> Result<Vec<Correction>> {
     validate(forcing, t_final, closure, free, candidates, opts)?;
     let form = Form { closure, free, h: opts.phase_step, bordered: None, bounds: (f64::NEG_INFINITY, f64::INFINITY), max_wz_step: opts.max_wz_step, max_angle_step: opts.max_angle_step };
-    run(form, candidates, opts, &on_table(forcing, t_final, opts))
+    run(form, candidates, opts, &on_table(forcing, t_final, opts, Sensitivity::None))
 }
 
 /// The bordered correction of continuation: as [`correct_planar_attitudes`], with the
@@ -603,7 +625,7 @@ pub fn correct_bordered(
     validate(forcing, t_final, closure, free, candidates, opts)?;
     let bounds = if bordered.parameter == Parameter::Kz { (-1.0, 1.0) } else { (f64::NEG_INFINITY, f64::INFINITY) };
     let form = Form { closure, free, h: opts.phase_step, bordered: Some(*bordered), bounds, max_wz_step: opts.max_wz_step, max_angle_step: opts.max_angle_step };
-    run(form, candidates, opts, &on_table(forcing, t_final, opts))
+    run(form, candidates, opts, &on_table(forcing, t_final, opts, form.sensitivity()))
 }
 
 fn validate_condition(a: &[f64; 3], b: f64, closure: Closure, whose: &str) -> Result<()> {
@@ -643,8 +665,8 @@ type Integrate<'a> = dyn Fn(&[Case], &[f64], bool) -> Result<Vec<Outcome>> + Syn
 
 /// All trajectories on one orbit's forcing table, in one sweep (over `t_final`, or twice it for
 /// the half closure's full-period monodromy).
-fn on_table<'a>(forcing: &'a OrbitForcing, t_final: f64, opts: &CorrectorOptions) -> impl Fn(&[Case], &[f64], bool) -> Result<Vec<Outcome>> + Sync + 'a {
-    let lane = LaneOptions { rtol: opts.rtol, atol: opts.atol, max_steps: opts.max_steps, sun_omega: opts.sun_omega, ..LaneOptions::default() };
+fn on_table<'a>(forcing: &'a OrbitForcing, t_final: f64, opts: &CorrectorOptions, sensitivity: Sensitivity) -> impl Fn(&[Case], &[f64], bool) -> Result<Vec<Outcome>> + Sync + 'a {
+    let lane = LaneOptions { rtol: opts.rtol, atol: opts.atol, max_steps: opts.max_steps, sun_omega: opts.sun_omega, sensitivity, ..LaneOptions::default() };
     let chunk = opts.chunk;
     move |cases: &[Case], _: &[f64], full: bool| {
         // small batches (a few branches of a lock-step continuation) still spread over every
@@ -654,7 +676,7 @@ fn on_table<'a>(forcing: &'a OrbitForcing, t_final: f64, opts: &CorrectorOptions
     }
 }
 
-const FAILED: Outcome = Outcome { phi_t: f64::NAN, wz_t: f64::NAN, stm: [f64::NAN; 4], accepted: 0, rejected: 0, status: LaneStatus::Failed };
+const FAILED: Outcome = Outcome { phi_t: f64::NAN, wz_t: f64::NAN, stm: [f64::NAN; 4], dparam: [f64::NAN; 2], accepted: 0, rejected: 0, status: LaneStatus::Failed };
 
 /// The planar forms on the one Newton driver ([`super::newton::solve`]): all pending points of
 /// all candidates integrated in one call of `integrate` per iteration, a line search per
