@@ -290,9 +290,8 @@ fn val_parameter_sensitivity_matches_differences() {
         let (p, m) = (sweep(&f, tf, &shifted(h), &plain, false, 8, None).unwrap(), sweep(&f, tf, &shifted(-h), &plain, false, 8, None).unwrap());
         for (i, o) in out.iter().enumerate() {
             let fd = [(p[i].phi_t - m[i].phi_t) / (2.0 * h), (p[i].wz_t - m[i].wz_t) / (2.0 * h)];
-            for k in 0..2 {
-                let scale = 1f64.max(fd[k].abs());
-                assert!((o.dparam[k] - fd[k]).abs() <= 1e-7 * scale, "{sens:?}, case {i}, component {k}: {} vs {}", o.dparam[k], fd[k]);
+            for (k, (&got, &want)) in o.dparam.iter().zip(&fd).enumerate() {
+                assert!((got - want).abs() <= 1e-7 * 1f64.max(want.abs()), "{sens:?}, case {i}, component {k}: {got} vs {want}");
             }
             // the trajectory itself is the plain one's to the integration's accuracy
             let q = sweep(&f, tf, &cases[i..i + 1], &plain, true, 8, None).unwrap()[0];
