@@ -6,7 +6,6 @@ a Sun-pointing body (:func:`sun_pointing_accelerations`)."""
 from __future__ import annotations
 
 import math
-import threading
 from collections.abc import Callable, Sequence
 
 import numpy as np
@@ -105,15 +104,14 @@ def srp_map(
     if progress is not None and not callable(progress):
         raise ValueError(f"invalid argument `progress`: must be a callable progress(done, total) or None, got {progress!r}")
     counts = {"done": 0, "total": 2}  # the sweep, one per branch (added as found), the assembly
-    count_lock = threading.Lock()
 
     def advance(done: int = 1, more: int = 0) -> None:
+        # every branch runs on this thread (lock step), so the counts need no lock
         if progress is None:
             return
-        with count_lock:
-            counts["done"] += done
-            counts["total"] += more
-            progress(counts["done"], counts["total"])
+        counts["done"] += done
+        counts["total"] += more
+        progress(counts["done"], counts["total"])
 
     orbit = check_orbit(orbit)
     kz = check_kz(kz)

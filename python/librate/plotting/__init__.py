@@ -129,7 +129,7 @@ def _check_family(family) -> OrbitFamily:
     return family
 
 
-def _axes(ax, n: int, *, three_d: Sequence[bool] | None = None, figsize=None) -> tuple[Figure, list[Axes]]:
+def figure_axes(ax, n: int, *, three_d: Sequence[bool] | None = None, figsize=None) -> tuple[Figure, list[Axes]]:
     """The figure and a list of ``n`` Axes: new ones (up to three per row, constrained layout)
     when ``ax`` is None, else the given Axes (one, or a sequence of ``n``)."""
     three_d = list(three_d or [False] * n)
@@ -260,7 +260,7 @@ def plot_family(
         raise ValueError(f"invalid argument `lagrange_points`: must list L-point numbers 1..5, got {lagrange_points!r}")
 
     created = ax is None
-    fig, axs = _axes(ax, len(projs), three_d=[p == "3d" for p in projs],
+    fig, axs = figure_axes(ax, len(projs), three_d=[p == "3d" for p in projs],
                      figsize=(7.0, 5.6) if len(projs) == 1 else None)
     sel = _pick(len(fam), n_orbits)
     if color_by is not None:
@@ -364,7 +364,7 @@ def plot_period(
         raise ValueError(f"invalid argument: resonance orders must be integers >= 1, got {tuple(res)} and {tuple(sres)}")
     res, sres = [int(k) for k in res], [int(k) for k in sres]
     created = ax is None
-    fig, (a,) = _axes(ax, 1, figsize=(7.0, 5.0))
+    fig, (a,) = figure_axes(ax, 1, figsize=(7.0, 5.0))
     period = fam.period * tscale
     (line,) = a.plot(x, period, color="k", linewidth=1.6, label=f"{fam.kind} period")
     line.set_gid("period")
@@ -426,7 +426,7 @@ def plot_stability(
     nu = np.asarray(fam.stability_indices)
     names = ("in-plane $\\nu_1$", "out-of-plane $\\nu_2$") if not fam.spatial else ("$\\nu_1$", "$\\nu_2$")
     created = ax is None
-    fig, (a,) = _axes(ax, 1, figsize=(7.0, 5.0))
+    fig, (a,) = figure_axes(ax, 1, figsize=(7.0, 5.0))
     if band:
         s = a.axhspan(-1.0, 1.0, color="tab:green", alpha=0.08, label="$|\\nu| \\leq 1$ (stable)")
         s.set_gid("stable-band")
@@ -512,7 +512,7 @@ def plot_eci(
     scale, unit = _length_scale(sys_, units)
     created = ax is None
     npanels = len(orbits) if separate else 1
-    fig, axs = _axes(ax, npanels, figsize=(6.4, 6.0) if npanels == 1 else None)
+    fig, axs = figure_axes(ax, npanels, figsize=(6.4, 6.0) if npanels == 1 else None)
     cycle = matplotlib.rcParams["axes.prop_cycle"].by_key().get("color", ["tab:blue"])
     for j, (orbit, label) in enumerate(zip(orbits, labels)):
         a = axs[j] if separate else axs[0]
@@ -563,7 +563,7 @@ def plot_attitude(traj, ax=None, *, period: float | None = None, relative_to: st
         raise ValueError(f"invalid argument `traj`: must be a librate.AttitudeTrajectory, got {type(traj).__name__}")
     if period is not None and not (math.isfinite(period) and period > 0):
         raise ValueError(f"invalid argument `period`: must be finite and > 0, got {period!r}")
-    fig, (a_rate, a_ang) = _axes(ax, 2, figsize=(11, 4.2))
+    fig, (a_rate, a_ang) = figure_axes(ax, 2, figsize=(11, 4.2))
     x = traj.t / period if period else traj.t
     xlabel = "revolutions (-)" if period else "t (TU)"
     ang = traj.relative_to_vertical(relative_to) if relative_to else traj.euler_angles("123")
@@ -773,7 +773,7 @@ def plot_residuals(
     dphi = np.asarray(ds["dphi"].values[i, j], dtype=float)
 
     created = ax is None
-    fig, (a,) = _axes(ax, 1, figsize=(7.4, 4.8))
+    fig, (a,) = figure_axes(ax, 1, figsize=(7.4, 4.8))
     z = a.axhline(0.0, color="0.35", linewidth=0.8, zorder=1)
     z.set_gid("zero")
     (h,) = a.plot(x, dwz, color=_DWZ_COLOR, linewidth=1.4, label="$\\Delta\\omega_z = \\omega_z(T) - \\omega_z(0)$ (1/TU)")
@@ -886,7 +886,7 @@ def plot_map(
     phi0 = float(ds.attrs.get("phi0", 0.0))
 
     created = ax is None
-    fig, (a,) = _axes(ax, 1, figsize=(8.6, 5.8))
+    fig, (a,) = figure_axes(ax, 1, figsize=(8.6, 5.8))
     dwz = np.asarray(ds["dwz"].values[:, j, :], dtype=float).T  # (rate, orbit)
     phi_t = np.asarray(ds["phi_T"].values[:, j, :], dtype=float).T if "phi_T" in ds.variables else None
     dphi = np.asarray(ds["dphi"].values[:, j, :], dtype=float).T
@@ -987,7 +987,7 @@ def plot_solution_families(
 
     created = ax is None
     npanels = len(groups) if separate else 1
-    fig, axs = _axes(ax, npanels, figsize=(7.4, 5.2) if npanels == 1 else None)
+    fig, axs = figure_axes(ax, npanels, figsize=(7.4, 5.2) if npanels == 1 else None)
     for g, (kind, nn) in enumerate(groups):
         a = axs[g] if separate else axs[0]
         drawn = False
@@ -1079,7 +1079,7 @@ def plot_attitude_motion(
     cycle = matplotlib.rcParams["axes.prop_cycle"].by_key().get("color", ["tab:blue"])
 
     created = ax is None
-    fig, (a_ang, a_rate) = _axes(ax, 2, figsize=(12.0, 4.6))
+    fig, (a_ang, a_rate) = figure_axes(ax, 2, figsize=(12.0, 4.6))
     for i, s in enumerate(sols):
         T = s.orbit.period
         m = max(2, int(math.ceil(samples * n_periods)) + 1)
@@ -1161,7 +1161,7 @@ def plot_sun_motion(
     tname = "d" if tunit == "days" else "TU"
     ts = SUN_SYNODIC_PERIOD
     created = ax is None
-    fig, (a_geo, a_ang) = _axes(ax, 2, figsize=(12.4, 5.4))
+    fig, (a_geo, a_ang) = figure_axes(ax, 2, figsize=(12.4, 5.4))
 
     # --- geometry in the synodic frame
     radius = 1.45
@@ -1276,7 +1276,7 @@ def plot_sun_resonant(
         raise ValueError(f"invalid argument `ks`: no Sun-resonant member 1:K (T = Ts/K) for K in {tuple(ks)} lies in the "
                          f"{fam.kind} family's period range [{fam.period_days.min():.2f}, {fam.period_days.max():.2f}] d")
     created = ax is None
-    fig, (a,) = _axes(ax, 1, figsize=(7.2, 6.2))
+    fig, (a,) = figure_axes(ax, 1, figsize=(7.2, 6.2))
     cm = matplotlib.colormaps["viridis"]
     for i, (k, o) in enumerate(found):
         color = cm(0.85 * i / max(1, len(found) - 1))
@@ -1379,7 +1379,7 @@ def plot_srp_map(
     y = np.asarray(ds["wz0"].values, dtype=float) - offset
     phi0 = float(ds.attrs.get("phi0", 0.0))
     created = ax is None
-    fig, (a,) = _axes(ax, 1, figsize=(8.6, 5.8))
+    fig, (a,) = figure_axes(ax, 1, figsize=(8.6, 5.8))
     handles = _map_contours(a, x, y, np.asarray(ds["dwz"].values, dtype=float).T, np.asarray(ds["phi_T"].values, dtype=float).T,
                             np.asarray(ds["dphi"].values, dtype=float).T, phi0, half_turn_contours)
     if branches and "branch_n" in ds.variables:
@@ -1485,7 +1485,7 @@ def plot_srp_maps(maps, ax=None, *, titles: Sequence[str] | None = None, **kwarg
     common = [k for k in names if k not in varying]
     label = dict(_MAP_PARAMETERS)
     created = ax is None
-    fig, axs = _axes(ax, len(maps), figsize=(8.6, 5.8) if len(maps) == 1 else (5.0 * min(len(maps), 3) + 2.6, 5.4 * math.ceil(len(maps) / 3)))
+    fig, axs = figure_axes(ax, len(maps), figsize=(8.6, 5.8) if len(maps) == 1 else (5.0 * min(len(maps), 3) + 2.6, 5.4 * math.ceil(len(maps) / 3)))
     import inspect
 
     takes = {f: set(inspect.signature(f).parameters) - {"ds", "ax"} for f in (plot_srp_map, plot_map)}
@@ -1553,7 +1553,7 @@ def plot_srp_comparison(
     T = s.orbit.period
     t = np.linspace(0.0, n * T, max(2, int(math.ceil(samples * n)) + 1))
     created = ax is None
-    fig, (a_ang, a_rate) = _axes(ax, 2, figsize=(12.4, 4.8))
+    fig, (a_ang, a_rate) = figure_axes(ax, 2, figsize=(12.4, 4.8))
     for key, sol, color, ls in (("gravity", g, _GRAVITY_COLOR, "--"), ("srp", s, _SRP_COLOR, "-")):
         tr = sol.propagate(n, t_eval=t)
         eps = 0.0 if sol.srp is None else float(sol.srp.eps)
@@ -1626,7 +1626,7 @@ def plot_sun_pointing(
         what = f"{len(body_or_plate.facets)}-facet body"
         kz_value = float(body_or_plate.kz)
     created = ax is None
-    fig, (a,) = _axes(ax, 1, figsize=(8.4, 4.8))
+    fig, (a,) = figure_axes(ax, 1, figsize=(8.4, 4.8))
     z = a.axhline(0.0, color="0.5", linewidth=0.7)
     z.set_gid("zero")
     (h,) = a.plot(t * tscale, gg, color="tab:blue", linewidth=1.4,
@@ -1742,7 +1742,7 @@ def plot_flexible_body(body, ax=None, *, annotate: bool = True, deflection=None,
             raise ValueError(f"invalid argument `deflection`: need {n} finite deflections (m), got {deflection!r}")
     if scale is not None and not (isinstance(scale, (int, float, np.floating, np.integer)) and math.isfinite(scale) and scale > 0):
         raise ValueError(f"invalid argument `scale`: must be a number > 0 or None, got {scale!r}")
-    fig, (a,) = _axes(ax, 1, figsize=(8.0, 6.0))
+    fig, (a,) = figure_axes(ax, 1, figsize=(8.0, 6.0))
     reach = max([math.hypot(*ap.position) for ap in b.appendages] + [1.0])
     hub = b.hub
     m0 = float(hub.mass_kg)
@@ -1853,7 +1853,7 @@ def plot_flexible_coordinate(quasi, traj=None, ax=None, *, index=None, period: f
         if traj.t.shape != quasi.t.shape or not np.allclose(traj.t, quasi.t, rtol=0, atol=1e-12 * max(1.0, float(np.max(np.abs(quasi.t))))):
             raise ValueError("invalid argument `traj`: must be sampled at the closed form's times (same t_eval)")
     idx = _indices(quasi.body.n, index)
-    fig, axs = _axes(ax, 2 if traj is not None else 1, figsize=(11, 4.2) if traj is not None else (7, 4.4))
+    fig, axs = figure_axes(ax, 2 if traj is not None else 1, figsize=(11, 4.2) if traj is not None else (7, 4.4))
     x, xlabel = _time_axis(quasi.t, period)
     cycle = matplotlib.rcParams["axes.prop_cycle"].by_key().get("color", ["tab:blue"])
     for k, j in enumerate(idx):
@@ -1897,7 +1897,7 @@ def plot_flexible_response(traj, rigid=None, ax=None, *, index=None, period: flo
     if rigid is not None and getattr(rigid, "wz", None) is None:
         raise ValueError("invalid argument `rigid`: needs a planar run (wz)")
     idx = _indices(traj.flex.body.n, index)
-    fig, (aq, aw) = _axes(ax, 2, figsize=(11, 4.2))
+    fig, (aq, aw) = figure_axes(ax, 2, figsize=(11, 4.2))
     x, xlabel = _time_axis(traj.t, period)
     for j in idx:
         name = traj.flex.body.appendages[j].name or f"$q_{{{j + 1}}}$"
@@ -1931,7 +1931,7 @@ def plot_frequency_scan(scan, ax=None, *, index=None) -> Figure:
     if not isinstance(scan, FrequencyScan):
         raise ValueError(f"invalid argument `scan`: must be a librate.periodicity.FrequencyScan, got {type(scan).__name__}")
     idx = _indices(scan.frequency.shape[1], index)
-    fig, (aa, ad) = _axes(ax, 2, figsize=(11, 4.2))
+    fig, (aa, ad) = figure_axes(ax, 2, figsize=(11, 4.2))
     w = scan.frequency[:, idx[0]]
     for j in idx:
         (h,) = aa.loglog(w, scan.amplification[:, j], marker=".", linewidth=1.0, label=f"$q_{{{j + 1}}}$")

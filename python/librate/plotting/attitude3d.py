@@ -24,11 +24,11 @@ def plot_equilibrium_stability(ds, ax=None, *, boundaries: bool = True) -> Figur
     from matplotlib.colors import ListedColormap
     from matplotlib.patches import Patch
 
-    from . import _axes
+    from . import figure_axes
 
     if not all(v in getattr(ds, "data_vars", {}) for v in ("stable", "pitch_stable", "roll_yaw", "b", "c")):
         raise ValueError("invalid argument `ds`: must be the Dataset of librate.equilibrium_stability")
-    fig, (a,) = _axes(ax, 1)
+    fig, (a,) = figure_axes(ax, 1)
     kx, ky = ds["k_x"].values, ds["k_y"].values
     # 0 stable, 1 pitch unstable, 2 roll-yaw divergent, 3 roll-yaw flutter (pitch stable)
     code = np.where(ds["stable"].values, 0, np.where(~ds["pitch_stable"].values, 1, np.where(ds["roll_yaw"].values == 1, 2, 3)))
@@ -73,7 +73,7 @@ def plot_out_of_plane_stability(datasets, ax=None, *, against: str = "period") -
     out of it (gids ``"class-<in>-<out>"``, e.g. ``"class-1-0"``: stable in the plane, unstable
     out of it). The bottom row shows the largest |roll/yaw multiplier| on a log scale (gid
     ``"out-of-plane-modulus"``). Returns the Figure."""
-    from . import _axes
+    from . import figure_axes
 
     dss = [datasets] if hasattr(datasets, "data_vars") else list(datasets)
     if not dss or not all("out_of_plane_modulus" in getattr(d, "data_vars", {}) for d in dss):
@@ -88,7 +88,7 @@ def plot_out_of_plane_stability(datasets, ax=None, *, against: str = "period") -
         axs = fig.subplots(2, ncol, sharex="col", squeeze=False)
         top, bottom = list(axs[0]), list(axs[1])
     else:
-        fig, flat = _axes(ax, 2 * ncol)
+        fig, flat = figure_axes(ax, 2 * ncol)
         top, bottom = flat[:ncol], flat[ncol:]
     for d, a, b in zip(dss, top, bottom):
         x = d["period_days"].values if against == "period" else d["x0"].values
@@ -123,13 +123,13 @@ def plot_family_multipliers(ds, ax=None, *, against: str = "period") -> Figure:
 
     from matplotlib.patches import Circle
 
-    from . import _axes
+    from . import figure_axes
 
     if "multipliers" not in getattr(ds, "data_vars", {}) or "period_days" not in getattr(ds, "data_vars", {}):
         raise ValueError("invalid argument `ds`: must be the Dataset of librate.attitude_family_3d")
     if against not in ("period", "x0", "z0"):
         raise ValueError(f"invalid argument `against`: must be 'period', 'x0' or 'z0', got {against!r}")
-    fig, (a, b) = _axes(ax, 2)
+    fig, (a, b) = figure_axes(ax, 2)
     x = ds["period_days" if against == "period" else against].values
     m = ds["multipliers"].values
     for k in range(m.shape[1]):
@@ -164,7 +164,7 @@ def plot_body_axes(solution, ax=None, *, samples: int = 16, planes=("xy", "xz"))
     evenly spaced times, the projections of the body x, y and z axes as arrows (gids
     ``"axis-x"``, ``"axis-y"``, ``"axis-z"``; red, green, blue), scaled to 6 % of the orbit's
     extent. Returns the Figure."""
-    from . import _axes
+    from . import figure_axes
 
     if not all(hasattr(solution, a) for a in ("q0", "w0", "orbit", "propagate", "n_periods")):
         raise ValueError(f"invalid argument `solution`: must be a librate.AttitudeSolution3D, got {type(solution).__name__}")
@@ -182,7 +182,7 @@ def plot_body_axes(solution, ax=None, *, samples: int = 16, planes=("xy", "xz"))
     axes = marks.dcm()  # (n, 3, 3): row i is body axis i in synodic components
     extent = float(np.max(np.ptp(pos, axis=0)))
     length = 0.06 * (extent if extent > 0 else 1.0)
-    fig, panels = _axes(ax, len(planes))
+    fig, panels = figure_axes(ax, len(planes))
     for a, plane in zip(panels, planes):
         i, j = index[plane[0]], index[plane[1]]
         (ln,) = a.plot(pos[:, i], pos[:, j], color="0.5", linewidth=0.8)
