@@ -436,3 +436,44 @@ fn val_correction_across_the_orbit_family() {
     let r = correct_across_family(&fam, &out, &[Candidate::new(0.0, p.wz0, 0.8, 0.0).with_x0(0.85)], &opts).unwrap()[0];
     assert!(!r.converged());
 }
+
+/// The family's orbit linearised from a member (`PlanarFamily::linearised`, the neighbours of
+/// the central differences in x0): against the orbit corrected at that x0 (reference: Newton's
+/// half-period shooting to 1e-12), its vy0 and period differ by O(dx^2) (Taylor): < 1e-5 at
+/// dx = 1e-3, and the error falls about 4-fold when dx halves (ratio in [3, 5]); at dx = 1e-6
+/// (the differences' step) vy0 and T agree to 1e-10 and the forcing tables to 1e-8 of their
+/// scale: there the difference is the corrected orbit's own noise (vy0 to ~1e-11, residual
+/// 1e-12, grown along the orbit), not the linearisation's O(dx^2) ~ 1e-12.
+#[test]
+fn val_linearised_family_orbit_is_second_order() {
+    use librate_core::periodic::PlanarFamily;
+    let members: Vec<([f64; 6], f64)> = [0.80, 0.83, 0.86, 0.89].iter().map(|&x| dro_x0(x)).collect();
+    let x0s: Vec<f64> = members.iter().map(|m| m.0[0]).collect();
+    let vy0s: Vec<f64> = members.iter().map(|m| m.0[4]).collect();
+    let fam = PlanarFamily::new(MU, &x0s, &vy0s).unwrap();
+    let centre = fam.orbit_at(0.845).unwrap();
+    let err = |dx: f64| {
+        let (period, _) = fam.linearised(&centre.0, 0.845 + dx).unwrap();
+        let exact = fam.orbit_at(0.845 + dx).unwrap();
+        // the linearised vy0: the table is built from it; recover it from the slope
+        let dvy = -centre.0.evaluation.dcond[0][0] / centre.0.evaluation.dcond[0][2];
+        let vy_lin = centre.0.state0[4] + dvy * dx;
+        ((vy_lin - exact.0.state0[4]).abs(), (period - exact.0.period).abs())
+    };
+    let (ev1, et1) = err(1e-3);
+    let (ev2, et2) = err(5e-4);
+    assert!(ev1 < 1e-5 && et1 < 1e-5, "{ev1} {et1}");
+    assert!((3.0..5.0).contains(&(ev1 / ev2)) && (3.0..5.0).contains(&(et1 / et2)), "{} {}", ev1 / ev2, et1 / et2);
+    let (_, near) = fam.linearised(&centre.0, 0.845 + 1e-6).unwrap();
+    let exact = fam.orbit_at(0.845 + 1e-6).unwrap();
+    let worst = (0..200).map(|i| {
+        let t = i as f64 * 0.005 * exact.0.period;
+        let (a, b) = (near.sc(t), exact.1.sc(t));
+        (a.0 - b.0).abs().max((a.1 - b.1).abs())
+    });
+    let worst = worst.fold(0.0f64, f64::max);
+    let scale = (0..200).map(|i| { let (a, b) = exact.1.sc(i as f64 * 0.005 * exact.0.period); a.abs().max(b.abs()) }).fold(0.0f64, f64::max);
+    let (ev, et) = err(1e-6);
+    assert!(worst < 1e-8 * scale && ev < 1e-10 && et < 1e-10, "{worst} {scale} {ev} {et}");
+    assert!(fam.linearised(&centre.0, f64::NAN).is_err());
+}

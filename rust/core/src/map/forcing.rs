@@ -51,6 +51,8 @@ impl OrbitForcing {
         }
         let opts = Options::with_tolerances(1e-14, 1e-14);
         let nodes = cheb_nodes();
+        // the discrete Chebyshev transform's weights cos(pi k (j + 1/2) / NC), once
+        let weights: [[f64; NC]; NC] = std::array::from_fn(|k| std::array::from_fn(|j| (std::f64::consts::PI * k as f64 * (j as f64 + 0.5) / NC as f64).cos()));
         let mut segments = 16;
         let mut previous = f64::INFINITY;
         loop {
@@ -96,7 +98,7 @@ impl OrbitForcing {
                     for jj in 0..NC {
                         let j = NC - 1 - jj;
                         let (sv, cv) = fit[s * NC + jj];
-                        let w = (std::f64::consts::PI * k as f64 * (j as f64 + 0.5) / NC as f64).cos();
+                        let w = weights[k][j];
                         cs += sv * w;
                         cc += cv * w;
                     }

@@ -772,13 +772,32 @@ impl PlanarFamily {
         c.insert(x0.to_bits(), out.clone());
         Ok(out)
     }
+
+    /// The family's orbit through (x, 0, 0) to first order from the corrected member `near`:
+    /// along the family's tangent there (d vy0 / d x0 from the half-period condition
+    /// xdot_c(x0, vy0) = 0, and d T / d x0), with its forcing table: (period, table). For the
+    /// central differences in x0 of [`correct_across_family`]: the linearisation's O(dx^2)
+    /// error is the same on both sides and cancels in the difference quotient, and no Newton
+    /// correction is needed for the two neighbours.
+    pub fn linearised(&self, near: &SymmetricOrbit, x: f64) -> Result<(f64, OrbitForcing)> {
+        let e = &near.evaluation;
+        let dvy = -e.dcond[0][0] / e.dcond[0][2];
+        let dhalf = e.dhalf[0] + e.dhalf[2] * dvy;
+        let dx = x - near.state0[0];
+        let state0 = [x, 0.0, 0.0, 0.0, near.state0[4] + dvy * dx, 0.0];
+        let period = near.period + 2.0 * dhalf * dx;
+        check_finite("x0", &state0)?;
+        check_positive("period", period)?;
+        Ok((period, OrbitForcing::new(self.mu, &state0, period, [true, true], 1e-12)?))
+    }
 }
 
 /// The bordered half-period correction across a planar orbit family: unknowns (wz0, x0) of
 /// the symmetric motion phi(T(x0)/2) = phi0 + pi turns (K = 1), the orbit's x0 freed and closed
 /// by the linear condition a[1] wz0 + a[2] x0 = b (a[0] must be 0); d g / d x0 by central
-/// differences over the orbits at x0 +- `bordered.step` (each corrected and tabulated; the
-/// three orbits of a point in parallel). Returns [`Correction`]s as [`correct_bordered`]
+/// differences over the orbits at x0 +- `bordered.step` (the point's orbit corrected, its two
+/// neighbours linearised from it with [`PlanarFamily::linearised`]; every table and trajectory
+/// group in parallel). Returns [`Correction`]s as [`correct_bordered`]
 /// (`parameter` = x0; the monodromy over the orbit's full period).
 pub fn correct_across_family(family: &PlanarFamily, bordered: &Bordered, candidates: &[Candidate], opts: &CorrectorOptions) -> Result<Vec<Correction>> {
     if bordered.parameter != Parameter::OrbitX0 {
@@ -790,20 +809,53 @@ pub fn correct_across_family(family: &PlanarFamily, bordered: &Bordered, candida
     let form = Form { closure: Closure::Half, free: Free::Phi0, h: opts.phase_step, bordered: Some(*bordered), bounds: family.range(), max_wz_step: opts.max_wz_step, max_angle_step: opts.max_angle_step };
     let lane = LaneOptions { rtol: opts.rtol, atol: opts.atol, max_steps: opts.max_steps, sun_omega: opts.sun_omega, ..LaneOptions::default() };
     let integrate = |cases: &[Case], values: &[f64], full: bool| -> Result<Vec<Outcome>> {
-        // distinct orbits, in parallel; then each orbit's trajectories in one sweep
-        let mut distinct: Vec<f64> = values.to_vec();
-        distinct.sort_by(f64::total_cmp);
-        distinct.dedup();
-        let orbits: Vec<Option<Arc<(SymmetricOrbit, OrbitForcing)>>> = distinct.par_iter().map(|&x| family.orbit_at(x).ok()).collect();
+        // The Newton iterations push each point as a triple (x0, x0 + h, x0 - h)
+        // (`Form::push_cases`); the full-period monodromy batch pushes the points alone. Each
+        // point's orbit is corrected (cached); its two neighbours are linearised from it.
+        if !full && values.len() % 3 != 0 {
+            return Err(invalid("values", "correct_across_family: the iterations' trajectories must come in (x0, x0 + h, x0 - h) triples"));
+        }
+        let centre_of = |i: usize| if full { values[i] } else { values[i - i % 3] };
+        let mut centres: Vec<f64> = (0..values.len()).map(centre_of).collect();
+        centres.sort_by(f64::total_cmp);
+        centres.dedup();
+        let orbits: Vec<Option<Arc<(SymmetricOrbit, OrbitForcing)>>> = centres.par_iter().map(|&x| family.orbit_at(x).ok()).collect();
+        // one job per distinct (centre, value): its table and its trajectories, in parallel
+        let mut jobs: Vec<(usize, f64, Vec<usize>)> = Vec::new();
+        for i in 0..values.len() {
+            let k = centres.binary_search_by(|c| c.total_cmp(&centre_of(i))).map_err(|_| invalid("values", "centre not found"))?;
+            match jobs.iter_mut().find(|j| j.0 == k && j.1.to_bits() == values[i].to_bits()) {
+                Some(j) => j.2.push(i),
+                None => jobs.push((k, values[i], vec![i])),
+            }
+        }
+        let swept: Vec<Result<Option<Vec<Outcome>>>> = jobs
+            .par_iter()
+            .map(|(k, v, idx)| {
+                let Some(o) = &orbits[*k] else { return Ok(None) };
+                let near;
+                let (period, table) = if v.to_bits() == centres[*k].to_bits() {
+                    (o.0.period, &o.1)
+                } else {
+                    match family.linearised(&o.0, *v) {
+                        Ok(n) => {
+                            near = n;
+                            (near.0, &near.1)
+                        }
+                        Err(_) => return Ok(None),
+                    }
+                };
+                let group: Vec<Case> = idx.iter().map(|&i| cases[i]).collect();
+                let t = if full { period } else { 0.5 * period };
+                map::sweep(table, t, &group, &lane, true, opts.chunk, None).map(Some)
+            })
+            .collect();
         let mut out = vec![FAILED; cases.len()];
-        for (x, orbit) in distinct.iter().zip(&orbits) {
-            let Some(o) = orbit else { continue };
-            let idx: Vec<usize> = (0..cases.len()).filter(|&i| values[i] == *x).collect();
-            let group: Vec<Case> = idx.iter().map(|&i| cases[i]).collect();
-            let t = if full { o.0.period } else { 0.5 * o.0.period };
-            let r = map::sweep(&o.1, t, &group, &lane, true, opts.chunk, None)?;
-            for (&i, v) in idx.iter().zip(r) {
-                out[i] = v;
+        for ((_, _, idx), r) in jobs.iter().zip(swept) {
+            if let Some(r) = r? {
+                for (&i, v) in idx.iter().zip(r) {
+                    out[i] = v;
+                }
             }
         }
         Ok(out)
