@@ -822,11 +822,11 @@ pub fn correct_across_family(family: &PlanarFamily, bordered: &Bordered, candida
         let orbits: Vec<Option<Arc<(SymmetricOrbit, OrbitForcing)>>> = centres.par_iter().map(|&x| family.orbit_at(x).ok()).collect();
         // one job per distinct (centre, value): its table and its trajectories, in parallel
         let mut jobs: Vec<(usize, f64, Vec<usize>)> = Vec::new();
-        for i in 0..values.len() {
+        for (i, &v) in values.iter().enumerate() {
             let k = centres.binary_search_by(|c| c.total_cmp(&centre_of(i))).map_err(|_| invalid("values", "centre not found"))?;
-            match jobs.iter_mut().find(|j| j.0 == k && j.1.to_bits() == values[i].to_bits()) {
+            match jobs.iter_mut().find(|j| j.0 == k && j.1.to_bits() == v.to_bits()) {
                 Some(j) => j.2.push(i),
-                None => jobs.push((k, values[i], vec![i])),
+                None => jobs.push((k, v, vec![i])),
             }
         }
         let swept: Vec<Result<Option<Vec<Outcome>>>> = jobs
