@@ -238,3 +238,27 @@ def test_srp_map_reports_progress_per_branch(sun12):
         np.testing.assert_array_equal(ds[v].values, plain[v].values)
     with pytest.raises(ValueError, match="invalid argument `progress`"):
         librate.srp_map(sun12, progress=3, **args)
+
+
+def test_scans_from_several_attitudes_share_one_sweep(sun12):
+    """find_periodic_attitudes with a sequence of phi0: the scans run in one engine sweep and one
+    corrector call, and give what the scans give one by one (reference: the single-phi0 calls):
+    per scan the same motions (turns, kind; wz0 and phi0 to 1e-9: the candidates share SIMD
+    groups with other scans' candidates, so only the last bits may differ), listed together by
+    wz0. A motion found from two starts is listed twice."""
+    plate = librate.FlatPlate(0.3, cs=0.4, cd=0.1)
+    seeds = (0.0, 0.5 * math.pi)
+    args = dict(kz=0.6, wz0_range=(-0.6, 1.0), n_periods=2, srp=plate, kinds=("periodic",))
+    alone = [librate.find_periodic_attitudes(sun12, phi0=s, **args) for s in seeds]
+    both = librate.find_periodic_attitudes(sun12, phi0=list(seeds), **args)
+    assert all(len(a) >= 2 for a in alone)
+    assert len(both) == sum(len(a) for a in alone)
+    assert [s.wz0 for s in both] == sorted(s.wz0 for s in both)
+    for a in alone:
+        for s in a:
+            assert any(b.n_total == s.n_total and b.kind == s.kind and abs(b.wz0 - s.wz0) < 1e-9
+                       and abs(math.remainder(b.phi0 - s.phi0, 2 * math.pi)) < 1e-9 for b in both), (s.wz0, s.phi0)
+    with pytest.raises(ValueError, match="`phi0`"):
+        librate.find_periodic_attitudes(sun12, phi0=[], **args)
+    with pytest.raises(ValueError, match="`phi0`"):
+        librate.find_periodic_attitudes(sun12, phi0=[0.0, float("nan")], **args)

@@ -28,7 +28,7 @@ from ..attitude.srp import FlatPlate
 from ..orbits.periodic import PeriodicOrbit
 
 __all__ = ["AttitudeSolution", "find_periodic_attitudes", "orbit_forcing", "clear_forcing_cache", "sweep", "candidates",
-           "check_orbit", "check_kz", "check_kinds", "KINDS", "check_srp", "is_symmetric", "MAP_RTOL", "MAP_ATOL", "correct", "verified", "refine",
+           "check_orbit", "check_kz", "check_kinds", "KINDS", "check_srp", "is_symmetric", "MAP_RTOL", "MAP_ATOL", "correct", "verified", "refine", "refine_groups",
            "turns_of", "n_total_of", "per_period", "SOLVE_RTOL", "SOLVE_ATOL", "STEP_MAX_ITER", "MAP_METHOD",
            "STEP_MAX_HALVINGS"]
 
@@ -291,31 +291,48 @@ def candidates(phi_t, phi0, wz, level):
 
 def refine(orbit, kz, phi0, cands, *, n_periods, srp, closure, window, kinds=KINDS, quick=False) -> list[AttitudeSolution]:
     """Refine (k, wz0) candidates (k = 2 turns over the K periods, odd k a half turn) in ONE
+    corrector call and verify the converged ones in one more: :func:`refine_groups` with every
+    candidate in one group."""
+    return [s for _, s in refine_groups(orbit, kz, phi0, cands, n_periods=n_periods, srp=srp, closure=closure, window=window, kinds=kinds,
+                                        quick=quick)]
+
+
+def refine_groups(orbit, kz, phi0, cands, *, n_periods, srp, closure, window, kinds=KINDS, quick=False,
+                  group=None) -> list[tuple[int, AttitudeSolution]]:
+    """Refine (k, wz0) candidates (k = 2 turns over the K periods, odd k a half turn) in ONE
     corrector call and verify the converged ones in one more; keep those inside ``window``
     with an independent residual below 1e-8, one per (turns, kind, wz0 to 1e-8), sorted by wz0.
-    ``kz`` may be one value or one per candidate. ``quick``: the candidates are close guesses
-    of the half-period closure (a fine map's crossings), and one that needs more than a few
-    Newton steps has no solution nearby: the corrector gives up early."""
-    cands = [(k, w, kk) for (k, w), kk in zip(cands, np.broadcast_to(np.asarray(kz, dtype=float), (len(cands),)))
-             if ("periodic" if k % 2 == 0 else "half-turn") in kinds]
-    if not cands:
+    ``kz`` and ``phi0`` may be one value or one per candidate. ``quick``: the candidates are
+    close guesses of the half-period closure (a fine map's crossings), and one that needs more
+    than a few Newton steps has no solution nearby: the corrector gives up early. ``group``:
+    one integer label per candidate (default: all 0); duplicates are merged within a group only.
+    Returns (group, solution) pairs, group by group (in order of first appearance), each group
+    sorted by wz0."""
+    n = len(cands)
+    grp = np.zeros(n, dtype=int) if group is None else np.asarray(group)
+    p0 = np.broadcast_to(np.asarray(phi0, dtype=float), (n,))
+    keep = [i for i, (k, _) in enumerate(cands) if ("periodic" if k % 2 == 0 else "half-turn") in kinds]
+    if not keep:
         return []
-    ks = np.array([c[0] for c in cands])
+    ks = np.array([cands[i][0] for i in keep])
     n_total = ks // 2
     kind = np.where(ks % 2 == 0, "periodic", "half-turn")
-    kzs = np.array([c[2] for c in cands])
-    b = correct(orbit, kz=kzs, n_total=n_total, kind=kind, phi0=phi0, wz0=np.array([c[1] for c in cands]), n_periods=n_periods, srp=srp,
+    kzs = np.broadcast_to(np.asarray(kz, dtype=float), (n,))[keep]
+    grp, p0 = grp[keep], p0[keep]
+    b = correct(orbit, kz=kzs, n_total=n_total, kind=kind, phi0=p0, wz0=np.array([cands[i][1] for i in keep]), n_periods=n_periods, srp=srp,
                 closure=closure, monodromy=False,  # the verification brings the monodromy
                 **({"max_iter": STEP_MAX_ITER, "max_halvings": 3} if quick else {}))
     lo, hi = window
-    conv = sorted(np.flatnonzero(b.converged & (b.wz0 >= lo) & (b.wz0 <= hi)), key=lambda i: (kzs[i], b.wz0[i]))
+    order = {g: j for j, g in enumerate(dict.fromkeys(grp.tolist()))}
+    conv = sorted(np.flatnonzero(b.converged & (b.wz0 >= lo) & (b.wz0 <= hi)), key=lambda i: (order[grp[i]], kzs[i], b.wz0[i]))
     ok: list[int] = []  # one per solution: candidates that converged onto the same one are verified once
     for i in conv:
-        if not any(kzs[j] == kzs[i] and n_total[j] == n_total[i] and kind[j] == kind[i] and abs(b.wz0[j] - b.wz0[i]) < 1e-8 for j in ok):
+        if not any(grp[j] == grp[i] and kzs[j] == kzs[i] and n_total[j] == n_total[i] and kind[j] == kind[i] and abs(b.wz0[j] - b.wz0[i]) < 1e-8
+                   for j in ok):
             ok.append(int(i))
     sols = verified(orbit, kz=kzs[ok], n_total=n_total[ok], kind=kind[ok], phi0=b.phi0[ok], wz0=b.wz0[ok], n_periods=n_periods,
                     plates=None if srp is None else [srp] * len(ok), iterations=b.iterations[ok])
-    return [s for s in sols if s.residual <= 1e-8]
+    return [(int(grp[i]), s) for i, s in zip(ok, sols) if s.residual <= 1e-8]
 
 
 def find_periodic_attitudes(
@@ -323,7 +340,7 @@ def find_periodic_attitudes(
     *,
     kz: float,
     wz0_range: tuple[float, float],
-    phi0: float = 0.0,
+    phi0: float | Sequence[float] = 0.0,
     kinds: Sequence[str] = KINDS,
     n_grid: int | None = None,
     n_periods: int = 1,
@@ -335,6 +352,13 @@ def find_periodic_attitudes(
     multiples of pi/2 for symmetric cases, of phi(T) - phi0 through multiples of pi otherwise);
     all are refined together by one call of the Rust corrector and kept when they converge
     inside the window (each re-propagated independently). Sorted by wz0.
+
+    ``phi0`` may be a sequence of starting attitudes: where the corrector frees phi0 (the full
+    closure, e.g. with SRP), scans from several attitudes find motions a single scan misses.
+    The scans then share one engine sweep and one corrector call per closure; duplicates are
+    merged within each scan, not across them (a motion found from two starts is listed twice,
+    possibly with different phi0 in the symmetric case), and the list is sorted by wz0, scans
+    in the given order where wz0 ties.
     """
     orbit = check_orbit(orbit)
     kz = check_kz(kz)
@@ -348,14 +372,30 @@ def find_periodic_attitudes(
     n_periods = as_count(n_periods, "n_periods", 1)
     if n_grid is not None:
         n_grid = as_count(n_grid, "n_grid", 2)
-    phi0 = as_number(phi0, "phi0")
+    seeds = [as_number(v, "phi0") for v in (phi0 if isinstance(phi0, (list, tuple, np.ndarray)) else [phi0])]
+    if not seeds:
+        raise ValueError("invalid argument `phi0`: need at least one starting attitude")
     srp = check_srp(srp)
     T = n_periods * orbit.period
     wz = _grid_for(T, lo, hi, n_grid)
-    symmetric = is_symmetric(orbit, phi0) and (srp is None or srp.eps == 0.0)
-    t_scan, level = (0.5 * T, 0.5 * math.pi) if symmetric else (T, math.pi)
-    r = sweep(orbit_forcing(orbit), t_scan, phi0, wz, kz, srp=srp)
-    # symmetric: phi(T/2) - phi0 = k pi/2 -> turns = k/2; else phi(T) - phi0 = k pi -> turns = k/2
-    found = refine(orbit, kz, phi0, candidates(r["phi_t"], phi0, wz, level), n_periods=n_periods, srp=srp,
-                   closure="half" if symmetric else "full", window=(lo, hi), kinds=kinds)
-    return sorted(found, key=lambda s: s.wz0)
+    found: list[list[AttitudeSolution]] = [[] for _ in seeds]
+    for symmetric in (True, False):
+        idx = [i for i, p in enumerate(seeds) if (is_symmetric(orbit, p) and (srp is None or srp.eps == 0.0)) == symmetric]
+        if not idx:
+            continue
+        t_scan, level = (0.5 * T, 0.5 * math.pi) if symmetric else (T, math.pi)
+        p_grid = np.array([seeds[i] for i in idx])[:, None]
+        r = sweep(orbit_forcing(orbit), t_scan, p_grid, wz[None, :], kz, srp=srp)
+        phi_t = np.asarray(r["phi_t"]).reshape(len(idx), wz.size)
+        # symmetric: phi(T/2) - phi0 = k pi/2 -> turns = k/2; else phi(T) - phi0 = k pi -> turns = k/2
+        cands, start, group = [], [], []
+        for j, i in enumerate(idx):
+            c = candidates(phi_t[j], seeds[i], wz, level)
+            cands += c
+            start += [seeds[i]] * len(c)
+            group += [i] * len(c)
+        for g, s_ in refine_groups(orbit, kz, np.array(start), cands, n_periods=n_periods, srp=srp, closure="half" if symmetric else "full",
+                                   window=(lo, hi), kinds=kinds, group=group):
+            found[g].append(s_)
+    # each scan sorted by wz0, then all (a stable sort: scans in order where wz0 ties)
+    return sorted((s_ for f in found for s_ in sorted(f, key=lambda s_: s_.wz0)), key=lambda s_: s_.wz0)

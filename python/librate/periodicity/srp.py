@@ -189,10 +189,9 @@ def srp_map(
                 + ([(float(es[0]), np.concatenate([neg[::-1][1:], zero]))] if es[0] < 0 else []))
         for e_end, inward in ends:
             known = [s for _, e, s in sols if e == e_end]
-            found = []
-            for seed in (0.0, 0.5 * math.pi, math.pi, -0.5 * math.pi):  # phi0 is free: scan from four initial attitudes
-                found += find_periodic_attitudes(orbit, kz=kz, wz0_range=window, phi0=phi0 + seed, kinds=kinds,
-                                                 n_periods=n_periods, srp=plate.with_eps(e_end))
+            # phi0 is free: scan from four initial attitudes (one sweep, one corrector call)
+            found = find_periodic_attitudes(orbit, kz=kz, wz0_range=window, phi0=[phi0 + s_ for s_ in (0.0, 0.5 * math.pi, math.pi, -0.5 * math.pi)],
+                                            kinds=kinds, n_periods=n_periods, srp=plate.with_eps(e_end))
             jobs, lead = [], []
             for s1 in sorted(found, key=lambda x: x.wz0):
                 if any(k.n_total == s1.n_total and k.kind == s1.kind and abs(k.wz0 - s1.wz0) < 1e-7
