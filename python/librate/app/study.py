@@ -1326,6 +1326,13 @@ gravity_gradient = ["earth", "moon"]   # the planar engine models both primaries
 # theta_sun0 = 0.0             # Sun phase at t = 0 (rad)
 # (SRP needs one Sun-resonant orbit: [orbits] sun_resonance = [2], and solver.n_periods = 2)
 
+# [attitude]
+# model = "3d"                 # the 3-D rigid body instead of the planar model (default "planar"):
+#                              # needs body.ix/iy/iz, works on any family (halos too); `librate solve`
+#                              # continues one periodic 3-D motion along the members
+# n = -1                       # starting from the planar n-turn solution on the first member
+#                              # (or start = "spin", the torque-free spin; or start = "given" with q0, w0)
+
 [rates]
 wz0 = { start = -3.0, stop = 2.0, num = 300 }   # inertial initial rates (1/TU), increasing
 # phidot0 = { start = -4.0, stop = 1.0, num = 300 }   # or relative to the synodic frame (wz0 - 1)
