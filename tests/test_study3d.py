@@ -329,3 +329,12 @@ def test_map_of_a_3d_study_stops_with_a_clear_error_and_writes_nothing(cli, tmp_
     # an invalid 3-D map study is refused first (exit 2), listing the problem
     res = cli("map", EXAMPLE, "--out", tmp_path / "x", code=2)
     assert "rates.wx0: missing" in res.output
+
+
+def test_solve_3d_reports_progress_per_member(tmp_path):
+    """``progress(done, total)`` after each requested member reached, as the planar solve."""
+    calls = []
+    st3 = Study.from_dict({"orbits": {"kind": "halo", "period_days": [14.0, 13.9]}, "body": {"ix": 1.0, "iy": 1.02, "iz": 1.04},
+                           "attitude": {"model": "3d", "n": 0}}, purpose="solve")
+    ds, path = st3.run_solve(tmp_path, progress=lambda done, total: calls.append((done, total)))
+    assert calls == [(1, 2), (2, 2)] and ds.sizes["member"] == 2 and path.name == "solve.zarr"
