@@ -301,20 +301,28 @@ def test_solve_a_3d_dro_study_embeds_the_planar_solution(cli, tmp_path):
 
 
 def test_solve_a_3d_halo_study_from_the_torque_free_spin(cli, tmp_path):
-    """A nearly spherical body on three L2 southern halos (14.0, 13.8, 13.6 d), started from the
-    torque-free spin n = 0 (wz0 = 1 about synodic Z): netCDF result, every member re-propagates."""
+    """The body 0.8 : 0.9 : 1 on four L2 southern halos (14 to 11 days), started from the
+    torque-free spin n = -1 (wz0 = 1 - 2 pi / T about synodic Z), as in tests/test_attitude3d.py's
+    NRHO family: netCDF result, every member re-propagates from the file, and the continuation
+    locates a stability change (a Krein collision between 12 and 11 days, test function zero to
+    1e-8 in the period), printed and stored."""
+    import ast
+
     study = tmp_path / "halo.toml"
     study.write_text(
-        '[orbits]\nkind = "halo"\npoint = 2\nbranch = "south"\nperiod_days = [14.0, 13.8, 13.6]\n'
-        '[body]\nix = 1.0\niy = 1.02\niz = 1.04\n[attitude]\nmodel = "3d"\nn = 0\n[output]\nformat = "netcdf"\nfigures = ["multipliers"]\n')
-    res = cli("solve", study, "-q")
-    assert res.output.strip().splitlines()[0].endswith("solve.nc")
+        '[orbits]\nkind = "halo"\npoint = 2\nbranch = "south"\nperiod_days = [14.0, 13.0, 12.0, 11.0]\n'
+        '[body]\nix = 0.8\niy = 0.9\niz = 1.0\n[attitude]\nmodel = "3d"\nn = -1\n[output]\nformat = "netcdf"\nfigures = ["multipliers"]\n')
+    res = cli("solve", study)
     ds = librate.open_result(tmp_path / "librate-out" / "solve.nc")
-    assert ds.attrs["start"] == "spin" and ds.attrs["start_w0"] == pytest.approx([0.0, 0.0, 1.0], abs=1e-15)
-    assert ds["period_days"].values.tolist() == pytest.approx([14.0, 13.8, 13.6], abs=1e-9)
+    t14 = librate.System.preset("earth-moon").from_days(14.0)
+    assert ds.attrs["start"] == "spin" and ds.attrs["start_w0"] == pytest.approx([0.0, 0.0, 1 - 2 * math.pi / t14], abs=1e-12)
+    assert ds["period_days"].values.tolist() == pytest.approx([14.0, 13.0, 12.0, 11.0], abs=1e-9)
     assert np.all(ds["z0"].values < 0)  # the southern branch
     check_stored_motions(ds)
     assert json.loads(ds.attrs["study"])["attitude"]["start"] == "spin"
+    (change,) = ast.literal_eval(ds.attrs["stability_changes"])
+    assert change["kind"] == "krein" and change["located"] and 11.0 < change["at"] < 12.0 and change["between"] == pytest.approx((12.0, 11.0))
+    assert f"stability change (krein) at T = {change['at']:.10g} d" in res.output
     assert (tmp_path / "librate-out" / "solve_multipliers.png").exists() and not (tmp_path / "librate-out" / "solve_body_axes.png").exists()
 
 

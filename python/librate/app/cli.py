@@ -501,7 +501,7 @@ def _summary_3d(ds, elapsed: float) -> None:
         turns = ds["turns"].values[j]
         click.echo(f"{j:>6d} {ds['period_days'].values[j]:>9.5f} {ds['x0'].values[j]:>9.5f} {ds['z0'].values[j]:>9.5f} "
                    f"{' '.join(f'{v:8.5f}' for v in q):>36} {' '.join(f'{v:11.7f}' for v in w):>36} {np.abs(m[j]).max():>10.6g} "
-                   f"{'yes' if ds['stable'].values[j] else 'no':>6} {'-' if np.isnan(turns) else f'{turns:.3f}':>6} {ds['residual'].values[j]:>9.1e}")
+                   f"{'yes' if ds['stable'].values[j] else 'no':>6} {'-' if np.isnan(turns) else f'{round(turns, 3) + 0.0:.3f}':>6} {ds['residual'].values[j]:>9.1e}")
     click.echo(f"continuation: {ds.attrs.get('end_reason')}")
     for ch in ast.literal_eval(ds.attrs.get("stability_changes", "[]")):
         where = f"at T = {ch['at']:.10g} d" + ("" if ch["located"] else " (interpolated)")
