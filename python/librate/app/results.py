@@ -463,7 +463,9 @@ def solution_3d(ds, member: int = 0):
     from ..periodicity.attitude3d import periodic_attitude_3d
 
     a = ds.attrs
-    system = System.preset(a["system_name"]) if a["system_name"] in System.presets() else System(mu=a["mu"], lu_km=a["lu_km"], tu_s=a["tu_s"], name=a["system_name"])
+    name = str(a["system_name"])
+    preset = name in System.presets() and System.preset(name).mu == float(a["mu"])
+    system = System.preset(name) if preset else System(mu=float(a["mu"]), lu_km=float(a["lu_km"]), tu_s=float(a["tu_s"]), name=name)
     orbit = PeriodicOrbit(system, np.asarray(ds["orbit_state0"].values[member], dtype=float), float(ds["orbit_period"].values[member]),
                           float(ds["orbit_jacobi"].values[member]))
     body = RigidBody(*(float(v) for v in np.atleast_1d(a["body_moments"])))
