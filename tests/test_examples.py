@@ -6,6 +6,7 @@ import sys
 from pathlib import Path
 
 import pytest
+from librate.app.study import Study
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 OUTPUTS = {
@@ -28,3 +29,9 @@ def test_example_runs(script, tmp_path):
     assert "written:" in res.stdout
     for rel in OUTPUTS[script]:
         assert (tmp_path / rel).exists(), rel
+
+
+@pytest.mark.parametrize("study", sorted(p.name for p in EXAMPLES.glob("*.toml")))
+def test_example_studies_are_valid(study):
+    """Every study file in examples/ validates for `librate solve` (tests/test_study3d.py runs them)."""
+    assert Study.from_toml(EXAMPLES / study, purpose="solve").title

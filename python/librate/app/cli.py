@@ -442,17 +442,35 @@ def solve(study, sets, out_dir, resume, quiet) -> None:
                       with the study (JSON) and the version as attributes
       solve_solutions.png   the solutions' rates against x0
     A table of the same inputs is reused; one of other inputs is refused (--force).
+
+    \b
+    With [attitude] model = "3d": one periodic 3-D attitude motion (quaternion and three
+    rates, body.ix/iy/iz) continued along the selected members in their order, started on
+    the first member from attitude.start ("planar": the planar n-family solution found in
+    the [rates] scan; "spin": the torque-free spin about synodic Z; "given": attitude.q0,
+    attitude.w0). Prints one line per member (q0, w0, multipliers, stability, turns,
+    residual) and the located stability changes, and writes solve.zarr (or .nc) with
+    solve_multipliers.png (Floquet multipliers along the family) and solve_body_axes.png
+    (the body axes along the first member's orbit).
     """
     from .progress import reporter
 
     st = _load_study(study, "solve", _overrides(sets))
     _check_writable(st.output_dir(out_dir), "--out" if out_dir else "output.folder")
+    three_d = st.attitude.model == "3d"
     t0 = time.perf_counter()
     try:
-        ds, path = st.run_solve(out_dir, progress=reporter("solutions", "orbit-Kz", _show(quiet)), force=not resume, say=_say)
+        ds, path = st.run_solve(out_dir, progress=reporter("3-D solutions" if three_d else "solutions", "member" if three_d else "orbit-Kz",
+                                                           _show(quiet)), force=not resume, say=_say)
     except _FAILURES as err:
         raise _failure(err) from None
     el = time.perf_counter() - t0
+    if three_d:
+        if not quiet:
+            _summary_3d(ds, el)
+        click.echo(f"written: {path}")
+        _figures(ds, path, st.figures(("multipliers", "body_axes")), quiet)
+        return
     n = ds.sizes["solution"]
     _echo(quiet, f"{n} periodic solution(s) over {ds.sizes['orbit']} orbit(s) x {ds.sizes['kz']} Kz ({el:.2f} s)")
     if n and not quiet:
@@ -463,6 +481,32 @@ def solve(study, sets, out_dir, resume, quiet) -> None:
                        f"{r['phidot0']:>13.8f} {r['phi0']:>9.5f} {r['trace']:>10.4g} {'yes' if r['stable'] else 'no':>6} {r['residual']:>9.1e}")
     click.echo(f"written: {path}")
     _figures(ds, path, st.figures(("solutions",)), quiet)
+
+
+def _summary_3d(ds, elapsed: float) -> None:
+    """The table of a 3-D solve: one line per member, then how the continuation ended and the
+    located stability changes."""
+    import ast
+
+    from .results import multipliers_3d
+
+    m = multipliers_3d(ds)
+    n = ds.sizes["member"]
+    click.echo(f"periodic 3-D attitude motion along {n} of {ds.attrs.get('members_requested', n)} member(s) of the {ds.attrs.get('orbit_family')} family, "
+               f"body moments ({', '.join(f'{v:.6g}' for v in np.atleast_1d(ds.attrs['body_moments']))}) kg m^2, K = {ds.attrs['n_periods']} ({elapsed:.2f} s); start: {ds.attrs.get('start_description')}")
+    click.echo(f"{'member':>6} {'T [d]':>9} {'x0 [LU]':>9} {'z0 [LU]':>9} {'q0 (x, y, z, w)':>36} {'w0 [1/TU] (x, y, z)':>36} "
+               f"{'max|mult|':>10} {'stable':>6} {'turns':>6} {'residual':>9}")
+    for j in range(n):
+        q, w = ds["q0"].values[j], ds["w0"].values[j]
+        turns = ds["turns"].values[j]
+        click.echo(f"{j:>6d} {ds['period_days'].values[j]:>9.5f} {ds['x0'].values[j]:>9.5f} {ds['z0'].values[j]:>9.5f} "
+                   f"{' '.join(f'{v:8.5f}' for v in q):>36} {' '.join(f'{v:11.7f}' for v in w):>36} {np.abs(m[j]).max():>10.6g} "
+                   f"{'yes' if ds['stable'].values[j] else 'no':>6} {'-' if np.isnan(turns) else f'{round(turns, 3) + 0.0:.3f}':>6} {ds['residual'].values[j]:>9.1e}")
+    click.echo(f"continuation: {ds.attrs.get('end_reason')}")
+    for ch in ast.literal_eval(ds.attrs.get("stability_changes", "[]")):
+        where = f"at T = {ch['at']:.10g} d" + ("" if ch["located"] else " (interpolated)")
+        click.echo(f"stability change ({ch['kind']}) {where}, between T = {ch['between'][0]:.6g} and {ch['between'][1]:.6g} d "
+                   f"(multipliers on the unit circle: {ch['on_unit_circle'][0]} -> {ch['on_unit_circle'][1]})")
 
 
 @main.command(name="map", context_settings=_CONTEXT, short_help="The attitude periodicity map of a study (thesis Fig. 24).")
@@ -545,6 +589,8 @@ def plot(result_path, quiet) -> None:
                  per Kz when several), STEM_residuals.png (dwz, dphi against phidot0 for
                  the first orbit), STEM_solutions.png (solution families across the orbits)
       solutions  STEM_solutions.png (initial rates phidot0 of the solutions against x0)
+      3-D solutions  STEM_multipliers.png (Floquet multipliers along the family),
+                 STEM_body_axes.png (body axes along the first member's orbit)
     """
     from .results import open_result, resolve_result_path
 
@@ -566,6 +612,9 @@ def plot(result_path, quiet) -> None:
     if isinstance(res, OrbitFamily):
         _echo(quiet, f"{res.kind} family: {len(res)} members")
         names = ("family", "period", "stability")
+    elif res.attrs.get("librate_result") == "solutions_3d":
+        _echo(quiet, f"3-D solutions: {', '.join(f'{k} {v}' for k, v in res.sizes.items() if k == 'member')}")
+        names = ("multipliers", "body_axes")
     else:
         kind = res.attrs.get("librate_result") or ("map" if "dwz" in res.variables else "solutions")
         _echo(quiet, f"{kind}: {', '.join(f'{k} {v}' for k, v in res.sizes.items())}")
@@ -616,7 +665,7 @@ def verify(result_path) -> None:
 
 #: The file suffix of each figure: a result STEM.zarr gets STEM_<suffix>.png beside it.
 _FIGURE_FILES = {"family": "orbits", "period": "period", "stability": "stability", "map": "contours", "residuals": "residuals",
-                 "solutions": "solutions"}
+                 "solutions": "solutions", "multipliers": "multipliers", "body_axes": "body_axes"}
 
 
 def _figures(result, path: Path, names, quiet: bool, extra: dict | None = None) -> list[Path]:
@@ -644,6 +693,12 @@ def _figures(result, path: Path, names, quiet: bool, extra: dict | None = None) 
     if isinstance(result, OrbitFamily):
         table = {"family": lambda: lp.plot_family(result, n_orbits=30), "period": lambda: lp.plot_period(result),
                  "stability": lambda: lp.plot_stability(result)}
+        jobs = [(fname(n), table[n]) for n in names if n in table]
+    elif result.attrs.get("librate_result") == "solutions_3d":
+        from .results import multipliers_3d, solution_3d
+
+        table = {"multipliers": lambda: lp.plot_family_multipliers(result.assign(multipliers=(("member", "k"), multipliers_3d(result)))),
+                 "body_axes": lambda: lp.plot_body_axes(solution_3d(result, 0))}
         jobs = [(fname(n), table[n]) for n in names if n in table]
     elif "dwz" in result.variables:
         kzs = np.atleast_1d(result["kz"].values)

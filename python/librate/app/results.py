@@ -1,7 +1,8 @@
 """Results on disk: orbit families, periodic-solution tables and periodicity maps.
 
 Every result is an xarray Dataset written as Zarr (a ``.zarr`` folder, chunked) or netCDF (a
-``.nc`` file) whose attributes carry ``librate_result`` ("family", "solutions" or "map"), the
+``.nc`` file) whose attributes carry ``librate_result`` ("family", "solutions", "solutions_3d"
+or "map"), the
 full study as JSON (``study``) and the package version (``librate_version``), next to the units
 of every variable. :func:`open_result` reloads any of them without recomputing. Writing is
 all-or-nothing (into a temporary sibling, then renamed), and an existing path that is not a
@@ -19,18 +20,20 @@ import numpy as np
 
 from .._integrity import write_atomically
 
-__all__ = ["RESULT_INPUTS", "RESULT_KINDS", "RESULT_STEMS", "ResultExists", "check_output", "describe_result", "open_result", "read_attrs", "result_kind", "run_map_to", "save_dataset", "save_family", "solutions_dataset",
+__all__ = ["RESULT_INPUTS", "RESULT_KINDS", "RESULT_STEMS", "ResultExists", "check_output", "describe_result", "open_result", "multipliers_3d", "read_attrs", "result_kind", "run_map_3d_to", "run_map_to", "save_dataset", "save_family", "solution_3d",
+           "solutions_3d_dataset", "solutions_dataset",
            "study_changes", "verify_result"]
 
 #: The kinds of result, as stored in the ``librate_result`` attribute.
-RESULT_KINDS = ("family", "solutions", "map")
+RESULT_KINDS = ("family", "solutions", "solutions_3d", "map")
 #: The file each command writes its result to (``<stem>.zarr`` or ``<stem>.nc``): the name says
 #: which command made it. Its figures are ``<stem>_<figure>.png`` beside it.
 RESULT_STEMS = {"family": "family", "solve": "solve", "map": "map", "demo": "demo"}
 #: The study sections each kind of result depends on: a change elsewhere (e.g. ``output``, or
 #: ``body`` for a family) leaves the result valid, so it is resumed rather than refused.
-RESULT_INPUTS = {"family": ("system", "orbits"), "solutions": ("system", "orbits", "body", "torques", "rates", "solver"),
-                 "map": ("system", "orbits", "body", "torques", "rates", "solver")}
+RESULT_INPUTS = {"family": ("system", "orbits"), "solutions": ("system", "orbits", "body", "torques", "rates", "attitude", "solver"),
+                 "solutions_3d": ("system", "orbits", "body", "torques", "rates", "attitude", "solver"),
+                 "map": ("system", "orbits", "body", "torques", "rates", "attitude", "solver")}
 # older names, still read: solutions.* (librate solve before 0.2), dro_map_kz*.nc (librate demo)
 _NAMES = tuple(f"{stem}{ext}" for stem in (*RESULT_STEMS.values(), "solutions") for ext in (".zarr", ".nc"))
 
@@ -392,6 +395,93 @@ def solutions_dataset(rows, orbits, kz, attrs: dict | None = None):
         **(attrs or {}),
     })
     return ds
+
+
+def solutions_3d_dataset(family_ds, orbits, period_days, start: dict, attrs: dict | None = None):
+    """The result of ``librate solve`` on a 3-D study: the Dataset of
+    :func:`librate.attitude_family_3d` (members at the requested ``period_days``, in order, or
+    the first ones when the continuation ended early) made self-describing and storable in
+    netCDF 3 too.
+
+    Adds, per ``member``: the orbit itself (``orbit_state0`` (member, state), ``orbit_period``
+    in TU, ``orbit_jacobi``), corrected by ``orbits.member(period_days=...)`` exactly as the
+    continuation did, so every motion can be re-propagated from the file; ``phi0`` (the body x
+    axis' angle about Z at t = 0). The complex ``multipliers`` are stored as
+    ``multipliers_real`` and ``multipliers_imag`` (:func:`multipliers_3d` joins them). Units
+    and long names on every variable. Attributes: those of the family Dataset
+    (``stability_changes``, ``end_reason``, ``body_moments``, ``n_periods``), the system
+    constants, ``stability_tol``, the start (``start`` and ``start_*``) and ``attrs``."""
+    from scipy.spatial.transform import Rotation
+
+    from ..periodicity.attitude3d import STABILITY_TOL
+
+    ds = family_ds.copy()
+    m = ds.sizes["member"]
+    members = [orbits.member(period_days=float(p)) for p in list(period_days)[:m]]
+    mult = ds["multipliers"].values
+    ds = ds.drop_vars("multipliers")
+    dim = ("member",)
+    x_axis = Rotation.from_quat(ds["q0"].values).as_matrix()[:, :, 0]
+    ds = ds.assign({
+        "multipliers_real": (("member", "k"), mult.real, {"long_name": "Floquet multipliers of the 6x6 attitude monodromy, real part"}),
+        "multipliers_imag": (("member", "k"), mult.imag, {"long_name": "Floquet multipliers of the 6x6 attitude monodromy, imaginary part"}),
+        "orbit_state0": (("member", "state"), np.array([o.state0 for o in members]).reshape(m, 6),
+                         {"units": "LU, LU/TU", "long_name": "orbit initial state (x, y, z, vx, vy, vz), synodic frame"}),
+        "orbit_period": (dim, np.array([o.period for o in members]), {"units": "TU"}),
+        "orbit_jacobi": (dim, np.array([o.jacobi for o in members]), {"long_name": "Jacobi constant"}),
+        "phi0": (dim, np.arctan2(x_axis[:, 1], x_axis[:, 0]), {"units": "rad", "long_name": "angle about Z of the body x axis' projection at t = 0"}),
+    })
+    ds = ds.assign_coords(member=np.arange(m), state=["x", "y", "z", "vx", "vy", "vz"], quaternion=["x", "y", "z", "w"], axis=["x", "y", "z"])
+    meta = {"period_days": ("d", "orbit period"), "x0": ("LU", "orbit x at t = 0"), "z0": ("LU", "orbit z at t = 0"),
+            "q0": (None, "attitude at t = 0, body relative to the synodic frame, scalar-last quaternion"),
+            "w0": ("1/TU", "inertial angular velocity at t = 0 in body axes"),
+            "stable": (None, f"every multiplier on the unit circle to {STABILITY_TOL:g}"),
+            "residual": (None, "max(|rotation vector of R(0)' R(KT)| rad, |w(KT) - w0| 1/TU), independent re-propagation at rtol = atol = 1e-14"),
+            "turns": (None, "net turns of the body x axis about synodic Z over the K periods (NaN: undefined)")}
+    for name, (units, long_name) in meta.items():
+        ds[name].attrs.update({"long_name": long_name, **({"units": units} if units else {})})
+    sys_ = orbits.system
+    ds.attrs.update({"title": "librate periodic 3-D attitude motions along an orbit family", "mu": sys_.mu, "lu_km": sys_.lu_km, "tu_s": sys_.tu_s,
+                     "system_name": sys_.name, "orbit_family": orbits.kind, "stability_tol": STABILITY_TOL,
+                     "members_requested": len(list(period_days)), **start, **(attrs or {})})
+    return ds
+
+
+def multipliers_3d(ds) -> np.ndarray:
+    """The complex Floquet multipliers (member, 6) of a saved 3-D solve (``multipliers_real``
+    and ``multipliers_imag``)."""
+    return ds["multipliers_real"].values + 1j * ds["multipliers_imag"].values
+
+
+def solution_3d(ds, member: int = 0):
+    """The :class:`~librate.AttitudeSolution3D` of one member of a saved 3-D solve, corrected
+    again by :func:`librate.periodic_attitude_3d` from the stored (q0, w0) on the stored orbit
+    (it returns at once when the stored motion is periodic; e.g. to draw its body axes)."""
+    from ..attitude.body import RigidBody
+    from ..orbits.periodic import PeriodicOrbit
+    from ..orbits.system import System
+    from ..periodicity.attitude3d import periodic_attitude_3d
+
+    a = ds.attrs
+    name = str(a["system_name"])
+    preset = name in System.presets() and System.preset(name).mu == float(a["mu"])
+    system = System.preset(name) if preset else System(mu=float(a["mu"]), lu_km=float(a["lu_km"]), tu_s=float(a["tu_s"]), name=name)
+    orbit = PeriodicOrbit(system, np.asarray(ds["orbit_state0"].values[member], dtype=float), float(ds["orbit_period"].values[member]),
+                          float(ds["orbit_jacobi"].values[member]))
+    body = RigidBody(*(float(v) for v in np.atleast_1d(a["body_moments"])))
+    return periodic_attitude_3d(orbit, body, guess=(ds["q0"].values[member], ds["w0"].values[member]), n_periods=int(a["n_periods"]),
+                                tol=float(a.get("attitude_tol", 1e-12)))
+
+
+def run_map_3d_to(orbits, store: str | Path, *, body, rates: dict, q0, n_periods: int = 1, tol: float = 1e-12, resume: bool = True,
+                  scheduler=None, progress: bool | None = None, attrs: dict[str, Any] | None = None):
+    """The 3-D attitude map of a ``[attitude] model = "3d"`` study into ``store``: for every
+    orbit, the 6 closure residuals over the two rate grids of ``rates`` (``{"wx0", "wy0",
+    "wz0"}``, one of them a single fixed value) from the attitude ``q0``. This librate has no
+    3-D map engine yet: raises ``NotImplementedError`` saying so (the study was validated and
+    nothing was written). Returns ``(dataset, store_path)`` once the engine is wired in."""
+    raise NotImplementedError("a 3-D attitude map ([attitude] model = \"3d\") needs the 3-D map engine, which this librate does not have yet; "
+                              "nothing was written. `librate solve` runs 3-D studies (periodic motions along the orbit family)")
 
 
 def run_map_to(

@@ -8,6 +8,14 @@ are collected and raised together as one :class:`StudyError`, one line per probl
 the key (dotted, e.g. ``body.kz``), the value given and what is allowed. Nothing is computed or
 written before the study is valid.
 
+The ``[attitude]`` section chooses the attitude model: ``model = "planar"`` (the default; every
+study without the section) or ``model = "3d"``: the 3-D rigid body (quaternion and three rates)
+with the gravity gradient of both primaries, on any orbit family (halos too). A 3-D ``solve``
+continues one periodic 3-D motion along the selected members (:func:`librate.attitude_family_3d`),
+started from the planar N-family solution on the first member (``start = "planar"``), from the
+torque-free spin about the synodic Z axis (``start = "spin"``) or from a given (q0, w0)
+(``start = "given"``).
+
 The ``build_*`` helpers turn a valid study into librate objects (:class:`~librate.System`, the
 :class:`~librate.OrbitFamily` or a list of :class:`~librate.PeriodicOrbit`, the Kz values, the
 :class:`~librate.FlatPlate` plate, the array of inertial initial rates); the ``run_*``
@@ -44,8 +52,8 @@ __all__ = ["EXAMPLE_STUDY", "FIGURES", "PURPOSES", "Study", "StudyError"]
 
 #: What a study can be checked for (the commands that run it).
 PURPOSES = ("family", "solve", "map")
-#: Figure names accepted in ``output.figures``.
-FIGURES = ("family", "period", "stability", "map", "residuals", "solutions")
+#: Figure names accepted in ``output.figures`` ("multipliers" and "body_axes": 3-D solves).
+FIGURES = ("family", "period", "stability", "map", "residuals", "solutions", "multipliers", "body_axes")
 
 
 class StudyError(ValueError):
@@ -92,6 +100,7 @@ def _number_grid_tag(v: Any) -> str | None:
 
 
 _GRID_MSG = "must be a list of numbers or a table {start, stop, num}"
+_RATE_MSG = "must be a number (a fixed rate, 3-D maps), a list of numbers or a table {start, stop, num}"
 Grid = Annotated[
     Annotated[list[float], Field(min_length=1), Tag("list")] | Annotated[Range, Tag("range")],
     Discriminator(_grid_tag, custom_error_type="grid", custom_error_message=_GRID_MSG),
@@ -100,6 +109,10 @@ KzValue = Annotated[float, Field(ge=-1, le=1)]
 KzGrid = Annotated[
     Annotated[KzValue, Tag("number")] | Annotated[list[KzValue], Field(min_length=1), Tag("list")] | Annotated[Range, Tag("range")],
     Discriminator(_number_grid_tag, custom_error_type="grid", custom_error_message="must be a number, a list of numbers or a table {start, stop, num}"),
+]
+RateGrid = Annotated[
+    Annotated[float, Tag("number")] | Annotated[list[float], Field(min_length=1), Tag("list")] | Annotated[Range, Tag("range")],
+    Discriminator(_number_grid_tag, custom_error_type="grid", custom_error_message=_RATE_MSG),
 ]
 _TAGS = {"list", "range", "number"}
 
@@ -131,6 +144,8 @@ class OrbitsSection(_Table):
 
 
 FLEXIBLE_PRESETS = ("sample-station", "sample-station-low-frequency")
+#: The 3-D corrector's default tolerance (``attitude.tol``).
+ATTITUDE_TOL = 1e-12
 
 
 class BodySection(_Table):
@@ -177,10 +192,24 @@ class TorquesSection(_Table):
 
 
 class RatesSection(_Table):
-    """[rates]: the initial rates, inertial wz0 or relative phidot0 = wz0 - 1 (1/TU)."""
+    """[rates]: the initial rates, inertial wz0 or relative phidot0 = wz0 - 1 (1/TU); for a 3-D
+    map also wx0 and wy0 (inertial, body axes): two grids and one fixed number."""
 
-    wz0: Grid | None = None
-    phidot0: Grid | None = None
+    wz0: RateGrid | None = None
+    phidot0: RateGrid | None = None
+    wx0: RateGrid | None = None
+    wy0: RateGrid | None = None
+
+
+class AttitudeSection(_Table):
+    """[attitude]: the attitude model ("planar" or "3d") and how a 3-D solve starts."""
+
+    model: Literal["planar", "3d"] = "planar"
+    start: Literal["planar", "spin", "given"] | None = None
+    n: int | None = Field(None, ge=-100, le=100)
+    q0: list[float] | None = Field(None, min_length=4, max_length=4)
+    w0: list[float] | None = Field(None, min_length=3, max_length=3)
+    tol: float | None = Field(None, ge=1e-14, le=1e-6)
 
 
 class SolverSection(_Table):
@@ -197,7 +226,7 @@ class OutputSection(_Table):
 
     folder: str = Field("librate-out", min_length=1)
     format: Literal["zarr", "netcdf"] = "zarr"
-    figures: list[Literal["family", "period", "stability", "map", "residuals", "solutions"]] | None = None
+    figures: list[Literal["family", "period", "stability", "map", "residuals", "solutions", "multipliers", "body_axes"]] | None = None
 
 
 _SECTIONS: dict[str, type[_Table]] = {
@@ -206,6 +235,7 @@ _SECTIONS: dict[str, type[_Table]] = {
     "body": BodySection,
     "torques": TorquesSection,
     "rates": RatesSection,
+    "attitude": AttitudeSection,
     "solver": SolverSection,
     "output": OutputSection,
 }
@@ -247,6 +277,14 @@ ALLOWED: dict[str, str] = {
     "torques.srp.pressure": "a number >= 0, the solar pressure in N/m^2 (default 4.56e-6)",
     "rates.wz0": "a list of inertial initial rates (1/TU), strictly increasing, or a table {start, stop, num} with start < stop, num >= 2",
     "rates.phidot0": "a list of initial rates relative to the synodic frame (1/TU), strictly increasing, or a table {start, stop, num} with start < stop, num >= 2",
+    "rates.wx0": "for attitude.model = '3d' maps: a number (fixed) or a grid of inertial initial rates about body x (1/TU): a strictly increasing list or a table {start, stop, num} with start < stop, num >= 2",
+    "rates.wy0": "for attitude.model = '3d' maps: a number (fixed) or a grid of inertial initial rates about body y (1/TU): a strictly increasing list or a table {start, stop, num} with start < stop, num >= 2",
+    "attitude.model": "'planar' (the default: the planar model, phi and wz) or '3d' (the 3-D rigid body, quaternion and three rates)",
+    "attitude.start": "'planar' (the planar N-family solution on the first member, planar families), 'spin' (the torque-free spin wz0 = 1 + 2 pi n / (K T) about synodic Z) or 'given' (attitude.q0 and attitude.w0), with attitude.model = '3d'",
+    "attitude.n": "an integer in [-100, 100], net turns about synodic Z per attitude period, with attitude.start = 'planar' or 'spin'",
+    "attitude.q0": "four numbers, a unit quaternion (scalar last): the body relative to the synodic frame at t = 0, with attitude.start = 'given' or 'spin'",
+    "attitude.w0": "three numbers, the inertial rate in body axes (1/TU), with attitude.start = 'given'",
+    "attitude.tol": "a number in [1e-14, 1e-6], the 3-D corrector's tolerance on the closure (default 1e-12; 1e-10 for NRHOs)",
     "solver.rtol": "a number in [1e-15, 1e-3]",
     "solver.atol": "a number in [1e-15, 1e-3]",
     "solver.n_periods": "an integer in [1, 1000], orbit periods per attitude period",
@@ -318,7 +356,7 @@ def _keys_of(parent: str) -> list[str] | None:
     if base in _TABLES:
         return list(_TABLES[base].model_fields)
     last = base.rsplit(".", 1)[-1]
-    if last in ("x0", "z0", "period_days", "wz0", "phidot0", "kz"):
+    if last in ("x0", "z0", "period_days", "wz0", "phidot0", "wx0", "wy0", "kz"):
         return list(Range.model_fields)
     return None
 
@@ -498,19 +536,40 @@ def _check_sections(s: dict[str, _Table], given: dict, purpose: str | None) -> l
                 problems.append(_problem("torques.srp.area_m2", srp.area_m2, "the plate's geometry needs the body's Iz in kg m^2 (body.ix, body.iy, body.iz); with body.kz alone give torques.srp.eps",
                                          "torques.srp.eps with body.kz, or the geometry with body.ix/iy/iz"))
 
+    # [attitude] (a section that failed type validation counts as the default planar model)
+    att = s.get("attitude")
+    three_d = att is not None and att.model == "3d"
+    start = _start_of(att, orb) if three_d else None
+
     # [rates]
     rates = s.get("rates")
     if rates is not None:
         if rates.wz0 is not None and rates.phidot0 is not None:
             problems.append(_problem("rates.phidot0", _grid_raw(rates.phidot0), "cannot be combined with rates.wz0 (phidot0 = wz0 - 1)", "either rates.wz0 or rates.phidot0"))
-        elif rates.wz0 is None and rates.phidot0 is None:
+        elif rates.wz0 is None and rates.phidot0 is None and not three_d:
             problems.append(_missing("rates.wz0", "missing: give rates.wz0 (inertial) or rates.phidot0 (relative to the synodic frame)"))
-        for k in ("wz0", "phidot0"):
-            if getattr(rates, k) is not None:
-                _check_increasing(f"rates.{k}", getattr(rates, k), problems)
+        if not three_d:
+            for k in ("wx0", "wy0"):
+                if getattr(rates, k) is not None:
+                    problems.append(_problem(f"rates.{k}", _grid_raw(getattr(rates, k)), "applies only to attitude.model = \"3d\" (the planar model has the one rate wz)",
+                                             "rates.wz0 or rates.phidot0 with the planar model; rates.wx0 and rates.wy0 with [attitude] model = '3d'"))
+        for k in ("wz0", "phidot0", "wx0", "wy0"):
+            g = getattr(rates, k)
+            # a number is a fixed rate of a 3-D map; every grid increases
+            if g is not None and not (three_d and isinstance(g, (int, float))) and (k in ("wz0", "phidot0") or three_d):
+                _check_increasing(f"rates.{k}", g, problems)
+
+    if att is not None and not three_d:
+        for k in ("start", "n", "q0", "w0", "tol"):
+            if getattr(att, k) is not None:
+                problems.append(_problem(f"attitude.{k}", getattr(att, k), "applies only to attitude.model = \"3d\"", "attitude.model = '3d' with it, or leave it out"))
+    if three_d:
+        problems += _check_3d(att, start, s, given)
 
     # what the command needs
-    if purpose in ("solve", "map"):
+    if purpose in ("solve", "map") and three_d:
+        problems += _needs_3d(purpose, start, s, given)
+    elif purpose in ("solve", "map"):
         what, need = ("periodic solutions", "need") if purpose == "solve" else ("a periodicity map", "needs")
         if "body" not in given:
             problems.append(_missing("body", f"missing section [body]: {what} {need} the body (body.kz, or body.ix/iy/iz)"))
@@ -518,7 +577,7 @@ def _check_sections(s: dict[str, _Table], given: dict, purpose: str | None) -> l
             problems.append(_missing("rates", f"missing section [rates]: {what} {need} the initial rates (rates.wz0 or rates.phidot0)"))
         if orb is not None and orb.kind == "halo":
             problems.append(_problem("orbits.kind", orb.kind, f"{what} use{'s' if need == 'needs' else ''} the planar attitude model, which needs a planar family",
-                                     "'dro' or 'lyapunov'"))
+                                     "'dro' or 'lyapunov' with the planar model, or any family with [attitude] model = '3d'"))
         if purpose == "map" and body is not None and body.flexible is not None:
             problems.append(_problem("body.flexible", body.flexible, "the periodicity-map engine integrates rigid bodies; "
                                      "`librate solve` reports how flexibility moves each periodic solution", "body.kz or body.ix/iy/iz for a map"))
@@ -542,6 +601,118 @@ def _check_sections(s: dict[str, _Table], given: dict, purpose: str | None) -> l
     return problems
 
 
+def _start_of(att, orb) -> str:
+    """How a 3-D solve starts: ``attitude.start``, else "given" with attitude.w0, else "spin"
+    on a halo family, else "planar"."""
+    if att.start is not None:
+        return att.start
+    if att.w0 is not None:
+        return "given"
+    return "spin" if orb is not None and orb.kind == "halo" else "planar"
+
+
+_NOT_3D = "not modelled in 3-D yet (the 3-D model has the gravity gradient of both primaries on a rigid body)"
+
+
+def _check_3d(att, start: str, s: dict, given: dict) -> list[str]:
+    """The checks of ``[attitude] model = "3d"`` on the sections that passed type validation."""
+    problems: list[str] = []
+    orb, body, tq, sol = s.get("orbits"), s.get("body"), s.get("torques"), s.get("solver")
+    if start == "planar":
+        if orb is not None and orb.kind == "halo":
+            problems.append(_problem("attitude.start", start, "the planar start takes a planar solution, which needs a planar family (orbits.kind = 'dro' or 'lyapunov')",
+                                     "'spin' or 'given' on a halo family"))
+        for k in ("q0", "w0"):
+            if getattr(att, k) is not None:
+                problems.append(_problem(f"attitude.{k}", getattr(att, k), "cannot be combined with attitude.start = \"planar\" (the start is the planar solution: "
+                                         "phi0 = solver.phi0 about Z, wz0 from the rates.wz0 scan)", "attitude.q0 and attitude.w0 with attitude.start = 'given'"))
+    elif start == "spin" and att.w0 is not None:
+        problems.append(_problem("attitude.w0", att.w0, "cannot be combined with attitude.start = \"spin\" (the spin is w = (1 + 2 pi n / (K T)) e_Z)",
+                                 "attitude.w0 with attitude.start = 'given'"))
+    if start in ("planar", "spin") and att.n is None:
+        problems.append(_missing("attitude.n", f"missing: attitude.start = \"{start}\" needs the net turns n per attitude period"))
+    if start == "given":
+        if att.w0 is None:
+            problems.append(_missing("attitude.w0", "missing: attitude.start = \"given\" starts from attitude.w0 (and attitude.q0, default the identity)"))
+        if att.n is not None:
+            problems.append(_problem("attitude.n", att.n, "does not apply to attitude.start = \"given\" (the start is attitude.q0, attitude.w0)",
+                                     "attitude.n with attitude.start = 'planar' or 'spin'"))
+    if att.q0 is not None and abs(math.hypot(*att.q0) - 1) > 1e-6:  # finite: the schema refuses inf and nan
+        problems.append(_problem("attitude.q0", att.q0, f"must be a unit quaternion (|q0| = {math.hypot(*att.q0):.6g})"))
+    if att.q0 is not None and sol is not None and "phi0" in (given.get("solver") or {}):
+        problems.append(_problem("solver.phi0", sol.phi0, "cannot be combined with attitude.q0 (q0 is the whole initial attitude)",
+                                 "solver.phi0 (a rotation about Z) or attitude.q0, not both"))
+    if body is not None:
+        if body.flexible is not None:
+            problems.append(_problem("body.flexible", body.flexible, f"flexible bodies are {_NOT_3D}", "body.ix, body.iy and body.iz (kg m^2) with attitude.model = '3d'"))
+        elif body.kz is not None and body.ix is None and body.iy is None and body.iz is None:
+            problems.append(_problem("body.kz", _grid_raw(body.kz), "the 3-D attitude model needs the full inertia, not Kz alone (Kz fixes only (Iy - Ix) / Iz)",
+                                     "body.ix, body.iy and body.iz in kg m^2 (principal moments, each <= the sum of the other two)"))
+    if tq is not None:
+        if tq.srp is not None:
+            problems.append(_problem("torques.srp", "[torques.srp]", f"solar radiation pressure is {_NOT_3D}", "no [torques.srp] with attitude.model = '3d'"))
+        if sorted(tq.gravity_gradient) != ["earth", "moon"]:
+            problems.append(_problem("torques.gravity_gradient", tq.gravity_gradient, "the 3-D attitude model has the gravity gradient of both primaries",
+                                     "[\"earth\", \"moon\"]"))
+    return problems
+
+
+def _member_count(orb) -> tuple[str, Any, int] | None:
+    """(key, value, count) of the members [orbits] selects, None for the whole family."""
+    for k in ("x0", "z0", "period_days"):
+        g = getattr(orb, k)
+        if g is not None:
+            return k, _grid_raw(g), int(_grid_values(g).size)
+    for k in ("resonance", "sun_resonance"):
+        if getattr(orb, k) is not None:
+            return k, getattr(orb, k), len(getattr(orb, k))
+    if orb.members is not None:
+        return "members", orb.members, orb.members
+    return None
+
+
+def _needs_3d(purpose: str, start: str, s: dict, given: dict) -> list[str]:
+    """What ``librate solve`` or ``librate map`` needs from a 3-D study."""
+    problems: list[str] = []
+    orb, rates = s.get("orbits"), s.get("rates")
+    what = "a 3-D solve" if purpose == "solve" else "a 3-D map"
+    if "body" not in given:
+        problems.append(_missing("body", f"missing section [body]: {what} needs the body's principal moments (body.ix, body.iy, body.iz)"))
+    if purpose == "solve":
+        if start == "planar":
+            if "rates" not in given:
+                problems.append(_missing("rates", "missing section [rates]: the planar start scans rates.wz0 (or rates.phidot0) for the planar solution"))
+            elif rates is not None:
+                if rates.wz0 is None and rates.phidot0 is None:
+                    problems.append(_missing("rates.wz0", "missing: the planar start scans rates.wz0 (or rates.phidot0) for the planar solution"))
+                for k in ("wz0", "phidot0"):
+                    g = getattr(rates, k)
+                    if isinstance(g, (int, float)):
+                        problems.append(_problem(f"rates.{k}", g, "the planar start scans a grid of rates for the planar solution, not one value"))
+        n = _member_count(orb) if orb is not None else None
+        if n is not None and n[2] < 2:
+            problems.append(_problem(f"orbits.{n[0]}", n[1], "a 3-D solve continues the motion along the selected members: select at least 2, in the order to follow",
+                                     "at least 2 members (e.g. orbits.period_days = [12.66, 13.5]), or the whole family"))
+        return problems
+    if "rates" not in given:
+        problems.append(_missing("rates", "missing section [rates]: a 3-D map needs rates.wx0, rates.wy0 and rates.wz0 (or rates.phidot0): two grids and one fixed number"))
+        return problems
+    if rates is None:
+        return problems
+    comp = {"wx0": rates.wx0, "wy0": rates.wy0, "wz0": rates.wz0 if rates.wz0 is not None else rates.phidot0}
+    for k, v in comp.items():
+        if v is None:
+            problems.append(_missing(f"rates.{k}", "missing: a 3-D map needs rates.wx0, rates.wy0 and rates.wz0 (or rates.phidot0): two grids and one fixed number"))
+    fixed = [k for k, v in comp.items() if isinstance(v, (int, float))]
+    if all(v is not None for v in comp.values()) and len(fixed) != 1:
+        key = fixed[-1] if fixed else "wz0"
+        name = key if key != "wz0" or rates.wz0 is not None else "phidot0"
+        problems.append(_problem(f"rates.{name}", _grid_raw(getattr(rates, name)), f"a 3-D map has grids over two rate components and one fixed number; "
+                                 f"given {len(fixed)} fixed ({', '.join('rates.' + f for f in fixed) or 'none'})",
+                                 "exactly one of rates.wx0, rates.wy0, rates.wz0 (or rates.phidot0) a number, the other two grids"))
+    return problems
+
+
 # --- the study -----------------------------------------------------------------------------------
 class Study(BaseModel):
     """A validated study (see the module docstring). Build it with :meth:`from_toml` or
@@ -557,6 +728,7 @@ class Study(BaseModel):
     body: BodySection | None = None
     torques: TorquesSection = Field(default_factory=TorquesSection)
     rates: RatesSection | None = None
+    attitude: AttitudeSection = Field(default_factory=AttitudeSection)
     solver: SolverSection = Field(default_factory=SolverSection)
     output: OutputSection = Field(default_factory=OutputSection)
     base_dir: str = Field(".", exclude=True)
@@ -640,6 +812,11 @@ class Study(BaseModel):
         if self.orbits.kind == "halo":
             d["orbits"].setdefault("branch", "south")
         d["solver"]["n_periods"] = self.n_periods()
+        if self.attitude.model == "planar":
+            d.pop("attitude", None)  # the default model: the stored study of a planar job is unchanged
+        else:
+            d["attitude"]["start"] = self.attitude_start()
+            d["attitude"].setdefault("tol", ATTITUDE_TOL)
         return d
 
     def to_json(self) -> str:
@@ -798,6 +975,30 @@ class Study(BaseModel):
             return int(self.orbits.sun_resonance[0])
         return 1
 
+    def attitude_start(self) -> str | None:
+        """How a 3-D solve starts ("planar", "spin" or "given"; see ``attitude.start``), None
+        with the planar model."""
+        return _start_of(self.attitude, self.orbits) if self.attitude.model == "3d" else None
+
+    def q0_3d(self) -> np.ndarray:
+        """The initial attitude of a 3-D study (scalar-last quaternion, body relative to the
+        synodic frame): ``attitude.q0``, else the rotation by ``solver.phi0`` about Z."""
+        if self.attitude.q0 is not None:
+            q = np.asarray(self.attitude.q0, dtype=float)
+            return q / np.linalg.norm(q)
+        h = 0.5 * self.solver.phi0
+        return np.array([0.0, 0.0, math.sin(h), math.cos(h)])
+
+    def rates_3d(self) -> dict[str, np.ndarray]:
+        """The initial rates of a 3-D map, ``{"wx0", "wy0", "wz0"}`` -> values (1/TU, inertial,
+        body axes; a fixed rate is one value; ``rates.phidot0`` + 1 for wz0)."""
+        r = self.rates
+        if r is None:
+            raise ValueError("the study has no [rates]")
+        wz = _grid_values(r.wz0) if r.wz0 is not None else (None if r.phidot0 is None else _grid_values(r.phidot0) + 1.0)
+        out = {"wx0": _grid_values(r.wx0), "wy0": _grid_values(r.wy0), "wz0": wz}
+        return {k: v for k, v in out.items() if v is not None}
+
     def output_dir(self, out: str | Path | None = None) -> Path:
         """The output folder, absolute: ``out`` if given (relative to the working directory),
         else ``output.folder`` (relative to ``base_dir``, the study file's folder)."""
@@ -856,7 +1057,11 @@ class Study(BaseModel):
         saved as ``solve.zarr`` (or ``.nc``). Returns ``(dataset, path)``; the Dataset has a
         ``solution`` dimension (orbit index, x0, period, Kz, N, kind, wz0, phidot0, phi0,
         stability, residual). An existing table of the same inputs is reused, one of other
-        inputs refused unless ``force``, as in :meth:`run_family`."""
+        inputs refused unless ``force``, as in :meth:`run_family`.
+
+        With ``[attitude] model = "3d"`` see :meth:`run_solve_3d` instead."""
+        if self.attitude.model == "3d":
+            return self.run_solve_3d(out, progress, force=force, say=say)
         from ..periodicity.solutions import find_periodic_attitudes
         from .results import check_output, open_result, save_dataset, solutions_dataset
 
@@ -893,6 +1098,93 @@ class Study(BaseModel):
         path = save_dataset(ds, path)
         return ds, path
 
+    def run_solve_3d(self, out: str | Path | None = None, progress: Callable[[int, int], None] | None = None, *, force: bool = False,
+                     say: Callable[[str], None] | None = None):
+        """``librate solve`` on a ``[attitude] model = "3d"`` study: one periodic 3-D attitude
+        motion of the body (body.ix/iy/iz) over ``solver.n_periods`` orbit periods, continued
+        along the selected members in their order (:func:`librate.attitude_family_3d`, natural
+        continuation in the orbit period on the orbit family, with the stability changes
+        located), saved as ``solve.zarr`` (or ``.nc``; :func:`~librate.app.results.solutions_3d_dataset`).
+
+        The first member's motion is corrected (:func:`librate.periodic_attitude_3d`) from the
+        start of ``attitude.start``: "planar", the planar periodic solution with
+        ``attitude.n`` turns found on the first member in the ``[rates]`` scan at
+        ``solver.phi0`` (the body's Kz; exactly one must be there); "spin", the torque-free spin
+        (1 + 2 pi n / (K T)) e_Z at :meth:`q0_3d`; "given", (:meth:`q0_3d`, ``attitude.w0``).
+        Returns ``(dataset, path)``; reuse and ``force`` as in :meth:`run_family`.
+        ``progress(done, total)`` after each member reached."""
+        from .._errors import ConvergenceError
+        from ..periodicity.attitude3d import attitude_family_3d
+        from .results import check_output, open_result, save_dataset, solutions_3d_dataset
+
+        path = self._result_path(out, "solve")
+        if check_output(path, "solutions_3d", self.to_json(), force=force, say=say) == "resume":
+            if say is not None:
+                say(f"reused: {path} already holds these 3-D solutions (--force recomputes them)")
+            return open_result(path), path
+        fam = self.build_family()
+        members = list(self.build_orbits(fam))
+        if len(members) < 2:
+            sel = _member_count(self.orbits)
+            key, value = (f"orbits.{sel[0]}", sel[1]) if sel else ("orbits.kind", self.orbits.kind)
+            raise StudyError([_problem(key, value, f"selects {len(members)} member(s); a 3-D solve continues the motion along at least 2",
+                                       "at least 2 members, in the order to follow")])
+        body = self.build_body()
+        k = self.n_periods()
+        guess, start = self._start_3d(members[0], body, k)
+        periods = [o.period_days for o in members]
+        tol = self.attitude.tol or ATTITUDE_TOL
+        try:
+            ds = attitude_family_3d(fam, body, guess=guess, period_days=periods, n_periods=k, tol=tol, progress=progress)
+        except ConvergenceError as err:
+            raise ConvergenceError(f"3-D solve: the start on the first member (x0 = {members[0].x0:.6g} LU, T = {periods[0]:.6g} d; "
+                                   f"{start['start_description']}) did not converge: {err}") from None
+        ds = solutions_3d_dataset(ds, fam, periods, {**start, "attitude_tol": tol}, self.result_attrs("solutions_3d", "solve"))
+        path = save_dataset(ds, path)
+        return ds, path
+
+    def _start_3d(self, orbit, body, n_periods: int):
+        """The guess of the first member's 3-D motion and its description (attributes)."""
+        from scipy.spatial.transform import Rotation
+
+        start = self.attitude_start()
+        n = self.attitude.n
+        if start == "planar":
+            from ..periodicity.solutions import find_periodic_attitudes
+
+            wz = self.wz0_values()
+            key = "rates.wz0" if self.rates.wz0 is not None else "rates.phidot0"
+            found = find_periodic_attitudes(orbit, kz=float(body.kz), wz0_range=(float(wz[0]), float(wz[-1])), phi0=self.solver.phi0,
+                                            n_grid=int(wz.size), n_periods=n_periods)
+            hits = [x for x in found if x.kind == "periodic" and x.n == n]
+            where = f"on the first member (x0 = {orbit.x0:.6g} LU, T = {orbit.period_days:.6g} d, Kz = {body.kz:.6g}, phi0 = {self.solver.phi0:g})"
+            if not hits:
+                others = ", ".join(f"n = {x.n:g} ({x.kind}) at wz0 = {x.wz0:.6g}" for x in found) or "none"
+                raise StudyError([_problem("attitude.n", n, f"no planar periodic solution with n = {n} {where} for wz0 in "
+                                           f"[{wz[0]:g}, {wz[-1]:g}]; found: {others}",
+                                           "the n of a planar periodic solution in the window, or widen " + key)])
+            if len(hits) > 1:
+                raise StudyError([_problem(key, _grid_raw(getattr(self.rates, key.split(".")[1])),
+                                           f"{len(hits)} planar periodic solutions with n = {n} {where}: wz0 = "
+                                           + ", ".join(f"{x.wz0:.6g}" for x in hits) + "; narrow the window to one of them",
+                                           "a rate window holding exactly one planar solution with n = attitude.n")])
+            sol = hits[0]
+            return sol, {"start": "planar", "start_n": int(n), "start_planar_wz0": float(sol.wz0), "start_planar_phi0": float(sol.phi0),
+                         "start_planar_trace": float(sol.trace), "start_planar_stable": int(bool(sol.stable)),
+                         "start_description": f"the planar n = {n} solution, phi0 = {sol.phi0:g} rad, wz0 = {sol.wz0:.12g} 1/TU"}
+        q0 = self.q0_3d()
+        if start == "spin":
+            wz = 1.0 + 2.0 * math.pi * n / (n_periods * orbit.period)
+            w0 = wz * Rotation.from_quat(q0).as_matrix().T @ np.array([0.0, 0.0, 1.0])
+            desc = f"the torque-free spin wz = 1 + 2 pi n / (K T) = {wz:.12g} 1/TU about synodic Z, n = {n}"
+            extra = {"start_n": int(n)}
+        else:
+            w0 = np.asarray(self.attitude.w0, dtype=float)
+            desc = "the given attitude.q0, attitude.w0"
+            extra = {}
+        return (q0, w0), {"start": start, **extra, "start_q0": [float(v) for v in q0], "start_w0": [float(v) for v in w0],
+                          "start_description": desc}
+
     def run_map(self, out: str | Path | None = None, *, scheduler=None, progress: bool | None = None, force: bool = False,
                 say: Callable[[str], None] | None = None):
         """The attitude periodicity map (grids of wz(T) - wz0 and phi(T) - phi0 over orbit x Kz
@@ -908,9 +1200,13 @@ class Study(BaseModel):
         ``progress``: progress bars on stderr (None: only when stderr is a terminal)."""
         import shutil
 
-        from .results import check_output, run_map_to
+        from .results import check_output, run_map_3d_to, run_map_to
 
         folder = self.output_dir(out)
+        if self.attitude.model == "3d":
+            return run_map_3d_to(self.build_orbits(), folder / "map.zarr", body=self.build_body(), rates=self.rates_3d(), q0=self.q0_3d(),
+                                 n_periods=self.n_periods(), tol=self.attitude.tol or ATTITUDE_TOL, resume=not force, scheduler=scheduler,
+                                 progress=progress, attrs=self.result_attrs("map_3d", "map"))
         store = folder / "map.zarr"
         # validated before the store is touched: a study error never costs an existing map
         orbits = self.build_orbits()
@@ -1020,6 +1316,13 @@ gravity_gradient = ["earth", "moon"]   # the planar engine models both primaries
 # cs = 0.4                     # specular fraction; cd: diffuse fraction (cs + cd <= 1)
 # theta_sun0 = 0.0             # Sun phase at t = 0 (rad)
 # (SRP needs one Sun-resonant orbit: [orbits] sun_resonance = [2], and solver.n_periods = 2)
+
+# [attitude]
+# model = "3d"                 # the 3-D rigid body instead of the planar model (default "planar"):
+#                              # needs body.ix/iy/iz, works on any family (halos too); `librate solve`
+#                              # continues one periodic 3-D motion along the members
+# n = -1                       # starting from the planar n-turn solution on the first member
+#                              # (or start = "spin", the torque-free spin; or start = "given" with q0, w0)
 
 [rates]
 wz0 = { start = -3.0, stop = 2.0, num = 300 }   # inertial initial rates (1/TU), increasing

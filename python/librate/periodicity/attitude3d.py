@@ -358,7 +358,8 @@ class OrbitFamilyBranch3D:
         return floquet_tests(point.data.monodromy)
 
 
-def attitude_family_3d(orbits, body: RigidBody, *, guess, period_days, n_periods: int = 1, tol: float = 1e-12, ds_min: float = 1e-4):
+def attitude_family_3d(orbits, body: RigidBody, *, guess, period_days, n_periods: int = 1, tol: float = 1e-12, ds_min: float = 1e-4,
+                       progress=None):
     """A periodic 3-D attitude motion of ``body`` continued along the orbit family ``orbits``
     (e.g. the L2 southern halos into the NRHOs) through the orbit periods ``period_days`` (days,
     in order), by natural-parameter continuation (:func:`librate.solving.continuation.natural`)
@@ -366,6 +367,7 @@ def attitude_family_3d(orbits, body: RigidBody, *, guess, period_days, n_periods
     tolerance (NRHOs pass within a few thousand km of the Moon, where the tidal torque is some
     1e4 times the Earth's at the Moon's distance; their attitude closure is reached to ~1e-11, so
     pass tol=1e-10 there). Every member is re-propagated independently to 1e-9.
+    ``progress(done, total)``: called with the number of requested periods reached so far.
 
     Returns an xarray Dataset along ``member`` (attribute ``parameter`` = "period_days"):
 
@@ -401,7 +403,19 @@ def attitude_family_3d(orbits, body: RigidBody, *, guess, period_days, n_periods
     from scipy.spatial.transform import Rotation
 
     first = Point(np.concatenate([[first_orbit.period_days], Rotation.from_quat(s0.q0).as_rotvec(), s0.w0]), s0, s0.iterations)
-    br = natural(problem, first, targets[1:], rules=StepRules(ds=abs(targets[1] - targets[0]), ds_min=ds_min), name="period_days")
+    report = None
+    if progress is not None:
+        progress(1, targets.size)
+        reached = [1]
+
+        def report(point):  # the driver's per-point hook: count the requested periods passed
+            p = float(point.x[0])
+            while reached[0] < targets.size and (targets[reached[0]] - p) * np.sign(targets[reached[0]] - targets[reached[0] - 1]) <= 1e-12:
+                reached[0] += 1
+                progress(reached[0], targets.size)
+            return None
+
+    br = natural(problem, first, targets[1:], rules=StepRules(ds=abs(targets[1] - targets[0]), ds_min=ds_min), name="period_days", stop=report)
     sols = [s0] + [p.data for p in br.points]
     dim = ("member",)
     extra = {"period_days": (dim, np.array([s.orbit.period_days for s in sols])), "x0": (dim, np.array([s.orbit.state0[0] for s in sols])),
