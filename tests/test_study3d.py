@@ -132,8 +132,6 @@ CASES = [
     # what `solve` needs
     ({"rates": ...}, "solve", "rates", None, None, "planar start scans"),
     ({"rates.wz0": 0.5}, "solve", "rates.wz0", "0.5", "strictly increasing", "not one value"),
-    ({"orbits.x0": [0.85]}, "solve", "orbits.x0", "[0.85]", "at least 2 members", "continues the motion"),
-    ({"orbits": {"kind": "halo", "resonance": [3]}, "attitude.start": "spin"}, "solve", "orbits.resonance", "[3]", "at least 2", None),
     # what `map` needs: two grids and one fixed rate
     ({"rates": ...}, "map", "rates", None, None, "two grids and one fixed number"),
     ({"rates.wx0": [0.0, 0.1]}, "map", "rates.wy0", None, "a number (fixed) or a grid", "missing"),
@@ -346,3 +344,18 @@ def test_solve_3d_reports_progress_per_member(tmp_path):
                            "attitude": {"model": "3d", "n": 0}}, purpose="solve")
     ds, path = st3.run_solve(tmp_path, progress=lambda done, total: calls.append((done, total)))
     assert calls == [(1, 2), (2, 2)] and ds.sizes["member"] == 2 and path.name == "solve.zarr"
+
+
+def test_solve_a_3d_study_of_one_orbit(cli, tmp_path):
+    """A study selecting one orbit (x0 = 0.85) solves the 3-D motion on it alone: a one-member
+    result, "no continuation", the same motion as the first member of the three-member example
+    (wz0 and q0 to 1e-10: the same start and corrector), re-propagating from the file to 1e-9."""
+    one = tomllib.loads(EXAMPLE.read_text())
+    one["orbits"]["x0"] = [0.85]
+    one["output"] = {"format": "netcdf"}
+    ds, path = Study.from_dict(one, purpose="solve").run_solve(tmp_path / "one")
+    assert ds.sizes["member"] == 1 and "no continuation" in ds.attrs["end_reason"]
+    check_stored_motions(librate.open_result(path))
+    three, _ = Study.from_toml(EXAMPLE).run_solve(tmp_path / "three")
+    assert np.max(np.abs(ds["w0"].values[0] - three["w0"].values[0])) <= 1e-10
+    assert np.max(np.abs(ds["q0"].values[0] - three["q0"].values[0])) <= 1e-10

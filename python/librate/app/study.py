@@ -689,10 +689,6 @@ def _needs_3d(purpose: str, start: str, s: dict, given: dict) -> list[str]:
                     g = getattr(rates, k)
                     if isinstance(g, (int, float)):
                         problems.append(_problem(f"rates.{k}", g, "the planar start scans a grid of rates for the planar solution, not one value"))
-        n = _member_count(orb) if orb is not None else None
-        if n is not None and n[2] < 2:
-            problems.append(_problem(f"orbits.{n[0]}", n[1], "a 3-D solve continues the motion along the selected members: select at least 2, in the order to follow",
-                                     "at least 2 members (e.g. orbits.period_days = [12.66, 13.5]), or the whole family"))
         return problems
     if "rates" not in given:
         problems.append(_missing("rates", "missing section [rates]: a 3-D map needs rates.wx0, rates.wy0 and rates.wz0 (or rates.phidot0): two grids and one fixed number"))
@@ -1124,11 +1120,10 @@ class Study(BaseModel):
             return open_result(path), path
         fam = self.build_family()
         members = list(self.build_orbits(fam))
-        if len(members) < 2:
+        if not members:
             sel = _member_count(self.orbits)
             key, value = (f"orbits.{sel[0]}", sel[1]) if sel else ("orbits.kind", self.orbits.kind)
-            raise StudyError([_problem(key, value, f"selects {len(members)} member(s); a 3-D solve continues the motion along at least 2",
-                                       "at least 2 members, in the order to follow")])
+            raise StudyError([_problem(key, value, "selects no member", "at least 1 member (with 2 or more, the motion is continued along them in order)")])
         body = self.build_body()
         k = self.n_periods()
         guess, start = self._start_3d(members[0], body, k)

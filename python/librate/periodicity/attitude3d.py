@@ -368,6 +368,7 @@ def attitude_family_3d(orbits, body: RigidBody, *, guess, period_days, n_periods
     1e4 times the Earth's at the Moon's distance; their attitude closure is reached to ~1e-11, so
     pass tol=1e-10 there). Every member is re-propagated independently to 1e-9.
     ``progress(done, total)``: called with the number of requested periods reached so far.
+    One period gives the one-member family of that orbit (no continuation).
 
     Returns an xarray Dataset along ``member`` (attribute ``parameter`` = "period_days"):
 
@@ -393,8 +394,8 @@ def attitude_family_3d(orbits, body: RigidBody, *, guess, period_days, n_periods
     if not isinstance(orbits, OrbitFamily):
         raise ValueError(f"invalid argument `orbits`: must be a librate.OrbitFamily, got {type(orbits).__name__}")
     targets = np.asarray(period_days, dtype=float).ravel()
-    if targets.size < 2 or not np.all(np.isfinite(targets)):
-        raise ValueError(f"invalid argument `period_days`: need at least two finite periods, got {period_days!r}")
+    if targets.size < 1 or not np.all(np.isfinite(targets)):
+        raise ValueError(f"invalid argument `period_days`: need at least one finite period, got {period_days!r}")
     n_periods = as_count(n_periods, "n_periods", 1)
     first_orbit = orbits.member(period_days=float(targets[0]))
     tol = as_number(tol, "tol", positive=True)
@@ -415,8 +416,11 @@ def attitude_family_3d(orbits, body: RigidBody, *, guess, period_days, n_periods
                 progress(reached[0], targets.size)
             return None
 
-    br = natural(problem, first, targets[1:], rules=StepRules(ds=abs(targets[1] - targets[0]), ds_min=ds_min), name="period_days", stop=report)
-    sols = [s0] + [p.data for p in br.points]
+    if targets.size == 1:
+        br = None
+    else:
+        br = natural(problem, first, targets[1:], rules=StepRules(ds=abs(targets[1] - targets[0]), ds_min=ds_min), name="period_days", stop=report)
+    sols = [s0] + ([] if br is None else [p.data for p in br.points])
     dim = ("member",)
     extra = {"period_days": (dim, np.array([s.orbit.period_days for s in sols])), "x0": (dim, np.array([s.orbit.state0[0] for s in sols])),
              "z0": (dim, np.array([s.orbit.state0[2] for s in sols]))}
@@ -427,18 +431,19 @@ def attitude_family_3d(orbits, body: RigidBody, *, guess, period_days, n_periods
 def _family_dataset(sols, parameter: str, extra: dict, branch, attrs: dict):
     """The Dataset of a 3-D family: ``extra`` variables (the parameter among them), the
     solutions' q0, w0, multipliers, stable, residual, turns, and the stability changes the
-    continuation driver located (the zeros of :func:`floquet_tests`; attribute)."""
+    continuation driver located (the zeros of :func:`floquet_tests`; attribute). ``branch``
+    None: one member, no continuation."""
     import xarray as xr
 
     p = np.asarray(extra[parameter][1], dtype=float)
     mult = np.array([_sorted_multipliers(s.multipliers) for s in sols])
     on = np.abs(np.abs(mult) - 1) <= STABILITY_TOL
     changes = []
-    for b in branch.bifurcations:
+    for b in ([] if branch is None else branch.bifurcations):
         i = b.after + 1  # the member before it (the first member is the start, not a returned point)
         changes.append({"at": float(b.parameter), "located": bool(b.located), "kind": FLOQUET_TESTS[b.name],
                         "between": (float(p[i]), float(p[i + 1])), "on_unit_circle": (int(on[i].sum()), int(on[i + 1].sum()))})
-    end_reason = branch.end_reason
+    end_reason = "one member: no continuation" if branch is None else branch.end_reason
     dim = ("member",)
     return xr.Dataset(
         {**extra,
