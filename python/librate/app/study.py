@@ -674,7 +674,7 @@ def _member_count(orb) -> tuple[str, Any, int] | None:
 def _needs_3d(purpose: str, start: str, s: dict, given: dict) -> list[str]:
     """What ``librate solve`` or ``librate map`` needs from a 3-D study."""
     problems: list[str] = []
-    orb, rates = s.get("orbits"), s.get("rates")
+    rates = s.get("rates")
     what = "a 3-D solve" if purpose == "solve" else "a 3-D map"
     if "body" not in given:
         problems.append(_missing("body", f"missing section [body]: {what} needs the body's principal moments (body.ix, body.iy, body.iz)"))
