@@ -183,3 +183,39 @@ def test_lockstep_runs_each_branch_as_alone():
         assert [m.x.tolist() for m in a.marked] == [m.x.tolist() for m in b.marked] and len(b.marked) == 2
         assert a.end_reason == b.end_reason and abs(b.folds[0].parameter - r) <= 1e-8
     assert 0 < Batched.batches < sum(pb.calls for pb in pbs)
+
+
+class Recording(Implicit):
+    """The reference corrector, recording each (guess, corrected point, condition)."""
+
+    def __init__(self, *args):
+        super().__init__(*args)
+        self.log = []
+
+    def correct(self, guess, c: Constraint) -> Point:
+        pt = super().correct(guess, c)
+        self.log.append((np.array(guess, dtype=float), pt.x.copy(), c))
+        return pt
+
+
+def test_predictor_and_mark_guesses_are_higher_order():
+    """The guesses the driver hands the corrector, on the cubic u^3 - u + p = 0 at fixed steps
+    ds = 0.02 and 0.01 (reference: Taylor's theorem). The step's predictor is quadratic (the
+    curvature from the point before): its distance to the corrected point falls 8-fold when ds
+    halves (O(ds^3); a linear predictor's falls 4-fold), ratio in [6, 10]. A mark's guess is the
+    cubic Hermite curve through the step's ends with their tangents: O(ds^4), ratio >= 12 (the
+    chord's would be 4). Medians over the steps and marks of the run."""
+    marks = [round(v, 3) for v in np.arange(-0.5, 0.3, 0.01)]
+
+    def errors(ds):
+        pb = Recording(lambda x: x[1] ** 3 - x[1] + x[0], lambda x: np.array([1.0, 3 * x[1] ** 2 - 1]))
+        u0 = 1.2
+        arclength(pb, Point(np.array([u0 - u0**3, u0])), direction=1, rules=StepRules(ds=ds, ds_max=ds), target=0.3, max_points=2000, marks=marks)
+        is_mark = [c.a[0] == 1 and c.a[1] == 0 and c.b in marks for _, _, c in pb.log]
+        step = [np.linalg.norm(g - x) for (g, x, _), m in zip(pb.log, is_mark) if not m]
+        mark = [np.linalg.norm(g - x) for (g, x, _), m in zip(pb.log, is_mark) if m]
+        return np.median(step[2:]), np.median(mark)  # the first steps have no point before
+
+    (s2, m2), (s1, m1) = errors(0.02), errors(0.01)
+    assert 6.0 <= s2 / s1 <= 10.0, s2 / s1
+    assert m2 / m1 >= 12.0, m2 / m1

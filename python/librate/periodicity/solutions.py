@@ -237,10 +237,12 @@ def correct(orbit: PeriodicOrbit, *, kz, n_total, kind, phi0, wz0, n_periods: in
                                   monodromy=monodromy, max_halvings=int(max_halvings), **extra, **kw)
 
 
-def verified(orbit: PeriodicOrbit, *, kz, n_total, kind, phi0, wz0, n_periods: int = 1, plates=None, iterations=None) -> list[AttitudeSolution]:
+def verified(orbit: PeriodicOrbit, *, kz, n_total, kind, phi0, wz0, n_periods: int = 1, plates=None, iterations=None,
+             threads: int | None = None) -> list[AttitudeSolution]:
     """AttitudeSolutions for converged corrections: every one re-propagated independently in one
     batched Rust call (scalar model, orbit integrated alongside, rtol = atol = 1e-14, in
-    parallel); ``plates``: one FlatPlate (or None) per solution."""
+    parallel on ``threads``, default all cores; the results do not depend on it); ``plates``: one
+    FlatPlate (or None) per solution."""
     kz, n_total, phi0, wz0, kind = (np.ascontiguousarray(np.atleast_1d(v).ravel())
                                     for v in np.broadcast_arrays(np.asarray(kz, dtype=float), np.asarray(n_total, dtype=float),
                                                                  np.asarray(phi0, dtype=float), np.asarray(wz0, dtype=float), np.asarray(kind)))
@@ -254,7 +256,7 @@ def verified(orbit: PeriodicOrbit, *, kz, n_total, kind, phi0, wz0, n_periods: i
                      cd=np.array([pl.cd if pl else 0.0 for pl in plates]), theta_sun0=np.array([pl.sun.theta0 if pl else 0.0 for pl in plates]))
     T = n_periods * orbit.period
     v = _core.planar_verify(orbit.system.mu, [float(x) for x in orbit.state0], T, np.ascontiguousarray(kz), np.ascontiguousarray(phi0),
-                            np.ascontiguousarray(wz0), **extra)
+                            np.ascontiguousarray(wz0), threads=threads, **extra)
     turns = turns_of(n_total, kind)
     its = np.zeros(m, dtype=int) if iterations is None else np.asarray(iterations)
     out = []

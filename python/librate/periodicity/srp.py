@@ -6,7 +6,9 @@ a Sun-pointing body (:func:`sun_pointing_accelerations`)."""
 from __future__ import annotations
 
 import math
+from collections import namedtuple
 from collections.abc import Callable, Sequence
+from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
@@ -41,6 +43,10 @@ def sun_resonance(orbit: PeriodicOrbit, tol: float = 1e-6) -> int | None:
 def sun_angle(theta_sun0: float, t) -> np.ndarray:
     """The Sun's angle from the synodic X axis at times t (TU), unwrapped (rad), from its phase at t = 0."""
     return Sun(theta0=float(theta_sun0)).angle(t)
+
+
+#: A motion a branch reached at some eps: what srp_map compares new far-end solutions with.
+Known = namedtuple("Known", "n_total kind wz0 phi0")
 
 
 def srp_map(
@@ -95,9 +101,9 @@ def srp_map(
     for a strongly unstable start, trace ~1e5; and ``branch_end_reason`` from
     :func:`librate.continue_srp`). Returns an xarray Dataset.
 
-    ``progress``: called as ``progress(done, total)`` after the grid's sweep and after each
-    branch (from worker threads, one call at a time); ``total`` grows as the branches to trace
-    are found, and ``done == total`` at the end.
+    ``progress``: called as ``progress(done, total)`` after each branch and after the grid's
+    sweep (which runs beside the branches), from the calling thread; ``total`` grows as the
+    branches to trace are found, and ``done == total`` at the end.
     """
     import xarray as xr
 
@@ -132,30 +138,55 @@ def srp_map(
     phi0 = as_number(phi0, "phi0")
     plate = FlatPlate(0.0, cs, cd, Sun(theta0=theta_sun0))
     e_grid, w_grid = np.meshgrid(es, wz, indexing="ij")
-    r = sweep(orbit_forcing(orbit), n_periods * orbit.period, phi0, w_grid, kz, srp=plate, eps=e_grid)
+    forcing = orbit_forcing(orbit)
     shape = (es.size, wz.size)
-    data = {k: np.asarray(r[k]).reshape(shape) for k in ("dwz", "dphi", "phi_t", "status")}
-    advance()
+    data: dict = {}
+
+    def grid_sweep(threads=None):
+        r = sweep(forcing, n_periods * orbit.period, phi0, w_grid, kz, srp=plate, eps=e_grid, threads=threads)
+        data.update({k: np.asarray(r[k]).reshape(shape) for k in ("dwz", "dphi", "phi_t", "status")})
 
     sols, path, branches = [], [], []
-    if solve:
+    if not solve:
+        grid_sweep()
+        advance()
+    else:
+        # The grid's sweep does not feed the branches: it runs beside them on a thread of its own
+        # (its own one-thread engine pool; the engine releases the GIL) and fills the cores the
+        # branches' small corrector batches leave idle. Results do not depend on it: each
+        # trajectory's result depends only on its group of lanes, never on the threads.
+        pool = ThreadPoolExecutor(max_workers=2)
+        grid = pool.submit(grid_sweep, 1)
         window = (float(wz[0]), float(wz[-1]))
+        runs = []  # (jobs, lead, branches, their marks' re-propagation (a future)), in order
 
         def run(jobs, lead):
             """Continue each job's ``start`` (at e_start) through the grid ``values`` in order
             (one pseudo-arclength run to the last value, corrected exactly at each grid value
             on the way; only those re-propagated), ending at the grid's end or at a located
             fold. The branches run in lock step (:func:`eps_branches`: each round's corrections
-            of every branch in one Rust call) and are recorded in order, each after its
-            ``lead`` solutions ((eps, solution) recorded at the branch's index first)."""
+            of every branch in one Rust call); their marked points are re-propagated in one
+            batch beside what follows (a one-thread engine pool, as the grid)."""
             advance(0, len(jobs))
             brs = eps_branches([(start, plate.with_eps(float(values[-1])), [float(e) for e in values]) for start, _, values, _ in jobs],
                                steps=steps, done=lambda _: advance())
-            # every branch's marked points re-propagated in one batch
             owners = [(start, p) for (start, _, _, _), br in zip(jobs, brs) for p in br.marked]
-            checked = iter(verified(orbit, kz=kz, n_total=[s_.n_total for s_, _ in owners], kind=[s_.kind for s_, _ in owners],
-                                    phi0=[p.x[1] for _, p in owners], wz0=[p.x[2] for _, p in owners], n_periods=n_periods,
-                                    plates=[plate.with_eps(float(p.x[0])) for _, p in owners], iterations=[p.iterations for _, p in owners]))
+            checked = pool.submit(verified, orbit, kz=kz, n_total=[s_.n_total for s_, _ in owners], kind=[s_.kind for s_, _ in owners],
+                                  phi0=[p.x[1] for _, p in owners], wz0=[p.x[2] for _, p in owners], n_periods=n_periods,
+                                  plates=[plate.with_eps(float(p.x[0])) for _, p in owners], iterations=[p.iterations for _, p in owners],
+                                  threads=1)
+            runs.append((jobs, lead, brs, checked))
+
+        def found_at(e_end):
+            """The motions the runs so far have at eps = e_end (their lead and marked points)."""
+            out = [s_ for jobs, lead, _, _ in runs for first in lead for e, s_ in first if e == e_end]
+            return out + [Known(start.n_total, start.kind, float(p.x[2]), float(p.x[1]))
+                          for jobs, _, brs, _ in runs for (start, _, _, _), br in zip(jobs, brs) for p in br.marked if float(p.x[0]) == e_end]
+
+        def record(jobs, lead, brs, checked):
+            """The branches of one run, recorded in order, each after its ``lead`` solutions
+            ((eps, solution) recorded at the branch's index first)."""
+            checked = iter(checked.result())
             for (start, e_start, _, origin), br, first in zip(jobs, brs, lead):
                 pts = [(float(p.x[0]), float(p.x[2]), float(p.x[1]), float(p.data["trace"])) for p in br.points]
                 marked = [(float(p.x[0]), next(checked)) for p in br.marked]
@@ -188,7 +219,7 @@ def srp_map(
         ends = (([(float(es[-1]), np.concatenate([pos[::-1][1:], zero]))] if es[-1] > 0 else [])
                 + ([(float(es[0]), np.concatenate([neg[::-1][1:], zero]))] if es[0] < 0 else []))
         for e_end, inward in ends:
-            known = [s for _, e, s in sols if e == e_end]
+            known = found_at(e_end)
             # phi0 is free: scan from four initial attitudes (one sweep, one corrector call)
             found = find_periodic_attitudes(orbit, kz=kz, wz0_range=window, phi0=[phi0 + s_ for s_ in (0.0, 0.5 * math.pi, math.pi, -0.5 * math.pi)],
                                             kinds=kinds, n_periods=n_periods, srp=plate.with_eps(e_end))
@@ -201,7 +232,12 @@ def srp_map(
                 jobs.append((s1, e_end, inward, "end"))
                 lead.append([(e_end, s1)])
             run(jobs, lead)
+        for r in runs:
+            record(*r)
         path.sort(key=lambda p: (p[0], p[1]))
+        grid.result()
+        pool.shutdown()
+        advance()
     sol_arr = lambda f, dt=float: np.array([f(b, e, s) for b, e, s in sols], dtype=dt)  # noqa: E731
     ds = xr.Dataset(
         {

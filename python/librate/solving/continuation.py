@@ -468,6 +468,55 @@ def arclength(problem: ContinuationProblem, first: Point, **options) -> Branch:
     return _run(problem, arclength_steps(problem, first, **options))
 
 
+def _bend(points: list, t: np.ndarray, sx: np.ndarray, h: float, ds: float) -> np.ndarray | None:
+    """The second derivative in arclength of the branch at its last point, from the point before
+    (a step ``h`` back) and the unit tangent ``t`` there (in the scaled coordinates x / sx):
+    x(-h) = x - h x' + h^2/2 x''. For a quadratic predictor x + ds x' + ds^2/2 x''; None without
+    a point before, or when that term would move the guess by more than ds/4 (scaled; a sharp
+    turn: the linear predictor is safer)."""
+    if len(points) < 2 or h <= 0.0:
+        return None
+    c = 2.0 * (points[-2].x - points[-1].x + h * t * sx) / (h * h)
+    if not (np.all(np.isfinite(c)) and 0.5 * ds * ds * float(np.linalg.norm(c / sx)) <= 0.25 * ds):
+        return None
+    return c
+
+
+def _mark_guess(x0: np.ndarray, m0: np.ndarray, x1: np.ndarray, m1: np.ndarray, k: int, value: float) -> np.ndarray:
+    """The guess for the point at parameter ``value`` between two points of a step: the cubic
+    Hermite curve through x0 and x1 with end derivatives m0, m1 (the unit tangents times the
+    step), at the curve parameter where component k equals ``value`` (Newton from the chord's
+    crossing). Its error is O(ds^4) against the chord's O(ds^2), so the mark's correction needs
+    fewer Newton steps; where the cubic is not monotone in component k over the step, or its
+    crossing leaves the step, the chord's point."""
+    w = (value - x0[k]) / (x1[k] - x0[k])
+    chord = x0 + w * (x1 - x0)
+    chord[k] = value
+
+    def curve(u: float) -> np.ndarray:
+        u2, u3 = u * u, u * u * u
+        return (2 * u3 - 3 * u2 + 1) * x0 + (u3 - 2 * u2 + u) * m0 + (3 * u2 - 2 * u3) * x1 + (u3 - u2) * m1
+
+    def slope(u: float) -> float:
+        u2 = u * u
+        return float((6 * u2 - 6 * u) * x0[k] + (3 * u2 - 4 * u + 1) * m0[k] + (6 * u - 6 * u2) * x1[k] + (3 * u2 - 2 * u) * m1[k])
+
+    if slope(0.0) * slope(1.0) <= 0 or slope(0.5) * slope(0.0) <= 0:
+        return chord
+    u = w
+    for _ in range(20):
+        d = slope(u)
+        step = (curve(u)[k] - value) / d
+        u -= step
+        if not 0.0 <= u <= 1.0:
+            return chord
+        if abs(step) <= 1e-15:
+            break
+    guess = curve(u)
+    guess[k] = value
+    return guess if np.all(np.isfinite(guess)) else chord
+
+
 def arclength_steps(
     problem: ContinuationProblem,
     first: Point,
@@ -536,6 +585,7 @@ def arclength_steps(
         return branch
     tests_prev = _tests(problem, first)
     ds = rules.ds
+    last_ds = 0.0
     sx = problem.scale
 
     def constraint(base: Point, tb: np.ndarray, s: float) -> Constraint:
@@ -543,8 +593,14 @@ def arclength_steps(
         a = tb / sx
         return Constraint(a, float(np.dot(a, base.x)) + s)
 
-    def at(base: Point, tb: np.ndarray, s: float):
-        return (yield from _try(problem, base.x + s * tb * sx, constraint(base, tb, s)))
+    def at(base: Point, tb: np.ndarray, s: float, bend: np.ndarray | None = None):
+        """Correct the point ``s`` along ``tb`` from ``base``; ``bend``: the curve's second
+        derivative in arclength, for a quadratic predictor (the guess only: the point is the
+        same)."""
+        guess = base.x + s * tb * sx
+        if bend is not None:
+            guess = guess + 0.5 * s * s * bend
+        return (yield from _try(problem, guess, constraint(base, tb, s)))
 
     def land(value: float):
         """The point exactly at parameter ``value``, from the last point along the tangent."""
@@ -579,7 +635,7 @@ def arclength_steps(
                     branch.end_reason = f"step floor: could not land on {name} = {edge[0]:.12g} from {base.x[k]:.12g} (step below {rules.ds_min:g})"
                     return (yield from finish())
                 continue
-            new = yield from at(base, t, ds)
+            new = yield from at(base, t, ds, _bend(points, t, sx, last_ds, ds))
             status = "fail"
             t_new = None
             if new is not None:
@@ -604,9 +660,16 @@ def arclength_steps(
                 branch.end_reason = f"step floor: arclength step below {rules.ds_min:g} at {name} = {base.x[k]:.12g} after {len(points)} points"
                 return (yield from finish())
         assert t_new is not None and new is not None
+        # the points inside this step (locating a fold or a sign change) start on the quadratic
+        # through base, with its tangent, and new
+        bend = 2.0 * (new.x - base.x - ds * t * sx) / (ds * ds)
+
+        def within(b_, tb, s_):
+            return at(b_, tb, s_, bend)
+
         # a fold: the parameter component of the tangent changes sign
         if t[k] * t_new[k] < 0:
-            fold = (yield from _locate_fold(problem, base, t, ds, new, t_new, at, fold_tol)) if locate else Fold(float(new.x[k]), new, False, abs(new.x[k] - base.x[k]))
+            fold = (yield from _locate_fold(problem, base, t, ds, new, t_new, within, fold_tol)) if locate else Fold(float(new.x[k]), new, False, abs(new.x[k] - base.x[k]))
             branch.folds.append(fold)
             if stop_at_fold:
                 if fold.located:
@@ -616,25 +679,24 @@ def arclength_steps(
         tests_new = _tests(problem, new)
         for test, u, v, w in sign_changes(tests_prev, tests_new):
             if locate and locate_bifurcations:
-                b = yield from _locate_sign(problem, test, base, t, ds, u, v, new, at, fold_tol)
+                b = yield from _locate_sign(problem, test, base, t, ds, u, v, new, within, fold_tol)
             else:  # the linear interpolation of the test function between the two points
                 b = Bifurcation(test, float(base.x[k] + w * (new.x[k] - base.x[k])), new, False)
             branch.bifurcations.append(dataclasses.replace(b, after=len(points) - 1))
         tests_prev = tests_new
         for m in marks:
             if (base.x[k] - m) * (new.x[k] - m) < 0 or new.x[k] == m:
-                w = (m - base.x[k]) / (new.x[k] - base.x[k])
-                guess = base.x + w * (new.x - base.x)
-                guess[k] = m
+                guess = _mark_guess(base.x, t * sx * ds, new.x, t_new * sx * ds, k, m)
                 pending_marks.append((guess, Constraint.fix(n, k, m), ds, new if new.x[k] == m else None))
         points.append(new)
         t = t_new
+        last_ds = ds
         why = stop(new) if stop else None
         if why:
             branch.end_reason = why
             return (yield from finish())
         if new.iterations <= rules.easy_iterations:
-            ds = min(ds * rules.growth, rules.ds_max)
+            ds = max(ds, min(ds * rules.growth, rules.ds_max))  # grows to ds_max, never shrinks (a first ds above it)
     branch.end_reason = f"completed: max_points = {max_points} reached"
     return (yield from finish())
 
