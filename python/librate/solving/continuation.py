@@ -664,7 +664,7 @@ def arclength_steps(
         # through base, with its tangent, and new
         bend = 2.0 * (new.x - base.x - ds * t * sx) / (ds * ds)
 
-        def within(b_, tb, s_):
+        def within(b_, tb, s_, bend=bend):
             return at(b_, tb, s_, bend)
 
         # a fold: the parameter component of the tangent changes sign
