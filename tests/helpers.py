@@ -1,6 +1,22 @@
 """Shared test helpers (independent references)."""
 
+import copy
+
 import librate
+
+
+def edit(data: dict, key: str, value=...) -> dict:
+    """``data`` with the dotted ``key`` set to ``value`` (deleted when value is omitted)."""
+    out = copy.deepcopy(data)
+    parts = key.split(".")
+    d = out
+    for p in parts[:-1]:
+        d = d.setdefault(p, {})
+    if value is ...:
+        d.pop(parts[-1], None)
+    else:
+        d[parts[-1]] = value
+    return out
 
 
 def continue_dros(system, xs):

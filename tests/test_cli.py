@@ -18,25 +18,15 @@ import types
 import librate
 import numpy as np
 import pytest
-from click.testing import CliRunner
-from librate.app.cli import main
 
 TINY = ["--set", "orbits.x0={start = 0.9, stop = 0.5, num = 3}", "--set", "rates.wz0.num=50"]
 
 
+
 @pytest.fixture
-def run(tmp_path, monkeypatch):
-    """Invoke the CLI in tmp_path; returns the click Result (stdout and stderr separate)."""
-    monkeypatch.chdir(tmp_path)
-    runner = CliRunner()
-
-    def invoke(*args, code=0):
-        res = runner.invoke(main, [str(a) for a in args], catch_exceptions=False)
-        assert res.exit_code == code, res.output
-        assert "Traceback" not in res.output
-        return res
-
-    return invoke
+def run(cli):
+    """The command line in tmp_path (conftest's ``cli``)."""
+    return cli
 
 
 @pytest.fixture

@@ -5,7 +5,6 @@ docstring; every message must name the key (dotted), the value given and what is
 Round trips are checked for exact equality of the saved numbers.
 """
 
-import copy
 import json
 import math
 
@@ -13,6 +12,7 @@ import librate
 import numpy as np
 import pytest
 import tomllib
+from helpers import edit
 from librate.app.results import read_attrs, save_dataset, save_family
 from librate.app.study import EXAMPLE_STUDY, Study, StudyError, apply_overrides
 
@@ -25,18 +25,6 @@ def base() -> dict:
     return apply_overrides(tomllib.loads(EXAMPLE_STUDY), TINY)
 
 
-def edit(data: dict, key: str, value=...) -> dict:
-    """``data`` with the dotted ``key`` set to ``value`` (deleted when value is omitted)."""
-    out = copy.deepcopy(data)
-    parts = key.split(".")
-    d = out
-    for p in parts[:-1]:
-        d = d.setdefault(p, {})
-    if value is ...:
-        d.pop(parts[-1], None)
-    else:
-        d[parts[-1]] = value
-    return out
 
 
 # --- the example and the builders ----------------------------------------------------------------

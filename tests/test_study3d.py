@@ -12,7 +12,6 @@ L2 southern halo family, the result re-opened and checked:
   wz0 equal to 1e-10, q0 a rotation about Z and w0 along z (issue 15 acceptance, thesis Fig. 23).
 """
 
-import copy
 import json
 import math
 from pathlib import Path
@@ -21,10 +20,9 @@ import librate
 import numpy as np
 import pytest
 import tomllib
-from click.testing import CliRunner
+from helpers import edit
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from librate.app.cli import main
 from librate.app.results import multipliers_3d, solution_3d
 from librate.app.study import Study, StudyError
 from scipy.spatial.transform import Rotation
@@ -44,17 +42,6 @@ def base() -> dict:
     return base_study()
 
 
-def edit(data: dict, key: str, value=...) -> dict:
-    out = copy.deepcopy(data)
-    parts = key.split(".")
-    d = out
-    for p in parts[:-1]:
-        d = d.setdefault(p, {})
-    if value is ...:
-        d.pop(parts[-1], None)
-    else:
-        d[parts[-1]] = value
-    return out
 
 
 def problems_of(data: dict, purpose=None) -> list[str]:
@@ -216,18 +203,6 @@ def test_the_example_3d_study_is_valid():
 
 
 # --- librate solve end to end ------------------------------------------------------------------------
-@pytest.fixture
-def cli(tmp_path, monkeypatch):
-    monkeypatch.chdir(tmp_path)
-    runner = CliRunner()
-
-    def invoke(*args, code=0):
-        res = runner.invoke(main, [str(a) for a in args], catch_exceptions=False)
-        assert res.exit_code == code, res.output
-        assert "Traceback" not in res.output
-        return res
-
-    return invoke
 
 
 def reprop_closure(ds, j) -> tuple[float, float]:

@@ -411,7 +411,8 @@ def attitude_family_3d(orbits, body: RigidBody, *, guess, period_days, n_periods
 
         def report(point):  # the driver's per-point hook: count the requested periods passed
             p = float(point.x[0])
-            while reached[0] < targets.size and (targets[reached[0]] - p) * np.sign(targets[reached[0]] - targets[reached[0] - 1]) <= 1e-12:
+            # a member counts as reached within the orbit correction's tolerance on its period
+            while reached[0] < targets.size and (targets[reached[0]] - p) * np.sign(targets[reached[0]] - targets[reached[0] - 1]) <= 1e-9:
                 reached[0] += 1
                 progress(reached[0], targets.size)
             return None
