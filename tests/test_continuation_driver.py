@@ -200,8 +200,8 @@ class Recording(Implicit):
 
 def test_predictor_and_mark_guesses_are_higher_order():
     """The guesses the driver hands the corrector, on the cubic u^3 - u + p = 0 at fixed steps
-    ds = 0.02 and 0.01 (reference: Taylor's theorem). The step's predictor is quadratic (the
-    curvature from the point before): its distance to the corrected point falls 8-fold when ds
+    ds = 0.02 and 0.01 (reference: Taylor's theorem). With predictor="quadratic" (the
+    curvature from the point before) the step's guess: its distance to the corrected point falls 8-fold when ds
     halves (O(ds^3); a linear predictor's falls 4-fold), ratio in [6, 10]. A mark's guess is the
     cubic Hermite curve through the step's ends with their tangents: O(ds^4), ratio >= 12 (the
     chord's would be 4). Medians over the steps and marks of the run."""
@@ -210,7 +210,8 @@ def test_predictor_and_mark_guesses_are_higher_order():
     def errors(ds):
         pb = Recording(lambda x: x[1] ** 3 - x[1] + x[0], lambda x: np.array([1.0, 3 * x[1] ** 2 - 1]))
         u0 = 1.2
-        arclength(pb, Point(np.array([u0 - u0**3, u0])), direction=1, rules=StepRules(ds=ds, ds_max=ds), target=0.3, max_points=2000, marks=marks)
+        arclength(pb, Point(np.array([u0 - u0**3, u0])), direction=1, rules=StepRules(ds=ds, ds_max=ds, predictor="quadratic"), target=0.3,
+                  max_points=2000, marks=marks)
         is_mark = [c.a[0] == 1 and c.a[1] == 0 and c.b in marks for _, _, c in pb.log]
         step = [np.linalg.norm(g - x) for (g, x, _), m in zip(pb.log, is_mark) if not m]
         mark = [np.linalg.norm(g - x) for (g, x, _), m in zip(pb.log, is_mark) if m]
@@ -219,3 +220,8 @@ def test_predictor_and_mark_guesses_are_higher_order():
     (s2, m2), (s1, m1) = errors(0.02), errors(0.01)
     assert 6.0 <= s2 / s1 <= 10.0, s2 / s1
     assert m2 / m1 >= 12.0, m2 / m1
+
+
+def test_step_rules_name_a_bad_predictor():
+    with pytest.raises(ValueError, match="`predictor`: must be 'linear' or 'quadratic'"):
+        StepRules(predictor="cubic")

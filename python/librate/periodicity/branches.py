@@ -333,7 +333,7 @@ def eps_branches(jobs, *, steps: int = 10, min_step: float = 1e-7, done=None) ->
         if first is None:
             raise ConvergenceError(f"continue_srp: the starting solution (wz0 = {solution.wz0:.10g}) does not correct at eps = {e0}")
         h = abs(target - e0) / steps
-        rules = StepRules(ds=h, ds_min=min(min_step, h), ds_max=max(h, min(4 * h, 0.25)))
+        rules = StepRules(ds=h, ds_min=min(min_step, h), ds_max=max(h, min(4 * h, 0.25)), predictor="quadratic")
         runs.append((problem, arclength_steps(problem, first, direction=1 if target > e0 else -1, target=target, stop_at_fold=True,
                                               locate_bifurcations=False, marks=marks, rules=rules, max_points=10_000, name="eps")))
     out: list = [None] * len(jobs)

@@ -117,7 +117,7 @@ def attitude_family(
     kz = check_kz(kz)
     max_points = as_count(max_points, "max_points", 2)
     rules = StepRules(ds=as_number(ds, "ds", positive=True), ds_min=as_number(ds_min, "ds_min", positive=True),
-                      ds_max=as_number(ds_max, "ds_max", positive=True))
+                      ds_max=as_number(ds_max, "ds_max", positive=True), predictor="quadratic")
     n_total = int(n)
     if isinstance(orbits, OrbitFamily):
         if orbits.spatial:
