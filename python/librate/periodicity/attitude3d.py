@@ -446,7 +446,8 @@ def attitude_family_3d(orbits, body: RigidBody, *, guess, period_days, n_periods
     - ``stability_changes``: where a pair of multipliers passes +1 or -1 ("+1", "-1") or two
       pairs collide ("krein": on the unit circle, or two real pairs meeting off it), located by
       the continuation driver on the test functions :func:`floquet_tests` to 1e-8 in the
-      parameter (``at``, ``located``), with the two branch points around it (``between``) and their
+      parameter (``at``, ``located``), with the two members around it (``between``; the second None
+      when natural continuation stalled past the last member) and their
       counts of multipliers on the unit circle (``on_unit_circle``).
     - ``folds`` (arclength): the turning points of the family in the period, located to 1e-8
       (``period_days``, ``located``, the ``w0`` there).
@@ -491,17 +492,19 @@ def attitude_family_3d(orbits, body: RigidBody, *, guess, period_days, n_periods
 
     folds = []
     if targets.size == 1:
-        br, members, path = None, [first], [first]
+        br, members = None, [first]
     elif method == "natural":
         br = natural(problem, first, targets[1:], rules=StepRules(ds=abs(targets[1] - targets[0]), ds_min=ds_min), name="period_days", stop=report)
-        members, path = [first] + br.points, [first] + br.points
+        members = [first] + br.points
     else:
         if not (np.all(np.diff(targets) > 0) or np.all(np.diff(targets) < 0)):
             raise ValueError("invalid argument `period_days`: method='arclength' needs strictly monotonic periods (the branch is followed "
                              "across their range); use method='natural' to visit them in any order")
         lo, hi = float(targets.min()), float(targets.max())
-        ds = max(abs(targets[1] - targets[0]), ds_min)
-        rules = StepRules(ds=ds, ds_min=ds_min, ds_max=max(ds, 0.25 * (hi - lo)))
+        # steps no longer than the closest requested spacing: each requested period is corrected from a
+        # nearby interpolation between two branch points
+        ds_max = max(ds_min, float(np.min(np.abs(np.diff(targets)))))
+        rules = StepRules(ds=ds_max, ds_min=ds_min, ds_max=ds_max)
         direction = 1 if targets[1] >= targets[0] else -1
         br = arclength(problem, first, direction=direction, rules=rules, bounds=(lo, hi), marks=[float(t) for t in targets[1:]],
                        max_points=max_points, name="period_days", stop=report)
@@ -510,8 +513,9 @@ def attitude_family_3d(orbits, body: RigidBody, *, guess, period_days, n_periods
         on_target = np.any(np.abs(targets - last.x[0]) <= 1e-12)
         if len(br.points) > 1 and on_target and not any(m is last for m in members):
             members.append(last)  # the branch ended landing exactly on a requested period (a bound)
-        path = br.points
         folds = [{"period_days": float(f.parameter), "located": bool(f.located), "w0": [float(v) for v in f.point.x[4:7]]} for f in br.folds]
+        if br.end_reason.startswith("parameter range end") and abs(last.x[0] - targets[-1]) <= 1e-12:
+            br.end_reason = f"completed: {br.end_reason}"  # crossed the whole range to the last requested period
     sols = [m.data.solution for m in members]
     dim = ("member",)
     extra = {"period_days": (dim, np.array([s.orbit.period_days for s in sols])), "x0": (dim, np.array([s.orbit.state0[0] for s in sols])),
@@ -519,27 +523,33 @@ def attitude_family_3d(orbits, body: RigidBody, *, guess, period_days, n_periods
     attrs = {"body_moments": list(body.moments), "n_periods": n_periods, "system": orbits.system.name, "method": method}
     if method == "arclength" and br is not None:
         attrs["folds"] = repr(folds)
-    return _family_dataset(sols, "period_days", extra, br, attrs, path=[p.data.solution for p in path],
-                           offset=1 if method == "natural" else 0)
+    return _family_dataset(sols, "period_days", extra, br, attrs, bracketed=method == "arclength")
 
 
-def _family_dataset(sols, parameter: str, extra: dict, branch, attrs: dict, path=None, offset: int = 1):
+def _family_dataset(sols, parameter: str, extra: dict, branch, attrs: dict, bracketed: bool = False):
     """The Dataset of a 3-D family: ``extra`` variables (the parameter among them), the
     solutions' q0, w0, multipliers, stable, residual, turns, and the stability changes the
     continuation driver located (the zeros of :func:`floquet_tests`; attribute). ``branch``
     None: one member, no continuation."""
     import xarray as xr
 
+    p = np.asarray(extra[parameter][1], dtype=float)
     mult = np.array([_sorted_multipliers(s.multipliers) for s in sols])
-    path = sols if path is None else path
-    p = np.asarray(extra[parameter][1], dtype=float) if path is sols else np.array([s.orbit.period_days for s in path])
-    on = np.abs(np.abs(np.array([_sorted_multipliers(s.multipliers) for s in path])) - 1) <= STABILITY_TOL
+    on = np.abs(np.abs(mult) - 1) <= STABILITY_TOL
     changes = []
     for b in ([] if branch is None else branch.bifurcations):
-        # the branch point before it: natural branches do not return their start (offset 1)
-        i = b.after + offset
+        if bracketed:
+            # the first two consecutive members around it (members are at requested values only)
+            i = next((k for k in range(len(p) - 1) if min(p[k], p[k + 1]) <= b.parameter <= max(p[k], p[k + 1])), None)
+            if i is None:
+                continue
+        else:
+            i = b.after + 1  # the member before it (the first member is the start, not a returned point)
+        # past the last member (natural continuation stalled after locating it): one side only
+        j = i + 1 if i + 1 < len(p) else None
         changes.append({"at": float(b.parameter), "located": bool(b.located), "kind": FLOQUET_TESTS[b.name],
-                        "between": (float(p[i]), float(p[i + 1])), "on_unit_circle": (int(on[i].sum()), int(on[i + 1].sum()))})
+                        "between": (float(p[i]), None if j is None else float(p[j])),
+                        "on_unit_circle": (int(on[i].sum()), None if j is None else int(on[j].sum()))})
     end_reason = "one member: no continuation" if branch is None else branch.end_reason
     dim = ("member",)
     return xr.Dataset(
