@@ -424,7 +424,8 @@ def test_family_followed_through_a_fold_in_the_period(em, dro_family):
     corrector) passes the fold, locates it to 1e-8 and it equals the planar family's located fold
     (attitude_family in x0, thesis Fig. 27) taken to the period, to 1e-6 d. The requested periods
     below the fold get two members, one on each branch (distinct wz0), every member repeats to
-    1e-9 on independent re-propagation, and natural continuation stops at the fold instead."""
+    1e-9 on independent re-propagation, a multiplier passes +1 at the fold, and natural
+    continuation stops before the fold instead."""
     from librate.periodicity import attitude_family
 
     body = librate.RigidBody.from_kz(0.8)
@@ -444,5 +445,8 @@ def test_family_followed_through_a_fold_in_the_period(em, dro_family):
         assert k.size == 2 and abs(wz[k[0]] - wz[k[1]]) > 1e-3
     assert float(ds.residual.max()) < 1e-9
     assert np.max(np.abs(ds.w0.values[:, :2])) < 1e-10  # the planar embedding stays planar
+    # at the fold a multiplier passes +1 (M - I singular): Q(2) changes sign there too (1e-7)
+    changes = ast.literal_eval(ds.attrs["stability_changes"])
+    assert any(c["kind"] == "+1" and abs(c["at"] - folds[0]["period_days"]) < 1e-7 for c in changes)
     nat = librate.attitude_family_3d(dro_family, body, guess=([0, 0, 0, 1.0], [0, 0, _FOLD_START_WZ0]), period_days=periods, method="natural")
     assert nat.sizes["member"] < periods.size and float(nat.period_days.max()) < folds[0]["period_days"]

@@ -447,7 +447,8 @@ def attitude_family_3d(orbits, body: RigidBody, *, guess, period_days, n_periods
       pairs collide ("krein": on the unit circle, or two real pairs meeting off it), located by
       the continuation driver on the test functions :func:`floquet_tests` to 1e-8 in the
       parameter (``at``, ``located``), with the two members around it (``between``; the second None
-      when natural continuation stalled past the last member) and their
+      when natural continuation stalled past the last member; with arclength, where no two
+      consecutive members bracket it, the two branch points around it and ``members`` False) and their
       counts of multipliers on the unit circle (``on_unit_circle``).
     - ``folds`` (arclength): the turning points of the family in the period, located to 1e-8
       (``period_days``, ``located``, the ``w0`` there).
@@ -523,10 +524,11 @@ def attitude_family_3d(orbits, body: RigidBody, *, guess, period_days, n_periods
     attrs = {"body_moments": list(body.moments), "n_periods": n_periods, "system": orbits.system.name, "method": method}
     if method == "arclength" and br is not None:
         attrs["folds"] = repr(folds)
-    return _family_dataset(sols, "period_days", extra, br, attrs, bracketed=method == "arclength")
+    path = [p.data.solution for p in br.points] if method == "arclength" and br is not None else None
+    return _family_dataset(sols, "period_days", extra, br, attrs, bracketed=path)
 
 
-def _family_dataset(sols, parameter: str, extra: dict, branch, attrs: dict, bracketed: bool = False):
+def _family_dataset(sols, parameter: str, extra: dict, branch, attrs: dict, bracketed: list | None = None):
     """The Dataset of a 3-D family: ``extra`` variables (the parameter among them), the
     solutions' q0, w0, multipliers, stable, residual, turns, and the stability changes the
     continuation driver located (the zeros of :func:`floquet_tests`; attribute). ``branch``
@@ -539,9 +541,14 @@ def _family_dataset(sols, parameter: str, extra: dict, branch, attrs: dict, brac
     changes = []
     for b in ([] if branch is None else branch.bifurcations):
         if bracketed:
-            # the first two consecutive members around it (members are at requested values only)
+            # the first two consecutive members around it (members are at requested values only);
+            # else (e.g. between the last requested period and a fold) the two branch points
             i = next((k for k in range(len(p) - 1) if min(p[k], p[k + 1]) <= b.parameter <= max(p[k], p[k + 1])), None)
             if i is None:
+                two = [bracketed[b.after], bracketed[b.after + 1]]
+                n_on = [int(np.sum(np.abs(np.abs(t.multipliers) - 1) <= STABILITY_TOL)) for t in two]
+                changes.append({"at": float(b.parameter), "located": bool(b.located), "kind": FLOQUET_TESTS[b.name],
+                                "between": tuple(float(t.orbit.period_days) for t in two), "on_unit_circle": tuple(n_on), "members": False})
                 continue
         else:
             i = b.after + 1  # the member before it (the first member is the start, not a returned point)
