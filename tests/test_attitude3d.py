@@ -450,3 +450,14 @@ def test_family_followed_through_a_fold_in_the_period(em, dro_family):
     assert any(c["kind"] == "+1" and abs(c["at"] - folds[0]["period_days"]) < 1e-7 for c in changes)
     nat = librate.attitude_family_3d(dro_family, body, guess=([0, 0, 0, 1.0], [0, 0, _FOLD_START_WZ0]), period_days=periods, method="natural")
     assert nat.sizes["member"] < periods.size and float(nat.period_days.max()) < folds[0]["period_days"]
+
+
+def test_family_3d_method_arguments(dro_family):
+    """attitude_family_3d refuses an unknown method, and non-monotonic periods for the
+    arclength method (ValueError naming the parameter)."""
+    body = librate.RigidBody.from_kz(0.8)
+    g = ([0, 0, 0, 1.0], [0, 0, _FOLD_START_WZ0])
+    with pytest.raises(ValueError, match="method"):
+        librate.attitude_family_3d(dro_family, body, guess=g, period_days=[25.5, 25.6], method="secant")
+    with pytest.raises(ValueError, match="period_days"):
+        librate.attitude_family_3d(dro_family, body, guess=g, period_days=[25.5, 25.6, 25.55])

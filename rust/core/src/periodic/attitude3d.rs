@@ -17,6 +17,11 @@
 //! in the unknowns (theta_y, w_x, w_z) (theta about body y keeps R(0) e_y = +-e_y). The
 //! full-period monodromy comes from one more batch over KT at the solutions.
 //!
+//! Across an orbit family ([`correct_attitudes_3d_across`], the corrector of continuation in
+//! the orbit period): the bordered form, with the period T a seventh unknown and a linear
+//! condition closing the system; each Newton point's orbit is the family member of its period
+//! (symmetric shooting), and d F / d T is exact from the STM and the family's tangent.
+//!
 //! Newton runs on the one batched driver ([`super::newton`]); each iteration integrates the
 //! pending points of every candidate in parallel (rayon). The 6x6 attitude monodromy is the
 //! STM in the coordinates (theta, dw) of [`crate::attitude::linear`].
@@ -853,5 +858,22 @@ mod tests {
             let fd = (xp[i] - xm[i]) / (tp - tm);
             assert!((fd - pred[i]).abs() <= 1e-6 * scale, "component {i}: {fd} vs {}", pred[i]);
         }
+    }
+
+    /// Invalid arguments of the bordered corrector are errors naming the parameter, never panics.
+    #[test]
+    fn bordered_invalid_arguments() {
+        let mu = 0.012150585609624;
+        let body = RigidBody::new(0.1, 0.9, 1.0).unwrap();
+        let dro = [0.8, 0.0, 0.0, 0.0, 0.5, 0.0];
+        let mut a = [0.0; 7];
+        a[6] = 1.0;
+        let ok = StartAcross3d { q: [0.0, 0.0, 0.0, 1.0], w: [0.0, 0.0, 1.0], period: 3.0, a, b: 3.0 };
+        let run = |m: &[f64; 6], s: StartAcross3d, o: Options3d| correct_attitudes_3d_across(mu, body, m, 3.0, 1, &[s], 0.5, &o).unwrap_err().to_string();
+        assert!(run(&[0.8, 0.1, 0.0, 0.0, 0.5, 0.0], ok, Options3d::default()).contains("orbit0"));
+        assert!(run(&dro, StartAcross3d { a: [0.0; 7], ..ok }, Options3d::default()).contains("`a`"));
+        assert!(run(&dro, StartAcross3d { period: -1.0, ..ok }, Options3d::default()).contains("period"));
+        assert!(run(&dro, ok, Options3d { half: true, ..Options3d::default() }).contains("half"));
+        assert!(correct_attitudes_3d_across(mu, body, &dro, 3.0, 0, &[ok], 0.5, &Options3d::default()).unwrap_err().to_string().contains("n_periods"));
     }
 }
