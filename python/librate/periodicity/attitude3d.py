@@ -452,6 +452,9 @@ def attitude_family_3d(orbits, body: RigidBody, *, guess, period_days, n_periods
       counts of multipliers on the unit circle (``on_unit_circle``).
     - ``folds`` (arclength): the turning points of the family in the period, located to 1e-8
       (``period_days``, ``located``, the ``w0`` there).
+    - ``unmarked_periods`` (arclength): requested periods the branch crossed where no member
+      was kept (the correction there landed further from the interpolation between the two
+      branch points than the driver's jump guard allows); normally empty.
     - ``end_reason``: why the continuation stopped.
     """
 
@@ -515,6 +518,12 @@ def attitude_family_3d(orbits, body: RigidBody, *, guess, period_days, n_periods
         if len(br.points) > 1 and on_target and not any(m is last for m in members):
             members.append(last)  # the branch ended landing exactly on a requested period (a bound)
         folds = [{"period_days": float(f.parameter), "located": bool(f.located), "w0": [float(v) for v in f.point.x[4:7]]} for f in br.folds]
+        # requested periods the branch crossed whose correction there was rejected (it left the
+        # jump guard: landed too far from the interpolation between the two branch points)
+        ps = [float(q.x[0]) for q in br.points]
+        crossed = [float(t) for a, b in zip(ps, ps[1:]) for t in targets[1:] if (a - t) * (b - t) < 0 or (b == t and not a == t)]
+        got = [float(m.x[0]) for m in members[1:]]
+        attrs_unmarked = [t for t in dict.fromkeys(crossed) if crossed.count(t) > sum(abs(g - t) <= 1e-12 for g in got)]
         if br.end_reason.startswith("parameter range end") and abs(last.x[0] - targets[-1]) <= 1e-12:
             br.end_reason = f"completed: {br.end_reason}"  # crossed the whole range to the last requested period
     sols = [m.data.solution for m in members]
@@ -524,6 +533,7 @@ def attitude_family_3d(orbits, body: RigidBody, *, guess, period_days, n_periods
     attrs = {"body_moments": list(body.moments), "n_periods": n_periods, "system": orbits.system.name, "method": method}
     if method == "arclength" and br is not None:
         attrs["folds"] = repr(folds)
+        attrs["unmarked_periods"] = repr(attrs_unmarked)
     path = [p.data.solution for p in br.points] if method == "arclength" and br is not None else None
     return _family_dataset(sols, "period_days", extra, br, attrs, bracketed=path)
 
