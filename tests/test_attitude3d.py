@@ -357,3 +357,107 @@ def test_body_axes_figure(em, tmp_path):
         lp.plot_body_axes(object())
     with pytest.raises(ValueError, match="planes"):
         lp.plot_body_axes(sol, planes=("xx",))
+
+
+# Issue 15, item 4: the bordered correction across an orbit family and folds in the period. The
+# reference fold is the planar N = 1 family of the body of Kz = 0.8 across the DROs (thesis
+# Fig. 27), which turns back in x0 near x0 = 0.518 (T = 25.74 d); its planar embedding is a 3-D
+# family with the same fold in the period.
+_FOLD_START_DAYS = 25.4927400194  # the DRO of x0 = 0.53855 on the fold's first branch
+_FOLD_START_WZ0 = 3.9254597
+
+
+def test_bordered_across_the_family_at_a_fixed_period_is_the_plain_solution(dro_family):
+    """With the period fixed, the bordered corrector (OrbitFamilyBranch3D, from a guess tilted by
+    ~3e-4 rad) returns periodic_attitude_3d's solution on that member: q0 and w0 to 1e-10, its
+    orbit the member's period to 1e-12 TU; re-propagation to 1e-9."""
+    from librate.periodicity.attitude3d import OrbitFamilyBranch3D
+    from librate.solving.continuation import Constraint
+
+    body = librate.RigidBody.from_kz(0.8)
+    orbit = dro_family.member(period_days=_FOLD_START_DAYS)
+    s = librate.periodic_attitude_3d(orbit, body, guess=([0, 0, 0, 1.0], [0, 0, _FOLD_START_WZ0]))
+    x = np.concatenate([[_FOLD_START_DAYS], Rotation.from_quat(s.q0).as_rotvec(), s.w0])
+    pt = OrbitFamilyBranch3D(dro_family, body).correct(x + np.r_[0, 1e-4, -2e-4, 3e-4, 1e-4, 1e-4, 1e-3], Constraint.fix(7, 0, x[0]))
+    b = pt.data.solution
+    assert pt.x[0] == _FOLD_START_DAYS and abs(b.orbit.period - orbit.period) < 1e-12
+    assert np.max(np.abs(_rotvec(s.q0, b.q0))) < 1e-10 and np.max(np.abs(b.w0 - s.w0)) < 1e-10
+    assert b.residual < 1e-9
+
+
+def _rotvec(q_from, q_to):
+    return (Rotation.from_quat(q_from).inv() * Rotation.from_quat(q_to)).as_rotvec()
+
+
+@pytest.mark.parametrize("orbits", ["dro", "halo"])
+def test_bordered_tangent_matches_central_differences(em, dro_family, orbits):
+    """The exact d F / d T of the bordered corrector: the family's tangent (null vector of
+    [M - I, dF/dT], mapped to x = (period_days, rotvec(q0), w0)) equals central differences of
+    plain periodic_attitude_3d solutions on the members at T +- h (h = 1e-4 d: O(h^2) ~ 1e-8),
+    relative 1e-6. On the planar DRO motion above, and on a tilted motion of the body
+    0.8 : 0.9 : 1 along the 12-day L2 southern halo (a spatial family: d(x0, z0, vy0)/dT)."""
+    from librate.periodicity.attitude3d import OrbitFamilyBranch3D
+    from librate.solving.continuation import Constraint
+
+    if orbits == "dro":
+        fam, body, p = dro_family, librate.RigidBody.from_kz(0.8), _FOLD_START_DAYS
+        guess = ([0, 0, 0, 1.0], [0, 0, _FOLD_START_WZ0])
+    else:
+        fam, body, p = librate.halo_family(em, 2, "south"), librate.RigidBody(0.8, 0.9, 1.0), 12.0
+        guess = ([0, 0, 0, 1.0], [0, 0, 1 - 2 * math.pi / fam.member(period_days=p).period])
+    s = librate.periodic_attitude_3d(fam.member(period_days=p), body, guess=guess)
+    br = OrbitFamilyBranch3D(fam, body)
+    pt = br.correct(np.concatenate([[p], Rotation.from_quat(s.q0).as_rotvec(), s.w0]), Constraint.fix(7, 0, p))
+    tan = br.tangent(pt)
+    tan = tan / tan[0]
+    h = 1e-4
+    side = [librate.periodic_attitude_3d(fam.member(period_days=p + d), body, guess=(s.q0, s.w0)) for d in (h, -h)]
+    xs = [np.concatenate([[o.orbit.period_days], Rotation.from_quat(o.q0).as_rotvec(), o.w0]) for o in side]
+    fd = (xs[0] - xs[1]) / (xs[0][0] - xs[1][0])
+    assert np.max(np.abs(tan - fd)) <= 1e-6 * np.max(np.abs(fd))
+
+
+@pytest.mark.slow
+def test_family_followed_through_a_fold_in_the_period(em, dro_family):
+    """A 3-D family that folds in the period (the planar embedding of the N = 1 family across the
+    DROs, Kz = 0.8, body 0.1 : 0.9 : 1): attitude_family_3d (pseudo-arclength on the bordered
+    corrector) passes the fold, locates it to 1e-8 and it equals the planar family's located fold
+    (attitude_family in x0, thesis Fig. 27) taken to the period, to 1e-6 d. The requested periods
+    below the fold get two members, one on each branch (distinct wz0), every member repeats to
+    1e-9 on independent re-propagation, a multiplier passes +1 at the fold, and natural
+    continuation stops before the fold instead."""
+    from librate.periodicity import attitude_family
+
+    body = librate.RigidBody.from_kz(0.8)
+    periods = np.linspace(_FOLD_START_DAYS, 25.80, 8)
+    ds = librate.attitude_family_3d(dro_family, body, guess=([0, 0, 0, 1.0], [0, 0, _FOLD_START_WZ0]), period_days=periods)
+    folds = ast.literal_eval(ds.attrs["folds"])
+    assert len(folds) == 1 and folds[0]["located"]
+    planar = attitude_family(dro_family, kz=0.8, n=1, start=0.5385453306274934, wz0=_FOLD_START_WZ0, direction=-1, max_points=40)
+    assert planar.folds and planar.folds[0]["located"]
+    fold_days = dro_family.member(x0=planar.folds[0]["x0"]).period_days
+    assert folds[0]["period_days"] == pytest.approx(fold_days, abs=1e-6)
+    below = periods[periods < folds[0]["period_days"]]
+    assert ds.sizes["member"] == 2 * below.size and ast.literal_eval(ds.attrs["unmarked_periods"]) == []
+    p, wz = ds.period_days.values, ds.w0.values[:, 2]
+    for t in below:
+        k = np.flatnonzero(np.abs(p - t) <= 1e-12)
+        assert k.size == 2 and abs(wz[k[0]] - wz[k[1]]) > 1e-3
+    assert float(ds.residual.max()) < 1e-9
+    assert np.max(np.abs(ds.w0.values[:, :2])) < 1e-10  # the planar embedding stays planar
+    # at the fold a multiplier passes +1 (M - I singular): Q(2) changes sign there too (1e-7)
+    changes = ast.literal_eval(ds.attrs["stability_changes"])
+    assert any(c["kind"] == "+1" and abs(c["at"] - folds[0]["period_days"]) < 1e-7 for c in changes)
+    nat = librate.attitude_family_3d(dro_family, body, guess=([0, 0, 0, 1.0], [0, 0, _FOLD_START_WZ0]), period_days=periods, method="natural")
+    assert nat.sizes["member"] < periods.size and float(nat.period_days.max()) < folds[0]["period_days"]
+
+
+def test_family_3d_method_arguments(dro_family):
+    """attitude_family_3d refuses an unknown method, and non-monotonic periods for the
+    arclength method (ValueError naming the parameter)."""
+    body = librate.RigidBody.from_kz(0.8)
+    g = ([0, 0, 0, 1.0], [0, 0, _FOLD_START_WZ0])
+    with pytest.raises(ValueError, match="method"):
+        librate.attitude_family_3d(dro_family, body, guess=g, period_days=[25.5, 25.6], method="secant")
+    with pytest.raises(ValueError, match="period_days"):
+        librate.attitude_family_3d(dro_family, body, guess=g, period_days=[25.5, 25.6, 25.55])

@@ -505,6 +505,10 @@ def _summary_3d(ds, elapsed: float) -> None:
     click.echo(f"continuation: {ds.attrs.get('end_reason')}")
     for ch in ast.literal_eval(ds.attrs.get("stability_changes", "[]")):
         where = f"at T = {ch['at']:.10g} d" + ("" if ch["located"] else " (interpolated)")
+        if ch["between"][1] is None:  # past the last member (the continuation stalled there)
+            click.echo(f"stability change ({ch['kind']}) {where}, after T = {ch['between'][0]:.6g} d, the last member "
+                       f"(multipliers on the unit circle there: {ch['on_unit_circle'][0]})")
+            continue
         click.echo(f"stability change ({ch['kind']}) {where}, between T = {ch['between'][0]:.6g} and {ch['between'][1]:.6g} d "
                    f"(multipliers on the unit circle: {ch['on_unit_circle'][0]} -> {ch['on_unit_circle'][1]})")
 

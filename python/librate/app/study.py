@@ -1130,7 +1130,7 @@ class Study(BaseModel):
         periods = [o.period_days for o in members]
         tol = self.attitude.tol or ATTITUDE_TOL
         try:
-            ds = attitude_family_3d(fam, body, guess=guess, period_days=periods, n_periods=k, tol=tol, progress=progress)
+            ds = attitude_family_3d(fam, body, guess=guess, period_days=periods, n_periods=k, tol=tol, progress=progress, method="natural")
         except ConvergenceError as err:
             raise ConvergenceError(f"3-D solve: the start on the first member (x0 = {members[0].x0:.6g} LU, T = {periods[0]:.6g} d; "
                                    f"{start['start_description']}) did not converge: {err}") from None

@@ -47,7 +47,7 @@ from ..orbits.periodic import PeriodicOrbit
 from .solutions import AttitudeSolution
 
 __all__ = ["AttitudeSolution3D", "periodic_attitude_3d", "is_mirror_symmetric", "out_of_plane_stability", "out_of_plane_family", "attitude_family_3d",
-           "attitude_family_3d_inertia", "OrbitFamilyBranch3D", "InertiaBranch3D", "STABILITY_TOL", "VERIFY_RTOL", "floquet_tests",
+           "attitude_family_3d_inertia", "OrbitFamilyBranch3D", "FamilyMember3D", "rotvec_jacobian", "InertiaBranch3D", "STABILITY_TOL", "VERIFY_RTOL", "floquet_tests",
            "SOLVE_RTOL"]
 
 #: A multiplier lies on the unit circle when ||m| - 1| <= STABILITY_TOL. The monodromy is
@@ -232,12 +232,17 @@ def periodic_attitude_3d(orbit: PeriodicOrbit, body: RigidBody, *, guess, n_peri
     if r.reason[0] != "converged":
         raise ConvergenceError(f"periodic 3-D attitude: the corrector stopped ({r.reason[0].replace('_', ' ')}) after {int(r.iterations[0])} "
                                f"Newton steps, residual {float(r.residual_norm[0]):.3e} (tolerance {tol:.1e})")
-    q0, w0 = np.asarray(r.q0[0]), np.asarray(r.w0[0])
+    return _verified(orbit, body, n_periods, np.asarray(r.q0[0]), np.asarray(r.w0[0]), np.asarray(r.monodromy[0]), int(r.iterations[0]))
+
+
+def _verified(orbit: PeriodicOrbit, body: RigidBody, n_periods: int, q0, w0, monodromy, iterations: int) -> AttitudeSolution3D:
+    """The solution with its independent re-propagation (``residual``) and turns."""
+    T = n_periods * float(orbit.period)
     t = np.linspace(0.0, T, 512 * n_periods + 1)
     tr = propagate_attitude(orbit.system, orbit.state0, (q0, w0), body, T, t_eval=t, rtol=VERIFY_RTOL, atol=VERIFY_RTOL)
     d_rot = float(np.linalg.norm(_rotvec(q0, tr.q[-1])))
     d_w = float(np.linalg.norm(tr.w[-1] - w0))
-    return AttitudeSolution3D(orbit, body, n_periods, q0, w0, np.asarray(r.monodromy[0]), d_rot, d_w, _turns(tr.q), int(r.iterations[0]))
+    return AttitudeSolution3D(orbit, body, n_periods, q0, w0, monodromy, d_rot, d_w, _turns(tr.q), iterations)
 
 
 def out_of_plane_stability(solution: AttitudeSolution) -> AttitudeSolution3D:
@@ -319,56 +324,115 @@ def out_of_plane_family(orbits, family, *, body: RigidBody | None = None, every:
                "system": orbits.system.name})
 
 
+def rotvec_jacobian(r) -> np.ndarray:
+    """d rotvec(R(r) Exp(theta)) / d theta at theta = 0 (theta a small rotation in body axes):
+    the inverse right Jacobian of SO(3), I + [r]/2 + (1/|r|^2 - (1 + cos|r|)/(2 |r| sin|r|)) [r]^2,
+    with [r] the cross-product matrix (series below |r| = 1e-4)."""
+    r = np.asarray(r, dtype=float)
+    a = float(np.linalg.norm(r))
+    k = np.array([[0.0, -r[2], r[1]], [r[2], 0.0, -r[0]], [-r[1], r[0], 0.0]])
+    c = 1.0 / 12.0 + a * a / 720.0 if a < 1e-4 else 1.0 / (a * a) - (1.0 + math.cos(a)) / (2.0 * a * math.sin(a))
+    return np.eye(3) + 0.5 * k + c * (k @ k)
+
+
+@dataclass(frozen=True)
+class FamilyMember3D:
+    """A point of :class:`OrbitFamilyBranch3D`: the verified ``solution`` and d F / d T of its six
+    closure residuals (``dparam``, exact, from the bordered corrector)."""
+
+    solution: AttitudeSolution3D
+    dparam: np.ndarray = field(repr=False)
+
+
 class OrbitFamilyBranch3D:
-    """A periodic 3-D attitude motion continued along a family of periodic orbits, for the
-    continuation driver (:func:`librate.solving.continuation.natural`). The vector is x = (orbit
-    period in days, the rotation vector of q0, w0). Every point corrects the family member with
-    that period (:meth:`OrbitFamily.member`) and then the attitude with
-    :func:`periodic_attitude_3d`, starting from the predicted (q0, w0). The tangent is the
-    driver's secant."""
+    """A periodic 3-D attitude motion continued along a family of x-z-symmetric periodic orbits
+    (DROs, planar Lyapunov orbits, halos, NRHOs), a bordered problem for the continuation driver
+    (:func:`librate.solving.continuation.arclength`, or ``natural``). The vector is x = (orbit
+    period in days, the rotation vector of q0, w0).
+
+    Every point is corrected by the Rust bordered corrector
+    (:func:`librate._core.attitude_correct_3d_across`): the unknowns are a rotation theta in body
+    axes in a chart about the guess's attitude, w0 and the orbit period T, closed by the driver's
+    linear condition a . x = b. That condition is taken to the chart linearised:
+    rotvec(q_ref Exp(theta)) ~ rotvec(q_ref) + J theta (:func:`rotvec_jacobian`), exact at the
+    guess (natural continuation fixes only the period, so there it is exact everywhere). Each
+    Newton point's orbit is the family member of its period, corrected in Rust to 1e-12, so the
+    solution's orbit is the member at the final period. The tangent is the null vector of the
+    family's Jacobian [M - I, dF/dT] in the solution's body-axis chart (M the monodromy), mapped
+    to x. The bifurcation tests are :func:`floquet_tests`."""
 
     parameter_index = 0
     scale = np.ones(7)
 
-    def __init__(self, orbits, body: RigidBody, n_periods: int = 1, tol: float = 1e-12):
-        self.orbits, self.body, self.n_periods, self.tol = orbits, body, n_periods, tol
+    def __init__(self, orbits, body: RigidBody, n_periods: int = 1, tol: float = 1e-12, max_iter: int = 40):
+        self.orbits, self.body, self.n_periods, self.tol, self.max_iter = orbits, body, n_periods, tol, max_iter
+        self.days = float(orbits.system.period_days(1.0))
 
     def correct(self, guess, c):
         from scipy.spatial.transform import Rotation
 
         from ..solving.continuation import CorrectionFailed, Point
 
-        if not (c.a[0] == 1 and not np.any(c.a[1:])):
-            raise CorrectionFailed("the 3-D attitude family across an orbit family is continued in the period only (natural parameter)")
+        guess = np.asarray(guess, dtype=float)
         try:
-            orbit = self.orbits.member(period_days=float(c.b))
-        except ValueError as e:
+            ref = self.orbits.member(period_days=float(guess[0]))
+        except (ValueError, ConvergenceError) as e:
             raise CorrectionFailed(str(e)) from None
-        q = Rotation.from_rotvec(np.asarray(guess[1:4], dtype=float)).as_quat()
-        s = periodic_attitude_3d(orbit, self.body, guess=(q, np.asarray(guess[4:7], dtype=float)), n_periods=self.n_periods, tol=self.tol)
+        rv = guess[1:4]
+        a = np.asarray(c.a, dtype=float)
+        a_chart = np.concatenate([rotvec_jacobian(rv).T @ a[1:4], a[4:7], [a[0] * self.days]])
+        b_chart = float(c.b) - float(a[1:4] @ rv)
+        r = _core.attitude_correct_3d_across(self.orbits.system.mu, list(self.body.moments), [float(v) for v in ref.state0], float(ref.period),
+                                             self.n_periods, Rotation.from_rotvec(rv).as_quat()[None, :], guess[None, 4:7],
+                                             np.array([float(ref.period)]), a_chart[None, :], np.array([b_chart]), tol=float(self.tol),
+                                             max_iter=int(self.max_iter), rtol=SOLVE_RTOL, atol=SOLVE_RTOL)
+        if r.reason[0] != "converged":
+            raise CorrectionFailed(f"3-D attitude across the orbit family: {r.reason[0].replace('_', ' ')} after {int(r.iterations[0])} steps, "
+                                   f"residual {float(r.residual_norm[0]):.2e}")
+        state0 = np.asarray(r.orbit0[0])
+        orbit = PeriodicOrbit(self.orbits.system, state0, float(r.period[0]), float(self.orbits.system.jacobi(state0)), ref.family)
+        s = _verified(orbit, self.body, self.n_periods, np.asarray(r.q0[0]), np.asarray(r.w0[0]), np.asarray(r.monodromy[0]), int(r.iterations[0]))
         if not s.residual <= 1e-9:
             raise CorrectionFailed(f"re-propagation residual {s.residual:.2e} above 1e-9")
         x = np.concatenate([[orbit.period_days], Rotation.from_quat(s.q0).as_rotvec(), s.w0])
-        return Point(x, s, s.iterations)
+        if c.fixed_index == 0:
+            x[0] = float(c.b)  # the member of exactly that period (its orbit corrected to 1e-12 TU)
+        return Point(x, FamilyMember3D(s, np.asarray(r.dparam[0])), s.iterations)
 
     def tangent(self, point):
-        return None
+        from scipy.spatial.transform import Rotation
+
+        m = point.data.solution.monodromy
+        jac = np.hstack([m - np.eye(6), point.data.dparam[:, None]])  # (theta, w0, T) in the solution's chart
+        if not np.all(np.isfinite(jac)):
+            return None
+        v = np.linalg.svd(jac)[2][-1]
+        rv = Rotation.from_quat(point.data.solution.q0).as_rotvec()
+        return np.concatenate([[v[6] * self.days], rotvec_jacobian(rv) @ v[:3], v[3:6]])
 
     def tests(self, point):
-        return floquet_tests(point.data.monodromy)
+        return floquet_tests(point.data.solution.monodromy)
 
 
 def attitude_family_3d(orbits, body: RigidBody, *, guess, period_days, n_periods: int = 1, tol: float = 1e-12, ds_min: float = 1e-4,
-                       progress=None):
+                       progress=None, method: str = "arclength", max_points: int = 400):
     """A periodic 3-D attitude motion of ``body`` continued along the orbit family ``orbits``
     (e.g. the L2 southern halos into the NRHOs) through the orbit periods ``period_days`` (days,
-    in order), by natural-parameter continuation (:func:`librate.solving.continuation.natural`)
-    from ``guess`` ((q0, w0) or a planar solution) at the first period. ``tol``: the corrector's
-    tolerance (NRHOs pass within a few thousand km of the Moon, where the tidal torque is some
-    1e4 times the Earth's at the Moon's distance; their attitude closure is reached to ~1e-11, so
-    pass tol=1e-10 there). Every member is re-propagated independently to 1e-9.
+    in order) from ``guess`` ((q0, w0) or a planar solution) at the first period. ``tol``: the
+    corrector's tolerance (NRHOs pass within a few thousand km of the Moon, where the tidal torque
+    is some 1e4 times the Earth's at the Moon's distance; their attitude closure is reached to
+    ~1e-11, so pass tol=1e-10 there). Every member is re-propagated independently to 1e-9.
     ``progress(done, total)``: called with the number of requested periods reached so far.
     One period gives the one-member family of that orbit (no continuation).
+
+    ``method``: "arclength" (the default) follows the family by pseudo-arclength continuation
+    (:func:`librate.solving.continuation.arclength`, at most ``max_points`` points) on the
+    bordered corrector (:class:`OrbitFamilyBranch3D`: the orbit period is an unknown, each Newton
+    point on its own family member), through folds, until it leaves the requested periods' range;
+    the members are the solutions corrected exactly at the requested periods each time the
+    branch crosses one (after a fold a period can have two or more members, in branch order).
+    "natural" steps in the period (:func:`librate.solving.continuation.natural`) and stops at a
+    fold (the step collapses there).
 
     Returns an xarray Dataset along ``member`` (attribute ``parameter`` = "period_days"):
 
@@ -382,54 +446,100 @@ def attitude_family_3d(orbits, body: RigidBody, *, guess, period_days, n_periods
     - ``stability_changes``: where a pair of multipliers passes +1 or -1 ("+1", "-1") or two
       pairs collide ("krein": on the unit circle, or two real pairs meeting off it), located by
       the continuation driver on the test functions :func:`floquet_tests` to 1e-8 in the
-      parameter (``at``, ``located``), with the two members around it (``between``) and their
+      parameter (``at``, ``located``), with the two members around it (``between``; the second None
+      when natural continuation stalled past the last member; with arclength, where no two
+      consecutive members bracket it, the two branch points around it and ``members`` False) and their
       counts of multipliers on the unit circle (``on_unit_circle``).
-    - ``end_reason``: why the continuation stopped; a fold in the period shows as the step
-      collapsing there.
+    - ``folds`` (arclength): the turning points of the family in the period, located to 1e-8
+      (``period_days``, ``located``, the ``w0`` there).
+    - ``unmarked_periods`` (arclength): requested periods the branch crossed where no member
+      was kept (the correction there landed further from the interpolation between the two
+      branch points than the driver's jump guard allows); normally empty.
+    - ``end_reason``: why the continuation stopped.
     """
 
     from ..orbits.families import OrbitFamily
-    from ..solving.continuation import Point, StepRules, natural
+    from ..solving.continuation import Constraint, CorrectionFailed, StepRules, arclength, natural
 
     if not isinstance(orbits, OrbitFamily):
         raise ValueError(f"invalid argument `orbits`: must be a librate.OrbitFamily, got {type(orbits).__name__}")
+    if method not in ("arclength", "natural"):
+        raise ValueError(f"invalid argument `method`: must be 'arclength' or 'natural', got {method!r}")
     targets = np.asarray(period_days, dtype=float).ravel()
     if targets.size < 1 or not np.all(np.isfinite(targets)):
         raise ValueError(f"invalid argument `period_days`: need at least one finite period, got {period_days!r}")
     n_periods = as_count(n_periods, "n_periods", 1)
+    max_points = as_count(max_points, "max_points", 2)
     first_orbit = orbits.member(period_days=float(targets[0]))
     tol = as_number(tol, "tol", positive=True)
     s0 = periodic_attitude_3d(first_orbit, body, guess=guess, n_periods=n_periods, tol=tol)
     problem = OrbitFamilyBranch3D(orbits, body, n_periods, tol)
     from scipy.spatial.transform import Rotation
 
-    first = Point(np.concatenate([[first_orbit.period_days], Rotation.from_quat(s0.q0).as_rotvec(), s0.w0]), s0, s0.iterations)
+    x_first = np.concatenate([[float(targets[0])], Rotation.from_quat(s0.q0).as_rotvec(), s0.w0])
+    try:
+        first = problem.correct(x_first, Constraint.fix(7, 0, float(x_first[0])))
+    except CorrectionFailed as e:
+        raise ConvergenceError(f"3-D attitude family: the bordered corrector did not reproduce the first solution: {e}") from None
     report = None
     if progress is not None:
         progress(1, targets.size)
         reached = [1]
+        sense = 1.0 if targets.size < 2 or targets[-1] >= targets[0] else -1.0
 
         def report(point):  # the driver's per-point hook: count the requested periods passed
             p = float(point.x[0])
             # a member counts as reached within the orbit correction's tolerance on its period
-            while reached[0] < targets.size and (targets[reached[0]] - p) * np.sign(targets[reached[0]] - targets[reached[0] - 1]) <= 1e-9:
+            while reached[0] < targets.size and (targets[reached[0]] - p) * sense <= 1e-9:
                 reached[0] += 1
                 progress(reached[0], targets.size)
             return None
 
+    folds = []
     if targets.size == 1:
-        br = None
-    else:
+        br, members = None, [first]
+    elif method == "natural":
         br = natural(problem, first, targets[1:], rules=StepRules(ds=abs(targets[1] - targets[0]), ds_min=ds_min), name="period_days", stop=report)
-    sols = [s0] + ([] if br is None else [p.data for p in br.points])
+        members = [first] + br.points
+    else:
+        if not (np.all(np.diff(targets) > 0) or np.all(np.diff(targets) < 0)):
+            raise ValueError("invalid argument `period_days`: method='arclength' needs strictly monotonic periods (the branch is followed "
+                             "across their range); use method='natural' to visit them in any order")
+        lo, hi = float(targets.min()), float(targets.max())
+        # steps no longer than the closest requested spacing: each requested period is corrected from a
+        # nearby interpolation between two branch points
+        ds_max = max(ds_min, float(np.min(np.abs(np.diff(targets)))))
+        rules = StepRules(ds=ds_max, ds_min=ds_min, ds_max=ds_max)
+        direction = 1 if targets[1] >= targets[0] else -1
+        br = arclength(problem, first, direction=direction, rules=rules, bounds=(lo, hi), marks=[float(t) for t in targets[1:]],
+                       max_points=max_points, name="period_days", stop=report)
+        members = [first] + list(br.marked)
+        last = br.points[-1]
+        on_target = np.any(np.abs(targets - last.x[0]) <= 1e-12)
+        if len(br.points) > 1 and on_target and not any(m is last for m in members):
+            members.append(last)  # the branch ended landing exactly on a requested period (a bound)
+        folds = [{"period_days": float(f.parameter), "located": bool(f.located), "w0": [float(v) for v in f.point.x[4:7]]} for f in br.folds]
+        # requested periods the branch crossed whose correction there was rejected (it left the
+        # jump guard: landed too far from the interpolation between the two branch points)
+        ps = [float(q.x[0]) for q in br.points]
+        crossed = [float(t) for a, b in zip(ps, ps[1:]) for t in targets[1:] if (a - t) * (b - t) < 0 or (b == t and not a == t)]
+        got = [float(m.x[0]) for m in members[1:]]
+        attrs_unmarked = [t for t in dict.fromkeys(crossed) if crossed.count(t) > sum(abs(g - t) <= 1e-12 for g in got)]
+        if br.end_reason.startswith("parameter range end") and abs(last.x[0] - targets[-1]) <= 1e-12:
+            br.end_reason = f"completed: {br.end_reason}"  # crossed the whole range to the last requested period
+    sols = [m.data.solution for m in members]
     dim = ("member",)
     extra = {"period_days": (dim, np.array([s.orbit.period_days for s in sols])), "x0": (dim, np.array([s.orbit.state0[0] for s in sols])),
              "z0": (dim, np.array([s.orbit.state0[2] for s in sols]))}
-    return _family_dataset(sols, "period_days", extra, br, {"body_moments": list(body.moments), "n_periods": n_periods,
-                                                            "system": orbits.system.name})
+    attrs = {"body_moments": list(body.moments), "n_periods": n_periods, "system": orbits.system.name, "method": method}
+    if method == "arclength" and br is not None:
+        attrs["folds"] = repr(folds)
+        attrs["unmarked_periods"] = repr(attrs_unmarked)
+    path = [p.data.solution for p in br.points] if method == "arclength" and br is not None else None
+    return _family_dataset(sols, "period_days", extra, br, attrs, bracketed=path)
 
 
-def _family_dataset(sols, parameter: str, extra: dict, branch, attrs: dict):
+def _family_dataset(sols, parameter: str, extra: dict, branch, attrs: dict, bracketed: list | None = None):
     """The Dataset of a 3-D family: ``extra`` variables (the parameter among them), the
     solutions' q0, w0, multipliers, stable, residual, turns, and the stability changes the
     continuation driver located (the zeros of :func:`floquet_tests`; attribute). ``branch``
@@ -441,9 +551,23 @@ def _family_dataset(sols, parameter: str, extra: dict, branch, attrs: dict):
     on = np.abs(np.abs(mult) - 1) <= STABILITY_TOL
     changes = []
     for b in ([] if branch is None else branch.bifurcations):
-        i = b.after + 1  # the member before it (the first member is the start, not a returned point)
+        if bracketed:
+            # the first two consecutive members around it (members are at requested values only);
+            # else (e.g. between the last requested period and a fold) the two branch points
+            i = next((k for k in range(len(p) - 1) if min(p[k], p[k + 1]) <= b.parameter <= max(p[k], p[k + 1])), None)
+            if i is None:
+                two = [bracketed[b.after], bracketed[b.after + 1]]
+                n_on = [int(np.sum(np.abs(np.abs(t.multipliers) - 1) <= STABILITY_TOL)) for t in two]
+                changes.append({"at": float(b.parameter), "located": bool(b.located), "kind": FLOQUET_TESTS[b.name],
+                                "between": tuple(float(t.orbit.period_days) for t in two), "on_unit_circle": tuple(n_on), "members": False})
+                continue
+        else:
+            i = b.after + 1  # the member before it (the first member is the start, not a returned point)
+        # past the last member (natural continuation stalled after locating it): one side only
+        j = i + 1 if i + 1 < len(p) else None
         changes.append({"at": float(b.parameter), "located": bool(b.located), "kind": FLOQUET_TESTS[b.name],
-                        "between": (float(p[i]), float(p[i + 1])), "on_unit_circle": (int(on[i].sum()), int(on[i + 1].sum()))})
+                        "between": (float(p[i]), None if j is None else float(p[j])),
+                        "on_unit_circle": (int(on[i].sum()), None if j is None else int(on[j].sum()))})
     end_reason = "one member: no continuation" if branch is None else branch.end_reason
     dim = ("member",)
     return xr.Dataset(

@@ -139,6 +139,7 @@ def plot_family_multipliers(ds, ax=None, *, against: str = "period") -> Figure:
     along_period = ds.attrs.get("parameter") == "period_days" and against == "period"
     for ch in ast.literal_eval(ds.attrs.get("stability_changes", "[]")) if along_period else []:
         lo, hi = ch["between"]
+        hi = ch.get("at", lo) if hi is None else hi  # natural continuation stalled past the last member
         a.axvspan(min(lo, hi), max(lo, hi), color="tab:orange", alpha=0.3, gid="stability-change")
         if "at" in ch:  # located by the continuation driver
             a.axvline(ch["at"], color="tab:orange", linewidth=1.0, gid="stability-change-at")

@@ -2,9 +2,9 @@
 //! released, convert.
 
 use librate_core::attitude::{collinear_equilibrium, RigidBody};
-use librate_core::periodic::{correct_attitudes_3d, Options3d, Start3d};
+use librate_core::periodic::{correct_attitudes_3d, correct_attitudes_3d_across, Options3d, Start3d, StartAcross3d};
 use numpy::ndarray::{Array2, Array3};
-use numpy::{IntoPyArray, PyReadonlyArray2};
+use numpy::{IntoPyArray, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
@@ -119,10 +119,101 @@ fn attitude_correct_3d<'py>(
     })
 }
 
+/// The outcome of a batch of bordered 3-D corrections across an orbit family, one row per
+/// candidate (librate_core::periodic::correct_attitudes_3d_across).
+#[pyclass(frozen, get_all, name = "CorrectionAcross3D", module = "librate._core")]
+pub struct PyCorrectionAcross3D {
+    /// Initial attitude (n, 4), scalar last, and inertial rate in body axes (n, 3).
+    pub q0: Py<PyAny>,
+    pub w0: Py<PyAny>,
+    /// The family member at the final point: initial state (n, 6) and period (n,), TU.
+    pub orbit0: Py<PyAny>,
+    pub period: Py<PyAny>,
+    /// (rotation vector of R(0)^T R(KT), w(KT) - w0, a . x - b), (n, 7).
+    pub residual: Py<PyAny>,
+    pub residual_norm: Py<PyAny>,
+    pub iterations: Py<PyAny>,
+    pub reason: Vec<&'static str>,
+    /// The 6x6 attitude monodromy, (n, 6, 6), and d F / d T of the six closure rows, (n, 6).
+    pub monodromy: Py<PyAny>,
+    pub dparam: Py<PyAny>,
+}
+
+#[pymethods]
+impl PyCorrectionAcross3D {
+    fn __len__(&self) -> usize {
+        self.reason.len()
+    }
+    fn __repr__(&self) -> String {
+        let c = self.reason.iter().filter(|r| **r == "converged").count();
+        format!("CorrectionAcross3D(n={}, converged={c})", self.reason.len())
+    }
+}
+
+/// Bordered 3-D periodic-attitude corrector across an x-z-symmetric orbit family (the orbit
+/// period freed): guesses q (n x 4), w (n x 3), periods (n,), conditions a (n x 7) . (theta, w0,
+/// T) = b (n,); the family through the member `member0` of period `period0`.
+#[pyfunction]
+#[pyo3(signature = (mu, inertia, member0, period0, n_periods, q, w, period, a, b, *, tol, max_iter, rtol, atol, max_period_step=0.5, max_halvings=10, primaries=[true, true], threads=None))]
+fn attitude_correct_3d_across<'py>(
+    py: Python<'py>,
+    mu: f64,
+    inertia: [f64; 3],
+    member0: [f64; 6],
+    period0: f64,
+    n_periods: usize,
+    q: PyReadonlyArray2<'py, f64>,
+    w: PyReadonlyArray2<'py, f64>,
+    period: PyReadonlyArray1<'py, f64>,
+    a: PyReadonlyArray2<'py, f64>,
+    b: PyReadonlyArray1<'py, f64>,
+    tol: f64,
+    max_iter: usize,
+    rtol: f64,
+    atol: f64,
+    max_period_step: f64,
+    max_halvings: u32,
+    primaries: [bool; 2],
+    threads: Option<usize>,
+) -> PyResult<PyCorrectionAcross3D> {
+    let body = RigidBody::new(inertia[0], inertia[1], inertia[2]).map_err(to_py)?;
+    let (qa, wa, pa, aa, ba) = (q.as_array(), w.as_array(), period.as_array(), a.as_array(), b.as_array());
+    let n = qa.nrows();
+    if qa.ncols() != 4 || wa.ncols() != 3 || aa.ncols() != 7 || wa.nrows() != n || pa.len() != n || aa.nrows() != n || ba.len() != n {
+        return Err(PyValueError::new_err(format!(
+            "invalid argument `guess`: need q (n, 4), w (n, 3), period (n,), a (n, 7), b (n,), got {:?}, {:?}, {:?}, {:?}, {:?}",
+            qa.shape(),
+            wa.shape(),
+            pa.shape(),
+            aa.shape(),
+            ba.shape()
+        )));
+    }
+    let starts: Vec<StartAcross3d> = (0..n)
+        .map(|i| StartAcross3d { q: std::array::from_fn(|k| qa[(i, k)]), w: std::array::from_fn(|k| wa[(i, k)]), period: pa[i], a: std::array::from_fn(|k| aa[(i, k)]), b: ba[i] })
+        .collect();
+    let opts = Options3d { tol, max_iter, max_halvings, rtol, atol, threads, primaries, ..Options3d::default() };
+    let out = py.detach(|| correct_attitudes_3d_across(mu, body, &member0, period0, n_periods, &starts, max_period_step, &opts)).map_err(to_py)?;
+    Ok(PyCorrectionAcross3D {
+        q0: Array2::from_shape_fn((n, 4), |(i, k)| out[i].q0[k]).into_pyarray(py).into_any().unbind(),
+        w0: Array2::from_shape_fn((n, 3), |(i, k)| out[i].w0[k]).into_pyarray(py).into_any().unbind(),
+        orbit0: Array2::from_shape_fn((n, 6), |(i, k)| out[i].orbit0[k]).into_pyarray(py).into_any().unbind(),
+        period: out.iter().map(|c| c.period).collect::<Vec<_>>().into_pyarray(py).into_any().unbind(),
+        residual: Array2::from_shape_fn((n, 7), |(i, k)| out[i].residual[k]).into_pyarray(py).into_any().unbind(),
+        residual_norm: out.iter().map(|c| c.residual_norm).collect::<Vec<_>>().into_pyarray(py).into_any().unbind(),
+        iterations: out.iter().map(|c| c.iterations as i64).collect::<Vec<_>>().into_pyarray(py).into_any().unbind(),
+        reason: out.iter().map(|c| c.reason.as_str()).collect(),
+        monodromy: Array3::from_shape_fn((n, 6, 6), |(i, r, c)| out[i].monodromy[r][c]).into_pyarray(py).into_any().unbind(),
+        dparam: Array2::from_shape_fn((n, 6), |(i, k)| out[i].dparam[k]).into_pyarray(py).into_any().unbind(),
+    })
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyLinearisedEquilibrium>()?;
     m.add_class::<PyCorrectionBatch3D>()?;
+    m.add_class::<PyCorrectionAcross3D>()?;
     m.add_function(wrap_pyfunction!(attitude_correct_3d, m)?)?;
+    m.add_function(wrap_pyfunction!(attitude_correct_3d_across, m)?)?;
     m.add_function(wrap_pyfunction!(attitude_equilibrium, m)?)?;
     Ok(())
 }

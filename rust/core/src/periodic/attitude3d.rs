@@ -17,6 +17,11 @@
 //! in the unknowns (theta_y, w_x, w_z) (theta about body y keeps R(0) e_y = +-e_y). The
 //! full-period monodromy comes from one more batch over KT at the solutions.
 //!
+//! Across an orbit family ([`correct_attitudes_3d_across`], the corrector of continuation in
+//! the orbit period): the bordered form, with the period T a seventh unknown and a linear
+//! condition closing the system; each Newton point's orbit is the family member of its period
+//! (symmetric shooting), and d F / d T is exact from the STM and the family's tangent.
+//!
 //! Newton runs on the one batched driver ([`super::newton`]); each iteration integrates the
 //! pending points of every candidate in parallel (rayon). The 6x6 attitude monodromy is the
 //! STM in the coordinates (theta, dw) of [`crate::attitude::linear`].
@@ -25,7 +30,9 @@ use rayon::prelude::*;
 
 use super::newton::{self, Eval, Problem, Settings, StopReason};
 use crate::attitude::linear::reduce;
-use crate::attitude::{propagate_attitude, GravityGradient, OrbitMode, RigidBody, Torque};
+use super::symmetric::{Constraint as SymConstraint, Evaluation, SymmetricOrbit, SymmetricShooting};
+use crate::attitude::{propagate_attitude, Coupled, GravityGradient, OrbitMode, RigidBody, Torque};
+use crate::integrate::System;
 use crate::cr3bp::check_mu;
 use crate::error::{check_finite, check_positive, invalid, Result};
 use crate::integrate::{Options, Output};
@@ -399,6 +406,332 @@ pub fn correct_attitudes_3d(mu: f64, body: RigidBody, orbit0: &[f64; 6], t_final
         .collect())
 }
 
+/// One candidate of [`correct_attitudes_3d_across`]: the guess (q the chart's centre, w), the
+/// orbit period `period` at which it starts (TU), and its linear condition
+/// `a . (theta, w0, period) = b` closing the 7x7 system (natural continuation: a = e_7, b the
+/// period; pseudo-arclength: the tangent in these coordinates and the step).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StartAcross3d {
+    pub q: Quat,
+    pub w: [f64; 3],
+    pub period: f64,
+    pub a: [f64; 7],
+    pub b: f64,
+}
+
+/// The outcome of one candidate of [`correct_attitudes_3d_across`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct CorrectionAcross3d {
+    pub q0: Quat,
+    pub w0: [f64; 3],
+    /// The family member at the final point: its initial state and period (TU), corrected by
+    /// symmetric shooting with the period fixed (NaN when none was reached).
+    pub orbit0: [f64; 6],
+    pub period: f64,
+    /// (rotation vector of R(0)' R(KT), w(KT) - w0, the linear condition's a . x - b).
+    pub residual: [f64; 7],
+    pub residual_norm: f64,
+    pub iterations: usize,
+    pub reason: StopReason,
+    /// 6x6 attitude monodromy over K T, as [`Correction3d::monodromy`].
+    pub monodromy: [[f64; 6]; 6],
+    /// d F / d T of the six closure residuals at the final point (exact, from the 13x13 STM and
+    /// the family's tangent d s0 / d T). At a solution it does not depend on the chart, and with
+    /// the monodromy M it gives the family's Jacobian [M - I, dF/dT] in the solution's own
+    /// body-axis chart.
+    pub dparam: [f64; 6],
+}
+
+/// The orbit family of [`correct_attitudes_3d_across`]: x-z-symmetric members
+/// (x0, 0, z0, 0, vy0, 0), each period its own member, corrected by symmetric shooting
+/// ([`SymmetricShooting`], [`Constraint::Period`]) from the first-order guess along the family's
+/// tangent at a reference member.
+struct SymmetricFamily {
+    shooting: SymmetricShooting,
+    reference: SymmetricOrbit,
+    tangent: [f64; 3],
+}
+
+/// d (x0, z0, vy0) / d T along an x-z-symmetric family at an evaluated member: the crossing
+/// conditions xdot_c = zdot_c = 0 stay zero and T = 2 t_half moves by dT (one 3x3 solve; the
+/// planar family: the 2x2 one in (x0, vy0)). None when singular (a fold of the family in T).
+fn family_tangent(e: &Evaluation, spatial: bool) -> Option<[f64; 3]> {
+    use nalgebra::{Matrix2, Matrix3, Vector2, Vector3};
+    if spatial {
+        let m = Matrix3::new(e.dcond[0][0], e.dcond[0][1], e.dcond[0][2], e.dcond[1][0], e.dcond[1][1], e.dcond[1][2], 2.0 * e.dhalf[0], 2.0 * e.dhalf[1], 2.0 * e.dhalf[2]);
+        let v = m.lu().solve(&Vector3::new(0.0, 0.0, 1.0))?;
+        Some([v[0], v[1], v[2]]).filter(|v| v.iter().all(|x| x.is_finite()))
+    } else {
+        let m = Matrix2::new(e.dcond[0][0], e.dcond[0][2], 2.0 * e.dhalf[0], 2.0 * e.dhalf[2]);
+        let v = m.lu().solve(&Vector2::new(0.0, 1.0))?;
+        Some([v[0], 0.0, v[1]]).filter(|v| v.iter().all(|x| x.is_finite()))
+    }
+}
+
+impl SymmetricFamily {
+    fn new(mu: f64, member: &[f64; 6], period: f64, rtol: f64, atol: f64) -> Result<Self> {
+        if member[1] != 0.0 || member[3] != 0.0 || member[5] != 0.0 {
+            return Err(invalid("orbit0", format!("the family's member must start on the x-z plane perpendicularly (y = xdot = zdot = 0), got {member:?}")));
+        }
+        let spatial = member[2] != 0.0;
+        let mut shooting = SymmetricShooting::new(mu, spatial, Options::with_tolerances(rtol, atol));
+        shooting.tol = 1e-12;
+        shooting.t_max = period;
+        let reference = shooting.correct([member[0], member[2], member[4]], SymConstraint::Period(period))?;
+        let tangent = family_tangent(&reference.evaluation, spatial).ok_or_else(|| invalid("orbit0", "the orbit family has no tangent in the period at this member (a fold of the family in T)"))?;
+        Ok(Self { shooting, reference, tangent })
+    }
+
+    /// The member of period `t` with its tangent d s0 / d T.
+    fn member(&self, t: f64) -> Option<(SymmetricOrbit, [f64; 6])> {
+        if !(t.is_finite() && t > 0.0) {
+            return None;
+        }
+        let r = &self.reference;
+        let dt = t - r.period;
+        let guess = [r.state0[0] + self.tangent[0] * dt, r.state0[2] + self.tangent[1] * dt, r.state0[4] + self.tangent[2] * dt];
+        let mut sh = self.shooting;
+        sh.t_max = t;
+        let o = sh.correct(guess, SymConstraint::Period(t)).ok()?;
+        let v = family_tangent(&o.evaluation, self.shooting.spatial)?;
+        Some((o, [v[0], 0.0, v[1], 0.0, v[2], 0.0]))
+    }
+}
+
+struct FormAcross<'a> {
+    starts: &'a [StartAcross3d],
+    opts: Options3d,
+    max_period_step: f64,
+}
+
+const ROWS7: [usize; 7] = [0, 1, 2, 3, 4, 5, 6];
+
+/// The end of one bordered trajectory: the state and 13x13 STM at K T(p), d y(KT) / d T along
+/// the family, and the member.
+type OutAcross = Option<(Vec<f64>, Vec<f64>, [f64; 13], [f64; 6], f64)>;
+
+impl Problem<7> for FormAcross<'_> {
+    type Cand = usize;
+    type Traj = (Traj, f64);
+    type Out = OutAcross;
+    fn initial(&self, c: &usize) -> [f64; 7] {
+        let s = &self.starts[*c];
+        [0.0, 0.0, 0.0, s.w[0], s.w[1], s.w[2], s.period]
+    }
+    fn push(&self, c: &usize, x: &[f64; 7], out: &mut Vec<(Traj, f64)>) -> bool {
+        if !(x[6].is_finite() && x[6] > 0.0) {
+            return false;
+        }
+        let (q, _) = qexp_about(&self.starts[*c].q, &[x[0], x[1], x[2]]);
+        let mut s = [0.0; 13];
+        s[6..10].copy_from_slice(&q);
+        s[10..13].copy_from_slice(&x[3..6]);
+        out.push((s, x[6]));
+        true
+    }
+    fn per_point(&self) -> usize {
+        1
+    }
+    fn evaluate(&self, c: &usize, x: &[f64; 7], o: &[OutAcross]) -> Option<Eval<7>> {
+        let (yt, stm, dydt, _, _) = o.first()?.as_ref()?;
+        let (q0, dq0) = qexp_about(&self.starts[*c].q, &[x[0], x[1], x[2]]);
+        let (f6, j6, mono) = closure_rows(&q0, &dq0, &[x[3], x[4], x[5]], yt, stm)?;
+        // d F / d T: the end state moves by dydt (orbit columns of the STM on d s0 / d T, plus
+        // the vector field times K); q0 and w0 do not depend on T
+        let qt: Quat = [yt[6], yt[7], yt[8], yt[9]];
+        let mut delta = qmul(&conj(&q0), &qt);
+        let nd = delta.iter().map(|v| v * v).sum::<f64>().sqrt();
+        let sign = if delta[3] < 0.0 { -1.0 } else { 1.0 } / nd;
+        delta = delta.map(|v| v * sign);
+        let (_, dlog) = qlog(&delta);
+        let lc = lmat(&conj(&q0));
+        let dd: [f64; 4] = std::array::from_fn(|i| sign * (0..4).map(|k| lc[i][k] * dydt[6 + k]).sum::<f64>());
+        let s = &self.starts[*c];
+        let mut f = [0.0; 7];
+        let mut jac = [[0.0; 7]; 7];
+        for i in 0..6 {
+            f[i] = f6[i];
+            jac[i][..6].copy_from_slice(&j6[i]);
+            jac[i][6] = if i < 3 { (0..4).map(|k| dlog[i][k] * dd[k]).sum() } else { dydt[10 + i - 3] };
+        }
+        f[6] = (0..7).map(|k| s.a[k] * x[k]).sum::<f64>() - s.b;
+        jac[6] = s.a;
+        let mut keep: Vec<f64> = mono.iter().flatten().copied().collect();
+        keep.extend((0..6).map(|i| jac[i][6]));
+        Some(Eval { f, jac, keep })
+    }
+    fn rows(&self) -> &[usize] {
+        &ROWS7
+    }
+    fn cols(&self) -> &[usize] {
+        &ROWS7
+    }
+    fn closure_rows(&self) -> &[usize] {
+        &ROWS7[..6]
+    }
+    fn step_scale(&self, d: &[f64; 7]) -> f64 {
+        let na = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+        let nw = (d[3] * d[3] + d[4] * d[4] + d[5] * d[5]).sqrt();
+        let cap = |v: f64, m: f64| if v > m { m / v } else { 1.0 };
+        cap(na, self.opts.max_angle_step).min(cap(nw, self.opts.max_rate_step)).min(cap(d[6].abs(), self.max_period_step))
+    }
+}
+
+/// q_ref (x) Exp(theta) and its derivative (4x3).
+fn qexp_about(qr: &Quat, theta: &[f64; 3]) -> (Quat, [[f64; 3]; 4]) {
+    let (e, de) = qexp(theta);
+    let l = lmat(qr);
+    let d: [[f64; 3]; 4] = std::array::from_fn(|i| std::array::from_fn(|j| (0..4).map(|k| l[i][k] * de[k][j]).sum()));
+    (qmul(qr, &e), d)
+}
+
+/// The full-period closure rows (Log(q0* (x) qT), wT - w0), their Jacobian in (theta, w0) and
+/// the 6x6 monodromy, from the end state and 13x13 STM (the same algebra as [`Form3d`]).
+#[allow(clippy::type_complexity)]
+fn closure_rows(q0: &Quat, dq0: &[[f64; 3]; 4], w0: &[f64; 3], yt: &[f64], stm: &[f64]) -> Option<([f64; 6], [[f64; 6]; 6], [[f64; 6]; 6])> {
+    if !(yt.iter().all(|v| v.is_finite()) && stm.iter().all(|v| v.is_finite())) {
+        return None;
+    }
+    let qt: Quat = [yt[6], yt[7], yt[8], yt[9]];
+    let phi = |i: usize, j: usize| stm[i * 13 + j];
+    let mut delta = qmul(&conj(q0), &qt);
+    let nd = delta.iter().map(|v| v * v).sum::<f64>().sqrt();
+    let sign = if delta[3] < 0.0 { -1.0 } else { 1.0 } / nd;
+    delta = delta.map(|v| v * sign);
+    let (r, dlog) = qlog(&delta);
+    let dqt: [[f64; 6]; 4] = std::array::from_fn(|i| std::array::from_fn(|j| if j < 3 { (0..4).map(|k| phi(6 + i, 6 + k) * dq0[k][j]).sum() } else { phi(6 + i, 10 + j - 3) }));
+    let dwt: [[f64; 6]; 3] = std::array::from_fn(|i| std::array::from_fn(|j| if j < 3 { (0..4).map(|k| phi(10 + i, 6 + k) * dq0[k][j]).sum() } else { phi(10 + i, 10 + j - 3) }));
+    let (rq, lc) = (rmat(&qt), lmat(&conj(q0)));
+    let ddelta: [[f64; 6]; 4] = std::array::from_fn(|i| {
+        std::array::from_fn(|j| {
+            let a: f64 = if j < 3 { (0..4).map(|k| rq[i][k] * if k < 3 { -dq0[k][j] } else { dq0[k][j] }).sum() } else { 0.0 };
+            let b: f64 = (0..4).map(|k| lc[i][k] * dqt[k][j]).sum();
+            sign * (a + b)
+        })
+    });
+    let mut f = [0.0; 6];
+    let mut jac = [[0.0; 6]; 6];
+    for i in 0..3 {
+        f[i] = r[i];
+        f[3 + i] = yt[10 + i] - w0[i];
+        for j in 0..6 {
+            jac[i][j] = (0..4).map(|k| dlog[i][k] * ddelta[k][j]).sum();
+            jac[3 + i][j] = dwt[i][j] - if j == 3 + i { 1.0 } else { 0.0 };
+        }
+    }
+    let m13: [[f64; 13]; 13] = std::array::from_fn(|i| std::array::from_fn(|j| phi(i, j)));
+    Some((f, jac, reduce(&m13, q0, &qt)))
+}
+
+/// The bordered 3-D correction across an x-z-symmetric orbit family (DROs, planar Lyapunov
+/// orbits, halos and NRHOs): as [`correct_attitudes_3d`] (full period, K = `n_periods`), with the
+/// orbit period T an unknown too, closed by each candidate's linear condition
+/// a . (theta, w0, T) = b ([`StartAcross3d`]).
+///
+/// The family enters through each point's own member: at every Newton point, the orbit of
+/// period T is corrected by symmetric shooting with the period fixed (from the first-order guess
+/// along the family's tangent at the reference member `member0` of period `period0`) to 1e-12,
+/// and the coupled model is integrated along it over K T. The column d F / d T is exact: the
+/// 13x13 STM's orbit columns applied to the family's tangent d s0 / d T (from the shooting's
+/// sensitivities: the crossing conditions xdot_c = zdot_c = 0 held and T = 2 t_half moved,
+/// one 3x3 solve), plus the vector field at K T times K, through the same Log/Exp Jacobians as the
+/// closure rows. So the reported solution's orbit is a family member corrected at the final T.
+/// Each Newton step in T is capped at `max_period_step` (TU).
+pub fn correct_attitudes_3d_across(
+    mu: f64,
+    body: RigidBody,
+    member0: &[f64; 6],
+    period0: f64,
+    n_periods: usize,
+    starts: &[StartAcross3d],
+    max_period_step: f64,
+    opts: &Options3d,
+) -> Result<Vec<CorrectionAcross3d>> {
+    check_mu(mu)?;
+    RigidBody::new(body.ix, body.iy, body.iz)?;
+    check_finite("orbit0", member0)?;
+    check_positive("period", period0)?;
+    check_positive("max_period_step", max_period_step)?;
+    check_positive("tol", opts.tol)?;
+    crate::integrate::check_tolerances(opts.rtol, opts.atol)?;
+    if n_periods == 0 {
+        return Err(invalid("n_periods", "must be >= 1"));
+    }
+    if opts.max_iter == 0 {
+        return Err(invalid("max_iter", "must be >= 1"));
+    }
+    if opts.half {
+        return Err(invalid("half", "the bordered correction across a family uses the full period"));
+    }
+    if opts.threads == Some(0) {
+        return Err(invalid("threads", "must be >= 1 (or None for all cores)"));
+    }
+    for (i, s) in starts.iter().enumerate() {
+        if !(s.q.iter().all(|v| v.is_finite()) && s.w.iter().all(|v| v.is_finite()) && s.a.iter().all(|v| v.is_finite()) && s.b.is_finite()) {
+            return Err(invalid("guess", format!("start {i}: q, w, a and b must be finite")));
+        }
+        if !(s.period.is_finite() && s.period > 0.0) {
+            return Err(invalid("period", format!("start {i}: must be finite and > 0, got {}", s.period)));
+        }
+        if s.a.iter().all(|&v| v == 0.0) {
+            return Err(invalid("a", format!("start {i}: the linear condition needs a non-zero row")));
+        }
+        let n = s.q.iter().map(|v| v * v).sum::<f64>().sqrt();
+        if (n - 1.0).abs() > 1e-9 {
+            return Err(invalid("guess", format!("start {i}: q must be a unit quaternion (scalar last), |q| = {n}")));
+        }
+    }
+    let starts: Vec<StartAcross3d> = starts.iter().map(|s| StartAcross3d { q: s.q.map(|v| v / s.q.iter().map(|u| u * u).sum::<f64>().sqrt()), ..*s }).collect();
+    let family = SymmetricFamily::new(mu, member0, period0, opts.rtol, opts.atol)?;
+    let form = FormAcross { starts: &starts, opts: *opts, max_period_step };
+    let gg = GravityGradient { primaries: opts.primaries };
+    let integ = Options::with_tolerances(opts.rtol, opts.atol);
+    let k = n_periods as f64;
+    let one = |(y, t): &(Traj, f64)| -> OutAcross {
+        let (orbit, ds0) = family.member(*t)?;
+        let mut s = *y;
+        s[..6].copy_from_slice(&orbit.state0);
+        let torques: [&dyn Torque; 1] = [&gg];
+        let tf = k * orbit.period;
+        let r = propagate_attitude(mu, body, &torques, OrbitMode::Integrate, &s, 0.0, tf, &integ, true, Output::Final, None, None).ok()?;
+        let yt: [f64; 13] = r.states[r.states.len() - 13..].try_into().ok()?;
+        let stm = r.stm_final?;
+        let model = Coupled { mu, body, torques: vec![&gg], orbit: OrbitMode::Integrate, orbit_srp: None };
+        let mut f = [0.0; 13];
+        model.derivative(tf, &yt, &mut f);
+        let dydt: [f64; 13] = std::array::from_fn(|i| (0..6).map(|j| stm[i * 13 + j] * ds0[j]).sum::<f64>() + k * f[i]);
+        Some((yt.to_vec(), stm, dydt, orbit.state0, orbit.period))
+    };
+    let settings = Settings { tol: opts.tol, max_iter: opts.max_iter, max_halvings: opts.max_halvings };
+    let cands: Vec<usize> = (0..starts.len()).collect();
+    let tracks = with_threads(opts.threads, || newton::solve(&form, &cands, &settings, &|b: &[(Traj, f64)]| Ok(b.par_iter().map(one).collect())))??;
+    // the member at each final point (cheap: one symmetric shooting, no attitude integration)
+    let members: Vec<Option<SymmetricOrbit>> = with_threads(opts.threads, || tracks.par_iter().map(|t| t.cur.as_ref().and_then(|p| family.member(p.x[6])).map(|m| m.0)).collect())?;
+    Ok(tracks
+        .iter()
+        .zip(members)
+        .enumerate()
+        .map(|(c, (t, m))| {
+            let x = t.x();
+            let (q0, _) = qexp_about(&starts[c].q, &[x[0], x[1], x[2]]);
+            let p = t.cur.as_ref();
+            let keep = p.map(|p| p.keep.as_slice()).filter(|k| k.len() == 42);
+            CorrectionAcross3d {
+                q0,
+                w0: [x[3], x[4], x[5]],
+                orbit0: m.as_ref().map_or([f64::NAN; 6], |m| m.state0),
+                period: m.as_ref().map_or(f64::NAN, |m| m.period),
+                residual: p.map_or([f64::NAN; 7], |p| p.f),
+                residual_norm: p.map_or(f64::NAN, |p| p.norm),
+                iterations: t.iterations,
+                reason: t.reason(),
+                monodromy: keep.map_or([[f64::NAN; 6]; 6], |k| std::array::from_fn(|i| std::array::from_fn(|j| k[6 * i + j]))),
+                dparam: keep.map_or([f64::NAN; 6], |k| std::array::from_fn(|i| k[36 + i])),
+            }
+        })
+        .collect())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -473,5 +806,74 @@ mod tests {
             let v: f64 = (0..3).map(|i| a[i][k] * w[i]).sum();
             assert!((v - if k == 2 { wz } else { 0.0 }).abs() < 1e-12);
         }
+    }
+
+    /// The bordered correction across the DRO family (earth-moon; the body of Kz = 0.8, the
+    /// N = 1 motion at T = 25.49 d, unstable in the plane): with the period fixed it converges
+    /// back onto the plain solution (1e-10), and its exact d F / d T gives the family's
+    /// derivative d(theta, w0)/dT = -(M - I)^-1 dF/dT, which matches central differences of
+    /// plain corrections on the members at T +- h (relative 1e-6; h = 1e-4 TU: O(h^2) ~ 1e-8).
+    #[test]
+    #[allow(clippy::needless_range_loop)]
+    fn bordered_derivative_matches_central_differences_of_plain_corrections() {
+        use nalgebra::{Matrix6, Vector6};
+        let mu = 0.012150585609624;
+        let body = RigidBody::new(0.1, 0.9, 1.0).unwrap();
+        let opts = Options3d::default();
+        // the DRO of x0 = 0.5385 and its period, from symmetric shooting with x0 fixed
+        let mut sh = SymmetricShooting::new(mu, false, Options::with_tolerances(1e-13, 1e-13));
+        sh.tol = 1e-12;
+        let dro = sh.correct([0.5385453306274934, 0.0, 0.6], SymConstraint::Fix(super::super::symmetric::Var::X0, 0.5385453306274934)).unwrap();
+        let t0 = dro.period;
+        let start = Start3d { q: [0.0, 0.0, 0.0, 1.0], w: [0.0, 0.0, 3.9254597] };
+        let plain = &correct_attitudes_3d(mu, body, &dro.state0, t0, &[start], &opts).unwrap()[0];
+        assert_eq!(plain.reason, StopReason::Converged);
+        let tilted = Start3d { q: qexp(&[1e-4, -2e-4, 3e-4]).0, w: [1e-4, 1e-4, plain.w0[2] + 1e-3] };
+        let mut a = [0.0; 7];
+        a[6] = 1.0;
+        let across = StartAcross3d { q: tilted.q, w: tilted.w, period: t0, a, b: t0 };
+        let b = &correct_attitudes_3d_across(mu, body, &dro.state0, t0, 1, &[across], 0.5, &opts).unwrap()[0];
+        assert_eq!(b.reason, StopReason::Converged, "{b:?}");
+        assert!((b.period - t0).abs() < 1e-12);
+        for k in 0..3 {
+            assert!((b.w0[k] - plain.w0[k]).abs() < 1e-10, "{:?} vs {:?}", b.w0, plain.w0);
+        }
+        let (dq, _) = qlog(&qmul(&conj(&plain.q0), &b.q0));
+        assert!(dq.iter().all(|v| v.abs() < 1e-10), "{dq:?}");
+        // predicted d(theta, w0)/dT in the solution's body-axis chart
+        let m = Matrix6::from_fn(|i, j| b.monodromy[i][j]) - Matrix6::identity();
+        let pred = -m.lu().solve(&Vector6::from_fn(|i, _| b.dparam[i])).unwrap();
+        let h = 1e-4;
+        let family = SymmetricFamily::new(mu, &dro.state0, t0, 1e-13, 1e-13).unwrap();
+        let side = |t: f64| {
+            let (o, _) = family.member(t).unwrap();
+            let c = correct_attitudes_3d(mu, body, &o.state0, o.period, &[Start3d { q: b.q0, w: b.w0 }], &opts).unwrap()[0].clone();
+            assert_eq!(c.reason, StopReason::Converged);
+            let (th, _) = qlog(&qmul(&conj(&b.q0), &c.q0));
+            (o.period, [th[0], th[1], th[2], c.w0[0], c.w0[1], c.w0[2]])
+        };
+        let ((tp, xp), (tm, xm)) = (side(t0 + h), side(t0 - h));
+        let scale = pred.amax();
+        for i in 0..6 {
+            let fd = (xp[i] - xm[i]) / (tp - tm);
+            assert!((fd - pred[i]).abs() <= 1e-6 * scale, "component {i}: {fd} vs {}", pred[i]);
+        }
+    }
+
+    /// Invalid arguments of the bordered corrector are errors naming the parameter, never panics.
+    #[test]
+    fn bordered_invalid_arguments() {
+        let mu = 0.012150585609624;
+        let body = RigidBody::new(0.1, 0.9, 1.0).unwrap();
+        let dro = [0.8, 0.0, 0.0, 0.0, 0.5, 0.0];
+        let mut a = [0.0; 7];
+        a[6] = 1.0;
+        let ok = StartAcross3d { q: [0.0, 0.0, 0.0, 1.0], w: [0.0, 0.0, 1.0], period: 3.0, a, b: 3.0 };
+        let run = |m: &[f64; 6], s: StartAcross3d, o: Options3d| correct_attitudes_3d_across(mu, body, m, 3.0, 1, &[s], 0.5, &o).unwrap_err().to_string();
+        assert!(run(&[0.8, 0.1, 0.0, 0.0, 0.5, 0.0], ok, Options3d::default()).contains("orbit0"));
+        assert!(run(&dro, StartAcross3d { a: [0.0; 7], ..ok }, Options3d::default()).contains("`a`"));
+        assert!(run(&dro, StartAcross3d { period: -1.0, ..ok }, Options3d::default()).contains("period"));
+        assert!(run(&dro, ok, Options3d { half: true, ..Options3d::default() }).contains("half"));
+        assert!(correct_attitudes_3d_across(mu, body, &dro, 3.0, 0, &[ok], 0.5, &Options3d::default()).unwrap_err().to_string().contains("n_periods"));
     }
 }
