@@ -95,10 +95,10 @@ fn val_lanes_match_scalar_model() {
                 let tr = propagate_attitude(MU, c.body, &[&gg as &dyn Torque], OrbitMode::Integrate, &y0, 0.0, k * period, &tight(), false, Output::Final, None, None).unwrap();
                 let y = &tr.states[..13];
                 let r = attitude_residual(&c.q0, &c.w0, &[y[6], y[7], y[8], y[9]], &[y[10], y[11], y[12]]);
-                for i in 0..6 {
-                    let d = (o.residual[i] - r[i]).abs();
+                for (i, (a, b)) in o.residual.iter().zip(&r).enumerate() {
+                    let d = (a - b).abs();
                     worst = worst.max(d);
-                    assert!(d < 1e-9, "period {period}, K = {k}, case {c:?}, component {i}: {} vs {}", o.residual[i], r[i]);
+                    assert!(d < 1e-9, "period {period}, K = {k}, case {c:?}, component {i}: {a} vs {b}");
                 }
             }
             eprintln!("orbit period {period:.6}, K = {k}: largest residual difference lanes vs scalar {worst:.2e}");
