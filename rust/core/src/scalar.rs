@@ -22,8 +22,37 @@ pub trait Arith: Copy + Add<Output = Self> + Sub<Output = Self> + Mul<Output = S
     fn scale(self, k: f64) -> Self;
 }
 
+/// Multiplication by a coefficient of type K: an f64 for f64 and [`Dual`] (a scaling), a per-lane
+/// value for [`F8`]. A trait rather than a closure argument: closures are not
+/// `#[inline(always)]`, and a lane operation left in an out-of-line closure is compiled without
+/// the dispatched level's target features (a call per operation).
+pub trait MulBy<K>: Copy {
+    fn mul_by(self, k: K) -> Self;
+}
+
+impl MulBy<f64> for f64 {
+    #[inline(always)]
+    fn mul_by(self, k: f64) -> Self {
+        self * k
+    }
+}
+
+impl<const N: usize> MulBy<f64> for Dual<N> {
+    #[inline(always)]
+    fn mul_by(self, k: f64) -> Self {
+        self.scale(k)
+    }
+}
+
+impl<I: Isa> MulBy<F8<I>> for F8<I> {
+    #[inline(always)]
+    fn mul_by(self, k: F8<I>) -> Self {
+        self * k
+    }
+}
+
 /// Scalar arithmetic needed by the dynamics.
-pub trait Real: Arith + Send + Sync {
+pub trait Real: Arith + MulBy<f64> + Send + Sync {
     fn cst(x: f64) -> Self;
     fn sqrt(self) -> Self;
     /// The value part.

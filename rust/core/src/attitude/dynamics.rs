@@ -55,11 +55,11 @@ pub fn dcm_with<R: Arith>(q: &[R; 4], one: R) -> [[R; 3]; 3] {
     let [q1, q2, q3, q4] = *q;
     let n = one / (q1 * q1 + q2 * q2 + q3 * q3 + q4 * q4);
     let (a, b, c, d) = (q1 * q1, q2 * q2, q3 * q3, q4 * q4);
-    let two = |x: R| x.scale(2.0) * n;
+    // 2 x n, written out (no closure: see crate::scalar::MulBy)
     [
-        [(a - b - c + d) * n, two(q1 * q2 + q3 * q4), two(q1 * q3 - q2 * q4)],
-        [two(q1 * q2 - q3 * q4), (-a + b - c + d) * n, two(q2 * q3 + q1 * q4)],
-        [two(q1 * q3 + q2 * q4), two(q2 * q3 - q1 * q4), (-a - b + c + d) * n],
+        [(a - b - c + d) * n, (q1 * q2 + q3 * q4).scale(2.0) * n, (q1 * q3 - q2 * q4).scale(2.0) * n],
+        [(q1 * q2 - q3 * q4).scale(2.0) * n, (-a + b - c + d) * n, (q2 * q3 + q1 * q4).scale(2.0) * n],
+        [(q1 * q3 + q2 * q4).scale(2.0) * n, (q2 * q3 - q1 * q4).scale(2.0) * n, (-a - b + c + d) * n],
     ]
 }
 
@@ -133,7 +133,7 @@ impl Coupled<'_> {
             }
         }
         let inv = inertia.map(|v| 1.0 / v);
-        let wd = euler_rate(&tq, &w, &inertia, &inv, |v: R, k: f64| v.scale(k));
+        let wd = euler_rate(&tq, &w, &inertia, &inv);
         dy[10..13].copy_from_slice(&wd);
     }
 }

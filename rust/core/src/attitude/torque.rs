@@ -1,7 +1,7 @@
 //! External torques on the body, one implementation per physical effect.
 
 use super::dual::{Dual, Real};
-use crate::scalar::Arith;
+use crate::scalar::{Arith, MulBy};
 
 /// Dual numbers over the 13 coupled states (orbit 6, quaternion 4, rate 3).
 pub type D13 = Dual<13>;
@@ -31,7 +31,12 @@ pub trait Torque: Send + Sync {
 
 #[inline(always)]
 pub(crate) fn mat_vec<R: Arith>(a: &[[R; 3]; 3], v: &[R; 3]) -> [R; 3] {
-    std::array::from_fn(|i| a[i][0] * v[0] + a[i][1] * v[1] + a[i][2] * v[2])
+    [dot3(&a[0], v), dot3(&a[1], v), dot3(&a[2], v)]
+}
+
+#[inline(always)]
+pub(crate) fn dot3<R: Arith>(u: &[R; 3], v: &[R; 3]) -> R {
+    u[0] * v[0] + u[1] * v[1] + u[2] * v[2]
 }
 
 #[inline(always)]
@@ -54,7 +59,7 @@ impl GravityGradient {
     #[inline(always)]
     fn eval<R: Real>(&self, x: &TorqueInput<R>) -> [R; 3] {
         let m = tidal_tensor(x.mu, &x.pos, self.primaries);
-        gravity_gradient_torque(&x.a, &m, &x.inertia, |v: R, k: f64| v.scale(k))
+        gravity_gradient_torque(&x.a, &m, &x.inertia)
     }
 }
 
@@ -87,26 +92,25 @@ pub fn tidal_tensor<R: Real>(mu: f64, pos: &[R; 3], primaries: [bool; 2]) -> [R;
 /// The gravity-gradient torque in body axes from the synodic tidal tensor `m` ([`tidal_tensor`])
 /// and the attitude matrix `a` (synodic -> body): with N = A M A' (the tensor in body axes),
 /// T = ((Iz - Iy) N_yz, (Ix - Iz) N_xz, (Iy - Ix) N_xy), i.e. sum_i 3 mu_i / r_i^5 (r_i x I r_i)
-/// with r_i in body axes. `inertia` (the principal moments, K = f64 or per-lane values) enters
-/// through `mul(value, moment difference)`, so the scalar model scales and the lanes multiply.
+/// with r_i in body axes. `inertia` holds the principal moments: f64 for the scalar model (a
+/// scaling), per-lane values for the SIMD lanes ([`MulBy`]).
 #[inline(always)]
-pub fn gravity_gradient_torque<R: Arith, K: Copy + std::ops::Sub<Output = K>>(a: &[[R; 3]; 3], m: &[R; 6], inertia: &[K; 3], mul: impl Fn(R, K) -> R) -> [R; 3] {
+pub fn gravity_gradient_torque<R: Arith + MulBy<K>, K: Copy + std::ops::Sub<Output = K>>(a: &[[R; 3]; 3], m: &[R; 6], inertia: &[K; 3]) -> [R; 3] {
     let [xx, yy, zz, xy, xz, yz] = *m;
     let full = [[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]];
     let v1 = mat_vec(&full, &a[1]);
     let v2 = mat_vec(&full, &a[2]);
-    let dot = |u: &[R; 3], v: &[R; 3]| u[0] * v[0] + u[1] * v[1] + u[2] * v[2];
-    let (n_xy, n_xz, n_yz) = (dot(&a[0], &v1), dot(&a[0], &v2), dot(&a[1], &v2));
-    [mul(n_yz, inertia[2] - inertia[1]), mul(n_xz, inertia[0] - inertia[2]), mul(n_xy, inertia[1] - inertia[0])]
+    let (n_xy, n_xz, n_yz) = (dot3(&a[0], &v1), dot3(&a[0], &v2), dot3(&a[1], &v2));
+    [n_yz.mul_by(inertia[2] - inertia[1]), n_xz.mul_by(inertia[0] - inertia[2]), n_xy.mul_by(inertia[1] - inertia[0])]
 }
 
 /// Euler's equations, wdot = I^-1 (T - w x I w), with the moments `inertia` and their inverses
-/// `inv` entering through `mul` (as in [`gravity_gradient_torque`]).
+/// `inv` (as in [`gravity_gradient_torque`]).
 #[inline(always)]
-pub fn euler_rate<R: Arith, K: Copy>(torque: &[R; 3], w: &[R; 3], inertia: &[K; 3], inv: &[K; 3], mul: impl Fn(R, K) -> R) -> [R; 3] {
-    let iw = [mul(w[0], inertia[0]), mul(w[1], inertia[1]), mul(w[2], inertia[2])];
+pub fn euler_rate<R: Arith + MulBy<K>, K: Copy>(torque: &[R; 3], w: &[R; 3], inertia: &[K; 3], inv: &[K; 3]) -> [R; 3] {
+    let iw = [w[0].mul_by(inertia[0]), w[1].mul_by(inertia[1]), w[2].mul_by(inertia[2])];
     let gyro = cross(w, &iw);
-    std::array::from_fn(|i| mul(torque[i] - gyro[i], inv[i]))
+    [(torque[0] - gyro[0]).mul_by(inv[0]), (torque[1] - gyro[1]).mul_by(inv[1]), (torque[2] - gyro[2]).mul_by(inv[2])]
 }
 
 impl Torque for GravityGradient {

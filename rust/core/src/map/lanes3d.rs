@@ -61,13 +61,14 @@ impl<I: Isa> Rhs<I, D> for Rigid<'_, I> {
     #[inline(always)]
     fn eval(&self, t: f64, y: &[F8<I>; D], dy: &mut [F8<I>; D]) {
         let isa = y[0].isa();
-        let m = self.table.eval_at::<I>(t).map(|v| F8::splat(isa, v));
+        let m6 = self.table.eval_at::<I>(t);
+        let m = [F8::splat(isa, m6[0]), F8::splat(isa, m6[1]), F8::splat(isa, m6[2]), F8::splat(isa, m6[3]), F8::splat(isa, m6[4]), F8::splat(isa, m6[5])];
         let q = [y[0], y[1], y[2], y[3]];
         let w = [y[4], y[5], y[6]];
         let a = dcm_with(&q, self.one);
         let qd = quat_rate(&q, &a, &w);
-        let tq = gravity_gradient_torque(&a, &m, &self.inertia, |v: F8<I>, k: F8<I>| v * k);
-        let wd = euler_rate(&tq, &w, &self.inertia, &self.inv, |v: F8<I>, k: F8<I>| v * k);
+        let tq = gravity_gradient_torque(&a, &m, &self.inertia);
+        let wd = euler_rate(&tq, &w, &self.inertia, &self.inv);
         dy[..4].copy_from_slice(&qd);
         dy[4..].copy_from_slice(&wd);
     }
