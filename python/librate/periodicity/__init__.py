@@ -13,6 +13,7 @@ from .attitude3d import (
 from .branches import SrpContinuation, continue_srp, periodic_attitude
 from .families import AttitudeFamily, attitude_family
 from .flexible import FlexiblePeriodic, FrequencyScan, flexible_periodic, frequency_scan
+from .map3d import attitude_map_3d, find_periodic_attitudes_3d
 from .maps import periodicity_map, zero_contours
 from .solutions import (
     MAP_ATOL,
@@ -29,6 +30,8 @@ __all__ = [
     "AttitudeSolution",
     "AttitudeSolution3D",
     "periodic_attitude_3d",
+    "attitude_map_3d",
+    "find_periodic_attitudes_3d",
     "out_of_plane_stability",
     "out_of_plane_family",
     "attitude_family_3d",

@@ -48,7 +48,7 @@ from .solutions import AttitudeSolution
 
 __all__ = ["AttitudeSolution3D", "periodic_attitude_3d", "is_mirror_symmetric", "out_of_plane_stability", "out_of_plane_family", "attitude_family_3d",
            "attitude_family_3d_inertia", "OrbitFamilyBranch3D", "FamilyMember3D", "rotvec_jacobian", "InertiaBranch3D", "STABILITY_TOL", "VERIFY_RTOL", "floquet_tests",
-           "SOLVE_RTOL"]
+           "SOLVE_RTOL", "verified_solution_3d"]
 
 #: A multiplier lies on the unit circle when ||m| - 1| <= STABILITY_TOL. The monodromy is
 #: accurate to about 1e-10, and a Krein collision spreads that to its square root.
@@ -232,17 +232,20 @@ def periodic_attitude_3d(orbit: PeriodicOrbit, body: RigidBody, *, guess, n_peri
     if r.reason[0] != "converged":
         raise ConvergenceError(f"periodic 3-D attitude: the corrector stopped ({r.reason[0].replace('_', ' ')}) after {int(r.iterations[0])} "
                                f"Newton steps, residual {float(r.residual_norm[0]):.3e} (tolerance {tol:.1e})")
-    return _verified(orbit, body, n_periods, np.asarray(r.q0[0]), np.asarray(r.w0[0]), np.asarray(r.monodromy[0]), int(r.iterations[0]))
+    return verified_solution_3d(orbit, body, n_periods, r.q0[0], r.w0[0], r.monodromy[0], int(r.iterations[0]))
 
 
-def _verified(orbit: PeriodicOrbit, body: RigidBody, n_periods: int, q0, w0, monodromy, iterations: int) -> AttitudeSolution3D:
-    """The solution with its independent re-propagation (``residual``) and turns."""
+def verified_solution_3d(orbit: PeriodicOrbit, body: RigidBody, n_periods: int, q0, w0, monodromy, iterations: int = 0) -> AttitudeSolution3D:
+    """A corrected motion (q0, w0) with the corrector's ``monodromy``, re-propagated
+    independently with the scalar 3-D model at rtol = atol = :data:`VERIFY_RTOL` (its residual
+    and turns), as an :class:`AttitudeSolution3D`."""
+    q0, w0 = np.array(q0, dtype=float), np.array(w0, dtype=float)
     T = n_periods * float(orbit.period)
     t = np.linspace(0.0, T, 512 * n_periods + 1)
     tr = propagate_attitude(orbit.system, orbit.state0, (q0, w0), body, T, t_eval=t, rtol=VERIFY_RTOL, atol=VERIFY_RTOL)
     d_rot = float(np.linalg.norm(_rotvec(q0, tr.q[-1])))
     d_w = float(np.linalg.norm(tr.w[-1] - w0))
-    return AttitudeSolution3D(orbit, body, n_periods, q0, w0, monodromy, d_rot, d_w, _turns(tr.q), iterations)
+    return AttitudeSolution3D(orbit, body, n_periods, q0, w0, np.asarray(monodromy), d_rot, d_w, _turns(tr.q), int(iterations))
 
 
 def out_of_plane_stability(solution: AttitudeSolution) -> AttitudeSolution3D:
@@ -391,7 +394,7 @@ class OrbitFamilyBranch3D:
                                    f"residual {float(r.residual_norm[0]):.2e}")
         state0 = np.asarray(r.orbit0[0])
         orbit = PeriodicOrbit(self.orbits.system, state0, float(r.period[0]), float(self.orbits.system.jacobi(state0)), ref.family)
-        s = _verified(orbit, self.body, self.n_periods, np.asarray(r.q0[0]), np.asarray(r.w0[0]), np.asarray(r.monodromy[0]), int(r.iterations[0]))
+        s = verified_solution_3d(orbit, self.body, self.n_periods, np.asarray(r.q0[0]), np.asarray(r.w0[0]), np.asarray(r.monodromy[0]), int(r.iterations[0]))
         if not s.residual <= 1e-9:
             raise CorrectionFailed(f"re-propagation residual {s.residual:.2e} above 1e-9")
         x = np.concatenate([[orbit.period_days], Rotation.from_quat(s.q0).as_rotvec(), s.w0])

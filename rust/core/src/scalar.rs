@@ -4,7 +4,11 @@
 //!   generic right-hand side gives both the values (f64) and the exact Jacobian (`Dual<N>`) used
 //!   by the variational equations (the CR3BP acceleration, the 3-D attitude model);
 //! - [`Lane`]: f64 and the eight-lane vector [`F8`], so the scalar planar model and the map
-//!   engine's lanes evaluate the same torque laws (gravity gradient, flat-plate SRP).
+//!   engine's lanes evaluate the same torque laws (gravity gradient, flat-plate SRP);
+//! - [`Arith`]: the field operations common to all three (f64, [`Dual`], [`F8`]; no constants,
+//!   which an [`F8`] cannot make without its instruction-set token), so the 3-D attitude laws
+//!   (kinematics, gravity-gradient torque from the tidal tensor, Euler's equations) are written
+//!   once for the scalar model, its STM and the 3-D map lanes.
 //!
 //! This module depends on nothing else in the crate but [`crate::simd`]'s instruction-set
 //! markers (cr3bp and attitude both build on it).
@@ -13,15 +17,53 @@ use std::ops::{Add, AddAssign, Div, Mul, Neg, Sub};
 
 use crate::simd::Isa;
 
+/// Field arithmetic and scaling by an f64 (f64, [`Dual`], [`F8`]).
+pub trait Arith: Copy + Add<Output = Self> + Sub<Output = Self> + Mul<Output = Self> + Div<Output = Self> + Neg<Output = Self> {
+    fn scale(self, k: f64) -> Self;
+}
+
+/// Multiplication by a coefficient of type K: an f64 for f64 and [`Dual`] (a scaling), a per-lane
+/// value for [`F8`]. A trait rather than a closure argument: closures are not
+/// `#[inline(always)]`, and a lane operation left in an out-of-line closure is compiled without
+/// the dispatched level's target features (a call per operation).
+pub trait MulBy<K>: Copy {
+    fn mul_by(self, k: K) -> Self;
+}
+
+impl MulBy<f64> for f64 {
+    #[inline(always)]
+    fn mul_by(self, k: f64) -> Self {
+        self * k
+    }
+}
+
+impl<const N: usize> MulBy<f64> for Dual<N> {
+    #[inline(always)]
+    fn mul_by(self, k: f64) -> Self {
+        self.scale(k)
+    }
+}
+
+impl<I: Isa> MulBy<F8<I>> for F8<I> {
+    #[inline(always)]
+    fn mul_by(self, k: F8<I>) -> Self {
+        self * k
+    }
+}
+
 /// Scalar arithmetic needed by the dynamics.
-pub trait Real:
-    Copy + Send + Sync + Add<Output = Self> + Sub<Output = Self> + Mul<Output = Self> + Div<Output = Self> + Neg<Output = Self>
-{
+pub trait Real: Arith + MulBy<f64> + Send + Sync {
     fn cst(x: f64) -> Self;
     fn sqrt(self) -> Self;
     /// The value part.
     fn re(self) -> f64;
-    fn scale(self, k: f64) -> Self;
+}
+
+impl Arith for f64 {
+    #[inline(always)]
+    fn scale(self, k: f64) -> Self {
+        self * k
+    }
 }
 
 impl Real for f64 {
@@ -36,10 +78,6 @@ impl Real for f64 {
     #[inline(always)]
     fn re(self) -> f64 {
         self
-    }
-    #[inline(always)]
-    fn scale(self, k: f64) -> Self {
-        self * k
     }
 }
 
@@ -97,6 +135,13 @@ impl<const N: usize> Neg for Dual<N> {
     }
 }
 
+impl<const N: usize> Arith for Dual<N> {
+    #[inline(always)]
+    fn scale(self, k: f64) -> Self {
+        Self { re: self.re * k, eps: self.eps.map(|e| e * k) }
+    }
+}
+
 impl<const N: usize> Real for Dual<N> {
     #[inline(always)]
     fn cst(x: f64) -> Self {
@@ -111,10 +156,6 @@ impl<const N: usize> Real for Dual<N> {
     #[inline(always)]
     fn re(self) -> f64 {
         self.re
-    }
-    #[inline(always)]
-    fn scale(self, k: f64) -> Self {
-        Self { re: self.re * k, eps: self.eps.map(|e| e * k) }
     }
 }
 
@@ -283,6 +324,13 @@ impl<I: Isa> AddAssign for F8<I> {
     #[inline(always)]
     fn add_assign(&mut self, o: Self) {
         *self = *self + o;
+    }
+}
+
+impl<I: Isa> Arith for F8<I> {
+    #[inline(always)]
+    fn scale(self, k: f64) -> Self {
+        self * Self::splat(self.isa, k)
     }
 }
 

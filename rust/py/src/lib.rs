@@ -23,6 +23,7 @@ mod build;
 mod flexible;
 mod fourier;
 mod map;
+mod map3d;
 mod records;
 
 use records::{PyBatchResult, PyEventHit, PyMultipleShooting, PyShootingEvaluation, PyStats, PySymmetricOrbit, PySystemConstants, PyTrajectory};
@@ -414,6 +415,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     map::register(m)?;
     flexible::register(m)?;
     attitude3d::register(m)?;
+    map3d::register(m)?;
     records::register(m)?;
     build::register(m)?;
     // Physical constants, read from the core (one definition: librate_core::constants).

@@ -12,7 +12,8 @@
 
 use super::body::RigidBody;
 use super::dual::{Dual, Real};
-use super::torque::{cross, mat_vec, Torque, TorqueInput, D13};
+use super::torque::{euler_rate, mat_vec, Torque, TorqueInput, D13};
+use crate::scalar::Arith;
 use crate::integrate::System;
 
 /// Dimension of the coupled state and of the state with its 13x13 STM.
@@ -45,14 +46,34 @@ pub struct Coupled<'a> {
 /// Attitude matrix A(q)/|q|^2 (synodic -> body), scalar-last quaternion.
 #[inline(always)]
 pub fn dcm<R: Real>(q: &[R; 4]) -> [[R; 3]; 3] {
+    dcm_with(q, R::cst(1.0))
+}
+
+/// [`dcm`] over any [`Arith`] type, given its `one` (the SIMD lanes: a splat of 1).
+#[inline(always)]
+pub fn dcm_with<R: Arith>(q: &[R; 4], one: R) -> [[R; 3]; 3] {
     let [q1, q2, q3, q4] = *q;
-    let n = R::cst(1.0) / (q1 * q1 + q2 * q2 + q3 * q3 + q4 * q4);
+    let n = one / (q1 * q1 + q2 * q2 + q3 * q3 + q4 * q4);
     let (a, b, c, d) = (q1 * q1, q2 * q2, q3 * q3, q4 * q4);
-    let two = |x: R| x.scale(2.0) * n;
+    // 2 x n, written out (no closure: see crate::scalar::MulBy)
     [
-        [(a - b - c + d) * n, two(q1 * q2 + q3 * q4), two(q1 * q3 - q2 * q4)],
-        [two(q1 * q2 - q3 * q4), (-a + b - c + d) * n, two(q2 * q3 + q1 * q4)],
-        [two(q1 * q3 + q2 * q4), two(q2 * q3 - q1 * q4), (-a - b + c + d) * n],
+        [(a - b - c + d) * n, (q1 * q2 + q3 * q4).scale(2.0) * n, (q1 * q3 - q2 * q4).scale(2.0) * n],
+        [(q1 * q2 - q3 * q4).scale(2.0) * n, (-a + b - c + d) * n, (q2 * q3 + q1 * q4).scale(2.0) * n],
+        [(q1 * q3 + q2 * q4).scale(2.0) * n, (q2 * q3 - q1 * q4).scale(2.0) * n, (-a - b + c + d) * n],
+    ]
+}
+
+/// The attitude kinematics relative to the synodic frame (turning at rate 1 about Z):
+/// qdot = 1/2 Xi(q) (w - A e_Z), with A = A(q) (its third column is A e_Z).
+#[inline(always)]
+pub fn quat_rate<R: Arith>(q: &[R; 4], a: &[[R; 3]; 3], w: &[R; 3]) -> [R; 4] {
+    let wr = [w[0] - a[0][2], w[1] - a[1][2], w[2] - a[2][2]];
+    let [q1, q2, q3, q4] = *q;
+    [
+        (q4 * wr[0] - q3 * wr[1] + q2 * wr[2]).scale(0.5),
+        (q3 * wr[0] + q4 * wr[1] - q1 * wr[2]).scale(0.5),
+        (-q2 * wr[0] + q1 * wr[1] + q4 * wr[2]).scale(0.5),
+        (-q1 * wr[0] - q2 * wr[1] - q3 * wr[2]).scale(0.5),
     ]
 }
 
@@ -99,12 +120,8 @@ impl Coupled<'_> {
         }
 
         // Kinematics: w_rel = w - A e_Z.
-        let wr = [w[0] - a[0][2], w[1] - a[1][2], w[2] - a[2][2]];
-        let [q1, q2, q3, q4] = q;
-        dy[6] = (q4 * wr[0] - q3 * wr[1] + q2 * wr[2]).scale(0.5);
-        dy[7] = (q3 * wr[0] + q4 * wr[1] - q1 * wr[2]).scale(0.5);
-        dy[8] = (-q2 * wr[0] + q1 * wr[1] + q4 * wr[2]).scale(0.5);
-        dy[9] = (-q1 * wr[0] - q2 * wr[1] - q3 * wr[2]).scale(0.5);
+        let qd = quat_rate(&q, &a, &w);
+        dy[6..10].copy_from_slice(&qd);
 
         // Euler's equations.
         let input = TorqueInput { t, mu, pos, vel, a, w, inertia };
@@ -115,11 +132,9 @@ impl Coupled<'_> {
                 tq[i] = tq[i] + ti[i];
             }
         }
-        let iw = [w[0].scale(inertia[0]), w[1].scale(inertia[1]), w[2].scale(inertia[2])];
-        let gyro = cross(&w, &iw);
-        for i in 0..3 {
-            dy[10 + i] = (tq[i] - gyro[i]).scale(1.0 / inertia[i]);
-        }
+        let inv = inertia.map(|v| 1.0 / v);
+        let wd = euler_rate(&tq, &w, &inertia, &inv);
+        dy[10..13].copy_from_slice(&wd);
     }
 }
 

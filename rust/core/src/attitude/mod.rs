@@ -12,9 +12,9 @@ pub mod srp;
 pub mod torque;
 
 pub use body::RigidBody;
-pub use dynamics::{dcm, Coupled, CoupledStm, OrbitMode};
+pub use dynamics::{dcm, dcm_with, quat_rate, Coupled, CoupledStm, OrbitMode};
 pub use linear::{collinear_equilibrium, Equilibrium};
 pub use planar::{forcing_sc, forcing_scp, gravity_gradient_wzdot, planar_gravity_gradient, Forcing, PlanarAlongOrbit, PlanarForced};
 pub use propagate::{evaluate_torques, propagate_attitude, propagate_planar, AttitudeTrajectory, PlanarTrajectory};
 pub use srp::{flat_plate_wzdot, Facet, FacetBody, FlatPlate, Sun, N_SUN, OMEGA_SUN, P0, SOLAR_PRESSURE_1AU};
-pub use torque::{gravity_gradient_by_name, GravityGradient, Torque, TorqueInput};
+pub use torque::{euler_rate, gravity_gradient_by_name, gravity_gradient_torque, tidal_tensor, GravityGradient, Torque, TorqueInput};

@@ -1,6 +1,7 @@
 //! External torques on the body, one implementation per physical effect.
 
 use super::dual::{Dual, Real};
+use crate::scalar::{Arith, MulBy};
 
 /// Dual numbers over the 13 coupled states (orbit 6, quaternion 4, rate 3).
 pub type D13 = Dual<13>;
@@ -29,12 +30,17 @@ pub trait Torque: Send + Sync {
 }
 
 #[inline(always)]
-pub(crate) fn mat_vec<R: Real>(a: &[[R; 3]; 3], v: &[R; 3]) -> [R; 3] {
-    std::array::from_fn(|i| a[i][0] * v[0] + a[i][1] * v[1] + a[i][2] * v[2])
+pub(crate) fn mat_vec<R: Arith>(a: &[[R; 3]; 3], v: &[R; 3]) -> [R; 3] {
+    [dot3(&a[0], v), dot3(&a[1], v), dot3(&a[2], v)]
 }
 
 #[inline(always)]
-pub(crate) fn cross<R: Real>(a: &[R; 3], b: &[R; 3]) -> [R; 3] {
+pub(crate) fn dot3<R: Arith>(u: &[R; 3], v: &[R; 3]) -> R {
+    u[0] * v[0] + u[1] * v[1] + u[2] * v[2]
+}
+
+#[inline(always)]
+pub(crate) fn cross<R: Arith>(a: &[R; 3], b: &[R; 3]) -> [R; 3] {
     [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
 }
 
@@ -50,26 +56,61 @@ pub struct GravityGradient {
 impl GravityGradient {
     pub const BOTH: Self = Self { primaries: [true, true] };
 
+    #[inline(always)]
     fn eval<R: Real>(&self, x: &TorqueInput<R>) -> [R; 3] {
-        let mut t = [R::cst(0.0); 3];
-        let centers = [(-x.mu, 1.0 - x.mu), (1.0 - x.mu, x.mu)];
-        for (k, &(cx, gm)) in centers.iter().enumerate() {
-            if !self.primaries[k] {
-                continue;
-            }
-            let rs = [x.pos[0] - R::cst(cx), x.pos[1], x.pos[2]];
-            let rb = mat_vec(&x.a, &rs);
-            let r2 = rb[0] * rb[0] + rb[1] * rb[1] + rb[2] * rb[2];
-            let r5 = r2 * r2 * r2.sqrt();
-            let k3 = R::cst(3.0 * gm) / r5;
-            let irb = [rb[0].scale(x.inertia[0]), rb[1].scale(x.inertia[1]), rb[2].scale(x.inertia[2])];
-            let c = cross(&rb, &irb);
-            for i in 0..3 {
-                t[i] = t[i] + k3 * c[i];
-            }
-        }
-        t
+        let m = tidal_tensor(x.mu, &x.pos, self.primaries);
+        gravity_gradient_torque(&x.a, &m, &x.inertia)
     }
+}
+
+/// The tidal tensor of the primaries at the synodic position `pos`:
+/// M = sum_i 3 mu_i / r_i^5 r_i r_i' (synodic axes, r_i from primary i, mu_1 = 1 - mu,
+/// mu_2 = mu; `primaries` switches either off), as (xx, yy, zz, xy, xz, yz). The gravity-gradient
+/// torque depends on the orbit only through M ([`gravity_gradient_torque`]); the 3-D map
+/// tabulates it once per orbit ([`crate::map::TidalTable`]).
+#[inline(always)]
+pub fn tidal_tensor<R: Real>(mu: f64, pos: &[R; 3], primaries: [bool; 2]) -> [R; 6] {
+    let mut m = [R::cst(0.0); 6];
+    let centers = [(-mu, 1.0 - mu), (1.0 - mu, mu)];
+    for (k, &(cx, gm)) in centers.iter().enumerate() {
+        if !primaries[k] {
+            continue;
+        }
+        let r = [pos[0] - R::cst(cx), pos[1], pos[2]];
+        let r2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
+        let r5 = r2 * r2 * r2.sqrt();
+        let k3 = R::cst(3.0 * gm) / r5;
+        let kr = [k3 * r[0], k3 * r[1], k3 * r[2]];
+        let terms = [kr[0] * r[0], kr[1] * r[1], kr[2] * r[2], kr[0] * r[1], kr[0] * r[2], kr[1] * r[2]];
+        for i in 0..6 {
+            m[i] = m[i] + terms[i];
+        }
+    }
+    m
+}
+
+/// The gravity-gradient torque in body axes from the synodic tidal tensor `m` ([`tidal_tensor`])
+/// and the attitude matrix `a` (synodic -> body): with N = A M A' (the tensor in body axes),
+/// T = ((Iz - Iy) N_yz, (Ix - Iz) N_xz, (Iy - Ix) N_xy), i.e. sum_i 3 mu_i / r_i^5 (r_i x I r_i)
+/// with r_i in body axes. `inertia` holds the principal moments: f64 for the scalar model (a
+/// scaling), per-lane values for the SIMD lanes ([`MulBy`]).
+#[inline(always)]
+pub fn gravity_gradient_torque<R: Arith + MulBy<K>, K: Copy + std::ops::Sub<Output = K>>(a: &[[R; 3]; 3], m: &[R; 6], inertia: &[K; 3]) -> [R; 3] {
+    let [xx, yy, zz, xy, xz, yz] = *m;
+    let full = [[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]];
+    let v1 = mat_vec(&full, &a[1]);
+    let v2 = mat_vec(&full, &a[2]);
+    let (n_xy, n_xz, n_yz) = (dot3(&a[0], &v1), dot3(&a[0], &v2), dot3(&a[1], &v2));
+    [n_yz.mul_by(inertia[2] - inertia[1]), n_xz.mul_by(inertia[0] - inertia[2]), n_xy.mul_by(inertia[1] - inertia[0])]
+}
+
+/// Euler's equations, wdot = I^-1 (T - w x I w), with the moments `inertia` and their inverses
+/// `inv` (as in [`gravity_gradient_torque`]).
+#[inline(always)]
+pub fn euler_rate<R: Arith + MulBy<K>, K: Copy>(torque: &[R; 3], w: &[R; 3], inertia: &[K; 3], inv: &[K; 3]) -> [R; 3] {
+    let iw = [w[0].mul_by(inertia[0]), w[1].mul_by(inertia[1]), w[2].mul_by(inertia[2])];
+    let gyro = cross(w, &iw);
+    [(torque[0] - gyro[0]).mul_by(inv[0]), (torque[1] - gyro[1]).mul_by(inv[1]), (torque[2] - gyro[2]).mul_by(inv[2])]
 }
 
 impl Torque for GravityGradient {

@@ -1,15 +1,17 @@
-//! Orbit data computed once per orbit and shared by every attitude trajectory on it: the
-//! gravity-gradient forcing S(t), C(t) of the planar model (docs/physics.md, attitude, atan2-free form)
-//! as piecewise Chebyshev series over one period.
+//! Orbit data computed once per orbit and shared by every attitude trajectory on it, as piecewise
+//! Chebyshev series over one period ([`OrbitTable`], N components): the gravity-gradient forcing
+//! S(t), C(t) of the planar model (docs/physics.md, attitude, atan2-free form; [`OrbitForcing`],
+//! N = 2) and the synodic-frame tidal tensor of both primaries of the 3-D model ([`TidalTable`],
+//! N = 6, [`crate::attitude::tidal_tensor`]).
 //!
 //! The orbit is integrated once at tight tolerance and sampled at the Chebyshev nodes of every
 //! segment (each sample an RK step from the enclosing accepted step); the coefficients are the
-//! exact interpolants at those nodes. The number of segments doubles until S and C at the
-//! segment quarter points, also sampled from the orbit, match the series to `tol` relative to
-//! max(|S|, |C|), or until doubling no longer halves the error (the samples' own integration
-//! noise, ~1e-13 on orbits grazing a primary) while it is below 1e-10.
+//! exact interpolants at those nodes. The number of segments doubles until every component at
+//! the segment quarter points, also sampled from the orbit, matches the series to `tol` relative
+//! to the largest component magnitude, or until doubling no longer halves the error (the
+//! samples' own integration noise, ~1e-13 on orbits grazing a primary) while it is below 1e-10.
 
-use crate::attitude::{forcing_sc, Forcing};
+use crate::attitude::{forcing_sc, tidal_tensor, Forcing};
 use crate::cr3bp::check_mu;
 use crate::error::{check_finite, check_positive, invalid, Error, Result};
 use crate::integrate::{Options, Output};
@@ -20,35 +22,78 @@ use crate::simd::Isa;
 pub const DEGREE: usize = 12;
 const NC: usize = DEGREE + 1;
 
-/// Piecewise Chebyshev representation of S(t), C(t) over one orbit period (periodic in t).
+/// Piecewise Chebyshev representation of N functions of the orbit over one period (periodic in t).
 #[derive(Debug, Clone, PartialEq)]
-pub struct OrbitForcing {
+pub struct OrbitTable<const N: usize> {
     pub period: f64,
     segments: usize,
     seg_len: f64,
-    /// [segment][k][S, C].
+    /// [segment][k][component].
     coef: Vec<f64>,
-    /// Largest relative error measured at the check points.
+    /// Largest error measured at the check points, relative to `scale`.
     pub max_error: f64,
-    /// max(|S|, |C|) over the samples.
+    /// The largest component magnitude over the samples.
     pub scale: f64,
 }
+
+/// Piecewise Chebyshev representation of S(t), C(t) over one orbit period (periodic in t).
+pub type OrbitForcing = OrbitTable<2>;
+
+/// The synodic-frame tidal tensor (xx, yy, zz, xy, xz, yz) of [`crate::attitude::tidal_tensor`]
+/// over one orbit period (periodic in t): all the 3-D gravity-gradient torque needs of the orbit.
+pub type TidalTable = OrbitTable<6>;
 
 fn cheb_nodes() -> [f64; NC] {
     std::array::from_fn(|j| (std::f64::consts::PI * (j as f64 + 0.5) / NC as f64).cos())
 }
 
-impl OrbitForcing {
+impl OrbitTable<2> {
     /// Tabulate the forcing of the planar orbit `state0` with period `period`; `primaries`
     /// selects the gravity-gradient sources [larger, smaller].
     pub fn new(mu: f64, state0: &[f64; 6], period: f64, primaries: [bool; 2], tol: f64) -> Result<Self> {
         check_mu(mu)?;
         check_finite("orbit_state", state0)?;
-        check_positive("period", period)?;
-        check_positive("tol", tol)?;
         if state0[2] != 0.0 || state0[5] != 0.0 {
             return Err(invalid("orbit_state", "the planar attitude model needs a planar orbit (z = zd = 0)"));
         }
+        Self::fit(mu, state0, period, tol, |s| {
+            let (a, b) = forcing_sc(mu, s, primaries);
+            [a, b]
+        })
+    }
+
+    /// S(t), C(t).
+    #[inline]
+    pub fn sc(&self, t: f64) -> (f64, f64) {
+        let [s, c] = self.eval_with(t, crate::scalar::fmadd);
+        (s, c)
+    }
+
+    /// S(t), C(t) with the multiply-adds of the instruction set `I` (the dispatched lane engine).
+    #[inline(always)]
+    pub fn sc_at<I: Isa>(&self, t: f64) -> (f64, f64) {
+        let [s, c] = self.eval_with(t, I::mul_add);
+        (s, c)
+    }
+}
+
+impl OrbitTable<6> {
+    /// Tabulate the tidal tensor of both primaries (or those `primaries` selects, [larger,
+    /// smaller]) along the periodic orbit `state0` (planar or spatial) with period `period`.
+    pub fn tidal(mu: f64, state0: &[f64; 6], period: f64, primaries: [bool; 2], tol: f64) -> Result<Self> {
+        check_mu(mu)?;
+        check_finite("orbit_state", state0)?;
+        Self::fit(mu, state0, period, tol, |s| tidal_tensor(mu, &[s[0], s[1], s[2]], primaries))
+    }
+}
+
+impl<const N: usize> OrbitTable<N> {
+    /// Fit the N functions `g` of the orbit state along the orbit `state0` over one `period`.
+    pub fn fit(mu: f64, state0: &[f64; 6], period: f64, tol: f64, g: impl Fn(&[f64]) -> [f64; N]) -> Result<Self> {
+        check_mu(mu)?;
+        check_finite("orbit_state", state0)?;
+        check_positive("period", period)?;
+        check_positive("tol", tol)?;
         let opts = Options::with_tolerances(1e-14, 1e-14);
         let nodes = cheb_nodes();
         // the discrete Chebyshev transform's weights cos(pi k (j + 1/2) / NC), once
@@ -80,39 +125,43 @@ impl OrbitForcing {
             all.sort_by(|a, b| a.0.total_cmp(&b.0));
             let ts: Vec<f64> = all.iter().map(|a| a.0).collect();
             // an orbit through a primary (within the point-mass sphere) is a typed collision,
-            // never a table of infinite S, C
+            // never a table of infinite values
             let tr = propagate_checked(mu, state0, 0.0, period, &opts, false, Output::At(&ts), &[], &Collision::new([0.0, 0.0])?)?;
             if let Some(hit) = tr.collision {
                 return Err(hit.error(tr.stats.accepted));
             }
             let (mut fit, mut check) = (Vec::with_capacity(fit_t.len()), Vec::with_capacity(check_t.len()));
             for (s, a) in tr.states.chunks_exact(6).zip(&all) {
-                if a.1 { fit.push(forcing_sc(mu, s, primaries)) } else { check.push(forcing_sc(mu, s, primaries)) }
+                if a.1 { fit.push(g(s)) } else { check.push(g(s)) }
             }
-            let mut coef = vec![0.0; segments * NC * 2];
+            let mut coef = vec![0.0; segments * NC * N];
             for s in 0..segments {
                 // fit_t is sorted: segment s holds samples s*NC .. (s+1)*NC in increasing time,
                 // i.e. nodes j = NC-1 .. 0 (x increasing).
                 for k in 0..NC {
-                    let (mut cs, mut cc) = (0.0, 0.0);
+                    let mut cs = [0.0; N];
                     for jj in 0..NC {
                         let j = NC - 1 - jj;
-                        let (sv, cv) = fit[s * NC + jj];
+                        let v = &fit[s * NC + jj];
                         let w = weights[k][j];
-                        cs += sv * w;
-                        cc += cv * w;
+                        for (c, x) in cs.iter_mut().zip(v) {
+                            *c += x * w;
+                        }
                     }
                     let f = if k == 0 { 1.0 } else { 2.0 } / NC as f64;
-                    coef[(s * NC + k) * 2] = cs * f;
-                    coef[(s * NC + k) * 2 + 1] = cc * f;
+                    for (i, c) in cs.iter().enumerate() {
+                        coef[(s * NC + k) * N + i] = c * f;
+                    }
                 }
             }
-            let scale = fit.iter().chain(check.iter()).fold(0.0f64, |m, &(a, b)| m.max(a.abs()).max(b.abs()));
+            let scale = fit.iter().chain(check.iter()).fold(0.0f64, |m, v| v.iter().fold(m, |m, x| m.max(x.abs())));
             let mut table = Self { period, segments, seg_len, coef, max_error: 0.0, scale };
             let mut err = 0.0f64;
-            for (t, &(sv, cv)) in check_t.iter().zip(&check) {
-                let (a, b) = table.sc(*t);
-                err = err.max((a - sv).abs()).max((b - cv).abs());
+            for (t, v) in check_t.iter().zip(&check) {
+                let a = table.eval(*t);
+                for i in 0..N {
+                    err = err.max((a[i] - v[i]).abs());
+                }
             }
             table.max_error = err / scale;
             let at_noise_floor = table.max_error < 1e-10 && table.max_error > 0.5 * previous;
@@ -121,7 +170,7 @@ impl OrbitForcing {
             }
             previous = table.max_error;
             if segments >= 1 << 16 {
-                return Err(Error::Convergence { what: "orbit forcing table (segments)", iterations: segments, residual: table.max_error, tolerance: tol });
+                return Err(Error::Convergence { what: "orbit table (segments)", iterations: segments, residual: table.max_error, tolerance: tol });
             }
             segments *= 2;
         }
@@ -140,38 +189,38 @@ impl OrbitForcing {
         (s, 2.0 * (u - s as f64) - 1.0)
     }
 
-    /// S(t), C(t).
+    /// The N components at time t.
     #[inline]
-    pub fn sc(&self, t: f64) -> (f64, f64) {
-        self.sc_with(t, crate::scalar::fmadd)
+    pub fn eval(&self, t: f64) -> [f64; N] {
+        self.eval_with(t, crate::scalar::fmadd)
     }
 
-    /// S(t), C(t) with the multiply-adds of the instruction set `I` (the dispatched lane engine).
+    /// The N components at time t with the multiply-adds of the instruction set `I`.
     #[inline(always)]
-    pub fn sc_at<I: Isa>(&self, t: f64) -> (f64, f64) {
-        self.sc_with(t, I::mul_add)
+    pub fn eval_at<I: Isa>(&self, t: f64) -> [f64; N] {
+        self.eval_with(t, I::mul_add)
     }
 
+    /// Clenshaw's recurrence on every component.
     #[inline(always)]
-    fn sc_with(&self, t: f64, fma: impl Fn(f64, f64, f64) -> f64) -> (f64, f64) {
+    fn eval_with(&self, t: f64, fma: impl Fn(f64, f64, f64) -> f64) -> [f64; N] {
         let (s, x) = self.locate(t);
-        let c = &self.coef[s * NC * 2..(s + 1) * NC * 2];
-        let (mut b1s, mut b2s, mut b1c, mut b2c) = (0.0, 0.0, 0.0, 0.0);
+        let c = &self.coef[s * NC * N..(s + 1) * NC * N];
+        let (mut b1, mut b2) = ([0.0; N], [0.0; N]);
         let x2 = 2.0 * x;
         for k in (1..NC).rev() {
-            let ts = fma(x2, b1s, c[2 * k] - b2s);
-            let tc = fma(x2, b1c, c[2 * k + 1] - b2c);
-            b2s = b1s;
-            b1s = ts;
-            b2c = b1c;
-            b1c = tc;
+            for i in 0..N {
+                let tk = fma(x2, b1[i], c[N * k + i] - b2[i]);
+                b2[i] = b1[i];
+                b1[i] = tk;
+            }
         }
-        (fma(x, b1s, c[0] - b2s), fma(x, b1c, c[1] - b2c))
+        std::array::from_fn(|i| fma(x, b1[i], c[i] - b2[i]))
     }
 }
 
-impl Forcing for OrbitForcing {
+impl Forcing for OrbitTable<2> {
     fn sc(&self, t: f64) -> (f64, f64) {
-        OrbitForcing::sc(self, t)
+        OrbitTable::<2>::sc(self, t)
     }
 }

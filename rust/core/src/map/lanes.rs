@@ -261,36 +261,61 @@ fn rhs<I: Isa, const D: usize, const SRP: bool>(f: &OrbitForcing, t: f64, y: &[F
     }
 }
 
-struct Stages<I, const D: usize> {
+/// A right-hand side of D states on the lanes at a shared time (the planar model here, the 3-D
+/// rigid body in [`super::lanes3d`]).
+pub(crate) trait Rhs<I: Isa, const D: usize> {
+    fn eval(&self, t: f64, y: &[F8<I>; D], dy: &mut [F8<I>; D]);
+}
+
+/// The planar model on the lanes: the orbit's forcing table and the lanes' parameters.
+pub(crate) struct Planar<'a, I, const SRP: bool> {
+    f: &'a OrbitForcing,
+    p: Params<I>,
+}
+
+impl<I: Isa, const D: usize, const SRP: bool> Rhs<I, D> for Planar<'_, I, SRP> {
+    #[inline(always)]
+    fn eval(&self, t: f64, y: &[F8<I>; D], dy: &mut [F8<I>; D]) {
+        rhs::<I, D, SRP>(self.f, t, y, &self.p, dy);
+    }
+}
+
+/// RKF7(8) stages of D states.
+pub(crate) struct Stages<I, const D: usize> {
     k: [[F8<I>; D]; 13],
     tmp: [F8<I>; D],
 }
 
 macro_rules! stage {
-    ($st:ident, $f:ident, $t:ident, $y:ident, $h:ident, $p:ident, $s:literal; $($j:literal),+) => {{
+    ($st:ident, $m:ident, $t:ident, $y:ident, $h:ident, $s:literal; $($j:literal),+) => {{
         lincomb(&mut $st.tmp, $y, F8::splat($y[0].isa(), $h), [$(A[$s][$j]),+], [$(&$st.k[$j]),+]);
-        rhs::<I, D, SRP>($f, C[$s].mul_add($h, $t), &$st.tmp, $p, &mut $st.k[$s]);
+        $m.eval(C[$s].mul_add($h, $t), &$st.tmp, &mut $st.k[$s]);
     }};
 }
 
-/// A lane integration scheme: its state, one step, and how a trajectory starts and ends.
-trait Scheme<I: Isa> {
+/// A lane integration scheme on the model `M`: its state and one step.
+pub(crate) trait Scheme<I: Isa, M> {
     type Y: Copy;
     /// The step-size controller (the scalar driver's, at this scheme's error order).
     const CONTROLLER: Controller;
     fn new(isa: I) -> Self;
     /// Forget anything kept from the previous group (its cases differ).
     fn begin(&mut self) {}
-    /// The state at t = 0 of the lanes' cases.
-    fn start(isa: I, pick: impl Fn(usize) -> Case) -> Self::Y;
     /// One step of size h from (t, y), all lanes: writes the propagated solution and returns
     /// the scaled max-norm error per lane.
-    fn step<const SRP: bool>(&mut self, f: &OrbitForcing, t: f64, y: &Self::Y, h: f64, p: &Params<I>, out: &mut Self::Y, rtol: F8<I>, atol: F8<I>) -> F8<I>;
-    /// The lanes' phi.
-    fn phi(y: &Self::Y) -> F8<I>;
+    #[allow(clippy::too_many_arguments)]
+    fn step(&mut self, m: &M, t: f64, y: &Self::Y, h: f64, out: &mut Self::Y, rtol: F8<I>, atol: F8<I>) -> F8<I>;
     fn finite(y: &Self::Y) -> bool;
+}
+
+/// How a planar trajectory's lane state starts and ends.
+trait PlanarY<I: Isa>: Copy {
+    /// The state at t = 0 of the lanes' cases.
+    fn start(isa: I, pick: impl Fn(usize) -> Case) -> Self;
+    /// The lanes' phi.
+    fn phi(&self) -> F8<I>;
     /// Lane l's (phi, wz, 2x2 STM row-major or NaN, d(phi, wz)/d parameter or NaN).
-    fn end(y: &Self::Y, l: usize) -> (f64, f64, [f64; 4], [f64; 2]);
+    fn end(&self, l: usize) -> (f64, f64, [f64; 4], [f64; 2]);
 }
 
 /// The scaled error of one component, |e| / (rtol max(|y|, |y_new|) + atol), folded into the
@@ -301,14 +326,7 @@ fn fold_error<I: Isa>(err: F8<I>, e: F8<I>, y: F8<I>, ynew: F8<I>, rtol: F8<I>, 
     r.le_select(err, err, r)
 }
 
-impl<I: Isa, const D: usize> Scheme<I> for Stages<I, D> {
-    type Y = [F8<I>; D];
-    const CONTROLLER: Controller = CONTROLLER;
-
-    fn new(isa: I) -> Self {
-        Stages { k: [[F8::splat(isa, 0.0); D]; 13], tmp: [F8::splat(isa, 0.0); D] }
-    }
-
+impl<I: Isa, const D: usize> PlanarY<I> for [F8<I>; D] {
     fn start(isa: I, pick: impl Fn(usize) -> Case) -> [F8<I>; D] {
         let mut y = [F8::splat(isa, 0.0); D];
         y[0] = F8::new(isa, std::array::from_fn(|l| pick(l).phi0));
@@ -322,37 +340,47 @@ impl<I: Isa, const D: usize> Scheme<I> for Stages<I, D> {
         y
     }
 
-    fn phi(y: &[F8<I>; D]) -> F8<I> {
-        y[0]
+    fn phi(&self) -> F8<I> {
+        self[0]
+    }
+
+    fn end(&self, l: usize) -> (f64, f64, [f64; 4], [f64; 2]) {
+        let y = self;
+        let stm = if D >= 8 { [lane(&y[4], l), lane(&y[5], l), lane(&y[6], l), lane(&y[7], l)] } else { [f64::NAN; 4] };
+        let dparam = if D == 10 { [lane(&y[8], l), lane(&y[9], l)] } else { [f64::NAN; 2] };
+        (lane(&y[0], l), lane(&y[1], l), stm, dparam)
+    }
+}
+
+impl<I: Isa, const D: usize, M: Rhs<I, D>> Scheme<I, M> for Stages<I, D> {
+    type Y = [F8<I>; D];
+    const CONTROLLER: Controller = CONTROLLER;
+
+    fn new(isa: I) -> Self {
+        Stages { k: [[F8::splat(isa, 0.0); D]; 13], tmp: [F8::splat(isa, 0.0); D] }
     }
 
     fn finite(y: &[F8<I>; D]) -> bool {
         (0..D).all(|i| y[i].to_array().iter().all(|v| v.is_finite()))
     }
 
-    fn end(y: &[F8<I>; D], l: usize) -> (f64, f64, [f64; 4], [f64; 2]) {
-        let stm = if D >= 8 { [lane(&y[4], l), lane(&y[5], l), lane(&y[6], l), lane(&y[7], l)] } else { [f64::NAN; 4] };
-        let dparam = if D == 10 { [lane(&y[8], l), lane(&y[9], l)] } else { [f64::NAN; 2] };
-        (lane(&y[0], l), lane(&y[1], l), stm, dparam)
-    }
-
     /// One RKF7(8) step: the 8th-order solution and the scaled max-norm error per lane.
     #[inline(always)]
-    fn step<const SRP: bool>(&mut self, f: &OrbitForcing, t: f64, y: &[F8<I>; D], h: f64, p: &Params<I>, out: &mut [F8<I>; D], rtol: F8<I>, atol: F8<I>) -> F8<I> {
+    fn step(&mut self, m: &M, t: f64, y: &[F8<I>; D], h: f64, out: &mut [F8<I>; D], rtol: F8<I>, atol: F8<I>) -> F8<I> {
         let isa = y[0].isa();
-        rhs::<I, D, SRP>(f, t, y, p, &mut self.k[0]);
-        stage!(self, f, t, y, h, p, 1; 0);
-        stage!(self, f, t, y, h, p, 2; 0, 1);
-        stage!(self, f, t, y, h, p, 3; 0, 2);
-        stage!(self, f, t, y, h, p, 4; 0, 2, 3);
-        stage!(self, f, t, y, h, p, 5; 0, 3, 4);
-        stage!(self, f, t, y, h, p, 6; 0, 3, 4, 5);
-        stage!(self, f, t, y, h, p, 7; 0, 4, 5, 6);
-        stage!(self, f, t, y, h, p, 8; 0, 3, 4, 5, 6, 7);
-        stage!(self, f, t, y, h, p, 9; 0, 3, 4, 5, 6, 7, 8);
-        stage!(self, f, t, y, h, p, 10; 0, 3, 4, 5, 6, 7, 8, 9);
-        stage!(self, f, t, y, h, p, 11; 0, 5, 6, 7, 8, 9);
-        stage!(self, f, t, y, h, p, 12; 0, 3, 4, 5, 6, 7, 8, 9, 11);
+        m.eval(t, y, &mut self.k[0]);
+        stage!(self, m, t, y, h, 1; 0);
+        stage!(self, m, t, y, h, 2; 0, 1);
+        stage!(self, m, t, y, h, 3; 0, 2);
+        stage!(self, m, t, y, h, 4; 0, 2, 3);
+        stage!(self, m, t, y, h, 5; 0, 3, 4);
+        stage!(self, m, t, y, h, 6; 0, 3, 4, 5);
+        stage!(self, m, t, y, h, 7; 0, 4, 5, 6);
+        stage!(self, m, t, y, h, 8; 0, 3, 4, 5, 6, 7);
+        stage!(self, m, t, y, h, 9; 0, 3, 4, 5, 6, 7, 8);
+        stage!(self, m, t, y, h, 10; 0, 3, 4, 5, 6, 7, 8, 9);
+        stage!(self, m, t, y, h, 11; 0, 5, 6, 7, 8, 9);
+        stage!(self, m, t, y, h, 12; 0, 3, 4, 5, 6, 7, 8, 9, 11);
         let k = &self.k;
         let hv = F8::splat(isa, h);
         lincomb(out, y, hv, [B8[5], B8[6], B8[7], B8[8], B8[9], B8[11], B8[12]], [&k[5], &k[6], &k[7], &k[8], &k[9], &k[11], &k[12]]);
@@ -400,7 +428,31 @@ impl<I: Isa, const P: usize> Nystrom<I, P> {
     }
 }
 
-impl<I: Isa, const P: usize> Scheme<I> for Nystrom<I, P> {
+impl<I: Isa, const P: usize> PlanarY<I> for NyState<I, P> {
+    fn start(isa: I, pick: impl Fn(usize) -> Case) -> NyState<I, P> {
+        let mut y = NyState { x: [F8::splat(isa, 0.0); P], v: [F8::splat(isa, 0.0); P] };
+        y.x[0] = F8::new(isa, std::array::from_fn(|l| pick(l).phi0));
+        y.v[0] = F8::new(isa, std::array::from_fn(|l| pick(l).wz0 - 1.0));
+        if P == 3 {
+            y.x[1] = F8::splat(isa, 1.0); // d phi / d phi0
+            y.v[2] = F8::splat(isa, 1.0); // d phidot / d wz0
+        }
+        y
+    }
+
+    fn phi(&self) -> F8<I> {
+        self.x[0]
+    }
+
+    fn end(&self, l: usize) -> (f64, f64, [f64; 4], [f64; 2]) {
+        let y = self;
+        // STM rows (phi, wz), columns (phi0, wz0): (Y1, Y2; Y1', Y2')
+        let stm = if P == 3 { [lane(&y.x[1], l), lane(&y.x[2], l), lane(&y.v[1], l), lane(&y.v[2], l)] } else { [f64::NAN; 4] };
+        (lane(&y.x[0], l), lane(&y.v[0], l) + 1.0, stm, [f64::NAN; 2])
+    }
+}
+
+impl<I: Isa, const P: usize, const SRP: bool> Scheme<I, Planar<'_, I, SRP>> for Nystrom<I, P> {
     type Y = NyState<I, P>;
     const CONTROLLER: Controller = Controller::new(0.8, 0.2, 5.0, RKN_ERROR_ORDER);
 
@@ -413,33 +465,13 @@ impl<I: Isa, const P: usize> Scheme<I> for Nystrom<I, P> {
         self.last_at = None;
     }
 
-    fn start(isa: I, pick: impl Fn(usize) -> Case) -> NyState<I, P> {
-        let mut y = NyState { x: [F8::splat(isa, 0.0); P], v: [F8::splat(isa, 0.0); P] };
-        y.x[0] = F8::new(isa, std::array::from_fn(|l| pick(l).phi0));
-        y.v[0] = F8::new(isa, std::array::from_fn(|l| pick(l).wz0 - 1.0));
-        if P == 3 {
-            y.x[1] = F8::splat(isa, 1.0); // d phi / d phi0
-            y.v[2] = F8::splat(isa, 1.0); // d phidot / d wz0
-        }
-        y
-    }
-
-    fn phi(y: &NyState<I, P>) -> F8<I> {
-        y.x[0]
-    }
-
     fn finite(y: &NyState<I, P>) -> bool {
         (0..P).all(|i| y.x[i].to_array().iter().chain(y.v[i].to_array().iter()).all(|v| v.is_finite()))
     }
 
-    fn end(y: &NyState<I, P>, l: usize) -> (f64, f64, [f64; 4], [f64; 2]) {
-        // STM rows (phi, wz), columns (phi0, wz0): (Y1, Y2; Y1', Y2')
-        let stm = if P == 3 { [lane(&y.x[1], l), lane(&y.x[2], l), lane(&y.v[1], l), lane(&y.v[2], l)] } else { [f64::NAN; 4] };
-        (lane(&y.x[0], l), lane(&y.v[0], l) + 1.0, stm, [f64::NAN; 2])
-    }
-
     #[inline(always)]
-    fn step<const SRP: bool>(&mut self, f: &OrbitForcing, t: f64, y: &NyState<I, P>, h: f64, p: &Params<I>, out: &mut NyState<I, P>, rtol: F8<I>, atol: F8<I>) -> F8<I> {
+    fn step(&mut self, m: &Planar<'_, I, SRP>, t: f64, y: &NyState<I, P>, h: f64, out: &mut NyState<I, P>, rtol: F8<I>, atol: F8<I>) -> F8<I> {
+        let (f, p) = (m.f, &m.p);
         let isa = y.x[0].isa();
         let (hv, h2) = (F8::splat(isa, h), F8::splat(isa, h * h));
         let same = |a: &[F8<I>; P], b: &[F8<I>; P]| (0..P).all(|i| a[i].to_array().iter().zip(b[i].to_array().iter()).all(|(u, v)| u.to_bits() == v.to_bits()));
@@ -486,29 +518,48 @@ impl<I: Isa, const P: usize> Scheme<I> for Nystrom<I, P> {
     }
 }
 
-fn lane<I: Isa>(v: &F8<I>, l: usize) -> f64 {
+pub(crate) fn lane<I: Isa>(v: &F8<I>, l: usize) -> f64 {
     v.to_array()[l]
 }
 
-/// Integrate one group of up to LANES trajectories in lock step; missing lanes repeat the last.
+/// How a lock-step run ended: steps taken (shared by the lanes) and the status.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Run {
+    pub accepted: u32,
+    pub rejected: u32,
+    pub status: LaneStatus,
+}
+
+/// A hook of the step loop that may shorten an accepted step (the planar SRP terminators).
+/// A trait with an `#[inline(always)]` method rather than a closure, so that it is compiled
+/// inside the dispatched kernel with the level's target features.
+pub(crate) trait Cut<I: Isa, M, S: Scheme<I, M>> {
+    /// For the accepted step of length `h` from (t, y) to `ynew`: the shorter length, with `ynew`
+    /// recomputed for it, or None to keep the step.
+    fn cut(&mut self, st: &mut S, m: &M, t: f64, h: f64, y: &S::Y, ynew: &mut S::Y) -> Option<f64>;
+}
+
+/// Steps are never cut.
+pub(crate) struct NoCut;
+
+impl<I: Isa, M, S: Scheme<I, M>> Cut<I, M, S> for NoCut {
+    #[inline(always)]
+    fn cut(&mut self, _: &mut S, _: &M, _: f64, _: f64, _: &S::Y, _: &mut S::Y) -> Option<f64> {
+        None
+    }
+}
+
+/// The lock-step loop of every lane engine: steps `y` from t = 0 to `t_final` with the scheme
+/// `st` on the model `m` and the controller, a step accepted when every lane's error is <= 1;
+/// `cut` may shorten accepted steps.
 #[inline(always)]
-fn integrate_group<I: Isa, S: Scheme<I>, const SRP: bool>(isa: I, f: &OrbitForcing, t_final: f64, group: &[Case], opts: &LaneOptions, st: &mut S) -> [Outcome; LANES] {
-    let n = group.len();
-    let pick = |l: usize| group[l.min(n - 1)];
-    let mut y = S::start(isa, pick);
-    st.begin();
-    let (p, plates) = Params::new(isa, pick, opts.sun_omega, opts.sensitivity);
-    // the steps stop at a lane's terminator crossings where its plate acts, or where the
-    // sensitivity to eps does (the law's kink is there for any amplitude)
-    let plate: [bool; LANES] = std::array::from_fn(|l| plates[l].eps != 0.0 || opts.sensitivity == Sensitivity::Eps);
+pub(crate) fn run_steps<I: Isa, M, S: Scheme<I, M>>(isa: I, st: &mut S, m: &M, y: &mut S::Y, t_final: f64, opts: &LaneOptions, cut: &mut impl Cut<I, M, S>) -> Run {
     let (rtol, atol) = (F8::splat(isa, opts.rtol), F8::splat(isa, opts.atol));
-    let mut ynew = y;
-    let mut yc = y;
+    let mut ynew = *y;
     let (mut t, mut h) = (0.0f64, t_final / 100.0);
     let (mut accepted, mut rejected) = (0u32, 0u32);
     let mut after_reject = false;
     let mut status = LaneStatus::Ok;
-    let g = |l: usize, tt: f64, phi: f64| plates[l].terminator(tt, phi);
     while t < t_final {
         if accepted + rejected >= opts.max_steps {
             status = LaneStatus::MaxSteps;
@@ -516,7 +567,7 @@ fn integrate_group<I: Isa, S: Scheme<I>, const SRP: bool>(isa: I, f: &OrbitForci
         }
         let rem = t_final - t;
         let (mut heff, mut last) = if h >= rem { (rem, true) } else { (h, false) };
-        let err = st.step::<SRP>(f, t, &y, heff, &p, &mut ynew, rtol, atol).to_array();
+        let err = st.step(m, t, y, heff, &mut ynew, rtol, atol).to_array();
         let emax = err.iter().fold(0.0f64, |m, &e| if e.is_nan() || e > m { if e.is_nan() { f64::INFINITY } else { e } } else { m });
         let finite = S::finite(&ynew);
         if !(emax <= 1.0) || !finite {
@@ -529,65 +580,113 @@ fn integrate_group<I: Isa, S: Scheme<I>, const SRP: bool>(isa: I, f: &OrbitForci
             }
             continue;
         }
-        if SRP {
-            // Cut the step at the earliest terminator crossing of any lane with a plate.
-            let mut cut = f64::INFINITY;
-            for (l, &has_plate) in plate.iter().enumerate() {
-                if !has_plate {
-                    continue;
-                }
-                let g0 = g(l, t, lane(&S::phi(&y), l));
-                let g1 = g(l, t + heff, lane(&S::phi(&ynew), l));
-                if !((g0 < 0.0 && g1 > 0.0) || (g0 > 0.0 && g1 < 0.0)) {
-                    continue;
-                }
-                let (mut ta, mut tb, mut ga, mut gb, mut side) = (0.0f64, heff, g0, g1, 0i8);
-                for _ in 0..60 {
-                    if (tb - ta).abs() <= 1e-15 * (1.0 + t.abs()) + 4.0 * f64::EPSILON * tb.abs() {
-                        break;
-                    }
-                    let tau = (tb - gb * (tb - ta) / (gb - ga)).clamp(ta.min(tb), ta.max(tb));
-                    st.step::<SRP>(f, t, &y, tau, &p, &mut yc, rtol, atol);
-                    let gc = g(l, t + tau, lane(&S::phi(&yc), l));
-                    if (gc > 0.0) == (gb > 0.0) {
-                        tb = tau;
-                        gb = gc;
-                        if side == 1 {
-                            ga *= 0.5;
-                        }
-                        side = 1;
-                    } else {
-                        ta = tau;
-                        ga = gc;
-                        if side == -1 {
-                            gb *= 0.5;
-                        }
-                        side = -1;
-                    }
-                }
-                // just past the crossing, unless it is at the very start (a restart)
-                if tb > 1e-12 * (1.0 + t.abs()) {
-                    cut = cut.min(tb);
-                }
-            }
-            if cut < heff {
-                st.step::<SRP>(f, t, &y, cut, &p, &mut ynew, rtol, atol);
-                heff = cut;
-                last = false;
-            }
+        if let Some(c) = cut.cut(st, m, t, heff, y, &mut ynew) {
+            heff = c;
+            last = false;
         }
         accepted += 1;
-        y = ynew;
+        *y = ynew;
         t = if last { t_final } else { t + heff };
         let fac = S::CONTROLLER.factor_accepted(emax, after_reject);
         after_reject = false;
         h = h.max(heff) * fac;
     }
+    Run { accepted, rejected, status }
+}
+
+/// The planar SRP cut: an accepted step never spans a lane's Sun-terminator crossing (where its
+/// plate acts); it is cut just past the earliest one (Illinois iterations on its length).
+struct Terminators<I, Y> {
+    plates: [FlatPlate; LANES],
+    plate: [bool; LANES],
+    /// Scratch state of the trial steps.
+    yc: Y,
+    rtol: F8<I>,
+    atol: F8<I>,
+}
+
+impl<'a, I: Isa, S: Scheme<I, Planar<'a, I, SRP>>, const SRP: bool> Cut<I, Planar<'a, I, SRP>, S> for Terminators<I, S::Y>
+where
+    S::Y: PlanarY<I>,
+{
+    #[inline(always)]
+    fn cut(&mut self, st: &mut S, model: &Planar<'a, I, SRP>, t: f64, heff: f64, y: &S::Y, ynew: &mut S::Y) -> Option<f64> {
+        if !SRP {
+            return None;
+        }
+        let (rtol, atol) = (self.rtol, self.atol);
+        let plates = &self.plates;
+        let g = |l: usize, tt: f64, phi: f64| plates[l].terminator(tt, phi);
+        // Cut the step at the earliest terminator crossing of any lane with a plate.
+        let mut cut = f64::INFINITY;
+        for (l, &has_plate) in self.plate.iter().enumerate() {
+            if !has_plate {
+                continue;
+            }
+            let g0 = g(l, t, lane(&y.phi(), l));
+            let g1 = g(l, t + heff, lane(&ynew.phi(), l));
+            if !((g0 < 0.0 && g1 > 0.0) || (g0 > 0.0 && g1 < 0.0)) {
+                continue;
+            }
+            let (mut ta, mut tb, mut ga, mut gb, mut side) = (0.0f64, heff, g0, g1, 0i8);
+            for _ in 0..60 {
+                if (tb - ta).abs() <= 1e-15 * (1.0 + t.abs()) + 4.0 * f64::EPSILON * tb.abs() {
+                    break;
+                }
+                let tau = (tb - gb * (tb - ta) / (gb - ga)).clamp(ta.min(tb), ta.max(tb));
+                st.step(model, t, y, tau, &mut self.yc, rtol, atol);
+                let gc = g(l, t + tau, lane(&self.yc.phi(), l));
+                if (gc > 0.0) == (gb > 0.0) {
+                    tb = tau;
+                    gb = gc;
+                    if side == 1 {
+                        ga *= 0.5;
+                    }
+                    side = 1;
+                } else {
+                    ta = tau;
+                    ga = gc;
+                    if side == -1 {
+                        gb *= 0.5;
+                    }
+                    side = -1;
+                }
+            }
+            // just past the crossing, unless it is at the very start (a restart)
+            if tb > 1e-12 * (1.0 + t.abs()) {
+                cut = cut.min(tb);
+            }
+        }
+        if cut < heff {
+            st.step(model, t, y, cut, ynew, rtol, atol);
+            return Some(cut);
+        }
+        None
+    }
+}
+
+/// Integrate one group of up to LANES trajectories in lock step; missing lanes repeat the last.
+#[inline(always)]
+fn integrate_group<'a, I: Isa, S: Scheme<I, Planar<'a, I, SRP>>, const SRP: bool>(isa: I, f: &'a OrbitForcing, t_final: f64, group: &[Case], opts: &LaneOptions, st: &mut S) -> [Outcome; LANES]
+where
+    S::Y: PlanarY<I>,
+{
+    let n = group.len();
+    let pick = |l: usize| group[l.min(n - 1)];
+    let mut y = <S::Y as PlanarY<I>>::start(isa, pick);
+    st.begin();
+    let (p, plates) = Params::new(isa, pick, opts.sun_omega, opts.sensitivity);
+    let model = Planar::<I, SRP> { f, p };
+    // the steps stop at a lane's terminator crossings where its plate acts, or where the
+    // sensitivity to eps does (the law's kink is there for any amplitude)
+    let plate: [bool; LANES] = std::array::from_fn(|l| plates[l].eps != 0.0 || opts.sensitivity == Sensitivity::Eps);
+    let mut cut = Terminators { plates, plate, yc: y, rtol: F8::splat(isa, opts.rtol), atol: F8::splat(isa, opts.atol) };
+    let Run { accepted, rejected, status } = run_steps(isa, st, &model, &mut y, t_final, opts, &mut cut);
     std::array::from_fn(|l| {
         if status != LaneStatus::Ok {
             return Outcome { phi_t: f64::NAN, wz_t: f64::NAN, stm: [f64::NAN; 4], dparam: [f64::NAN; 2], accepted, rejected, status };
         }
-        let (phi_t, wz_t, stm, dparam) = S::end(&y, l);
+        let (phi_t, wz_t, stm, dparam) = y.end(l);
         Outcome { phi_t, wz_t, stm, dparam, accepted, rejected, status }
     })
 }
@@ -622,9 +721,12 @@ impl<const D: usize, const SRP: bool> Kernel for Groups<'_, D, SRP> {
     }
 }
 
-impl<const D: usize, const SRP: bool> Groups<'_, D, SRP> {
+impl<'a, const D: usize, const SRP: bool> Groups<'a, D, SRP> {
     #[inline(always)]
-    fn with<I: Isa, S: Scheme<I>>(self, isa: I) -> Vec<Outcome> {
+    fn with<I: Isa, S: Scheme<I, Planar<'a, I, SRP>>>(self, isa: I) -> Vec<Outcome>
+    where
+        S::Y: PlanarY<I>,
+    {
         let mut st = S::new(isa);
         let mut out = Vec::with_capacity(self.cases.len());
         for group in self.cases.chunks(LANES) {

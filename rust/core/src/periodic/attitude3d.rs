@@ -110,6 +110,23 @@ pub fn qlog(q: &Quat) -> ([f64; 3], [[f64; 4]; 3]) {
     (r, d)
 }
 
+/// q0* (x) qT scaled to a unit quaternion with a non-negative scalar part (q and -q are one
+/// attitude), and the factor applied (+-1 / |q0* (x) qT|).
+fn relative(q0: &Quat, qt: &Quat) -> (Quat, f64) {
+    let delta = qmul(&conj(q0), qt);
+    let nd = delta.iter().map(|v| v * v).sum::<f64>().sqrt();
+    let sign = if delta[3] < 0.0 { -1.0 } else { 1.0 } / nd;
+    (delta.map(|v| v * sign), sign)
+}
+
+/// The residuals of a 3-D attitude motion from (q0, w0) to (qT, wT), as the corrector defines
+/// them: (Log(q0* (x) qT), the rotation vector of R(0)' R(T) in body axes at t = 0, with angle in
+/// [0, pi]; wT - w0).
+pub fn attitude_residual(q0: &Quat, w0: &[f64; 3], qt: &Quat, wt: &[f64; 3]) -> [f64; 6] {
+    let (r, _) = qlog(&relative(q0, qt).0);
+    [r[0], r[1], r[2], wt[0] - w0[0], wt[1] - w0[1], wt[2] - w0[2]]
+}
+
 /// One starting guess: the attitude q (scalar last, body relative to synodic; the chart's
 /// centre) and the inertial rate w (body axes).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -220,10 +237,7 @@ impl Problem<6> for Form3d<'_> {
         let (q0, dq0) = self.q0(*c, x);
         let qt: Quat = [yt[6], yt[7], yt[8], yt[9]];
         let phi = |i: usize, j: usize| stm[i * 13 + j];
-        let mut delta = qmul(&conj(&q0), &qt);
-        let nd = delta.iter().map(|v| v * v).sum::<f64>().sqrt();
-        let sign = if delta[3] < 0.0 { -1.0 } else { 1.0 } / nd;
-        delta = delta.map(|v| v * sign);
+        let (delta, sign) = relative(&q0, &qt);
         let (r, dlog) = qlog(&delta);
         // d qT / d x (4x6) and d wT / d x (3x6)
         let mut dqt = [[0.0; 6]; 4];

@@ -10,7 +10,7 @@ mod newton;
 mod stability;
 mod symmetric;
 
-pub use attitude3d::{correct_attitudes_3d, correct_attitudes_3d_across, Correction3d, CorrectionAcross3d, Options3d, Start3d, StartAcross3d};
+pub use attitude3d::{attitude_residual, correct_attitudes_3d, correct_attitudes_3d_across, Correction3d, CorrectionAcross3d, Options3d, Start3d, StartAcross3d};
 pub use multiple::{correct_multiple_shooting, MemberCondition, ShotOrbit};
 pub use stability::{broucke_indices, monodromy, Stability};
 pub use symmetric::{correct_planar_symmetric, Constraint, Evaluation, SymmetricOrbit, SymmetricShooting, Var};
