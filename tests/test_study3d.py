@@ -299,17 +299,86 @@ def test_solve_a_3d_halo_study_from_the_torque_free_spin(cli, tmp_path):
     assert (tmp_path / "librate-out" / "solve_multipliers.png").exists() and not (tmp_path / "librate-out" / "solve_body_axes.png").exists()
 
 
-def test_map_of_a_3d_study_stops_with_a_clear_error_and_writes_nothing(cli, tmp_path):
+def map_3d_study(tmp_path) -> Path:
+    """The example 3-D study with a 3-D map's rates: wx0 a grid (21), wy0 = 0, wz0 a grid (60)."""
     study = tmp_path / "m.toml"
-    data = tomllib.loads(EXAMPLE.read_text())
-    study.write_text(EXAMPLE.read_text().replace("# wx0 = {", "wx0 = {").replace("# wy0 = 0.0", "wy0 = 0.0"))
-    assert "wx0" in tomllib.loads(study.read_text())["rates"] and "wx0" not in data["rates"]
-    res = cli("map", study, code=1)
-    assert "3-D map engine" in res.output and "librate solve" in res.output
-    assert not (tmp_path / "librate-out" / "map.zarr").exists()
+    text = EXAMPLE.read_text().replace("# wx0 = {", "wx0 = {").replace("# wy0 = 0.0", "wy0 = 0.0")
+    study.write_text(text.replace("num = 101", "num = 21").replace("num = 300", "num = 60"))
+    return study
+
+
+def test_map_of_a_3d_study(cli, tmp_path):
+    """`librate map` on a 3-D study: the six residuals over (orbit, wx0, wz0) of the 3-D map
+    engine, written to map.zarr with the study, the per-orbit parts removed, a summary line per
+    orbit and the residual figure. Reference: the planar embedding (the body's z on synodic Z,
+    wx0 = wy0 = 0) is a planar motion, so rx, ry, dwx, dwy vanish there exactly; and each orbit's
+    map equals librate.attitude_map_3d on that orbit (bit for bit: the same engine and grid)."""
+    study = map_3d_study(tmp_path)
+    res = cli("map", study)
+    assert "3-D attitude map: 3 orbits x 21 wx0 x 60 wz0 = 3780 trajectories" in res.output
+    assert res.output.count("smallest max |residual|") == 3
+    path = tmp_path / "librate-out" / "map.zarr"
+    ds = librate.open_result(path, verify=True)
+    assert ds.attrs["librate_result"] == "map_3d" and ds.attrs["librate_command"] == "map" and int(ds.attrs["complete"]) == 1
+    assert ds["residual"].dims == ("orbit", "wx0", "wz0", "component") and float(ds["wy0"]) == 0.0
+    assert not (tmp_path / "librate-out" / "map.zarr.parts").exists()
+    j = int(np.argmin(np.abs(ds["wx0"].values)))
+    assert ds["wx0"].values[j] == 0.0
+    planar = ds["residual"].isel(wx0=j).sel(component=["rx", "ry", "dwx", "dwy"]).values
+    assert np.all(planar == 0.0)
+    st3 = Study.from_toml(study)
+    alone = librate.attitude_map_3d(st3.build_orbits()[1], st3.build_body(), wx0=ds["wx0"].values, wy0=0.0, wz0=ds["wz0"].values,
+                                    tol=float(ds.attrs["tol"]))
+    np.testing.assert_array_equal(alone["residual"].values, ds["residual"].isel(orbit=1).values)
+    # re-running reuses it; `librate plot` draws the residual map
+    again = cli("map", study)
+    assert "3-D attitude map" in again.output
+    cli("plot", path)
+    assert (tmp_path / "librate-out" / "map_residual_norm.png").stat().st_size > 0
     # an invalid 3-D map study is refused first (exit 2), listing the problem
     res = cli("map", EXAMPLE, "--out", tmp_path / "x", code=2)
     assert "rates.wx0: missing" in res.output
+
+
+def test_an_interrupted_3d_map_keeps_its_finished_orbits(tmp_path, monkeypatch):
+    """A 3-D map stopped in its second orbit keeps the first (saved on its own, all or nothing):
+    the same run again computes only the two others, and the result equals an uninterrupted run
+    bit for bit. A damaged part (its bytes overwritten) is named in a warning and recomputed."""
+    import librate.periodicity.map3d as m3
+
+    study = Study.from_toml(map_3d_study(tmp_path))
+    real, calls = m3.attitude_map_3d, []
+
+    def stop_second(orbit, *args, **kw):
+        calls.append(orbit.period_days)
+        if len(calls) == 2:
+            raise KeyboardInterrupt
+        return real(orbit, *args, **kw)
+
+    monkeypatch.setattr(m3, "attitude_map_3d", stop_second)
+    with pytest.raises(KeyboardInterrupt):
+        study.run_map(tmp_path / "a", progress=False)
+    parts = tmp_path / "a" / "map.zarr.parts"
+    assert sorted(p.name for p in parts.iterdir()) == ["orbit-00000.nc"] and not (tmp_path / "a" / "map.zarr").exists()
+    calls.clear()
+    monkeypatch.setattr(m3, "attitude_map_3d", lambda orbit, *a, **k: calls.append(orbit.period_days) or real(orbit, *a, **k))
+    ds, _ = study.run_map(tmp_path / "a", progress=False)
+    assert len(calls) == 2  # the finished first orbit was reused
+    whole, _ = study.run_map(tmp_path / "b", progress=False)
+    np.testing.assert_array_equal(ds["residual"].values, whole["residual"].values)
+    # damage: a part whose bytes changed is detected by its checksums and recomputed
+    monkeypatch.setattr(m3, "attitude_map_3d", stop_second)
+    calls.clear()
+    with pytest.raises(KeyboardInterrupt):
+        study.run_map(tmp_path / "c", progress=False)
+    part = tmp_path / "c" / "map.zarr.parts" / "orbit-00000.nc"
+    raw = bytearray(part.read_bytes())
+    raw[-64:] = b"\x00" * 64
+    part.write_bytes(bytes(raw))
+    monkeypatch.setattr(m3, "attitude_map_3d", real)
+    with pytest.warns(RuntimeWarning, match="orbit-00000.nc: damaged"):
+        ds_c, _ = study.run_map(tmp_path / "c", progress=False)
+    np.testing.assert_array_equal(ds_c["residual"].values, whole["residual"].values)
 
 
 def test_solve_3d_reports_progress_per_member(tmp_path):

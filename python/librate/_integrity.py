@@ -76,7 +76,12 @@ def write_atomically(ds, p) -> None:
     remove_path(tmp)
     try:
         if p.suffix == ".zarr":
-            ds.to_zarr(tmp, mode="w-", zarr_format=2, consolidated=True)
+            import zarr
+
+            # every chunk on disk, even one equal to the fill value (e.g. a status array of all
+            # 0 = ok): a missing chunk is what damage looks like
+            with zarr.config.set({"array.write_empty_chunks": True}):
+                ds.to_zarr(tmp, mode="w-", zarr_format=2, consolidated=True)
         else:
             ds.to_netcdf(tmp, engine="scipy")
         remove_path(p)

@@ -543,6 +543,9 @@ def map_(study, out_dir, quiet, scheduler, resume, sets) -> None:
                    the solutions by N (one file per Kz: map_contours_kz<Kz>.png)
       map_residuals.png  dwz and dphi against phidot0, first orbit (thesis Fig. 23)
       map_solutions.png  the solution families across the orbits (thesis Figs. 27-29)
+
+    With [attitude] model = "3d": the six 3-D closure residuals over (orbit, two rate grids)
+    in map.zarr (or .nc), saved orbit by orbit (resumable), and map_residual_norm.png.
     """
     st = _load_study(study, "map", _overrides(sets))
     _check_writable(st.output_dir(out_dir), "--out" if out_dir else "output.folder")
@@ -552,6 +555,12 @@ def map_(study, out_dir, quiet, scheduler, resume, sets) -> None:
     except _FAILURES as err:
         raise _failure(err) from None
     el = time.perf_counter() - t0
+    if ds.attrs.get("librate_result") == "map_3d":
+        if not quiet:
+            _map_3d_summary(ds, el)
+        click.echo(f"written: {path}")
+        _figures(ds, path, st.figures(("map",)), quiet)
+        return
     if not quiet:
         no, nk, nw = ds.sizes["orbit"], ds.sizes["kz"], ds.sizes["wz0"]
         click.echo(f"periodicity map: {no} orbits x {nk} Kz x {nw} rates = {no * nk * nw} attitude trajectories ({el:.2f} s)"
@@ -559,6 +568,19 @@ def map_(study, out_dir, quiet, scheduler, resume, sets) -> None:
         _solution_summary(ds)
     click.echo(f"written: {path}")
     _figures(ds, path, st.figures(("map", "residuals", "solutions")), quiet)
+
+
+def _map_3d_summary(ds, elapsed: float) -> None:
+    """One line for the 3-D map and one per orbit: its smallest residual max-norm and where."""
+    grid = [d for d in ds["residual_norm"].dims if d != "orbit"]
+    n = int(np.prod([ds.sizes[d] for d in ds["residual_norm"].dims]))
+    click.echo(f"3-D attitude map: {ds.sizes['orbit']} orbits x {' x '.join(f'{ds.sizes[d]} {d}' for d in grid)} = {n} trajectories "
+               f"({elapsed:.2f} s); residual = (rotation vector of R(0)' R(KT), w(KT) - w0)")
+    for i in range(ds.sizes["orbit"]):
+        r = ds["residual_norm"].isel(orbit=i)
+        k = np.unravel_index(int(np.nanargmin(r.values)), r.shape)
+        at = ", ".join(f"{d} = {float(ds[d].values[j]):.4f}" for d, j in zip(grid, k))
+        click.echo(f"  orbit {i} (T = {float(ds['period_days'].values[i]):.4f} d): smallest max |residual| {float(r.values[k]):.2e} at {at}")
 
 
 def _solution_summary(ds) -> None:
@@ -595,6 +617,8 @@ def plot(result_path, quiet) -> None:
       solutions  STEM_solutions.png (initial rates phidot0 of the solutions against x0)
       3-D solutions  STEM_multipliers.png (Floquet multipliers along the family),
                  STEM_body_axes.png (body axes along the first member's orbit)
+      a 3-D map  STEM_residual_norm.png (log10 of the residual max-norm over the two rate
+                 grids, the first three orbits)
     """
     from .results import open_result, resolve_result_path
 
@@ -622,7 +646,7 @@ def plot(result_path, quiet) -> None:
     else:
         kind = res.attrs.get("librate_result") or ("map" if "dwz" in res.variables else "solutions")
         _echo(quiet, f"{kind}: {', '.join(f'{k} {v}' for k, v in res.sizes.items())}")
-        names = ("map", "residuals", "solutions") if "dwz" in res.variables else ("solutions",)
+        names = ("map", "residuals", "solutions") if "dwz" in res.variables or kind == "map_3d" else ("solutions",)
     written = _figures(res, p, names, quiet)
     if not written:
         raise click.ClickException("no figure could be drawn (see the messages above)")
@@ -698,6 +722,8 @@ def _figures(result, path: Path, names, quiet: bool, extra: dict | None = None) 
         table = {"family": lambda: lp.plot_family(result, n_orbits=30), "period": lambda: lp.plot_period(result),
                  "stability": lambda: lp.plot_stability(result)}
         jobs = [(fname(n), table[n]) for n in names if n in table]
+    elif result.attrs.get("librate_result") == "map_3d":
+        jobs = [(fname("residual_norm"), lambda: lp.plot_map_3d(result)) for n in names if n == "map"]
     elif result.attrs.get("librate_result") == "solutions_3d":
         from .results import multipliers_3d, solution_3d
 

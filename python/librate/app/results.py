@@ -25,7 +25,7 @@ __all__ = ["RESULT_INPUTS", "RESULT_KINDS", "RESULT_STEMS", "ResultExists", "che
            "study_changes", "verify_result"]
 
 #: The kinds of result, as stored in the ``librate_result`` attribute.
-RESULT_KINDS = ("family", "solutions", "solutions_3d", "map")
+RESULT_KINDS = ("family", "solutions", "solutions_3d", "map", "map_3d")
 #: The file each command writes its result to (``<stem>.zarr`` or ``<stem>.nc``): the name says
 #: which command made it. Its figures are ``<stem>_<figure>.png`` beside it.
 RESULT_STEMS = {"family": "family", "solve": "solve", "map": "map", "demo": "demo"}
@@ -33,7 +33,8 @@ RESULT_STEMS = {"family": "family", "solve": "solve", "map": "map", "demo": "dem
 #: ``body`` for a family) leaves the result valid, so it is resumed rather than refused.
 RESULT_INPUTS = {"family": ("system", "orbits"), "solutions": ("system", "orbits", "body", "torques", "rates", "attitude", "solver"),
                  "solutions_3d": ("system", "orbits", "body", "torques", "rates", "attitude", "solver"),
-                 "map": ("system", "orbits", "body", "torques", "rates", "attitude", "solver")}
+                 "map": ("system", "orbits", "body", "torques", "rates", "attitude", "solver"),
+                 "map_3d": ("system", "orbits", "body", "torques", "rates", "attitude", "solver")}
 # older names, still read: solutions.* (librate solve before 0.2), dro_map_kz*.nc (librate demo)
 _NAMES = tuple(f"{stem}{ext}" for stem in (*RESULT_STEMS.values(), "solutions") for ext in (".zarr", ".nc"))
 
@@ -475,13 +476,75 @@ def solution_3d(ds, member: int = 0):
 
 def run_map_3d_to(orbits, store: str | Path, *, body, rates: dict, q0, n_periods: int = 1, tol: float = 1e-12, resume: bool = True,
                   scheduler=None, progress: bool | None = None, attrs: dict[str, Any] | None = None):
-    """The 3-D attitude map of a ``[attitude] model = "3d"`` study into ``store``: for every
-    orbit, the 6 closure residuals over the two rate grids of ``rates`` (``{"wx0", "wy0",
-    "wz0"}``, one of them a single fixed value) from the attitude ``q0``. This librate has no
-    3-D map engine yet: raises ``NotImplementedError`` saying so (the study was validated and
-    nothing was written). Returns ``(dataset, store_path)`` once the engine is wired in."""
-    raise NotImplementedError("a 3-D attitude map ([attitude] model = \"3d\") needs the 3-D map engine, which this librate does not have yet; "
-                              "nothing was written. `librate solve` runs 3-D studies (periodic motions along the orbit family)")
+    """The 3-D attitude map of a ``[attitude] model = "3d"`` study, written to ``store`` (a
+    ``.zarr`` or ``.nc`` result, ``librate_result = "map_3d"``): for every orbit, the six closure
+    residuals (:func:`librate.attitude_map_3d`, integration tolerance ``tol``) over the rate
+    grids of ``rates`` (``{"wx0", "wy0", "wz0"}``: arrays or single values) from the attitude
+    ``q0``, along a dimension ``orbit`` (coordinates ``x0``, ``z0``, ``period_days``).
+
+    Nothing finished is lost: each orbit's map is saved on its own as it finishes, all or nothing
+    and with checksums, in the folder ``<store>.parts``; a run stopped at any moment (Ctrl-C, a
+    kill) loses at most the orbit in flight, and the same call again reuses the finished orbits
+    (one that fails its checksums, or was made for another study, is named and recomputed). The
+    whole map is then written to ``store`` (all or nothing) and the parts removed. An existing
+    ``store`` of the same study is reused; of another study it is refused unless ``resume`` is
+    False. Returns ``(dataset, store_path)``."""
+    import shutil
+    import warnings
+
+    import xarray as xr
+
+    from ..periodicity.map3d import attitude_map_3d
+    from ..periodicity.maps import orbits_of
+    from .progress import bar as progress_bar
+
+    if scheduler is not None:
+        raise ValueError("invalid argument `scheduler`: 3-D maps run in this process (all cores); a Dask scheduler is for planar maps")
+    store = Path(store)
+    attrs = dict(attrs or {})
+    study = attrs.get("study")
+    olist, _ = orbits_of(orbits)
+    # a rate given as one value is fixed (a number, not a dimension of length 1)
+    rates = {k: float(np.ravel(v)[0]) if np.size(v) == 1 else np.asarray(v, dtype=float) for k, v in rates.items()}
+    state = check_output(store, "map_3d", study, force=not resume)
+    if state == "resume":
+        ds = open_result(store, verify=True)
+        if int(ds.attrs.get("complete", 0)) == 1:
+            return ds.load(), store
+    parts = store.with_name(store.name + ".parts")
+    parts.mkdir(parents=True, exist_ok=True)
+    maps = []
+    with progress_bar(len(olist), "3-D attitude map", "orbit", progress) as bar:
+        for i, orbit in enumerate(olist):
+            part = parts / f"orbit-{i:05d}.nc"
+            ds_i = None
+            if part.exists():
+                try:
+                    ds_i = open_result(part, verify=True).load()
+                except Exception as err:  # noqa: BLE001 - any damage: named, then recomputed
+                    warnings.warn(f"{part}: damaged ({err}); orbit {i} is recomputed", RuntimeWarning, stacklevel=2)
+                if ds_i is not None and not (ds_i.attrs.get("study") == study and int(ds_i.attrs.get("complete", 0)) == 1):
+                    ds_i = None
+            if ds_i is None:
+                ds_i = attitude_map_3d(orbit, body, wx0=rates["wx0"], wy0=rates["wy0"], wz0=rates["wz0"], q0=q0, n_periods=n_periods, tol=tol)
+                if int(ds_i.attrs.get("complete", 0)) != 1:  # interrupted: the finished orbits are kept
+                    raise KeyboardInterrupt(f"3-D map interrupted in orbit {i}; {i} finished orbit(s) kept in {parts}")
+                ds_i.attrs.update({"librate_result": "map_3d", "study": study or "", "orbit_index": i})
+                save_dataset(ds_i, part)
+            maps.append(ds_i)
+            bar.update(1)
+    per_orbit = ("mu", "lu_km", "tu_s", "system_name", "n_periods", "tol", "q0", "simd_level", "librate_version", "title")
+    ds = xr.concat([m.drop_attrs() for m in maps], dim="orbit", coords="minimal", compat="override")
+    ds = ds.assign_coords(orbit=np.arange(len(olist)), x0=("orbit", np.array([o.state0[0] for o in olist])),
+                          z0=("orbit", np.array([o.state0[2] for o in olist])), period_days=("orbit", np.array([o.period_days for o in olist])))
+    ds["orbit_state0"] = (("orbit", "state"), np.array([np.asarray(o.state0, dtype=float) for o in olist]))
+    ds.attrs.update({k: maps[0].attrs[k] for k in per_orbit if k in maps[0].attrs})
+    ds.attrs.update({**attrs, "title": "librate 3-D attitude map", "complete": 1})
+    if state == "replace" and store.exists():
+        shutil.rmtree(store) if store.is_dir() else store.unlink()
+    save_dataset(ds, store)
+    shutil.rmtree(parts, ignore_errors=True)
+    return ds, store
 
 
 def run_map_to(

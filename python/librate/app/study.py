@@ -1199,7 +1199,7 @@ class Study(BaseModel):
 
         folder = self.output_dir(out)
         if self.attitude.model == "3d":
-            return run_map_3d_to(self.build_orbits(), folder / "map.zarr", body=self.build_body(), rates=self.rates_3d(), q0=self.q0_3d(),
+            return run_map_3d_to(self.build_orbits(), self._result_path(out, "map"), body=self.build_body(), rates=self.rates_3d(), q0=self.q0_3d(),
                                  n_periods=self.n_periods(), tol=self.attitude.tol or ATTITUDE_TOL, resume=not force, scheduler=scheduler,
                                  progress=progress, attrs=self.result_attrs("map_3d", "map"))
         store = folder / "map.zarr"

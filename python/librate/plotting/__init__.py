@@ -1951,6 +1951,6 @@ def plot_frequency_scan(scan, ax=None, *, index=None) -> Figure:
 
 __all__ += ["plot_flexible_body", "plot_flexible_coordinate", "plot_flexible_response", "plot_frequency_scan"]
 
-from .attitude3d import plot_body_axes, plot_equilibrium_stability, plot_family_multipliers, plot_out_of_plane_stability  # noqa: E402
+from .attitude3d import plot_body_axes, plot_equilibrium_stability, plot_family_multipliers, plot_map_3d, plot_out_of_plane_stability  # noqa: E402
 
-__all__ += ["plot_equilibrium_stability", "plot_out_of_plane_stability", "plot_family_multipliers", "plot_body_axes"]
+__all__ += ["plot_equilibrium_stability", "plot_out_of_plane_stability", "plot_family_multipliers", "plot_body_axes", "plot_map_3d"]

@@ -1,6 +1,7 @@
 """Figures of the 3-D attitude: the stability diagram of the equilibrium attitudes at a collinear
 Lagrange point (thesis Fig. 19, after Robinson 1974), the out-of-plane stability of planar
-families, Floquet multipliers along 3-D families and the body axes along the orbit.
+families, Floquet multipliers along 3-D families, the body axes along the orbit and 3-D
+attitude maps.
 Re-exported by :mod:`librate.plotting`."""
 
 from __future__ import annotations
@@ -12,7 +13,7 @@ import numpy as np
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
-__all__ = ["plot_equilibrium_stability", "plot_out_of_plane_stability", "plot_family_multipliers", "plot_body_axes"]
+__all__ = ["plot_equilibrium_stability", "plot_out_of_plane_stability", "plot_family_multipliers", "plot_body_axes", "plot_map_3d"]
 
 
 def plot_equilibrium_stability(ds, ax=None, *, boundaries: bool = True) -> Figure:
@@ -197,4 +198,42 @@ def plot_body_axes(solution, ax=None, *, samples: int = 16, planes=("xy", "xz"))
         a.set_ylabel(f"{plane[1]} (LU)")
     panels[0].legend(fontsize="small", loc="best")
     panels[0].set_title(f"body axes along the orbit (T = {solution.orbit.period_days:.3f} d, K = {solution.n_periods})")
+    return fig
+
+
+def plot_map_3d(ds, ax=None, *, orbits=None) -> Figure:
+    """A 3-D attitude map (:func:`librate.attitude_map_3d`, or the ``librate map`` result of a
+    3-D study with its ``orbit`` dimension): log10 of the residual max-norm over its two rate
+    grids, one panel per orbit (``orbits``: the indices to draw, default the first three), the
+    smallest residual marked (gid ``"minimum"``; where the 3-D corrector's seeds come from).
+    Returns the Figure."""
+    from . import figure_axes
+
+    if "residual_norm" not in getattr(ds, "data_vars", {}):
+        raise ValueError("invalid argument `ds`: must be a 3-D attitude map (librate.attitude_map_3d)")
+    has_orbit = "orbit" in ds["residual_norm"].dims
+    idx = list(range(min(3, ds.sizes["orbit"]))) if has_orbit and orbits is None else list(orbits or [None])
+    rate_dims = [d for d in ds["residual_norm"].dims if d in ("wx0", "wy0", "wz0")]
+    if len(rate_dims) != 2 or len(ds["residual_norm"].dims) != 2 + has_orbit:
+        raise ValueError(f"invalid argument `ds`: the figure needs exactly two rate grids (and at most an orbit dimension), got dims {ds['residual_norm'].dims}")
+    fig, axs = figure_axes(ax, len(idx))
+    for a, i in zip(axs, idx):
+        r = ds["residual_norm"] if i is None else ds["residual_norm"].isel(orbit=i)
+        r = r.transpose(rate_dims[1], rate_dims[0])
+        x, y = ds[rate_dims[0]].values, ds[rate_dims[1]].values
+        with np.errstate(divide="ignore", invalid="ignore"):
+            z = np.log10(r.values)
+        mesh = a.pcolormesh(x, y, z, shading="nearest", cmap="viridis")
+        mesh.set_gid("log-residual")
+        k = np.nanargmin(r.values)
+        iy, ix = np.unravel_index(k, r.shape)
+        (pt,) = a.plot(x[ix], y[iy], "r*", markersize=10)
+        pt.set_gid("minimum")
+        a.set_xlabel(f"{rate_dims[0]} (1/TU)")
+        a.set_ylabel(f"{rate_dims[1]} (1/TU)")
+        title = "" if i is None else f"orbit {i}"
+        if i is not None and "period_days" in ds.coords:
+            title += f": T = {float(ds['period_days'].values[i]):.3f} d"
+        a.set_title(f"{title}  min {float(np.nanmin(r.values)):.2e}".strip())
+        fig.colorbar(mesh, ax=a, label="log10 max |residual|")
     return fig
