@@ -219,7 +219,7 @@ def main():
     lib_tol = None
     for tol in LADDER:
         r = lib(tol)
-        acc = accuracy(r["q_t"][idx], r["w_t"][idx], ref)
+        acc = accuracy(r.q_t[idx], r.w_t[idx], ref)
         print(f"  librate rtol = atol = {tol:.0e}: accuracy {acc:.2e}, steps/traj {r['steps'].sum(axis=1).mean():.1f}")
         if acc <= TARGET:
             lib_tol = tol
@@ -260,14 +260,14 @@ def main():
     rows = []
     for name, (out, best, med) in res.items():
         if name.startswith("librate"):
-            acc = accuracy(out["q_t"][idx], out["w_t"][idx], ref)
+            acc = accuracy(out.q_t[idx], out.w_t[idx], ref)
             tol, extra = lib_tol, f"(+ table {t_table * 1e3:.1f} ms once per orbit)"
         else:
             acc = accuracy(out[0][idx], out[1][idx], ref)
             tol, extra = hy_tol, f"(+ JIT {jit[name]:.1f} s once per system and tolerance)"
         rows.append((name, best, acc))
         print(f"  {name:<26} tol {tol:.0e}  {best * 1e3:9.1f} ms ({med * 1e3:.1f})  accuracy {acc:.2e}  {extra}")
-    same = np.array_equal(res["librate, all cores"][0]["residual"], res["librate, 1 thread"][0]["residual"])
+    same = np.array_equal(res["librate, all cores"][0].residual, res["librate, 1 thread"][0].residual)
     print(f"  librate bit-identical across thread counts: {same}")
     lib_best = min(b for nm, b, _ in rows if nm.startswith("librate"))
     hy_name, hy_best, _ = min((r for r in rows if r[0].startswith("heyoka")), key=lambda r: r[1])

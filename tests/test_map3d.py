@@ -67,7 +67,7 @@ def test_dataset_layout_and_chunking(halo13):
     # chunks and threads
     g = map3d_grid(bodies, wx0=wx, wy0=0.01, wz0=wz)
     flat = m["residual"].values.reshape(-1, 6)
-    parts = [map3d_chunk(halo13, g, a, min(a + 2 * LANES, g.n_cases), tol=1e-10, threads=1)["residual"] for a in range(0, g.n_cases, 2 * LANES)]
+    parts = [map3d_chunk(halo13, g, a, min(a + 2 * LANES, g.n_cases), tol=1e-10, threads=1).residual for a in range(0, g.n_cases, 2 * LANES)]
     np.testing.assert_array_equal(np.concatenate(parts), flat)
     with pytest.raises(ValueError, match="start"):
         map3d_chunk(halo13, g, 3, 10)

@@ -143,11 +143,11 @@ def _check(orbit, n_periods, tol) -> tuple[int, float]:
 
 
 def map3d_chunk(orbit: PeriodicOrbit, grid: Map3DGrid, start: int, stop: int, *, n_periods: int = 1, tol: float = 1e-10,
-                threads: int | None = None) -> dict[str, np.ndarray]:
+                threads: int | None = None):
     """Integrate the flat cases [start, stop) of ``grid`` (C order over (body, wx0, wy0, wz0)) along
     ``orbit`` over ``n_periods`` periods at rtol = atol = ``tol``. ``start`` must be a multiple of
-    :data:`LANES`, so that any chunking gives the results of one call, bit for bit. Returns
-    ``residual`` (m, 6), ``q_t`` (m, 4), ``w_t`` (m, 3), ``status`` (m,) uint8 (0 ok, 1 max steps,
+    :data:`LANES`, so that any chunking gives the results of one call, bit for bit. Returns the
+    engine's Sweep3DResult: ``residual`` (m, 6), ``q_t`` (m, 4), ``w_t`` (m, 3), ``status`` (m,) uint8 (0 ok, 1 max steps,
     2 failed) and ``steps`` (m, 2)."""
     n_periods, tol = _check(orbit, n_periods, tol)
     start, stop = as_count(start, "start", 0), as_count(stop, "stop", 0)
@@ -218,7 +218,7 @@ def attitude_map_3d(orbit: PeriodicOrbit, body, *, wx0, wy0, wz0, q0=None, n_per
         for start in range(0, n, step):
             stop = min(n, start + step)
             r = map3d_chunk(orbit, grid, start, stop, n_periods=n_periods, tol=tol, threads=threads)
-            residual[start:stop], status[start:stop] = r["residual"], r["status"]
+            residual[start:stop], status[start:stop] = r.residual, r.status
             if progress is not None:
                 progress(stop, n)
     except KeyboardInterrupt:

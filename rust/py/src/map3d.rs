@@ -7,7 +7,6 @@ use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
 
 use crate::to_py;
 
@@ -54,10 +53,56 @@ fn rows<const N: usize>(a: &PyReadonlyArray2<'_, f64>, name: &str, n: usize) -> 
     Ok((0..n).map(|i| std::array::from_fn(|k| a[(i, k)])).collect())
 }
 
+/// The outcome of `map_sweep_3d`: arrays over the cases.
+#[pyclass(frozen, name = "Sweep3DResult", module = "librate._core")]
+pub struct PySweep3DResult {
+    residual: Py<PyAny>,
+    q_t: Py<PyAny>,
+    w_t: Py<PyAny>,
+    status: Py<PyAny>,
+    steps: Py<PyAny>,
+}
+
+#[pymethods]
+impl PySweep3DResult {
+    /// The six closure residuals (n, 6): the rotation vector of R(0)' R(t_final) in body axes,
+    /// then w(t_final) - w0.
+    #[getter]
+    fn residual(&self, py: Python<'_>) -> Py<PyAny> {
+        self.residual.clone_ref(py)
+    }
+    /// The attitude at t_final (n, 4), scalar last.
+    #[getter]
+    fn q_t(&self, py: Python<'_>) -> Py<PyAny> {
+        self.q_t.clone_ref(py)
+    }
+    /// The inertial rate at t_final in body axes (n, 3).
+    #[getter]
+    fn w_t(&self, py: Python<'_>) -> Py<PyAny> {
+        self.w_t.clone_ref(py)
+    }
+    /// Lane status per case (0 ok, 1 max steps, 2 failed), uint8 (n,).
+    #[getter]
+    fn status(&self, py: Python<'_>) -> Py<PyAny> {
+        self.status.clone_ref(py)
+    }
+    /// Accepted and rejected steps per case, (n, 2).
+    #[getter]
+    fn steps(&self, py: Python<'_>) -> Py<PyAny> {
+        self.steps.clone_ref(py)
+    }
+    fn __len__(&self, py: Python<'_>) -> PyResult<usize> {
+        self.status.bind(py).len()
+    }
+    fn __repr__(&self, py: Python<'_>) -> PyResult<String> {
+        Ok(format!("Sweep3DResult(n={})", self.__len__(py)?))
+    }
+}
+
 /// Integrate 3-D attitude trajectories (q0 (n, 4) scalar last, w0 (n, 3) inertial in body axes,
-/// inertia (n, 3) principal moments) over t_final along the tabulated orbit. Returns a dict of
-/// arrays: residual (n, 6), q_t (n, 4), w_t (n, 3), status (n,) uint8 (0 ok, 1 max steps,
-/// 2 failed), steps (n, 2) accepted and rejected.
+/// inertia (n, 3) principal moments) over t_final along the tabulated orbit. Returns a
+/// `Sweep3DResult`: residual (n, 6), q_t (n, 4), w_t (n, 3), status (n,) uint8 (0 ok, 1 max
+/// steps, 2 failed), steps (n, 2) accepted and rejected.
 #[pyfunction]
 #[pyo3(signature = (table, t_final, q0, w0, inertia, *, rtol, atol, max_steps=200_000, chunk=64, threads=None))]
 #[allow(clippy::too_many_arguments)]
@@ -73,29 +118,30 @@ fn map_sweep_3d<'py>(
     max_steps: u32,
     chunk: usize,
     threads: Option<usize>,
-) -> PyResult<Bound<'py, PyDict>> {
+) -> PyResult<PySweep3DResult> {
     let n = q0.as_array().nrows();
     let (q, w, m) = (rows::<4>(&q0, "q0", n)?, rows::<3>(&w0, "w0", n)?, rows::<3>(&inertia, "inertia", n)?);
     let cases: Vec<Case3d> = (0..n).map(|i| Case3d { q0: q[i], w0: w[i], body: RigidBody { ix: m[i][0], iy: m[i][1], iz: m[i][2] } }).collect();
     let opts = LaneOptions { rtol, atol, max_steps, ..LaneOptions::default() };
     let f = &table.inner;
     let out = py.detach(|| sweep_3d(f, t_final, &cases, &opts, chunk, threads)).map_err(to_py)?;
-    let flat = |k: usize, g: &dyn Fn(&librate_core::map::Outcome3d) -> Vec<f64>| -> PyResult<Bound<'py, PyAny>> {
+    let flat = |k: usize, g: &dyn Fn(&librate_core::map::Outcome3d) -> Vec<f64>| -> PyResult<Py<PyAny>> {
         let v: Vec<f64> = out.iter().flat_map(g).collect();
-        Ok(Array2::from_shape_vec((n, k), v).map_err(|e| PyValueError::new_err(e.to_string()))?.into_pyarray(py).into_any())
+        Ok(Array2::from_shape_vec((n, k), v).map_err(|e| PyValueError::new_err(e.to_string()))?.into_pyarray(py).into_any().unbind())
     };
-    let d = PyDict::new(py);
-    d.set_item("residual", flat(6, &|o| o.residual.to_vec())?)?;
-    d.set_item("q_t", flat(4, &|o| o.q_t.to_vec())?)?;
-    d.set_item("w_t", flat(3, &|o| o.w_t.to_vec())?)?;
-    d.set_item("status", out.iter().map(|o| o.status as u8).collect::<Vec<u8>>().into_pyarray(py))?;
     let steps: Vec<u32> = out.iter().flat_map(|o| [o.accepted, o.rejected]).collect();
-    d.set_item("steps", Array2::from_shape_vec((n, 2), steps).map_err(|e| PyValueError::new_err(e.to_string()))?.into_pyarray(py))?;
-    Ok(d)
+    Ok(PySweep3DResult {
+        residual: flat(6, &|o| o.residual.to_vec())?,
+        q_t: flat(4, &|o| o.q_t.to_vec())?,
+        w_t: flat(3, &|o| o.w_t.to_vec())?,
+        status: out.iter().map(|o| o.status as u8).collect::<Vec<u8>>().into_pyarray(py).into_any().unbind(),
+        steps: Array2::from_shape_vec((n, 2), steps).map_err(|e| PyValueError::new_err(e.to_string()))?.into_pyarray(py).into_any().unbind(),
+    })
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyTidalTable>()?;
+    m.add_class::<PySweep3DResult>()?;
     m.add_function(wrap_pyfunction!(map_sweep_3d, m)?)?;
     Ok(())
 }
