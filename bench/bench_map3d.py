@@ -220,7 +220,7 @@ def main():
     for tol in LADDER:
         r = lib(tol)
         acc = accuracy(r.q_t[idx], r.w_t[idx], ref)
-        print(f"  librate rtol = atol = {tol:.0e}: accuracy {acc:.2e}, steps/traj {r['steps'].sum(axis=1).mean():.1f}")
+        print(f"  librate rtol = atol = {tol:.0e}: accuracy {acc:.2e}, steps/traj {r.steps.sum(axis=1).mean():.1f}")
         if acc <= TARGET:
             lib_tol = tol
             break
