@@ -168,8 +168,8 @@ def test_out_of_plane_figure(dro_family):
 @pytest.mark.slow
 def test_family_along_the_l2_southern_halos_reaches_the_9_2_nrho(em):
     """Issue 15 acceptance (family): the motion of the body 0.8 : 0.9 : 1 on the 14-day L2
-    southern halo corrected from the torque-free N = -1 rate, continued along the halo family by natural
-    parameter in the period, reaches the 9:2 NRHO (6.56 days; Zimovan-Spreen et al. 2020). Every
+    southern halo corrected from the torque-free N = -1 rate, continued along the halo family in the
+    period (pseudo-arclength on the bordered corrector, the default), reaches the 9:2 NRHO (6.56 days; Zimovan-Spreen et al. 2020). Every
     member repeats to 1e-9 on independent re-propagation (tol = 1e-10 for the close lunar passes),
     multipliers in reciprocal pairs (product form, 1e-7 at the NRHO's |m| ~ 50), and the
     stability changes are listed, each where the count of multipliers on the unit circle (to
