@@ -11,7 +11,11 @@ import math
 import librate
 import numpy as np
 import pytest
-import tomllib
+
+try:
+    import tomllib
+except ImportError:  # Python 3.10
+    import tomli as tomllib
 from helpers import edit
 from librate.app.results import read_attrs, save_dataset, save_family
 from librate.app.study import EXAMPLE_STUDY, Study, StudyError, apply_overrides

@@ -19,7 +19,11 @@ from pathlib import Path
 import librate
 import numpy as np
 import pytest
-import tomllib
+
+try:
+    import tomllib
+except ImportError:  # Python 3.10
+    import tomli as tomllib
 from helpers import edit
 from hypothesis import given, settings
 from hypothesis import strategies as st
