@@ -781,10 +781,10 @@ impl PlanarFamily {
     /// correction is needed for the two neighbours.
     pub fn linearised(&self, near: &SymmetricOrbit, x: f64) -> Result<(f64, OrbitForcing)> {
         let e = &near.evaluation;
-        let dvy = -e.dcond[0][0] / e.dcond[0][2];
-        let dhalf = e.dhalf[0] + e.dhalf[2] * dvy;
+        let v = e.tangent(false, [1.0, 0.0, 0.0]).ok_or_else(|| invalid("x0", "the family has no tangent in x0 at this member (a fold in x0)"))?;
+        let dhalf = e.dhalf[0] * v[0] + e.dhalf[2] * v[2];
         let dx = x - near.state0[0];
-        let state0 = [x, 0.0, 0.0, 0.0, near.state0[4] + dvy * dx, 0.0];
+        let state0 = [x, 0.0, 0.0, 0.0, near.state0[4] + v[2] * dx, 0.0];
         let period = near.period + 2.0 * dhalf * dx;
         check_finite("x0", &state0)?;
         check_positive("period", period)?;

@@ -466,20 +466,10 @@ struct SymmetricFamily {
     tangent: [f64; 3],
 }
 
-/// d (x0, z0, vy0) / d T along an x-z-symmetric family at an evaluated member: the crossing
-/// conditions xdot_c = zdot_c = 0 stay zero and T = 2 t_half moves by dT (one 3x3 solve; the
-/// planar family: the 2x2 one in (x0, vy0)). None when singular (a fold of the family in T).
+/// d (x0, z0, vy0) / d T along an x-z-symmetric family at an evaluated member
+/// ([`Evaluation::tangent`] per unit of T = 2 t_half). None at a fold of the family in T.
 fn family_tangent(e: &Evaluation, spatial: bool) -> Option<[f64; 3]> {
-    use nalgebra::{Matrix2, Matrix3, Vector2, Vector3};
-    if spatial {
-        let m = Matrix3::new(e.dcond[0][0], e.dcond[0][1], e.dcond[0][2], e.dcond[1][0], e.dcond[1][1], e.dcond[1][2], 2.0 * e.dhalf[0], 2.0 * e.dhalf[1], 2.0 * e.dhalf[2]);
-        let v = m.lu().solve(&Vector3::new(0.0, 0.0, 1.0))?;
-        Some([v[0], v[1], v[2]]).filter(|v| v.iter().all(|x| x.is_finite()))
-    } else {
-        let m = Matrix2::new(e.dcond[0][0], e.dcond[0][2], 2.0 * e.dhalf[0], 2.0 * e.dhalf[2]);
-        let v = m.lu().solve(&Vector2::new(0.0, 1.0))?;
-        Some([v[0], 0.0, v[1]]).filter(|v| v.iter().all(|x| x.is_finite()))
-    }
+    e.tangent(spatial, e.dhalf.map(|d| 2.0 * d))
 }
 
 impl SymmetricFamily {

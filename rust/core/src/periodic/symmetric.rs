@@ -82,6 +82,28 @@ impl Evaluation {
     }
 }
 
+impl Evaluation {
+    /// The family's tangent dp = (dx0, dz0, dvy0) at this point: the direction along which the
+    /// symmetric conditions (xdot_c, and zdot_c in 3-D) stay zero to first order, scaled so that
+    /// `along` . dp = 1 (e.g. (1, 0, 0): per unit x0; 2 dhalf: per unit period). Planar
+    /// (`spatial` false): dz0 = 0, one condition. None when singular (a fold of the family in
+    /// that parameter).
+    pub fn tangent(&self, spatial: bool, along: [f64; 3]) -> Option<[f64; 3]> {
+        use nalgebra::{Matrix2, Matrix3, Vector2, Vector3};
+        let v = if spatial {
+            let d = &self.dcond;
+            let m = Matrix3::new(d[0][0], d[0][1], d[0][2], d[1][0], d[1][1], d[1][2], along[0], along[1], along[2]);
+            let v = m.lu().solve(&Vector3::new(0.0, 0.0, 1.0))?;
+            [v[0], v[1], v[2]]
+        } else {
+            let m = Matrix2::new(self.dcond[0][0], self.dcond[0][2], along[0], along[2]);
+            let v = m.lu().solve(&Vector2::new(0.0, 1.0))?;
+            [v[0], 0.0, v[1]]
+        };
+        v.iter().all(|x| x.is_finite()).then_some(v)
+    }
+}
+
 /// A corrected symmetric orbit.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SymmetricOrbit {
