@@ -1,6 +1,6 @@
 //! One RKF7(8) step with preallocated stage storage.
 
-use super::tableau::{A, B8, C, ERR};
+use super::tableau::{rkf78_stages, A, B8, C, ERR};
 use super::{State, System};
 use crate::simd::{Isa, Kernel, Level};
 
@@ -90,18 +90,7 @@ impl<S: State> Rkf78<S> {
 
     #[inline(always)]
     fn step_at<I: Isa, Sys: System<S>>(&mut self, sys: &Sys, t: f64, y: &S, h: f64, y_out: &mut S, rtol: f64, atol: f64) -> f64 {
-        stage!(self, sys, t, y, h, 1; 0);
-        stage!(self, sys, t, y, h, 2; 0, 1);
-        stage!(self, sys, t, y, h, 3; 0, 2);
-        stage!(self, sys, t, y, h, 4; 0, 2, 3);
-        stage!(self, sys, t, y, h, 5; 0, 3, 4);
-        stage!(self, sys, t, y, h, 6; 0, 3, 4, 5);
-        stage!(self, sys, t, y, h, 7; 0, 4, 5, 6);
-        stage!(self, sys, t, y, h, 8; 0, 3, 4, 5, 6, 7);
-        stage!(self, sys, t, y, h, 9; 0, 3, 4, 5, 6, 7, 8);
-        stage!(self, sys, t, y, h, 10; 0, 3, 4, 5, 6, 7, 8, 9);
-        stage!(self, sys, t, y, h, 11; 0, 5, 6, 7, 8, 9);
-        stage!(self, sys, t, y, h, 12; 0, 3, 4, 5, 6, 7, 8, 9, 11);
+        rkf78_stages!(stage!(self, sys, t, y, h));
         let k = &self.k;
         lincomb::<I, _>(
             y_out.as_mut_slice(),

@@ -49,9 +49,47 @@ pub const ERR: f64 = 41.0 / 840.0;
 pub const ORDER: u32 = 8;
 pub const ERROR_ORDER: u32 = 7;
 
+/// The stages 1..=12 of an RKF7(8) step, each with the columns j of its row where A[s][j] is
+/// not zero (the one place of the tableau's sparsity, used by the scalar stepper and the SIMD
+/// lanes): `rkf78_stages!(stage!(args))` expands to `stage!(args, s; j, ...)` for every stage,
+/// unrolled.
+macro_rules! rkf78_stages {
+    ($stage:ident!($($a:tt)*)) => {
+        $stage!($($a)*, 1; 0);
+        $stage!($($a)*, 2; 0, 1);
+        $stage!($($a)*, 3; 0, 2);
+        $stage!($($a)*, 4; 0, 2, 3);
+        $stage!($($a)*, 5; 0, 3, 4);
+        $stage!($($a)*, 6; 0, 3, 4, 5);
+        $stage!($($a)*, 7; 0, 4, 5, 6);
+        $stage!($($a)*, 8; 0, 3, 4, 5, 6, 7);
+        $stage!($($a)*, 9; 0, 3, 4, 5, 6, 7, 8);
+        $stage!($($a)*, 10; 0, 3, 4, 5, 6, 7, 8, 9);
+        $stage!($($a)*, 11; 0, 5, 6, 7, 8, 9);
+        $stage!($($a)*, 12; 0, 3, 4, 5, 6, 7, 8, 9, 11);
+    };
+}
+pub(crate) use rkf78_stages;
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The stages' column lists of `rkf78_stages!` are exactly the non-zero entries of A.
+    #[test]
+    fn stage_columns_are_the_nonzero_entries_of_a() {
+        let mut got = vec![Vec::new(); 13];
+        macro_rules! record {
+            ($v:ident, $s:literal; $($j:literal),+) => {
+                $v[$s] = vec![$($j),+];
+            };
+        }
+        rkf78_stages!(record!(got));
+        for (s, cols) in got.iter().enumerate().skip(1) {
+            let nonzero: Vec<usize> = (0..12).filter(|&j| A[s][j] != 0.0).collect();
+            assert_eq!(cols, &nonzero, "stage {s}");
+        }
+    }
 
     /// Consistency of the tableau (row sums equal the nodes; weights sum to one; the error
     /// weights are B7 - B8): guards against a mistyped coefficient.

@@ -29,7 +29,7 @@ use super::forcing::OrbitForcing;
 use crate::attitude::{flat_plate_wzdot, gravity_gradient_wzdot, FlatPlate, Sun};
 use crate::constants::SOLAR_PRESSURE_1AU;
 use crate::integrate::rkn::{A as RKN_A, B as RKN_B, BP as RKN_BP, BPT as RKN_BPT, BT as RKN_BT, C as RKN_C, ERROR_ORDER as RKN_ERROR_ORDER, STAGES as RKN_STAGES};
-use crate::integrate::tableau::{A, B8, C, ERR};
+use crate::integrate::tableau::{rkf78_stages, A, B8, C, ERR};
 use crate::integrate::Controller;
 use crate::scalar::F8;
 use crate::error::Result;
@@ -369,18 +369,7 @@ impl<I: Isa, const D: usize, M: Rhs<I, D>> Scheme<I, M> for Stages<I, D> {
     fn step(&mut self, m: &M, t: f64, y: &[F8<I>; D], h: f64, out: &mut [F8<I>; D], rtol: F8<I>, atol: F8<I>) -> F8<I> {
         let isa = y[0].isa();
         m.eval(t, y, &mut self.k[0]);
-        stage!(self, m, t, y, h, 1; 0);
-        stage!(self, m, t, y, h, 2; 0, 1);
-        stage!(self, m, t, y, h, 3; 0, 2);
-        stage!(self, m, t, y, h, 4; 0, 2, 3);
-        stage!(self, m, t, y, h, 5; 0, 3, 4);
-        stage!(self, m, t, y, h, 6; 0, 3, 4, 5);
-        stage!(self, m, t, y, h, 7; 0, 4, 5, 6);
-        stage!(self, m, t, y, h, 8; 0, 3, 4, 5, 6, 7);
-        stage!(self, m, t, y, h, 9; 0, 3, 4, 5, 6, 7, 8);
-        stage!(self, m, t, y, h, 10; 0, 3, 4, 5, 6, 7, 8, 9);
-        stage!(self, m, t, y, h, 11; 0, 5, 6, 7, 8, 9);
-        stage!(self, m, t, y, h, 12; 0, 3, 4, 5, 6, 7, 8, 9, 11);
+        rkf78_stages!(stage!(self, m, t, y, h));
         let k = &self.k;
         let hv = F8::splat(isa, h);
         lincomb(out, y, hv, [B8[5], B8[6], B8[7], B8[8], B8[9], B8[11], B8[12]], [&k[5], &k[6], &k[7], &k[8], &k[9], &k[11], &k[12]]);
