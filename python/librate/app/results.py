@@ -533,16 +533,14 @@ def run_map_3d_to(orbits, store: str | Path, *, body, rates: dict, q0, n_periods
                 save_dataset(ds_i, part)
             maps.append(ds_i)
             bar.update(1)
-    per_orbit = ("mu", "lu_km", "tu_s", "system_name", "n_periods", "tol", "q0", "simd_level", "librate_version", "title")
+    shared = ("mu", "lu_km", "tu_s", "system_name", "n_periods", "tol", "q0", "simd_level", "librate_version")  # the same for every orbit
     ds = xr.concat([m.drop_attrs() for m in maps], dim="orbit", coords="minimal", compat="override")
     ds = ds.assign_coords(orbit=np.arange(len(olist)), x0=("orbit", np.array([o.state0[0] for o in olist])),
                           z0=("orbit", np.array([o.state0[2] for o in olist])), period_days=("orbit", np.array([o.period_days for o in olist])))
     ds["orbit_state0"] = (("orbit", "state"), np.array([np.asarray(o.state0, dtype=float) for o in olist]))
-    ds.attrs.update({k: maps[0].attrs[k] for k in per_orbit if k in maps[0].attrs})
+    ds.attrs.update({k: maps[0].attrs[k] for k in shared if k in maps[0].attrs})
     ds.attrs.update({**attrs, "title": "librate 3-D attitude map", "complete": 1})
-    if state == "replace" and store.exists():
-        shutil.rmtree(store) if store.is_dir() else store.unlink()
-    save_dataset(ds, store)
+    save_dataset(ds, store)  # replaces a librate result at store (check_output allowed it) all or nothing
     shutil.rmtree(parts, ignore_errors=True)
     return ds, store
 

@@ -140,103 +140,101 @@ def srp_map(
     e_grid, w_grid = np.meshgrid(es, wz, indexing="ij")
     forcing = orbit_forcing(orbit)
     shape = (es.size, wz.size)
-    data: dict = {}
 
-    def grid_sweep(threads=None):
+    def grid_sweep(threads=None) -> dict:
         r = sweep(forcing, n_periods * orbit.period, phi0, w_grid, kz, srp=plate, eps=e_grid, threads=threads)
-        data.update({k: np.asarray(r[k]).reshape(shape) for k in ("dwz", "dphi", "phi_t", "status")})
+        return {k: np.asarray(r[k]).reshape(shape) for k in ("dwz", "dphi", "phi_t", "status")}
 
     sols, path, branches = [], [], []
     if not solve:
-        grid_sweep()
+        data = grid_sweep()
         advance()
     else:
         # The grid's sweep does not feed the branches: it runs beside them on a thread of its own
         # (its own one-thread engine pool; the engine releases the GIL) and fills the cores the
         # branches' small corrector batches leave idle. Results do not depend on it: each
         # trajectory's result depends only on its group of lanes, never on the threads.
-        pool = ThreadPoolExecutor(max_workers=2)
-        grid = pool.submit(grid_sweep, 1)
-        window = (float(wz[0]), float(wz[-1]))
-        runs = []  # (jobs, lead, branches, their marks' re-propagation (a future)), in order
+        with ThreadPoolExecutor(max_workers=2) as pool:
+            grid = pool.submit(grid_sweep, 1)
+            window = (float(wz[0]), float(wz[-1]))
+            runs = []  # (jobs, lead, branches, their marks' re-propagation (a future)), in order
 
-        def run(jobs, lead):
-            """Continue each job's ``start`` (at e_start) through the grid ``values`` in order
-            (one pseudo-arclength run to the last value, corrected exactly at each grid value
-            on the way; only those re-propagated), ending at the grid's end or at a located
-            fold. The branches run in lock step (:func:`eps_branches`: each round's corrections
-            of every branch in one Rust call); their marked points are re-propagated in one
-            batch beside what follows (a one-thread engine pool, as the grid)."""
-            advance(0, len(jobs))
-            brs = eps_branches([(start, plate.with_eps(float(values[-1])), [float(e) for e in values]) for start, _, values, _ in jobs],
-                               steps=steps, done=lambda _: advance())
-            owners = [(start, p) for (start, _, _, _), br in zip(jobs, brs) for p in br.marked]
-            checked = pool.submit(verified, orbit, kz=kz, n_total=[s_.n_total for s_, _ in owners], kind=[s_.kind for s_, _ in owners],
-                                  phi0=[p.x[1] for _, p in owners], wz0=[p.x[2] for _, p in owners], n_periods=n_periods,
-                                  plates=[plate.with_eps(float(p.x[0])) for _, p in owners], iterations=[p.iterations for _, p in owners],
-                                  threads=1)
-            runs.append((jobs, lead, brs, checked))
+            def run(jobs, lead):
+                """Continue each job's ``start`` (at e_start) through the grid ``values`` in order
+                (one pseudo-arclength run to the last value, corrected exactly at each grid value
+                on the way; only those re-propagated), ending at the grid's end or at a located
+                fold. The branches run in lock step (:func:`eps_branches`: each round's corrections
+                of every branch in one Rust call); their marked points are re-propagated in one
+                batch beside what follows (a one-thread engine pool, as the grid)."""
+                advance(0, len(jobs))
+                brs = eps_branches([(start, plate.with_eps(float(values[-1])), [float(e) for e in values]) for start, _, values, _ in jobs],
+                                   steps=steps, done=lambda _: advance())
+                owners = [(start, p) for (start, _, _, _), br in zip(jobs, brs) for p in br.marked]
+                checked = pool.submit(verified, orbit, kz=kz, n_total=[s_.n_total for s_, _ in owners], kind=[s_.kind for s_, _ in owners],
+                                      phi0=[p.x[1] for _, p in owners], wz0=[p.x[2] for _, p in owners], n_periods=n_periods,
+                                      plates=[plate.with_eps(float(p.x[0])) for _, p in owners], iterations=[p.iterations for _, p in owners],
+                                      threads=1)
+                runs.append((jobs, lead, brs, checked))
 
-        def found_at(e_end):
-            """The motions the runs so far have at eps = e_end (their lead and marked points)."""
-            out = [s_ for jobs, lead, _, _ in runs for first in lead for e, s_ in first if e == e_end]
-            return out + [Known(start.n_total, start.kind, float(p.x[2]), float(p.x[1]))
-                          for jobs, _, brs, _ in runs for (start, _, _, _), br in zip(jobs, brs) for p in br.marked if float(p.x[0]) == e_end]
+            def found_at(e_end):
+                """The motions the runs so far have at eps = e_end (their lead and marked points)."""
+                out = [s_ for jobs, lead, _, _ in runs for first in lead for e, s_ in first if e == e_end]
+                return out + [Known(start.n_total, start.kind, float(p.x[2]), float(p.x[1]))
+                              for jobs, _, brs, _ in runs for (start, _, _, _), br in zip(jobs, brs) for p in br.marked if float(p.x[0]) == e_end]
 
-        def record(jobs, lead, brs, checked):
-            """The branches of one run, recorded in order, each after its ``lead`` solutions
-            ((eps, solution) recorded at the branch's index first)."""
-            checked = iter(checked.result())
-            for (start, e_start, _, origin), br, first in zip(jobs, brs, lead):
-                pts = [(float(p.x[0]), float(p.x[2]), float(p.x[1]), float(p.data["trace"])) for p in br.points]
-                marked = [(float(p.x[0]), next(checked)) for p in br.marked]
-                if br.reached:
-                    end = (math.nan, math.nan, False, "reached the end of the eps grid")
-                else:
-                    f = branch_fold(br)
-                    fold = f is not None and f["located"]
-                    last = br.points[-1]
-                    end = (float(f["eps"]) if fold else float(last.x[0]), float(last.x[2]), fold, br.end_reason)
-                b = len(branches)
-                sols.extend((b, e, s_) for e, s_ in first)
-                path.extend((b, *pt) for pt in pts)
-                sols.extend((b, e, s_) for e, s_ in marked)
-                branches.append((start.n_total, start.kind, origin, e_start) + end)
+            def record(jobs, lead, brs, checked):
+                """The branches of one run, recorded in order, each after its ``lead`` solutions
+                ((eps, solution) recorded at the branch's index first)."""
+                checked = iter(checked.result())
+                for (start, e_start, _, origin), br, first in zip(jobs, brs, lead):
+                    pts = [(float(p.x[0]), float(p.x[2]), float(p.x[1]), float(p.data["trace"])) for p in br.points]
+                    marked = [(float(p.x[0]), next(checked)) for p in br.marked]
+                    if br.reached:
+                        end = (math.nan, math.nan, False, "reached the end of the eps grid")
+                    else:
+                        f = branch_fold(br)
+                        fold = f is not None and f["located"]
+                        last = br.points[-1]
+                        end = (float(f["eps"]) if fold else float(last.x[0]), float(last.x[2]), fold, br.end_reason)
+                    b = len(branches)
+                    sols.extend((b, e, s_) for e, s_ in first)
+                    path.extend((b, *pt) for pt in pts)
+                    sols.extend((b, e, s_) for e, s_ in marked)
+                    branches.append((start.n_total, start.kind, origin, e_start) + end)
 
-        pos, neg = es[es > 0], es[es < 0][::-1]
-        jobs, lead = [], []
-        for s0 in find_periodic_attitudes(orbit, kz=kz, wz0_range=window, phi0=phi0, kinds=kinds, n_periods=n_periods):
-            first = [(0.0, s0)] if 0.0 in es else []
-            for side in (pos, neg):
-                if side.size:
-                    jobs.append((s0, 0.0, side, "gravity"))
-                    lead.append(first)
-                    first = []
-        run(jobs, lead)
-        # Solutions at the grid's far ends (SRP-dominated ones too), continued back towards eps = 0
-        # unless a branch from eps = 0 already reached them.
-        zero = np.array([0.0] if 0.0 in es else [])
-        ends = (([(float(es[-1]), np.concatenate([pos[::-1][1:], zero]))] if es[-1] > 0 else [])
-                + ([(float(es[0]), np.concatenate([neg[::-1][1:], zero]))] if es[0] < 0 else []))
-        for e_end, inward in ends:
-            known = found_at(e_end)
-            # phi0 is free: scan from four initial attitudes (one sweep, one corrector call)
-            found = find_periodic_attitudes(orbit, kz=kz, wz0_range=window, phi0=[phi0 + s_ for s_ in (0.0, 0.5 * math.pi, math.pi, -0.5 * math.pi)],
-                                            kinds=kinds, n_periods=n_periods, srp=plate.with_eps(e_end))
+            pos, neg = es[es > 0], es[es < 0][::-1]
             jobs, lead = [], []
-            for s1 in sorted(found, key=lambda x: x.wz0):
-                if any(k.n_total == s1.n_total and k.kind == s1.kind and abs(k.wz0 - s1.wz0) < 1e-7
-                       and abs(math.remainder(k.phi0 - s1.phi0, 2 * math.pi)) < 1e-7 for k in known):
-                    continue
-                known.append(s1)
-                jobs.append((s1, e_end, inward, "end"))
-                lead.append([(e_end, s1)])
+            for s0 in find_periodic_attitudes(orbit, kz=kz, wz0_range=window, phi0=phi0, kinds=kinds, n_periods=n_periods):
+                first = [(0.0, s0)] if 0.0 in es else []
+                for side in (pos, neg):
+                    if side.size:
+                        jobs.append((s0, 0.0, side, "gravity"))
+                        lead.append(first)
+                        first = []
             run(jobs, lead)
-        for r in runs:
-            record(*r)
-        path.sort(key=lambda p: (p[0], p[1]))
-        grid.result()
-        pool.shutdown()
+            # Solutions at the grid's far ends (SRP-dominated ones too), continued back towards eps = 0
+            # unless a branch from eps = 0 already reached them.
+            zero = np.array([0.0] if 0.0 in es else [])
+            ends = (([(float(es[-1]), np.concatenate([pos[::-1][1:], zero]))] if es[-1] > 0 else [])
+                    + ([(float(es[0]), np.concatenate([neg[::-1][1:], zero]))] if es[0] < 0 else []))
+            for e_end, inward in ends:
+                known = found_at(e_end)
+                # phi0 is free: scan from four initial attitudes (one sweep, one corrector call)
+                found = find_periodic_attitudes(orbit, kz=kz, wz0_range=window, phi0=[phi0 + s_ for s_ in (0.0, 0.5 * math.pi, math.pi, -0.5 * math.pi)],
+                                                kinds=kinds, n_periods=n_periods, srp=plate.with_eps(e_end))
+                jobs, lead = [], []
+                for s1 in sorted(found, key=lambda x: x.wz0):
+                    if any(k.n_total == s1.n_total and k.kind == s1.kind and abs(k.wz0 - s1.wz0) < 1e-7
+                           and abs(math.remainder(k.phi0 - s1.phi0, 2 * math.pi)) < 1e-7 for k in known):
+                        continue
+                    known.append(s1)
+                    jobs.append((s1, e_end, inward, "end"))
+                    lead.append([(e_end, s1)])
+                run(jobs, lead)
+            for r in runs:
+                record(*r)
+            path.sort(key=lambda p: (p[0], p[1]))
+            data = grid.result()
         advance()
     sol_arr = lambda f, dt=float: np.array([f(b, e, s) for b, e, s in sols], dtype=dt)  # noqa: E731
     ds = xr.Dataset(
