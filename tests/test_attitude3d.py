@@ -31,6 +31,21 @@ def reciprocal_gap(m):
     return max(np.min(np.abs(z * np.delete(m, i) - 1)) for i, z in enumerate(m))
 
 
+def bracketed_changes(ds) -> list:
+    """The family's listed stability changes (at least one), each checked against its two
+    members: their counts of multipliers on the unit circle (to 1e-6) are the listed ones.
+    Returns (change, (period before, period after)) pairs."""
+    changes = ast.literal_eval(ds.attrs["stability_changes"])
+    assert changes
+    on_circle = {round(float(p), 9): int(np.sum(np.abs(np.abs(m) - 1) < 1e-6)) for p, m in zip(ds.period_days.values, ds.multipliers.values)}
+    out = []
+    for c in changes:
+        a, b = (round(float(p), 9) for p in c["between"])
+        assert (on_circle[a], on_circle[b]) == tuple(c["on_unit_circle"])
+        out.append((c, (a, b)))
+    return out
+
+
 def test_planar_embedding_fig23(dro, planar_n_minus_1):
     """Thesis Fig. 23 (12.66-day DRO, Kz = 0.8, N = -1): started from the planar solution, the 3-D
     corrector returns it (wz0 to 1e-10, q0 a rotation about z, w0 along z); its in-plane
@@ -191,12 +206,7 @@ def test_family_along_the_l2_southern_halos_reaches_the_9_2_nrho(em):
     assert float(ds.residual.max()) < 1e-9
     for m in ds.multipliers.values:
         assert reciprocal_gap(m) < 1e-7
-    changes = ast.literal_eval(ds.attrs["stability_changes"])
-    assert changes
-    on_circle = {round(float(p), 9): int(np.sum(np.abs(np.abs(m) - 1) < 1e-6)) for p, m in zip(ds.period_days.values, ds.multipliers.values)}
-    for c in changes:
-        a, b = (round(float(p), 9) for p in c["between"])
-        assert (on_circle[a], on_circle[b]) == tuple(c["on_unit_circle"])
+    for c, (a, b) in bracketed_changes(ds):
         assert c["located"] and min(a, b) < c["at"] < max(a, b)
     # turns of the body x axis about synodic Z: whole numbers wherever defined (this family's
     # motions are tilted: the count depends on the tilt, 0, -1 or -2 along it)
@@ -249,12 +259,7 @@ def test_family_multipliers_figure(em):
     s = librate.periodic_attitude_3d(h, body, guess=([0, 0, 0, 1.0], [0, 0, 1 - 2 * math.pi / h.period]))
     ds = attitude_family_3d(hf, body, guess=(s.q0, s.w0), period_days=np.linspace(14.0, 8.5, 12))
     assert ds.sizes["member"] == 12 and float(ds.residual.max()) < 1e-9
-    changes = ast.literal_eval(ds.attrs["stability_changes"])
-    assert changes
-    on_circle = {round(float(p), 9): int(np.sum(np.abs(np.abs(m) - 1) < 1e-6)) for p, m in zip(ds.period_days.values, ds.multipliers.values)}
-    for c in changes:
-        a, b = (round(float(p), 9) for p in c["between"])
-        assert (on_circle[a], on_circle[b]) == tuple(c["on_unit_circle"])
+    bracketed_changes(ds)
     fig = lp.plot_family_multipliers(ds)
     gids = {c.get_gid() for a in fig.axes for c in a.get_children()}
     assert {"modulus", "multipliers", "stability-change"} <= gids
