@@ -11,6 +11,7 @@ from pathlib import Path
 
 import librate
 import librate.plotting as lp
+from librate.app.jobs import run_map
 
 out = Path(sys.argv[1] if len(sys.argv) > 1 else "examples-out") / "study"
 out.mkdir(parents=True, exist_ok=True)
@@ -35,7 +36,7 @@ except librate.StudyError as err:
     print(err)  # body.kz = 1.5 ... rates.wz0 = [2.0, 1.0] ...
 
 study = librate.Study.from_toml(toml, purpose="map")
-ds, path = study.run_map()
+ds, path = run_map(study)
 print(f"map: {dict(ds.sizes)}, written to {path}")
 
 ds = librate.open_result(path)  # reload without recomputing; the study travels with it

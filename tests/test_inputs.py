@@ -5,6 +5,7 @@ then failed, read character by character, or reported with misleading errors."""
 import librate
 import numpy as np
 import pytest
+from librate.app.jobs import run_map
 
 # --- Kz = +-1 (issue 12 #6: RigidBody.from_kz(1.0) built a zero moment and failed) ---------
 
@@ -37,7 +38,7 @@ def test_study_map_at_kz_one(tmp_path):
     st = librate.Study.from_dict({"orbits": {"kind": "dro", "x0": [0.9, 0.85]}, "body": {"kz": 1.0},
                                   "rates": {"wz0": {"start": -1.0, "stop": 1.5, "num": 20}}}, purpose="map")
     assert st.build_body().kz == 1.0
-    ds, path = st.run_map(tmp_path)
+    ds, path = run_map(st, tmp_path)
     assert int(ds.attrs["complete"]) == 1 and np.all(np.isfinite(ds.dwz.values))
 
 

@@ -17,6 +17,7 @@ try:
 except ImportError:  # Python 3.10
     import tomli as tomllib
 from helpers import edit
+from librate.app.jobs import run_family, run_map, run_solve
 from librate.app.results import read_attrs, save_dataset, save_family
 from librate.app.study import EXAMPLE_STUDY, Study, StudyError, apply_overrides
 
@@ -230,7 +231,7 @@ def test_a_valid_study_can_be_checked_again_for_a_command(base):
 @pytest.mark.parametrize("fmt", ["zarr", "netcdf"])
 def test_family_round_trip(tmp_path, base, fmt):
     st = Study.from_dict(edit(base, "output.format", fmt))
-    fam, path = st.run_family(tmp_path)
+    fam, path = run_family(st, tmp_path)
     assert path.name == ("family.zarr" if fmt == "zarr" else "family.nc")
     back = librate.open_result(path)
     assert isinstance(back, librate.OrbitFamily)
@@ -246,7 +247,7 @@ def test_family_round_trip(tmp_path, base, fmt):
 
 def test_selected_members_are_saved_as_a_family(tmp_path):
     st = Study.from_dict({"orbits": {"kind": "dro", "resonance": [2, 3]}})
-    fam, path = st.run_family(tmp_path)
+    fam, path = run_family(st, tmp_path)
     assert len(fam) == 2
     assert fam.period.tolist() == pytest.approx([math.pi, 2 * math.pi / 3], abs=1e-10)
     assert np.array_equal(librate.open_result(path).period, fam.period)
@@ -257,7 +258,7 @@ def test_map_and_solutions_round_trip(tmp_path, base, monkeypatch):
 
     monkeypatch.setitem(sys.modules, "librate.app.runner", None)  # the periodicity_map fallback
     st = Study.from_dict(base, purpose="map")
-    ds, path = st.run_map(tmp_path / "m")
+    ds, path = run_map(st, tmp_path / "m")
     assert path == tmp_path / "m" / "map.zarr"
     back = librate.open_result(path)
     for v in ("dwz", "dphi", "phi_T", "sol_wz0", "sol_n"):
@@ -270,7 +271,7 @@ def test_map_and_solutions_round_trip(tmp_path, base, monkeypatch):
     ref = librate.periodicity_map(st.build_orbits(), kz=0.8, wz0=st.wz0_values())
     assert np.array_equal(ref["dwz"].values, back["dwz"].values, equal_nan=True)
 
-    sols, spath = Study.from_dict(edit(base, "output.format", "netcdf"), purpose="solve").run_solve(tmp_path / "s")
+    sols, spath = run_solve(Study.from_dict(edit(base, "output.format", "netcdf"), purpose="solve"), tmp_path / "s")
     assert spath.suffix == ".nc"
     sback = librate.open_result(spath)
     assert sback.attrs["librate_result"] == "solutions"
@@ -331,7 +332,7 @@ def test_a_map_is_exported_to_netcdf_too(tmp_path, base, monkeypatch):
 
     monkeypatch.setitem(sys.modules, "librate.app.runner", None)
     st = Study.from_dict(edit(edit(base, "output.format", "netcdf"), "body.kz", [0.5, 0.8]), purpose="map")
-    ds, path = st.run_map(tmp_path)
+    ds, path = run_map(st, tmp_path)
     nc = librate.open_result(tmp_path / "map.nc")
     zr = librate.open_result(path)
     assert nc.attrs["study"] == zr.attrs["study"] == st.to_json()
@@ -354,8 +355,8 @@ def test_flexible_body_in_a_study(tmp_path):
     solutions of the composite body and reports each one's first-order shift from flexibility
     (docs/physics.md, flexible spacecraft): negligible for the real-scale station (0.1 Hz arrays: < 1e-9), large for
     its low-frequency variant (> 1e-4 rad/TU somewhere)."""
-    real, _ = _flex_study(tmp_path, "sample-station").run_solve(out=tmp_path / "real")
-    low, _ = _flex_study(tmp_path, "sample-station-low-frequency").run_solve(out=tmp_path / "low")
+    real, _ = run_solve(_flex_study(tmp_path, "sample-station"), out=tmp_path / "real")
+    low, _ = run_solve(_flex_study(tmp_path, "sample-station-low-frequency"), out=tmp_path / "low")
     assert real.sizes["solution"] > 0 and real.flex_dwz0.attrs["units"] == "1/TU"
     assert np.max(np.abs(real.flex_dwz0.values)) < 1e-9
     assert np.max(np.abs(low.flex_dwz0.values)) > 1e-4

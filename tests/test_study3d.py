@@ -27,6 +27,7 @@ except ImportError:  # Python 3.10
 from helpers import edit
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from librate.app.jobs import run_map, run_solve
 from librate.app.results import multipliers_3d, solution_3d
 from librate.app.study import Study, StudyError
 from scipy.spatial.transform import Rotation
@@ -256,7 +257,7 @@ def test_solve_a_3d_dro_study_embeds_the_planar_solution(cli, tmp_path):
     planar.pop("attitude")
     planar["body"] = {"kz": (MOMENTS["iy"] - MOMENTS["ix"]) / MOMENTS["iz"]}
     planar["output"] = {"format": "netcdf"}
-    sols, _ = Study.from_dict(planar, purpose="solve").run_solve(tmp_path / "p")
+    sols, _ = run_solve(Study.from_dict(planar, purpose="solve"), tmp_path / "p")
     sel = (sols["sol_orbit"].values == 0) & (sols["sol_n"].values == -1) & (sols["sol_kind"].values.astype(str) == "periodic")
     (wz_planar,) = sols["sol_wz0"].values[sel]
     q0, w0 = ds["q0"].values[0], ds["w0"].values[0]
@@ -361,27 +362,27 @@ def test_an_interrupted_3d_map_keeps_its_finished_orbits(tmp_path, monkeypatch):
 
     monkeypatch.setattr(m3, "attitude_map_3d", stop_second)
     with pytest.raises(KeyboardInterrupt):
-        study.run_map(tmp_path / "a", progress=False)
+        run_map(study, tmp_path / "a", progress=False)
     parts = tmp_path / "a" / "map.zarr.parts"
     assert sorted(p.name for p in parts.iterdir()) == ["orbit-00000.nc"] and not (tmp_path / "a" / "map.zarr").exists()
     calls.clear()
     monkeypatch.setattr(m3, "attitude_map_3d", lambda orbit, *a, **k: calls.append(orbit.period_days) or real(orbit, *a, **k))
-    ds, _ = study.run_map(tmp_path / "a", progress=False)
+    ds, _ = run_map(study, tmp_path / "a", progress=False)
     assert len(calls) == 2  # the finished first orbit was reused
-    whole, _ = study.run_map(tmp_path / "b", progress=False)
+    whole, _ = run_map(study, tmp_path / "b", progress=False)
     np.testing.assert_array_equal(ds["residual"].values, whole["residual"].values)
     # damage: a part whose bytes changed is detected by its checksums and recomputed
     monkeypatch.setattr(m3, "attitude_map_3d", stop_second)
     calls.clear()
     with pytest.raises(KeyboardInterrupt):
-        study.run_map(tmp_path / "c", progress=False)
+        run_map(study, tmp_path / "c", progress=False)
     part = tmp_path / "c" / "map.zarr.parts" / "orbit-00000.nc"
     raw = bytearray(part.read_bytes())
     raw[-64:] = b"\x00" * 64
     part.write_bytes(bytes(raw))
     monkeypatch.setattr(m3, "attitude_map_3d", real)
     with pytest.warns(RuntimeWarning, match="orbit-00000.nc: damaged"):
-        ds_c, _ = study.run_map(tmp_path / "c", progress=False)
+        ds_c, _ = run_map(study, tmp_path / "c", progress=False)
     np.testing.assert_array_equal(ds_c["residual"].values, whole["residual"].values)
 
 
@@ -390,7 +391,7 @@ def test_solve_3d_reports_progress_per_member(tmp_path):
     calls = []
     st3 = Study.from_dict({"orbits": {"kind": "halo", "period_days": [14.0, 13.9]}, "body": {"ix": 1.0, "iy": 1.02, "iz": 1.04},
                            "attitude": {"model": "3d", "n": 0}}, purpose="solve")
-    ds, path = st3.run_solve(tmp_path, progress=lambda done, total: calls.append((done, total)))
+    ds, path = run_solve(st3, tmp_path, progress=lambda done, total: calls.append((done, total)))
     assert calls == [(1, 2), (2, 2)] and ds.sizes["member"] == 2 and path.name == "solve.zarr"
 
 
@@ -401,9 +402,9 @@ def test_solve_a_3d_study_of_one_orbit(cli, tmp_path):
     one = tomllib.loads(EXAMPLE.read_text())
     one["orbits"]["x0"] = [0.85]
     one["output"] = {"format": "netcdf"}
-    ds, path = Study.from_dict(one, purpose="solve").run_solve(tmp_path / "one")
+    ds, path = run_solve(Study.from_dict(one, purpose="solve"), tmp_path / "one")
     assert ds.sizes["member"] == 1 and "no continuation" in ds.attrs["end_reason"]
     check_stored_motions(librate.open_result(path))
-    three, _ = Study.from_toml(EXAMPLE).run_solve(tmp_path / "three")
+    three, _ = run_solve(Study.from_toml(EXAMPLE), tmp_path / "three")
     assert np.max(np.abs(ds["w0"].values[0] - three["w0"].values[0])) <= 1e-10
     assert np.max(np.abs(ds["q0"].values[0] - three["q0"].values[0])) <= 1e-10

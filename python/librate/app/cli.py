@@ -20,6 +20,7 @@ from .._errors import LibrateError
 from ..orbits.families import correct_dro
 from ..orbits.propagation import propagate
 from ..orbits.system import System
+from .jobs import run_family, run_map, run_solve
 
 _CONTEXT = {"help_option_names": ["-h", "--help"], "max_content_width": 100}
 
@@ -397,7 +398,7 @@ def family(study, kind, point, branch, x0, members, system_name, fmt, sets, out_
     try:
         from .progress import reporter
 
-        fam, path = st.run_family(out_dir, force=not resume, say=_say, progress=reporter("orbit family", "member", _show(quiet)))
+        fam, path = run_family(st, out_dir, force=not resume, say=_say, progress=reporter("orbit family", "member", _show(quiet)))
     except _FAILURES as err:
         raise _failure(err) from None
     el = time.perf_counter() - t0
@@ -460,7 +461,7 @@ def solve(study, sets, out_dir, resume, quiet) -> None:
     three_d = st.attitude.model == "3d"
     t0 = time.perf_counter()
     try:
-        ds, path = st.run_solve(out_dir, progress=reporter("3-D solutions" if three_d else "solutions", "member" if three_d else "orbit-Kz",
+        ds, path = run_solve(st, out_dir, progress=reporter("3-D solutions" if three_d else "solutions", "member" if three_d else "orbit-Kz",
                                                            _show(quiet)), force=not resume, say=_say)
     except _FAILURES as err:
         raise _failure(err) from None
@@ -551,7 +552,7 @@ def map_(study, out_dir, quiet, scheduler, resume, sets) -> None:
     _check_writable(st.output_dir(out_dir), "--out" if out_dir else "output.folder")
     t0 = time.perf_counter()
     try:
-        ds, path = st.run_map(out_dir, scheduler=scheduler, progress=_show(quiet), force=not resume, say=_say)
+        ds, path = run_map(st, out_dir, scheduler=scheduler, progress=_show(quiet), force=not resume, say=_say)
     except _FAILURES as err:
         raise _failure(err) from None
     el = time.perf_counter() - t0

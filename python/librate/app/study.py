@@ -18,8 +18,8 @@ torque-free spin about the synodic Z axis (``start = "spin"``) or from a given (
 
 The ``build_*`` helpers turn a valid study into librate objects (:class:`~librate.System`, the
 :class:`~librate.OrbitFamily` or a list of :class:`~librate.PeriodicOrbit`, the Kz values, the
-:class:`~librate.FlatPlate` plate, the array of inertial initial rates); the ``run_*``
-methods do what the ``librate family``, ``librate solve`` and ``librate map`` commands do.
+:class:`~librate.FlatPlate` plate, the array of inertial initial rates); the jobs that the ``librate family``, ``librate solve`` and ``librate map`` commands run are in
+:mod:`librate.app.jobs`.
 
 Units: rates in 1/TU (nondimensional: the synodic frame turns at rate 1), angles in rad, the
 inertia in kg m^2, areas in m^2, lengths in m, the solar pressure in N/m^2, periods in days.
@@ -326,7 +326,7 @@ def _show(value: Any) -> str:
     return repr(value)
 
 
-def _problem(key: str, value: Any, message: str, allowed: str | None = None) -> str:
+def problem(key: str, value: Any, message: str, allowed: str | None = None) -> str:
     allowed = _allowed(key) if allowed is None else allowed
     text = f"{key} = {_show(value)}: {message}"
     return text + (f"; allowed: {allowed}" if allowed else "")
@@ -384,7 +384,7 @@ def _pydantic_problems(prefix: str, err: ValidationError) -> list[str]:
             msg = msg.removeprefix("value error, ")
             if e["type"] == "model_type":
                 msg = "must be a table"
-            out.append(_problem(key, e["input"], msg))
+            out.append(problem(key, e["input"], msg))
     return out
 
 
@@ -399,7 +399,7 @@ def _grid_values(g) -> np.ndarray | None:
     return np.asarray(g, dtype=float)
 
 
-def _grid_raw(g) -> Any:
+def grid_raw(g) -> Any:
     if isinstance(g, Range):
         return g.model_dump()
     return g
@@ -408,16 +408,16 @@ def _grid_raw(g) -> Any:
 def _check_increasing(key: str, g, problems: list[str]) -> None:
     if isinstance(g, Range):
         if g.num < 2:
-            problems.append(_problem(f"{key}.num", g.num, "a rate grid needs at least 2 values", "an integer in [2, 1000000]"))
+            problems.append(problem(f"{key}.num", g.num, "a rate grid needs at least 2 values", "an integer in [2, 1000000]"))
         if not g.start < g.stop:
-            problems.append(_problem(f"{key}.stop", g.stop, f"must be greater than {key}.start = {_show(g.start)} (rates increase)",
+            problems.append(problem(f"{key}.stop", g.stop, f"must be greater than {key}.start = {_show(g.start)} (rates increase)",
                                      f"a number > {key}.start"))
     else:
         v = np.asarray(g, dtype=float)
         if v.size < 2:
-            problems.append(_problem(key, g, "a rate grid needs at least 2 values"))
+            problems.append(problem(key, g, "a rate grid needs at least 2 values"))
         elif np.any(np.diff(v) <= 0):
-            problems.append(_problem(key, g, "must be strictly increasing"))
+            problems.append(problem(key, g, "must be strictly increasing"))
 
 
 def _check_sections(s: dict[str, _Table], given: dict, purpose: str | None) -> list[str]:
@@ -433,11 +433,11 @@ def _check_sections(s: dict[str, _Table], given: dict, purpose: str | None) -> l
         custom = [k for k in ("mu", "lu_km", "tu_s", "radii_km") if getattr(sysc, k) is not None]
         if sysc.preset is not None:
             if sysc.preset not in System.presets():
-                problems.append(_problem("system.preset", sysc.preset, "unknown preset"))
+                problems.append(problem("system.preset", sysc.preset, "unknown preset"))
             else:
                 mu = System.preset(sysc.preset).mu
             for k in custom:
-                problems.append(_problem(f"system.{k}", getattr(sysc, k), "cannot be combined with system.preset (a preset fixes the constants)",
+                problems.append(problem(f"system.{k}", getattr(sysc, k), "cannot be combined with system.preset (a preset fixes the constants)",
                                          "either system.preset alone, or system.mu, system.lu_km and system.tu_s (and optionally system.radii_km)"))
         elif custom:
             for k in ("mu", "lu_km", "tu_s"):
@@ -454,26 +454,26 @@ def _check_sections(s: dict[str, _Table], given: dict, purpose: str | None) -> l
         if orb.kind == "dro":
             for k in ("point", "branch", "max_members"):
                 if getattr(orb, k) is not None:
-                    problems.append(_problem(f"orbits.{k}", getattr(orb, k), "does not apply to orbits.kind = \"dro\"",
+                    problems.append(problem(f"orbits.{k}", getattr(orb, k), "does not apply to orbits.kind = \"dro\"",
                                              "orbits.point and orbits.max_members for 'lyapunov' and 'halo', orbits.branch for 'halo'"))
         if orb.kind == "lyapunov" and orb.branch is not None:
-            problems.append(_problem("orbits.branch", orb.branch, "does not apply to orbits.kind = \"lyapunov\" (planar)", "orbits.branch only with orbits.kind = 'halo'"))
+            problems.append(problem("orbits.branch", orb.branch, "does not apply to orbits.kind = \"lyapunov\" (planar)", "orbits.branch only with orbits.kind = 'halo'"))
         if orb.kind != "halo" and orb.z0 is not None:
-            problems.append(_problem("orbits.z0", _grid_raw(orb.z0), f"does not apply to orbits.kind = \"{orb.kind}\" (planar: z0 = 0)", "orbits.z0 only with orbits.kind = 'halo'"))
+            problems.append(problem("orbits.z0", grid_raw(orb.z0), f"does not apply to orbits.kind = \"{orb.kind}\" (planar: z0 = 0)", "orbits.z0 only with orbits.kind = 'halo'"))
         sel = [k for k in ("x0", "z0", "period_days", "resonance", "sun_resonance", "members") if getattr(orb, k) is not None]
         if len(sel) > 1:
             for k in sel[1:]:
-                problems.append(_problem(f"orbits.{k}", _grid_raw(getattr(orb, k)), f"cannot be combined with orbits.{sel[0]}: choose the members one way",
+                problems.append(problem(f"orbits.{k}", grid_raw(getattr(orb, k)), f"cannot be combined with orbits.{sel[0]}: choose the members one way",
                                          "at most one of orbits.x0, z0, period_days, resonance, sun_resonance, members"))
         for k in ("x0", "z0", "period_days"):
             v = _grid_values(getattr(orb, k))
             if v is None:
                 continue
             if k == "x0" and mu is not None and orb.kind == "dro" and (np.any(v <= -mu) or np.any(v >= 1 - mu)):
-                problems.append(_problem("orbits.x0", _grid_raw(orb.x0), f"DROs start between the primaries, -mu < x0 < 1 - mu = ({-mu:.6g}, {1 - mu:.6g})",
+                problems.append(problem("orbits.x0", grid_raw(orb.x0), f"DROs start between the primaries, -mu < x0 < 1 - mu = ({-mu:.6g}, {1 - mu:.6g})",
                                          "values in (-mu, 1 - mu)"))
             if k == "period_days" and np.any(v <= 0):
-                problems.append(_problem("orbits.period_days", _grid_raw(orb.period_days), "periods must be > 0 days"))
+                problems.append(problem("orbits.period_days", grid_raw(orb.period_days), "periods must be > 0 days"))
 
     # [body]
     body = s.get("body")
@@ -482,16 +482,16 @@ def _check_sections(s: dict[str, _Table], given: dict, purpose: str | None) -> l
         if body.flexible is not None and (body.kz is not None or moments):
             for k in ["kz", *moments]:
                 if getattr(body, k) is not None:
-                    problems.append(_problem(f"body.{k}", _grid_raw(body.kz) if k == "kz" else getattr(body, k),
+                    problems.append(problem(f"body.{k}", grid_raw(body.kz) if k == "kz" else getattr(body, k),
                                              "cannot be combined with body.flexible (the flexible body defines its inertia)",
                                              "either body.flexible, or body.kz, or body.ix/iy/iz"))
         elif body.kz is not None and moments:
             for k, v in moments.items():
-                problems.append(_problem(f"body.{k}", v, "cannot be combined with body.kz (Kz follows from the moments)",
+                problems.append(problem(f"body.{k}", v, "cannot be combined with body.kz (Kz follows from the moments)",
                                          "either body.kz, or body.ix, body.iy and body.iz"))
         elif body.flexible is not None:
             if body.flexible not in FLEXIBLE_PRESETS and not body.flexible.endswith(".toml"):
-                problems.append(_problem("body.flexible", body.flexible, "not a flexible-body preset or TOML file",
+                problems.append(problem("body.flexible", body.flexible, "not a flexible-body preset or TOML file",
                                          f"one of {', '.join(FLEXIBLE_PRESETS)}, or the path of a FlexibleBody TOML file (*.toml)"))
         elif body.kz is None and not moments:
             problems.append(_missing("body.kz", "missing: give body.kz, or body.ix, body.iy and body.iz in kg m^2 (or body.flexible)"))
@@ -503,37 +503,37 @@ def _check_sections(s: dict[str, _Table], given: dict, purpose: str | None) -> l
             ix, iy, iz = moments["ix"], moments["iy"], moments["iz"]
             for k, a, b, c in (("ix", ix, iy, iz), ("iy", iy, ix, iz), ("iz", iz, ix, iy)):
                 if a > b + c:
-                    problems.append(_problem(f"body.{k}", a, f"violates the triangle inequality: {k} must not exceed the sum of the other two moments ({b + c:g} kg m^2)",
+                    problems.append(problem(f"body.{k}", a, f"violates the triangle inequality: {k} must not exceed the sum of the other two moments ({b + c:g} kg m^2)",
                                              "principal moments with each <= the sum of the other two"))
                     break
         if isinstance(body.kz, Range):
             for k in ("start", "stop"):
                 v = getattr(body.kz, k)
                 if not -1 <= v <= 1:
-                    problems.append(_problem(f"body.kz.{k}", v, "Kz must be in [-1, 1]", "a number in [-1, 1]"))
+                    problems.append(problem(f"body.kz.{k}", v, "Kz must be in [-1, 1]", "a number in [-1, 1]"))
 
     # [torques]
     tq = s.get("torques")
     if tq is not None:
         if len(set(tq.gravity_gradient)) != len(tq.gravity_gradient):
-            problems.append(_problem("torques.gravity_gradient", tq.gravity_gradient, "a primary is listed twice"))
+            problems.append(problem("torques.gravity_gradient", tq.gravity_gradient, "a primary is listed twice"))
         srp = tq.srp
         if srp is not None:
             geo = [k for k in ("area_m2", "offset_m") if getattr(srp, k) is not None]
             if srp.eps is not None and geo:
                 for k in geo:
-                    problems.append(_problem(f"torques.srp.{k}", getattr(srp, k), "cannot be combined with torques.srp.eps (eps follows from the geometry)",
+                    problems.append(problem(f"torques.srp.{k}", getattr(srp, k), "cannot be combined with torques.srp.eps (eps follows from the geometry)",
                                              "either torques.srp.eps, or torques.srp.area_m2 and torques.srp.offset_m"))
             elif srp.eps is None and len(geo) < 2:
                 missing = [k for k in ("area_m2", "offset_m") if k not in geo] if geo else ["eps"]
                 for k in missing:
                     problems.append(_missing(f"torques.srp.{k}", "missing: the plate needs torques.srp.eps, or torques.srp.area_m2 and torques.srp.offset_m"))
             if srp.cs + srp.cd > 1 + 1e-12:
-                problems.append(_problem("torques.srp.cd", srp.cd, f"cs + cd = {srp.cs + srp.cd:g} exceeds 1 (the absorbed fraction is 1 - cs - cd)"))
+                problems.append(problem("torques.srp.cd", srp.cd, f"cs + cd = {srp.cs + srp.cd:g} exceeds 1 (the absorbed fraction is 1 - cs - cd)"))
             if srp.pressure is not None and srp.eps is not None:
-                problems.append(_problem("torques.srp.pressure", srp.pressure, "only used with the geometry (area_m2, offset_m); eps already includes it"))
+                problems.append(problem("torques.srp.pressure", srp.pressure, "only used with the geometry (area_m2, offset_m); eps already includes it"))
             if srp.eps is None and len(geo) == 2 and body is not None and body.iz is None and body.kz is not None:
-                problems.append(_problem("torques.srp.area_m2", srp.area_m2, "the plate's geometry needs the body's Iz in kg m^2 (body.ix, body.iy, body.iz); with body.kz alone give torques.srp.eps",
+                problems.append(problem("torques.srp.area_m2", srp.area_m2, "the plate's geometry needs the body's Iz in kg m^2 (body.ix, body.iy, body.iz); with body.kz alone give torques.srp.eps",
                                          "torques.srp.eps with body.kz, or the geometry with body.ix/iy/iz"))
 
     # [attitude] (a section that failed type validation counts as the default planar model)
@@ -545,13 +545,13 @@ def _check_sections(s: dict[str, _Table], given: dict, purpose: str | None) -> l
     rates = s.get("rates")
     if rates is not None:
         if rates.wz0 is not None and rates.phidot0 is not None:
-            problems.append(_problem("rates.phidot0", _grid_raw(rates.phidot0), "cannot be combined with rates.wz0 (phidot0 = wz0 - 1)", "either rates.wz0 or rates.phidot0"))
+            problems.append(problem("rates.phidot0", grid_raw(rates.phidot0), "cannot be combined with rates.wz0 (phidot0 = wz0 - 1)", "either rates.wz0 or rates.phidot0"))
         elif rates.wz0 is None and rates.phidot0 is None and not three_d:
             problems.append(_missing("rates.wz0", "missing: give rates.wz0 (inertial) or rates.phidot0 (relative to the synodic frame)"))
         if not three_d:
             for k in ("wx0", "wy0"):
                 if getattr(rates, k) is not None:
-                    problems.append(_problem(f"rates.{k}", _grid_raw(getattr(rates, k)), "applies only to attitude.model = \"3d\" (the planar model has the one rate wz)",
+                    problems.append(problem(f"rates.{k}", grid_raw(getattr(rates, k)), "applies only to attitude.model = \"3d\" (the planar model has the one rate wz)",
                                              "rates.wz0 or rates.phidot0 with the planar model; rates.wx0 and rates.wy0 with [attitude] model = '3d'"))
         for k in ("wz0", "phidot0", "wx0", "wy0"):
             g = getattr(rates, k)
@@ -562,7 +562,7 @@ def _check_sections(s: dict[str, _Table], given: dict, purpose: str | None) -> l
     if att is not None and not three_d:
         for k in ("start", "n", "q0", "w0", "tol"):
             if getattr(att, k) is not None:
-                problems.append(_problem(f"attitude.{k}", getattr(att, k), "applies only to attitude.model = \"3d\"", "attitude.model = '3d' with it, or leave it out"))
+                problems.append(problem(f"attitude.{k}", getattr(att, k), "applies only to attitude.model = \"3d\"", "attitude.model = '3d' with it, or leave it out"))
     if three_d:
         problems += _check_3d(att, start, s, given)
 
@@ -576,27 +576,27 @@ def _check_sections(s: dict[str, _Table], given: dict, purpose: str | None) -> l
         if "rates" not in given:
             problems.append(_missing("rates", f"missing section [rates]: {what} {need} the initial rates (rates.wz0 or rates.phidot0)"))
         if orb is not None and orb.kind == "halo":
-            problems.append(_problem("orbits.kind", orb.kind, f"{what} use{'s' if need == 'needs' else ''} the planar attitude model, which needs a planar family",
+            problems.append(problem("orbits.kind", orb.kind, f"{what} use{'s' if need == 'needs' else ''} the planar attitude model, which needs a planar family",
                                      "'dro' or 'lyapunov' with the planar model, or any family with [attitude] model = '3d'"))
         if purpose == "map" and body is not None and body.flexible is not None:
-            problems.append(_problem("body.flexible", body.flexible, "the periodicity-map engine integrates rigid bodies; "
+            problems.append(problem("body.flexible", body.flexible, "the periodicity-map engine integrates rigid bodies; "
                                      "`librate solve` reports how flexibility moves each periodic solution", "body.kz or body.ix/iy/iz for a map"))
         if body is not None and body.flexible is not None and tq is not None and tq.srp is not None:
-            problems.append(_problem("torques.srp", "[torques.srp]", "the flexible model has no solar radiation pressure yet", "no [torques.srp] with body.flexible"))
+            problems.append(problem("torques.srp", "[torques.srp]", "the flexible model has no solar radiation pressure yet", "no [torques.srp] with body.flexible"))
         if tq is not None and sorted(tq.gravity_gradient) != ["earth", "moon"]:
-            problems.append(_problem("torques.gravity_gradient", tq.gravity_gradient,
+            problems.append(problem("torques.gravity_gradient", tq.gravity_gradient,
                                      f"the planar engine behind {what} models the gravity gradient of both primaries", "[\"earth\", \"moon\"]"))
         if tq is not None and tq.srp is not None and orb is not None:
             why = "with torques.srp the forcing is periodic only on a Sun-resonant orbit (T = Ts / k): select exactly one"
             if orb.sun_resonance is None:
                 problems.append(_missing("orbits.sun_resonance", f"missing: {why}, e.g. orbits.sun_resonance = [2]"))
             elif len(orb.sun_resonance) != 1:
-                problems.append(_problem("orbits.sun_resonance", orb.sun_resonance, why, "a list of one integer k >= 1, e.g. [2]"))
+                problems.append(problem("orbits.sun_resonance", orb.sun_resonance, why, "a list of one integer k >= 1, e.g. [2]"))
             else:
                 k = orb.sun_resonance[0]
                 sol = s.get("solver")
                 if sol is not None and sol.n_periods is not None and sol.n_periods % k:
-                    problems.append(_problem("solver.n_periods", sol.n_periods, f"with torques.srp on the 1:{k} Sun-resonant orbit the attitude period must cover whole Sun periods",
+                    problems.append(problem("solver.n_periods", sol.n_periods, f"with torques.srp on the 1:{k} Sun-resonant orbit the attitude period must cover whole Sun periods",
                                              f"a multiple of {k}"))
     return problems
 
@@ -620,14 +620,14 @@ def _check_3d(att, start: str, s: dict, given: dict) -> list[str]:
     orb, body, tq, sol = s.get("orbits"), s.get("body"), s.get("torques"), s.get("solver")
     if start == "planar":
         if orb is not None and orb.kind == "halo":
-            problems.append(_problem("attitude.start", start, "the planar start takes a planar solution, which needs a planar family (orbits.kind = 'dro' or 'lyapunov')",
+            problems.append(problem("attitude.start", start, "the planar start takes a planar solution, which needs a planar family (orbits.kind = 'dro' or 'lyapunov')",
                                      "'spin' or 'given' on a halo family"))
         for k in ("q0", "w0"):
             if getattr(att, k) is not None:
-                problems.append(_problem(f"attitude.{k}", getattr(att, k), "cannot be combined with attitude.start = \"planar\" (the start is the planar solution: "
+                problems.append(problem(f"attitude.{k}", getattr(att, k), "cannot be combined with attitude.start = \"planar\" (the start is the planar solution: "
                                          "phi0 = solver.phi0 about Z, wz0 from the rates.wz0 scan)", "attitude.q0 and attitude.w0 with attitude.start = 'given'"))
     elif start == "spin" and att.w0 is not None:
-        problems.append(_problem("attitude.w0", att.w0, "cannot be combined with attitude.start = \"spin\" (the spin is w = (1 + 2 pi n / (K T)) e_Z)",
+        problems.append(problem("attitude.w0", att.w0, "cannot be combined with attitude.start = \"spin\" (the spin is w = (1 + 2 pi n / (K T)) e_Z)",
                                  "attitude.w0 with attitude.start = 'given'"))
     if start in ("planar", "spin") and att.n is None:
         problems.append(_missing("attitude.n", f"missing: attitude.start = \"{start}\" needs the net turns n per attitude period"))
@@ -635,34 +635,34 @@ def _check_3d(att, start: str, s: dict, given: dict) -> list[str]:
         if att.w0 is None:
             problems.append(_missing("attitude.w0", "missing: attitude.start = \"given\" starts from attitude.w0 (and attitude.q0, default the identity)"))
         if att.n is not None:
-            problems.append(_problem("attitude.n", att.n, "does not apply to attitude.start = \"given\" (the start is attitude.q0, attitude.w0)",
+            problems.append(problem("attitude.n", att.n, "does not apply to attitude.start = \"given\" (the start is attitude.q0, attitude.w0)",
                                      "attitude.n with attitude.start = 'planar' or 'spin'"))
     if att.q0 is not None and abs(math.hypot(*att.q0) - 1) > 1e-6:  # finite: the schema refuses inf and nan
-        problems.append(_problem("attitude.q0", att.q0, f"must be a unit quaternion (|q0| = {math.hypot(*att.q0):.6g})"))
+        problems.append(problem("attitude.q0", att.q0, f"must be a unit quaternion (|q0| = {math.hypot(*att.q0):.6g})"))
     if att.q0 is not None and sol is not None and "phi0" in (given.get("solver") or {}):
-        problems.append(_problem("solver.phi0", sol.phi0, "cannot be combined with attitude.q0 (q0 is the whole initial attitude)",
+        problems.append(problem("solver.phi0", sol.phi0, "cannot be combined with attitude.q0 (q0 is the whole initial attitude)",
                                  "solver.phi0 (a rotation about Z) or attitude.q0, not both"))
     if body is not None:
         if body.flexible is not None:
-            problems.append(_problem("body.flexible", body.flexible, f"flexible bodies are {_NOT_3D}", "body.ix, body.iy and body.iz (kg m^2) with attitude.model = '3d'"))
+            problems.append(problem("body.flexible", body.flexible, f"flexible bodies are {_NOT_3D}", "body.ix, body.iy and body.iz (kg m^2) with attitude.model = '3d'"))
         elif body.kz is not None and body.ix is None and body.iy is None and body.iz is None:
-            problems.append(_problem("body.kz", _grid_raw(body.kz), "the 3-D attitude model needs the full inertia, not Kz alone (Kz fixes only (Iy - Ix) / Iz)",
+            problems.append(problem("body.kz", grid_raw(body.kz), "the 3-D attitude model needs the full inertia, not Kz alone (Kz fixes only (Iy - Ix) / Iz)",
                                      "body.ix, body.iy and body.iz in kg m^2 (principal moments, each <= the sum of the other two)"))
     if tq is not None:
         if tq.srp is not None:
-            problems.append(_problem("torques.srp", "[torques.srp]", f"solar radiation pressure is {_NOT_3D}", "no [torques.srp] with attitude.model = '3d'"))
+            problems.append(problem("torques.srp", "[torques.srp]", f"solar radiation pressure is {_NOT_3D}", "no [torques.srp] with attitude.model = '3d'"))
         if sorted(tq.gravity_gradient) != ["earth", "moon"]:
-            problems.append(_problem("torques.gravity_gradient", tq.gravity_gradient, "the 3-D attitude model has the gravity gradient of both primaries",
+            problems.append(problem("torques.gravity_gradient", tq.gravity_gradient, "the 3-D attitude model has the gravity gradient of both primaries",
                                      "[\"earth\", \"moon\"]"))
     return problems
 
 
-def _member_count(orb) -> tuple[str, Any, int] | None:
+def member_count(orb) -> tuple[str, Any, int] | None:
     """(key, value, count) of the members [orbits] selects, None for the whole family."""
     for k in ("x0", "z0", "period_days"):
         g = getattr(orb, k)
         if g is not None:
-            return k, _grid_raw(g), int(_grid_values(g).size)
+            return k, grid_raw(g), int(_grid_values(g).size)
     for k in ("resonance", "sun_resonance"):
         if getattr(orb, k) is not None:
             return k, getattr(orb, k), len(getattr(orb, k))
@@ -688,7 +688,7 @@ def _needs_3d(purpose: str, start: str, s: dict, given: dict) -> list[str]:
                 for k in ("wz0", "phidot0"):
                     g = getattr(rates, k)
                     if isinstance(g, (int, float)):
-                        problems.append(_problem(f"rates.{k}", g, "the planar start scans a grid of rates for the planar solution, not one value"))
+                        problems.append(problem(f"rates.{k}", g, "the planar start scans a grid of rates for the planar solution, not one value"))
         return problems
     if "rates" not in given:
         problems.append(_missing("rates", "missing section [rates]: a 3-D map needs rates.wx0, rates.wy0 and rates.wz0 (or rates.phidot0): two grids and one fixed number"))
@@ -703,7 +703,7 @@ def _needs_3d(purpose: str, start: str, s: dict, given: dict) -> list[str]:
     if all(v is not None for v in comp.values()) and len(fixed) != 1:
         key = fixed[-1] if fixed else "wz0"
         name = key if key != "wz0" or rates.wz0 is not None else "phidot0"
-        problems.append(_problem(f"rates.{name}", _grid_raw(getattr(rates, name)), f"a 3-D map has grids over two rate components and one fixed number; "
+        problems.append(problem(f"rates.{name}", grid_raw(getattr(rates, name)), f"a 3-D map has grids over two rate components and one fixed number; "
                                  f"given {len(fixed)} fixed ({', '.join('rates.' + f for f in fixed) or 'none'})",
                                  "exactly one of rates.wx0, rates.wy0, rates.wz0 (or rates.phidot0) a number, the other two grids"))
     return problems
@@ -746,10 +746,10 @@ class Study(BaseModel):
         for key, value in data.items():
             if key in ("title", "description"):
                 if not isinstance(value, str):
-                    problems.append(_problem(key, value, "must be a string"))
+                    problems.append(problem(key, value, "must be a string"))
             elif key in _SECTIONS:
                 if not isinstance(value, dict):
-                    problems.append(_problem(key, value, f"must be a table [{key}]", f"a table [{key}] with keys {', '.join(_SECTIONS[key].model_fields)}"))
+                    problems.append(problem(key, value, f"must be a table [{key}]", f"a table [{key}] with keys {', '.join(_SECTIONS[key].model_fields)}"))
                     continue
                 try:
                     sections[key] = _SECTIONS[key].model_validate(value)
@@ -853,7 +853,7 @@ class Study(BaseModel):
                 missing = getattr(err, "missing", None)
                 if not missing:
                     raise
-                raise StudyError([_problem("orbits.x0", _grid_raw(o.x0),
+                raise StudyError([problem("orbits.x0", grid_raw(o.x0),
                                            f"no DRO reached at x0 = {', '.join(f'{v:g}' for v in missing)} (the continuation ended: {err.end_reason}); "
                                            f"{len(err.found)} of the requested members were found",
                                            "x0 values on the DRO family, between the Moon and the DRO that grazes the Earth (about 0.985 to 0.005)")]) from None
@@ -889,14 +889,14 @@ class Study(BaseModel):
                     cands = getattr(err, "candidates", None)
                     if cands:
                         days = ", ".join(f"{fam.system.period_days(c['period']):.4g}" for c in cands)
-                        raise StudyError([_problem(f"orbits.{key}", _grid_raw(sel), f"{len(cands)} members of the {fam.kind} family have {key} = {float(v):g} "
+                        raise StudyError([problem(f"orbits.{key}", grid_raw(sel), f"{len(cands)} members of the {fam.kind} family have {key} = {float(v):g} "
                                                    f"(periods {days} d)",
                                                    "a value that one member has, or select by orbits.period_days")]) from None
                     span = {"x0": fam.x0, "z0": fam.z0, "period_days": fam.period_days,
                             "resonance": 2 * math.pi / fam.period, "sun_resonance": _sun_period() / fam.period}[key]
                     what = {"x0": "x0 (LU)", "z0": "z0 (LU)", "period_days": "periods (days)", "resonance": "k = 2 pi / T",
                             "sun_resonance": "k = Ts / T"}[key]
-                    raise StudyError([_problem(f"orbits.{key}", _grid_raw(sel), f"no member at {float(v):g} on the {fam.kind} family ({len(fam)} members)",
+                    raise StudyError([problem(f"orbits.{key}", grid_raw(sel), f"no member at {float(v):g} on the {fam.kind} family ({len(fam)} members)",
                                                f"{what} from {np.min(span):.6g} to {np.max(span):.6g}")]) from None
             return out
         return fam
@@ -924,7 +924,7 @@ class Study(BaseModel):
             return FlexibleBody.preset(b.flexible)
         path = Path(self.base_dir) / b.flexible
         if not path.is_file():
-            raise StudyError([_problem("body.flexible", b.flexible, f"no such file: {path}", "an existing FlexibleBody TOML file")])
+            raise StudyError([problem("body.flexible", b.flexible, f"no such file: {path}", "an existing FlexibleBody TOML file")])
         return FlexibleBody.from_toml(path)
 
     def build_body(self):
@@ -1016,209 +1016,6 @@ class Study(BaseModel):
         return {"librate_result": kind, **({"librate_command": command} if command else {}), "study": self.to_json(),
                 "librate_version": __version__}
 
-    # --- jobs ----------------------------------------------------------------------------------
-    def _result_path(self, out, command: str) -> Path:
-        from .results import RESULT_STEMS
-
-        return self.output_dir(out) / (RESULT_STEMS[command] + (".zarr" if self.output.format == "zarr" else ".nc"))
-
-    def run_family(self, out: str | Path | None = None, *, force: bool = False, say: Callable[[str], None] | None = None,
-                   progress: Callable[[int, int], None] | None = None):
-        """Compute the orbit family (and the selected members, when the selection is a
-        subset) and save it as ``family.zarr`` (or ``family.nc``) in the output folder with the
-        study and version as attributes. Returns ``(family, path)``.
-
-        An existing family of the same ``[system]`` and ``[orbits]`` is reused (``say`` tells);
-        one of other inputs raises :class:`~librate.app.results.ResultExists` naming the changed
-        keys, unless ``force`` (then it is replaced, after ``say`` names it). ``progress(done,
-        total)`` after each member of the continuation."""
-        from .results import check_output, open_result, save_family
-
-        path = self._result_path(out, "family")
-        if check_output(path, "family", self.to_json(), force=force, say=say) == "resume":
-            if say is not None:
-                say(f"reused: {path} already holds this family (--force recomputes it)")
-            return open_result(path), path
-        fam = self.build_family(progress=progress)
-        sel = self.build_orbits(fam)
-        if isinstance(sel, list):
-            sel = _family_of(fam, sel)
-        path = save_family(sel, path, self.result_attrs("family", "family"))
-        return sel, path
-
-    def run_solve(self, out: str | Path | None = None, progress: Callable[[int, int], None] | None = None, *, force: bool = False,
-                  say: Callable[[str], None] | None = None):
-        """The periodic attitude solutions of every selected orbit and Kz with wz0 in the rate
-        window (:func:`librate.find_periodic_attitudes`, scanning on the study's rate grid),
-        saved as ``solve.zarr`` (or ``.nc``). Returns ``(dataset, path)``; the Dataset has a
-        ``solution`` dimension (orbit index, x0, period, Kz, N, kind, wz0, phidot0, phi0,
-        stability, residual). An existing table of the same inputs is reused, one of other
-        inputs refused unless ``force``, as in :meth:`run_family`.
-
-        With ``[attitude] model = "3d"`` see :meth:`run_solve_3d` instead."""
-        if self.attitude.model == "3d":
-            return self.run_solve_3d(out, progress, force=force, say=say)
-        from ..periodicity.solutions import find_periodic_attitudes
-        from .results import check_output, open_result, save_dataset, solutions_dataset
-
-        path = self._result_path(out, "solve")
-        if check_output(path, "solutions", self.to_json(), force=force, say=say) == "resume":
-            if say is not None:
-                say(f"reused: {path} already holds these solutions (--force recomputes them)")
-            return open_result(path), path
-        orbits = self.build_orbits()
-        olist = list(orbits)
-        wz = self.wz0_values()
-        srp = self.build_srp(olist[0].system if olist else None)
-        rows = []
-        total = len(olist) * len(self.kz_values())
-        done = 0
-        for i, o in enumerate(olist):
-            for kz in self.kz_values():
-                sols = find_periodic_attitudes(o, kz=float(kz), wz0_range=(float(wz[0]), float(wz[-1])), phi0=self.solver.phi0,
-                                               n_grid=int(wz.size), n_periods=self.n_periods(), srp=srp)
-                rows += [(i, s) for s in sols]
-                done += 1
-                if progress is not None:
-                    progress(done, total)
-        ds = solutions_dataset(rows, olist, self.kz_values(), self.result_attrs("solutions", "solve"))
-        flex = self.build_flexible()
-        if flex is not None and rows:
-            # Flexibility's first-order effect on each rigid solution (the closed quasi-static form).
-            from ..periodicity.flexible import flexible_periodic
-
-            res = [flexible_periodic(sol, flex, resolve=False) for _, sol in rows]
-            ds["flex_dphi0"] = ("solution", np.array([r.shift[0] for r in res]), {"units": "rad", "long_name": "first-order shift of phi0 from flexibility"})
-            ds["flex_dwz0"] = ("solution", np.array([r.shift[1] for r in res]), {"units": "1/TU", "long_name": "first-order shift of wz0 from flexibility"})
-            ds["flex_max_dphi"] = ("solution", np.array([r.max_dphi for r in res]), {"units": "rad", "long_name": "largest attitude departure over a period"})
-        path = save_dataset(ds, path)
-        return ds, path
-
-    def run_solve_3d(self, out: str | Path | None = None, progress: Callable[[int, int], None] | None = None, *, force: bool = False,
-                     say: Callable[[str], None] | None = None):
-        """``librate solve`` on a ``[attitude] model = "3d"`` study: one periodic 3-D attitude
-        motion of the body (body.ix/iy/iz) over ``solver.n_periods`` orbit periods, continued
-        along the selected members in their order (:func:`librate.attitude_family_3d`, natural
-        continuation in the orbit period on the orbit family, with the stability changes
-        located), saved as ``solve.zarr`` (or ``.nc``; :func:`~librate.app.results.solutions_3d_dataset`).
-
-        The first member's motion is corrected (:func:`librate.periodic_attitude_3d`) from the
-        start of ``attitude.start``: "planar", the planar periodic solution with
-        ``attitude.n`` turns found on the first member in the ``[rates]`` scan at
-        ``solver.phi0`` (the body's Kz; exactly one must be there); "spin", the torque-free spin
-        (1 + 2 pi n / (K T)) e_Z at :meth:`q0_3d`; "given", (:meth:`q0_3d`, ``attitude.w0``).
-        Returns ``(dataset, path)``; reuse and ``force`` as in :meth:`run_family`.
-        ``progress(done, total)`` after each member reached."""
-        from .._errors import ConvergenceError
-        from ..periodicity.attitude3d import attitude_family_3d
-        from .results import check_output, open_result, save_dataset, solutions_3d_dataset
-
-        path = self._result_path(out, "solve")
-        if check_output(path, "solutions_3d", self.to_json(), force=force, say=say) == "resume":
-            if say is not None:
-                say(f"reused: {path} already holds these 3-D solutions (--force recomputes them)")
-            return open_result(path), path
-        fam = self.build_family()
-        members = list(self.build_orbits(fam))
-        if not members:
-            sel = _member_count(self.orbits)
-            key, value = (f"orbits.{sel[0]}", sel[1]) if sel else ("orbits.kind", self.orbits.kind)
-            raise StudyError([_problem(key, value, "selects no member", "at least 1 member (with 2 or more, the motion is continued along them in order)")])
-        body = self.build_body()
-        k = self.n_periods()
-        guess, start = self._start_3d(members[0], body, k)
-        periods = [o.period_days for o in members]
-        tol = self.attitude.tol or ATTITUDE_TOL
-        try:
-            ds = attitude_family_3d(fam, body, guess=guess, period_days=periods, n_periods=k, tol=tol, progress=progress, method="natural")
-        except ConvergenceError as err:
-            raise ConvergenceError(f"3-D solve: the start on the first member (x0 = {members[0].x0:.6g} LU, T = {periods[0]:.6g} d; "
-                                   f"{start['start_description']}) did not converge: {err}") from None
-        ds = solutions_3d_dataset(ds, fam, periods, {**start, "attitude_tol": tol}, self.result_attrs("solutions_3d", "solve"))
-        path = save_dataset(ds, path)
-        return ds, path
-
-    def _start_3d(self, orbit, body, n_periods: int):
-        """The guess of the first member's 3-D motion and its description (attributes)."""
-        from scipy.spatial.transform import Rotation
-
-        start = self.attitude_start()
-        n = self.attitude.n
-        if start == "planar":
-            from ..periodicity.solutions import find_periodic_attitudes
-
-            wz = self.wz0_values()
-            key = "rates.wz0" if self.rates.wz0 is not None else "rates.phidot0"
-            found = find_periodic_attitudes(orbit, kz=float(body.kz), wz0_range=(float(wz[0]), float(wz[-1])), phi0=self.solver.phi0,
-                                            n_grid=int(wz.size), n_periods=n_periods)
-            hits = [x for x in found if x.kind == "periodic" and x.n == n]
-            where = f"on the first member (x0 = {orbit.x0:.6g} LU, T = {orbit.period_days:.6g} d, Kz = {body.kz:.6g}, phi0 = {self.solver.phi0:g})"
-            if not hits:
-                others = ", ".join(f"n = {x.n:g} ({x.kind}) at wz0 = {x.wz0:.6g}" for x in found) or "none"
-                raise StudyError([_problem("attitude.n", n, f"no planar periodic solution with n = {n} {where} for wz0 in "
-                                           f"[{wz[0]:g}, {wz[-1]:g}]; found: {others}",
-                                           "the n of a planar periodic solution in the window, or widen " + key)])
-            if len(hits) > 1:
-                raise StudyError([_problem(key, _grid_raw(getattr(self.rates, key.split(".")[1])),
-                                           f"{len(hits)} planar periodic solutions with n = {n} {where}: wz0 = "
-                                           + ", ".join(f"{x.wz0:.6g}" for x in hits) + "; narrow the window to one of them",
-                                           "a rate window holding exactly one planar solution with n = attitude.n")])
-            sol = hits[0]
-            return sol, {"start": "planar", "start_n": int(n), "start_planar_wz0": float(sol.wz0), "start_planar_phi0": float(sol.phi0),
-                         "start_planar_trace": float(sol.trace), "start_planar_stable": int(bool(sol.stable)),
-                         "start_description": f"the planar n = {n} solution, phi0 = {sol.phi0:g} rad, wz0 = {sol.wz0:.12g} 1/TU"}
-        q0 = self.q0_3d()
-        if start == "spin":
-            wz = 1.0 + 2.0 * math.pi * n / (n_periods * orbit.period)
-            w0 = wz * Rotation.from_quat(q0).as_matrix().T @ np.array([0.0, 0.0, 1.0])
-            desc = f"the torque-free spin wz = 1 + 2 pi n / (K T) = {wz:.12g} 1/TU about synodic Z, n = {n}"
-            extra = {"start_n": int(n)}
-        else:
-            w0 = np.asarray(self.attitude.w0, dtype=float)
-            desc = "the given attitude.q0, attitude.w0"
-            extra = {}
-        return (q0, w0), {"start": start, **extra, "start_q0": [float(v) for v in q0], "start_w0": [float(v) for v in w0],
-                          "start_description": desc}
-
-    def run_map(self, out: str | Path | None = None, *, scheduler=None, progress: bool | None = None, force: bool = False,
-                say: Callable[[str], None] | None = None):
-        """The attitude periodicity map (grids of wz(T) - wz0 and phi(T) - phi0 over orbit x Kz
-        x wz0, and the refined solutions) through ``librate.app.runner.run_map`` into
-        ``map.zarr`` in the output folder (resumable), or, when the runner is not installed,
-        through :func:`librate.periodicity_map` written with ``to_zarr``. With
-        ``output.format = "netcdf"`` a ``map.nc`` copy is exported too. Returns
-        ``(dataset, path)``.
-
-        A store of the same inputs (finished or interrupted) is resumed; one of other inputs
-        raises :class:`~librate.app.results.ResultExists` naming the changed keys, unless
-        ``force``: then it is removed (after ``say`` names it) and the map recomputed.
-        ``progress``: progress bars on stderr (None: only when stderr is a terminal)."""
-        import shutil
-
-        from .results import check_output, run_map_3d_to, run_map_to
-
-        folder = self.output_dir(out)
-        if self.attitude.model == "3d":
-            return run_map_3d_to(self.build_orbits(), self._result_path(out, "map"), body=self.build_body(), rates=self.rates_3d(), q0=self.q0_3d(),
-                                 n_periods=self.n_periods(), tol=self.attitude.tol or ATTITUDE_TOL, resume=not force, scheduler=scheduler,
-                                 progress=progress, attrs=self.result_attrs("map_3d", "map"))
-        store = folder / "map.zarr"
-        # validated before the store is touched: a study error never costs an existing map
-        orbits = self.build_orbits()
-        srp = self.build_srp()
-        if check_output(store, "map", self.to_json(), force=force, say=say) == "replace":
-            shutil.rmtree(store)
-        ds, path = run_map_to(
-            orbits, store, kz=self.kz_values(), wz0=self.wz0_values(), phi0=self.solver.phi0, n_periods=self.n_periods(),
-            srp=srp, rtol=self.solver.rtol, atol=self.solver.atol, resume=True, scheduler=scheduler, progress=progress,
-            attrs=self.result_attrs("map", "map"),
-        )
-        if self.output.format == "netcdf":
-            from .results import save_dataset
-
-            save_dataset(ds, folder / "map.nc")
-        return ds, path
-
 
 def _sun_period() -> float:
     from ..constants import SUN_SYNODIC_PERIOD
@@ -1234,14 +1031,6 @@ def _subset(fam, idx):
         eigenvalues=fam.eigenvalues[idx], stability_indices=fam.stability_indices[idx], bifurcations=[],
         parameters={**fam.parameters, "members": [int(i) for i in idx]},
     )
-
-
-def _family_of(fam, orbits):
-    """An OrbitFamily holding the corrected members ``orbits`` of ``fam`` (for saving)."""
-    from ..orbits.families import OrbitFamily
-
-    return OrbitFamily.from_members(fam.system, fam.kind, fam.spatial, orbits, fam.end_reason,
-                                    {**fam.parameters, "selected": True})
 
 
 def parse_value(text: str) -> Any:

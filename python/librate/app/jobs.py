@@ -1,0 +1,230 @@
+"""The jobs a study runs: the work behind ``librate family``, ``librate solve`` and ``librate map``.
+
+Each job takes a valid :class:`~librate.app.study.Study` (the schema) and an output folder, reuses
+or refuses an existing result of the same name (:func:`librate.app.results.check_output`),
+computes, and saves the result with the study and the package version as attributes.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+
+from .study import ATTITUDE_TOL, Study, StudyError, grid_raw, member_count, problem
+
+__all__ = ["run_family", "run_map", "run_solve"]
+
+
+# --- jobs ----------------------------------------------------------------------------------
+def _result_path(study: Study, out, command: str) -> Path:
+    from .results import RESULT_STEMS
+
+    return study.output_dir(out) / (RESULT_STEMS[command] + (".zarr" if study.output.format == "zarr" else ".nc"))
+
+def run_family(study: Study, out: str | Path | None = None, *, force: bool = False, say: Callable[[str], None] | None = None,
+               progress: Callable[[int, int], None] | None = None):
+    """Compute the orbit family (and the selected members, when the selection is a
+    subset) and save it as ``family.zarr`` (or ``family.nc``) in the output folder with the
+    study and version as attributes. Returns ``(family, path)``.
+
+    An existing family of the same ``[system]`` and ``[orbits]`` is reused (``say`` tells);
+    one of other inputs raises :class:`~librate.app.results.ResultExists` naming the changed
+    keys, unless ``force`` (then it is replaced, after ``say`` names it). ``progress(done,
+    total)`` after each member of the continuation."""
+    from .results import check_output, open_result, save_family
+
+    path = _result_path(study, out, "family")
+    if check_output(path, "family", study.to_json(), force=force, say=say) == "resume":
+        if say is not None:
+            say(f"reused: {path} already holds this family (--force recomputes it)")
+        return open_result(path), path
+    fam = study.build_family(progress=progress)
+    sel = study.build_orbits(fam)
+    if isinstance(sel, list):
+        sel = _family_of(fam, sel)
+    path = save_family(sel, path, study.result_attrs("family", "family"))
+    return sel, path
+
+def run_solve(study: Study, out: str | Path | None = None, progress: Callable[[int, int], None] | None = None, *, force: bool = False,
+              say: Callable[[str], None] | None = None):
+    """The periodic attitude solutions of every selected orbit and Kz with wz0 in the rate
+    window (:func:`librate.find_periodic_attitudes`, scanning on the study's rate grid),
+    saved as ``solve.zarr`` (or ``.nc``). Returns ``(dataset, path)``; the Dataset has a
+    ``solution`` dimension (orbit index, x0, period, Kz, N, kind, wz0, phidot0, phi0,
+    stability, residual). An existing table of the same inputs is reused, one of other
+    inputs refused unless ``force``, as in :func:`run_family`.
+
+    With ``[attitude] model = "3d"`` see the 3-D branch below instead."""
+    if study.attitude.model == "3d":
+        return _run_solve_3d(study, out, progress, force=force, say=say)
+    from ..periodicity.solutions import find_periodic_attitudes
+    from .results import check_output, open_result, save_dataset, solutions_dataset
+
+    path = _result_path(study, out, "solve")
+    if check_output(path, "solutions", study.to_json(), force=force, say=say) == "resume":
+        if say is not None:
+            say(f"reused: {path} already holds these solutions (--force recomputes them)")
+        return open_result(path), path
+    orbits = study.build_orbits()
+    olist = list(orbits)
+    wz = study.wz0_values()
+    srp = study.build_srp(olist[0].system if olist else None)
+    rows = []
+    total = len(olist) * len(study.kz_values())
+    done = 0
+    for i, o in enumerate(olist):
+        for kz in study.kz_values():
+            sols = find_periodic_attitudes(o, kz=float(kz), wz0_range=(float(wz[0]), float(wz[-1])), phi0=study.solver.phi0,
+                                           n_grid=int(wz.size), n_periods=study.n_periods(), srp=srp)
+            rows += [(i, s) for s in sols]
+            done += 1
+            if progress is not None:
+                progress(done, total)
+    ds = solutions_dataset(rows, olist, study.kz_values(), study.result_attrs("solutions", "solve"))
+    flex = study.build_flexible()
+    if flex is not None and rows:
+        # Flexibility's first-order effect on each rigid solution (the closed quasi-static form).
+        from ..periodicity.flexible import flexible_periodic
+
+        res = [flexible_periodic(sol, flex, resolve=False) for _, sol in rows]
+        ds["flex_dphi0"] = ("solution", np.array([r.shift[0] for r in res]), {"units": "rad", "long_name": "first-order shift of phi0 from flexibility"})
+        ds["flex_dwz0"] = ("solution", np.array([r.shift[1] for r in res]), {"units": "1/TU", "long_name": "first-order shift of wz0 from flexibility"})
+        ds["flex_max_dphi"] = ("solution", np.array([r.max_dphi for r in res]), {"units": "rad", "long_name": "largest attitude departure over a period"})
+    path = save_dataset(ds, path)
+    return ds, path
+
+def _run_solve_3d(study: Study, out: str | Path | None = None, progress: Callable[[int, int], None] | None = None, *, force: bool = False,
+                 say: Callable[[str], None] | None = None):
+    """``librate solve`` on a ``[attitude] model = "3d"`` study: one periodic 3-D attitude
+    motion of the body (body.ix/iy/iz) over ``solver.n_periods`` orbit periods, continued
+    along the selected members in their order (:func:`librate.attitude_family_3d`, natural
+    continuation in the orbit period on the orbit family, with the stability changes
+    located), saved as ``solve.zarr`` (or ``.nc``; :func:`~librate.app.results.solutions_3d_dataset`).
+
+    The first member's motion is corrected (:func:`librate.periodic_attitude_3d`) from the
+    start of ``attitude.start``: "planar", the planar periodic solution with
+    ``attitude.n`` turns found on the first member in the ``[rates]`` scan at
+    ``solver.phi0`` (the body's Kz; exactly one must be there); "spin", the torque-free spin
+    (1 + 2 pi n / (K T)) e_Z at :meth:`Study.q0_3d`; "given", (:meth:`Study.q0_3d`, ``attitude.w0``).
+    Returns ``(dataset, path)``; reuse and ``force`` as in :func:`run_family`.
+    ``progress(done, total)`` after each member reached."""
+    from .._errors import ConvergenceError
+    from ..periodicity.attitude3d import attitude_family_3d
+    from .results import check_output, open_result, save_dataset, solutions_3d_dataset
+
+    path = _result_path(study, out, "solve")
+    if check_output(path, "solutions_3d", study.to_json(), force=force, say=say) == "resume":
+        if say is not None:
+            say(f"reused: {path} already holds these 3-D solutions (--force recomputes them)")
+        return open_result(path), path
+    fam = study.build_family()
+    members = list(study.build_orbits(fam))
+    if not members:
+        sel = member_count(study.orbits)
+        key, value = (f"orbits.{sel[0]}", sel[1]) if sel else ("orbits.kind", study.orbits.kind)
+        raise StudyError([problem(key, value, "selects no member", "at least 1 member (with 2 or more, the motion is continued along them in order)")])
+    body = study.build_body()
+    k = study.n_periods()
+    guess, start = _start_3d(study, members[0], body, k)
+    periods = [o.period_days for o in members]
+    tol = study.attitude.tol or ATTITUDE_TOL
+    try:
+        ds = attitude_family_3d(fam, body, guess=guess, period_days=periods, n_periods=k, tol=tol, progress=progress, method="natural")
+    except ConvergenceError as err:
+        raise ConvergenceError(f"3-D solve: the start on the first member (x0 = {members[0].x0:.6g} LU, T = {periods[0]:.6g} d; "
+                               f"{start['start_description']}) did not converge: {err}") from None
+    ds = solutions_3d_dataset(ds, fam, periods, {**start, "attitude_tol": tol}, study.result_attrs("solutions_3d", "solve"))
+    path = save_dataset(ds, path)
+    return ds, path
+
+def _start_3d(study: Study, orbit, body, n_periods: int):
+    """The guess of the first member's 3-D motion and its description (attributes)."""
+    from scipy.spatial.transform import Rotation
+
+    start = study.attitude_start()
+    n = study.attitude.n
+    if start == "planar":
+        from ..periodicity.solutions import find_periodic_attitudes
+
+        wz = study.wz0_values()
+        key = "rates.wz0" if study.rates.wz0 is not None else "rates.phidot0"
+        found = find_periodic_attitudes(orbit, kz=float(body.kz), wz0_range=(float(wz[0]), float(wz[-1])), phi0=study.solver.phi0,
+                                        n_grid=int(wz.size), n_periods=n_periods)
+        hits = [x for x in found if x.kind == "periodic" and x.n == n]
+        where = f"on the first member (x0 = {orbit.x0:.6g} LU, T = {orbit.period_days:.6g} d, Kz = {body.kz:.6g}, phi0 = {study.solver.phi0:g})"
+        if not hits:
+            others = ", ".join(f"n = {x.n:g} ({x.kind}) at wz0 = {x.wz0:.6g}" for x in found) or "none"
+            raise StudyError([problem("attitude.n", n, f"no planar periodic solution with n = {n} {where} for wz0 in "
+                                       f"[{wz[0]:g}, {wz[-1]:g}]; found: {others}",
+                                       "the n of a planar periodic solution in the window, or widen " + key)])
+        if len(hits) > 1:
+            raise StudyError([problem(key, grid_raw(getattr(study.rates, key.split(".")[1])),
+                                       f"{len(hits)} planar periodic solutions with n = {n} {where}: wz0 = "
+                                       + ", ".join(f"{x.wz0:.6g}" for x in hits) + "; narrow the window to one of them",
+                                       "a rate window holding exactly one planar solution with n = attitude.n")])
+        sol = hits[0]
+        return sol, {"start": "planar", "start_n": int(n), "start_planar_wz0": float(sol.wz0), "start_planar_phi0": float(sol.phi0),
+                     "start_planar_trace": float(sol.trace), "start_planar_stable": int(bool(sol.stable)),
+                     "start_description": f"the planar n = {n} solution, phi0 = {sol.phi0:g} rad, wz0 = {sol.wz0:.12g} 1/TU"}
+    q0 = study.q0_3d()
+    if start == "spin":
+        wz = 1.0 + 2.0 * math.pi * n / (n_periods * orbit.period)
+        w0 = wz * Rotation.from_quat(q0).as_matrix().T @ np.array([0.0, 0.0, 1.0])
+        desc = f"the torque-free spin wz = 1 + 2 pi n / (K T) = {wz:.12g} 1/TU about synodic Z, n = {n}"
+        extra = {"start_n": int(n)}
+    else:
+        w0 = np.asarray(study.attitude.w0, dtype=float)
+        desc = "the given attitude.q0, attitude.w0"
+        extra = {}
+    return (q0, w0), {"start": start, **extra, "start_q0": [float(v) for v in q0], "start_w0": [float(v) for v in w0],
+                      "start_description": desc}
+
+def run_map(study: Study, out: str | Path | None = None, *, scheduler=None, progress: bool | None = None, force: bool = False,
+            say: Callable[[str], None] | None = None):
+    """The attitude periodicity map (grids of wz(T) - wz0 and phi(T) - phi0 over orbit x Kz
+    x wz0, and the refined solutions) through ``librate.app.runner.run_map`` into
+    ``map.zarr`` in the output folder (resumable), or, when the runner is not installed,
+    through :func:`librate.periodicity_map` written with ``to_zarr``. With
+    ``output.format = "netcdf"`` a ``map.nc`` copy is exported too. Returns
+    ``(dataset, path)``.
+
+    A store of the same inputs (finished or interrupted) is resumed; one of other inputs
+    raises :class:`~librate.app.results.ResultExists` naming the changed keys, unless
+    ``force``: then it is removed (after ``say`` names it) and the map recomputed.
+    ``progress``: progress bars on stderr (None: only when stderr is a terminal)."""
+    import shutil
+
+    from .results import check_output, run_map_3d_to, run_map_to
+
+    folder = study.output_dir(out)
+    if study.attitude.model == "3d":
+        return run_map_3d_to(study.build_orbits(), _result_path(study, out, "map"), body=study.build_body(), rates=study.rates_3d(), q0=study.q0_3d(),
+                             n_periods=study.n_periods(), tol=study.attitude.tol or ATTITUDE_TOL, resume=not force, scheduler=scheduler,
+                             progress=progress, attrs=study.result_attrs("map_3d", "map"))
+    store = folder / "map.zarr"
+    # validated before the store is touched: a study error never costs an existing map
+    orbits = study.build_orbits()
+    srp = study.build_srp()
+    if check_output(store, "map", study.to_json(), force=force, say=say) == "replace":
+        shutil.rmtree(store)
+    ds, path = run_map_to(
+        orbits, store, kz=study.kz_values(), wz0=study.wz0_values(), phi0=study.solver.phi0, n_periods=study.n_periods(),
+        srp=srp, rtol=study.solver.rtol, atol=study.solver.atol, resume=True, scheduler=scheduler, progress=progress,
+        attrs=study.result_attrs("map", "map"),
+    )
+    if study.output.format == "netcdf":
+        from .results import save_dataset
+
+        save_dataset(ds, folder / "map.nc")
+    return ds, path
+
+
+def _family_of(fam, orbits):
+    """An OrbitFamily holding the corrected members ``orbits`` of ``fam`` (for saving)."""
+    from ..orbits.families import OrbitFamily
+
+    return OrbitFamily.from_members(fam.system, fam.kind, fam.spatial, orbits, fam.end_reason,
+                                    {**fam.parameters, "selected": True})
