@@ -3,6 +3,7 @@ at files outside the repository, the gallery has a page section, a command and a
 figure its script makes, every command has a how-to, and the README keeps its two commands and
 links the docs. (The site itself is built with `mkdocs build --strict` in .ci/run.)"""
 
+import os
 import re
 import subprocess
 import sys
@@ -60,5 +61,5 @@ def test_every_readme_python_block_runs_as_pasted(tmp_path):
     assert blocks
     for i, code in enumerate(blocks):
         res = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, capture_output=True, text=True, timeout=600,
-                             env={**__import__("os").environ, "MPLBACKEND": "Agg"})
+                             env={**os.environ, "MPLBACKEND": "Agg"})
         assert res.returncode == 0, f"README block {i + 1} failed:\n{res.stderr[-2000:]}"
