@@ -32,7 +32,10 @@ import librate
 import numpy as np
 import pytest
 from librate.app.runner import run_map
-from librate.app.store import ROW_VARS, StoreBusyError, verify_map_store, writer_lock
+from librate.results import StoreBusyError, writer_lock
+from librate.results import verify_store as verify_map_store
+
+ROW_VARS = ("dwz", "dphi", "phi_T", "status")
 
 X0 = [0.9, 0.85]
 KZ = [0.8]
@@ -395,5 +398,5 @@ def test_plot_refuses_a_damaged_store_by_name(tmp_path, good_store):
     out = _copy(good_store, tmp_path)
     _damage(out / "dwz" / "0.0.0", "garbage", 3)
     r = CliRunner().invoke(main, ["plot", str(out)])
-    assert r.exit_code == 1 and "chunk dwz/0.0.0" in r.output and "row 0" in r.output, r.output
+    assert r.exit_code == 2 and "chunk dwz/0.0.0" in r.output and "row 0" in r.output, r.output  # refused (issue 24 #4)
     assert "Traceback" not in r.output and "asyncio" not in r.output
