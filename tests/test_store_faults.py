@@ -400,3 +400,292 @@ def test_plot_refuses_a_damaged_store_by_name(tmp_path, good_store):
     r = CliRunner().invoke(main, ["plot", str(out)])
     assert r.exit_code == 2 and "chunk dwz/0.0.0" in r.output and "row 0" in r.output, r.output  # refused (issue 24 #4)
     assert "Traceback" not in r.output and "asyncio" not in r.output
+
+
+# ---------------------------------------------------------------------------------------------
+# Issue 24: every result kind (family, solutions, map, map_3d) through librate.results. Each test
+# below fails on main 126a94a (the defect it names) and passes with the one writer and store.
+
+from librate.app.results import run_map_3d_to, run_map_to, save_dataset, verify_result  # noqa: E402
+from librate.results import atomic  # noqa: E402
+
+BODY = librate.RigidBody(1.0, 1.02, 1.04)
+RATES_3D = {"wx0": np.linspace(-0.05, 0.05, 5), "wy0": 0.0, "wz0": np.linspace(1.1, 1.4, 8)}
+RATES_3D_OLD = {"wx0": np.linspace(-0.05, 0.05, 3), "wy0": 0.0, "wz0": np.linspace(1.1, 1.4, 8)}
+
+
+def _map3d(fam, out, rates=RATES_3D, resume=True):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        return run_map_3d_to(fam, out, body=BODY, rates=rates, q0=[0.0, 0.0, 0.0, 1.0], tol=1e-10, resume=resume, progress=False)[0]
+
+
+def _zattrs_edit(folder: Path, key: str, edit) -> None:
+    """Apply ``edit`` to the attributes JSON ``key`` (e.g. "period/.zattrs" or ".zattrs") of a Zarr
+    folder, in the file and in the consolidated metadata (both: a reader may use either)."""
+    f = folder / key
+    attrs = json.loads(f.read_text())
+    edit(attrs)
+    f.write_text(json.dumps(attrs))
+    zm = folder / ".zmetadata"
+    if zm.exists():
+        meta = json.loads(zm.read_text())
+        edit(meta["metadata"][key])
+        zm.write_text(json.dumps(meta))
+
+
+def _no_leftovers(path: Path) -> None:
+    left = [q.name for q in path.parent.iterdir() if q.name.startswith(f".{path.name}.")]
+    assert not left, left
+
+
+@pytest.fixture(scope="module")
+def map3d_ref(fam):
+    return run_map_3d_ref(fam)
+
+
+def run_map_3d_ref(fam):
+    """The uninterrupted 3-D map (each orbit by librate.attitude_map_3d, as the store holds it)."""
+    maps = [librate.attitude_map_3d(o, BODY, wx0=RATES_3D["wx0"], wy0=0.0, wz0=RATES_3D["wz0"], tol=1e-10) for o in fam]
+    return np.stack([m["residual"].values for m in maps]), np.stack([m["status"].values for m in maps])
+
+
+def _same3d(ds, ref):
+    np.testing.assert_array_equal(ds["residual"].values, ref[0])
+    np.testing.assert_array_equal(ds["status"].values, ref[1])
+    assert ds["status"].dtype == np.uint8 and int(ds.attrs["complete"]) == 1
+
+
+def test_force_while_another_process_writes_removes_nothing(tmp_path, fam, good_store):
+    """#1: `map --force` while another writer holds the store: refused naming the holder, and the
+    store is untouched (main removed it before taking the lock)."""
+    out = _copy(good_store, tmp_path)
+    script = textwrap.dedent(f"""
+        import time, librate.results as r
+        with r.writer_lock({str(out)!r}):
+            print("locked", flush=True)
+            time.sleep(60)
+    """)
+    holder = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE, text=True)
+    try:
+        assert holder.stdout.readline().strip() == "locked"
+        with pytest.raises(StoreBusyError, match=f"pid {holder.pid}"):
+            run_map_to(fam, out, kz=[0.5], wz0=WZ, replace=True, progress=False)
+        assert verify_map_store(out).ok
+    finally:
+        holder.kill()
+        holder.wait()
+
+
+def test_force_is_all_or_nothing(tmp_path, fam, good_store, monkeypatch):
+    """#5: a replacing map that fails (a full disk at its second row) leaves the old map whole."""
+    import errno
+
+    import librate.app.runner as runner
+
+    out = _copy(good_store, tmp_path)
+    real, calls = runner._row, []
+
+    def full_disk(*a, **k):
+        calls.append(1)
+        if len(calls) == 2:
+            raise OSError(errno.ENOSPC, "No space left on device")
+        return real(*a, **k)
+
+    monkeypatch.setattr(runner, "_row", full_disk)
+    with pytest.raises(OSError, match="No space left"):
+        run_map_to(fam, out, kz=[0.5], wz0=WZ, replace=True, progress=False)
+    assert verify_map_store(out).ok and _raw_equal(out, good_store, "dwz")
+    monkeypatch.setattr(runner, "_row", real)
+    ds, _ = run_map_to(fam, out, kz=[0.5], wz0=WZ, replace=True, progress=False)
+    assert float(ds["kz"][0]) == 0.5 and verify_map_store(out).ok
+    _no_leftovers(out)
+
+
+def test_orphans_of_dead_processes_are_cleaned_at_start(tmp_path, fam):
+    """#2: temporary siblings left by killed writers (dead pids) are removed at the next write; a
+    live process's are kept; an old result set aside by a killed replacement is put back."""
+    p = tmp_path / "family.zarr"
+    fam.save(p)
+    sleeper = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(60)"])
+    dead = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"], capture_output=True, text=True).stdout.strip()
+    try:
+        for what, pid in (("tmp", dead), ("tmp", sleeper.pid)):
+            (tmp_path / f".family.zarr.{what}-{pid}").mkdir()
+            (tmp_path / f".family.zarr.{what}-{pid}" / "x").write_text("partial")
+        fam.save(p)
+        assert sorted(q.name for q in tmp_path.iterdir()) == [f".family.zarr.tmp-{sleeper.pid}", "family.zarr"]
+    finally:
+        sleeper.kill()
+        sleeper.wait()
+    # a replacement killed between its two renames (systems without an atomic exchange)
+    os.rename(p, tmp_path / f".family.zarr.old-{dead}")
+    back = atomic.clean_orphans(p)
+    assert p.exists() and len(back) == 2 and librate.OrbitFamily.load(p).period.tolist() == fam.period.tolist()
+
+
+@pytest.mark.parametrize("suffix", [".zarr", ".nc"])
+def test_checksums_cover_attributes_names_and_constants_of_a_family(tmp_path, fam, suffix):
+    """#3: a `scale_factor` added to an array (its values doubled on reading), a flipped bit in the
+    mass ratio, and a flipped bit in a variable name are each detected and named, by
+    OrbitFamily.load and by verify."""
+    import xarray as xr
+
+    p = tmp_path / f"family{suffix}"
+    fam.save(p)
+    if suffix == ".nc":  # netCDF: the same three edits through a rewrite with the old digests
+        ds = xr.open_dataset(p, engine="scipy").load()
+        ds["period"].attrs["scale_factor"] = 2.0
+        ds.to_netcdf(tmp_path / "scaled.nc", engine="scipy")
+        ds = xr.open_dataset(p, engine="scipy").load()
+        ds.attrs["mu"] = float(np.frombuffer((np.frombuffer(np.float64(ds.attrs["mu"]).tobytes(), np.uint64) ^ np.uint64(1)).tobytes())[0])
+        ds.to_netcdf(tmp_path / "mu.nc", engine="scipy")
+        ds = xr.open_dataset(p, engine="scipy").load().rename({"jacobi": "jacobj"})
+        ds.to_netcdf(tmp_path / "name.nc", engine="scipy")
+        cases = [(tmp_path / "scaled.nc", "period"), (tmp_path / "mu.nc", "root attributes"), (tmp_path / "name.nc", "jacobi")]
+    else:
+        cases = []
+        for name, edit in (("scaled", lambda q: _zattrs_edit(q, "period/.zattrs", lambda a: a.update(scale_factor=2.0))),
+                           ("mu", lambda q: _zattrs_edit(q, ".zattrs", lambda a: a.update(mu=a["mu"] * (1 + 2.0 ** -52)))),
+                           ("name", lambda q: (os.rename(q / "jacobi", q / "jacobj"), (q / ".zmetadata").unlink()))):
+            q = tmp_path / f"{name}.zarr"
+            shutil.copytree(p, q)
+            edit(q)
+            cases.append((q, {"scaled": "period", "mu": "root attributes", "name": "jacobi"}[name]))
+    for q, what in cases:
+        with pytest.raises(ValueError, match=f"damaged librate family file|not a librate family file.*{what}"):
+            librate.OrbitFamily.load(q)
+        ok, report = verify_result(q)
+        assert not ok and what in report, report
+
+
+def test_scale_factor_in_a_map_store_is_named_and_repaired(tmp_path, fam, reference, good_store):
+    """#3: `scale_factor` slipped into dwz's metadata doubled dwz and passed verify on main; now
+    verify names the array and a resume puts the attributes back."""
+    out = _copy(good_store, tmp_path)
+    _zattrs_edit(out, "dwz/.zattrs", lambda a: a.update(scale_factor=2.0))
+    rep = verify_map_store(out)
+    assert not rep.ok and any("array dwz: its dtype, shape or attributes" in q for q in rep.problems), rep.describe()
+    with pytest.raises(ValueError, match="array dwz"):
+        librate.open_result(out, verify=True)
+    _resume_is_identical(out, fam, reference)
+
+
+def _solve_dataset(fam):
+    from librate.app.results import solutions_dataset
+
+    rows = [(0, s) for s in librate.find_periodic_attitudes(fam[0], kz=0.8, wz0_range=(-1.0, 1.5), n_grid=40)]
+    return solutions_dataset(rows, list(fam), [0.8], {"librate_result": "solutions", "study": "{}"})
+
+
+def test_a_damaged_solve_is_named_never_a_crash_and_plot_refuses_it(tmp_path, fam):
+    """#4: truncated, padded and garbage chunks of a saved solve: verify names them (exit 1, no
+    segfault: chunks are checked before Blosc sees them), `librate plot` refuses with exit 2, and
+    the name flip that made `librate solve` raise a KeyError is named too."""
+    from click.testing import CliRunner
+    from librate.app.cli import main
+
+    p = tmp_path / "good" / "solve.zarr"
+    save_dataset(_solve_dataset(fam), p)
+    assert verify_result(p)[0]
+    for i, how in enumerate(("truncate", "garbage", "bitflip", "delete")):
+        q = tmp_path / how / "solve.zarr"
+        shutil.copytree(p, q)
+        _damage(q / "sol_wz0" / "0", how, i)
+        ok, report = verify_result(q)
+        assert not ok and "sol_wz0" in report, report
+        r = CliRunner().invoke(main, ["verify", str(q)])
+        assert r.exit_code == 1 and "sol_wz0" in r.output, r.output
+        r = CliRunner().invoke(main, ["plot", str(q)])
+        assert r.exit_code == 2 and "sol_wz0" in r.output and not list(q.parent.glob("*.png")), r.output
+
+
+def test_a_damaged_3d_part_is_really_recomputed(tmp_path, fam, map3d_ref):
+    """#4: a truncated chunk of one orbit of a 3-D map is named by verify (no crash), `librate plot`
+    refuses the map (exit 2), and the same map again recomputes that orbit: identical to an
+    uninterrupted run (on main every rerun exited 2)."""
+    from click.testing import CliRunner
+    from librate.app.cli import main
+
+    out = tmp_path / "map.zarr"
+    _same3d(_map3d(fam, out), map3d_ref)
+    _damage(out / "residual" / "1.0.0.0", "truncate", 0)
+    rep = verify_map_store(out)
+    assert 1 in rep.damaged and "residual/1.0.0.0" in rep.damaged[1], rep.describe()
+    r = CliRunner().invoke(main, ["plot", str(out)])
+    assert r.exit_code == 2 and "residual/1.0.0.0" in r.output, r.output
+    with pytest.warns(RuntimeWarning, match="orbit 1: chunk residual/1.0.0.0"):
+        ds = run_map_3d_to(fam, out, body=BODY, rates=RATES_3D, q0=[0, 0, 0, 1.0], tol=1e-10, progress=False)[0]
+    _same3d(ds, map3d_ref)
+    assert verify_map_store(out).ok
+
+
+def test_3d_maps_are_locked_and_keep_their_dtypes(tmp_path, fam, map3d_ref):
+    """#10: a second writer of a 3-D map is refused; a resumed 3-D map stores status as uint8
+    (main: int8 after a resume from its netCDF parts, int16 after two concurrent runs)."""
+    out = tmp_path / "map.zarr"
+    with writer_lock(out):
+        script = textwrap.dedent(f"""
+            import numpy as np, librate
+            from librate.app.results import run_map_3d_to
+            fam = librate.dro_family(librate.System.preset("earth-moon"), x0={X0!r})
+            run_map_3d_to(fam, {str(out)!r}, body=librate.RigidBody(1.0, 1.02, 1.04), rates={{"wx0": np.linspace(-0.05, 0.05, 5),
+                          "wy0": 0.0, "wz0": np.linspace(1.1, 1.4, 8)}}, q0=[0, 0, 0, 1.0], tol=1e-10, progress=False)
+        """)
+        proc = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120)
+        assert proc.returncode != 0 and f"pid {os.getpid()}" in proc.stderr and "StoreBusyError" in proc.stderr, proc.stderr[-2000:]
+    import librate.periodicity.map3d as m3
+
+    real, calls = m3.attitude_map_3d, []
+
+    def stop_second(*a, **k):
+        calls.append(1)
+        if len(calls) == 2:
+            raise KeyboardInterrupt
+        return real(*a, **k)
+
+    m3.attitude_map_3d = stop_second
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            _map3d(fam, out)
+    finally:
+        m3.attitude_map_3d = real
+    import zarr
+
+    assert zarr.open_group(str(out), mode="r")["status"].dtype == np.uint8
+    ds = _map3d(fam, out)
+    _same3d(ds, map3d_ref)
+    assert librate.open_result(out, verify=True)["status"].dtype == np.uint8
+
+
+def test_two_processes_saving_one_family(tmp_path, fam):
+    """#11: two processes saving one OrbitFamily to the same .zarr 20 times each, at once: every
+    call succeeds (the second waits for the lock; main: 33 of 80 failed as "damaged"), and the file
+    loads and verifies."""
+    p = tmp_path / "family.zarr"
+    script = textwrap.dedent(f"""
+        import librate
+        fam = librate.dro_family(librate.System.preset("earth-moon"), x0={X0!r})
+        for _ in range(20):
+            fam.save({str(p)!r})
+            librate.OrbitFamily.load({str(p)!r})
+    """)
+    procs = [subprocess.Popen([sys.executable, "-c", script], stderr=subprocess.PIPE, text=True) for _ in range(2)]
+    errs = [q.communicate(timeout=300)[1] for q in procs]
+    assert [q.returncode for q in procs] == [0, 0], errs
+    assert librate.OrbitFamily.load(p).period.tolist() == fam.period.tolist() and verify_result(p)[0]
+    _no_leftovers(p)
+
+
+def test_a_deleted_lock_file_lets_no_second_writer_in(tmp_path):
+    """#11: the lock file deleted while a writer runs: a second process is refused (the first one's
+    owner record names a live pid), and the first stops before its next commit."""
+    out = tmp_path / "map.zarr"
+    with writer_lock(out) as lock:
+        (tmp_path / ".map.zarr.lock").unlink()
+        script = f"import librate.results as r\nwith r.writer_lock({str(out)!r}): print('in')"
+        proc = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=60)
+        assert proc.returncode != 0 and f"pid {os.getpid()}" in proc.stderr and "lock file was removed" in proc.stderr, proc.stderr[-2000:]
+        (tmp_path / ".map.zarr.lock").write_text("")  # another process's fresh lock file
+        with pytest.raises(StoreBusyError, match="removed or replaced"):
+            lock.check()

@@ -496,7 +496,7 @@ def run_map_3d_to(orbits, store: str | Path, *, body, rates: dict, q0, n_periods
                 bar.update(1)
         shared = ("mu", "lu_km", "tu_s", "system_name", "n_periods", "tol", "q0", "simd_level", "librate_version")  # the same for every orbit
         final = {k: tpl.attrs[k] for k in shared if k in tpl.attrs}
-        final.update({**attrs, "title": "librate 3-D attitude map"})
+        final.update({"librate_result": "map_3d", **attrs, "title": "librate 3-D attitude map"})
         state0 = np.array([np.asarray(o.state0, dtype=float) for o in olist])
         pstore.finalise({"orbit_state0": (("orbit", "state"), state0, {"units": "LU, LU/TU", "long_name": "orbit initial state"})}, final, complete=True)
         if parts != store:

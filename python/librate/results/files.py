@@ -63,7 +63,11 @@ def open_dataset(p: Path):
             if p.is_file() and p.suffix == ".nc":
                 return xr.open_dataset(p, engine="scipy")
             if is_zarr(p):
-                return xr.open_dataset(p, engine="zarr", chunks=None)
+                import warnings
+
+                with warnings.catch_warnings():  # no consolidated metadata (e.g. a store in progress): read without
+                    warnings.simplefilter("ignore", RuntimeWarning)
+                    return xr.open_dataset(p, engine="zarr", chunks=None)
     except Exception as err:  # noqa: BLE001 - whatever the reader raises, named
         raise ValueError(f"{str(p)!r} cannot be read as a librate result: {short(err)}") from None
     raise ValueError(f"{str(p)!r} is neither a netCDF file (.nc) nor a Zarr store (.zarr folder)")

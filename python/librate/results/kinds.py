@@ -144,6 +144,10 @@ class Map3DResult(ResultKind):
     figures = ("map", "residuals", "solutions")
     dtypes = {"status": "uint8"}
 
+    @classmethod
+    def recognise(cls, ds) -> bool:
+        return ds.attrs.get("librate_result") == "map_3d" or ds.attrs.get("librate_store") == "map_3d"
+
 
 #: The classes by kind, in the order they are recognised.
 KINDS: dict[str, type[ResultKind]] = {c.kind: c for c in (FamilyResult, SolutionsResult, Solutions3DResult, MapResult, Map3DResult)}
