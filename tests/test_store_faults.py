@@ -855,3 +855,28 @@ def test_kill_campaign_loses_nothing(tmp_path, fam, em, good_store):
         _no_leftovers(p)
         counts[k] += 1
     print(f"kill campaign: {sum(counts.values())} SIGKILLs, {counts}; 0 lost or wrong")
+
+
+def test_results_written_by_main_still_open(tmp_path, fam, reference, good_store):
+    """Files of librate 126a94a: a map store without the metadata digests verifies and resumes
+    (its row checksums are the same); a 3-D map saved whole with status as int8 (as its netCDF
+    parts made it) opens with status uint8 (255 = not computed, as written)."""
+    out = _copy(good_store, tmp_path)
+
+    def strip(a):  # main's root attributes: the solutions' digests under their old name, no metadata digests
+        a["sol_checksums"] = a.pop("extra_checksums")
+        for k in ("array_meta", "attrs_checksum"):
+            a.pop(k, None)
+
+    _zattrs_edit(out, ".zattrs", strip)
+    assert verify_map_store(out).ok
+    _resume_is_identical(out, fam, reference)
+    from librate._integrity import write_atomically
+
+    m = librate.attitude_map_3d(fam[0], BODY, wx0=RATES_3D["wx0"], wy0=0.0, wz0=RATES_3D["wz0"], tol=1e-10)
+    m["status"] = m["status"].astype(np.int8)
+    m.attrs.update({"librate_result": "map_3d", "complete": 1})
+    write_atomically(m, tmp_path / "old3d.nc")
+    back = librate.open_result(tmp_path / "old3d.nc", verify=True)
+    assert back["status"].dtype == np.uint8
+    np.testing.assert_array_equal(back["status"].values, m["status"].values.astype(np.uint8))

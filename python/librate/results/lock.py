@@ -52,6 +52,7 @@ class WriterLock:
         self.path, self.owner = lock_paths(self.out)
         self.fd: int | None = None
         self.inode: tuple[int, int] | None = None
+        self.portable = None
 
     def _busy(self, who: str) -> StoreBusyError:
         return StoreBusyError(f"{self.out} is being written by another librate process ({who}); "
@@ -78,9 +79,11 @@ class WriterLock:
                 time.sleep(0.05)
 
     def _acquire(self) -> None:
-        import fcntl
-
         self.out.parent.mkdir(parents=True, exist_ok=True)
+        try:
+            import fcntl
+        except ImportError:  # Windows: filelock's lock, without the inode checks
+            return self._acquire_portable()
         for _ in range(20):
             fd = os.open(self.path, os.O_RDWR | os.O_CREAT, 0o644)
             try:
@@ -110,11 +113,24 @@ class WriterLock:
         self.fd, self.inode = fd, (st.st_dev, st.st_ino)
         atomic_write_text(self.owner, f"pid {os.getpid()} on {socket.gethostname()}, since {time.strftime('%Y-%m-%d %H:%M:%S')}")
 
+    def _acquire_portable(self) -> None:
+        from filelock import FileLock, Timeout
+
+        lock = FileLock(str(self.path), timeout=0)
+        try:
+            lock.acquire()
+        except Timeout:
+            raise self._busy(self._who()) from None
+        self.portable, self.fd, self.inode = lock, -1, None
+        atomic_write_text(self.owner, f"pid {os.getpid()} on {socket.gethostname()}, since {time.strftime('%Y-%m-%d %H:%M:%S')}")
+
     def check(self) -> None:
         """Raise :class:`StoreBusyError` unless this writer still holds the lock on disk (call it
         before every commit)."""
         if self.fd is None:
             raise StoreBusyError(f"{self.out}: the writer lock is not held")
+        if self.inode is None:  # the portable lock: nothing more to check
+            return
         try:
             st = os.stat(self.path)
             same = (st.st_dev, st.st_ino) == self.inode
@@ -126,6 +142,12 @@ class WriterLock:
 
     def release(self) -> None:
         if self.fd is None:
+            return
+        if self.inode is None:
+            with contextlib.suppress(OSError):
+                self.owner.unlink()
+            self.portable.release()
+            self.fd = None
             return
         try:
             mine = True
