@@ -104,6 +104,7 @@ def run_map(
             lock = stack.enter_context(writer_lock(Path(out)))  # before anything is created or removed
             clean_orphans(Path(out))
             if replace and Path(out).exists():
+                _check_replaceable(Path(out))
                 target = temporary_sibling(Path(out))
                 remove_path(target)
             # every chunk on disk, even one equal to the fill value: a missing chunk is damage
@@ -178,3 +179,22 @@ def _run(olist, family, kzs, wz, coords, fp, args, out, resume, scheduler, progr
         sol = {v: (("solution",), np.ascontiguousarray(ds[v].values), dict(ds[v].attrs)) for v in ds.data_vars if v.startswith("sol_")}
         store.finalise(sol, dict(ds.attrs), complete=bool(ds.attrs.get("complete", 0)))
     return ds
+
+
+def _check_replaceable(out: Path) -> None:
+    """Only a librate result may be replaced (a foreign folder is refused, never overwritten)."""
+    from ..results.files import open_dataset
+    from ..results.kinds import kind_of
+    from ..results.store import store_kind
+
+    if out.is_dir() and (not any(out.iterdir()) or store_kind(out) is not None):
+        return
+    try:
+        ds = open_dataset(out)
+    except ValueError:
+        ds = None
+    kind = None if ds is None else kind_of(ds)
+    if ds is not None:
+        ds.close()
+    if kind is None:
+        raise ValueError(f"invalid argument `out`: {out} exists and is not a librate result; refusing to replace it")
