@@ -314,7 +314,7 @@ def map_3d_study(tmp_path) -> Path:
 
 def test_map_of_a_3d_study(cli, tmp_path):
     """`librate map` on a 3-D study: the six residuals over (orbit, wx0, wz0) of the 3-D map
-    engine, written to map.zarr with the study, the per-orbit parts removed, a summary line per
+    engine, written to map.zarr (a part store) with the study, a summary line per
     orbit and the residual figure. Reference: the planar embedding (the body's z on synodic Z,
     wx0 = wy0 = 0) is a planar motion, so rx, ry, dwx, dwy vanish there exactly; and each orbit's
     map equals librate.attitude_map_3d on that orbit (bit for bit: the same engine and grid)."""
@@ -326,7 +326,7 @@ def test_map_of_a_3d_study(cli, tmp_path):
     ds = librate.open_result(path, verify=True)
     assert ds.attrs["librate_result"] == "map_3d" and ds.attrs["librate_command"] == "map" and int(ds.attrs["complete"]) == 1
     assert ds["residual"].dims == ("orbit", "wx0", "wz0", "component") and float(ds["wy0"]) == 0.0
-    assert not (tmp_path / "librate-out" / "map.zarr.parts").exists()
+    assert ds["status"].dtype == np.uint8 and "done" not in ds.variables
     j = int(np.argmin(np.abs(ds["wx0"].values)))
     assert ds["wx0"].values[j] == 0.0
     planar = ds["residual"].isel(wx0=j).sel(component=["rx", "ry", "dwx", "dwy"]).values
@@ -346,7 +346,7 @@ def test_map_of_a_3d_study(cli, tmp_path):
 
 
 def test_an_interrupted_3d_map_keeps_its_finished_orbits(tmp_path, monkeypatch):
-    """A 3-D map stopped in its second orbit keeps the first (saved on its own, all or nothing):
+    """A 3-D map stopped in its second orbit keeps the first (its part committed with a checksum):
     the same run again computes only the two others, and the result equals an uninterrupted run
     bit for bit. A damaged part (its bytes overwritten) is named in a warning and recomputed."""
     import librate.periodicity.map3d as m3
@@ -363,8 +363,10 @@ def test_an_interrupted_3d_map_keeps_its_finished_orbits(tmp_path, monkeypatch):
     monkeypatch.setattr(m3, "attitude_map_3d", stop_second)
     with pytest.raises(KeyboardInterrupt):
         run_map(study, tmp_path / "a", progress=False)
-    parts = tmp_path / "a" / "map.zarr.parts"
-    assert sorted(p.name for p in parts.iterdir()) == ["orbit-00000.nc"] and not (tmp_path / "a" / "map.zarr").exists()
+    from librate.results import verify_store
+
+    rep = verify_store(tmp_path / "a" / "map.zarr")  # the part store: orbit 0 done, 1 and 2 not
+    assert rep.not_done == [1, 2] and not rep.damaged and not rep.complete
     calls.clear()
     monkeypatch.setattr(m3, "attitude_map_3d", lambda orbit, *a, **k: calls.append(orbit.period_days) or real(orbit, *a, **k))
     ds, _ = run_map(study, tmp_path / "a", progress=False)
@@ -376,12 +378,12 @@ def test_an_interrupted_3d_map_keeps_its_finished_orbits(tmp_path, monkeypatch):
     calls.clear()
     with pytest.raises(KeyboardInterrupt):
         run_map(study, tmp_path / "c", progress=False)
-    part = tmp_path / "c" / "map.zarr.parts" / "orbit-00000.nc"
+    part = tmp_path / "c" / "map.zarr" / "residual" / "0.0.0.0"  # orbit 0's residuals
     raw = bytearray(part.read_bytes())
     raw[-64:] = b"\x00" * 64
     part.write_bytes(bytes(raw))
     monkeypatch.setattr(m3, "attitude_map_3d", real)
-    with pytest.warns(RuntimeWarning, match="orbit-00000.nc: damaged"):
+    with pytest.warns(RuntimeWarning, match="damaged orbit\\(s\\) are recomputed: orbit 0: chunk residual/0.0.0.0"):
         ds_c, _ = run_map(study, tmp_path / "c", progress=False)
     np.testing.assert_array_equal(ds_c["residual"].values, whole["residual"].values)
 

@@ -629,8 +629,8 @@ def plot(result_path, quiet) -> None:
         raise UserError(str(err)) from None
     try:
         _refuse_damaged_store(p)
-    except ValueError as err:  # damage, not a mistake: exit status 1, as `librate verify`
-        raise click.ClickException(str(err)) from None
+    except ValueError as err:  # refused: exit status 2, nothing drawn
+        raise UserError(str(err)) from None
     try:
         res = open_result(p)
     except (ValueError, FileNotFoundError) as err:
@@ -654,14 +654,18 @@ def plot(result_path, quiet) -> None:
 
 
 def _refuse_damaged_store(p: Path) -> None:
-    """A map store with damaged rows or arrays is refused by name (an incomplete one is drawn)."""
-    from .store import verify_map_store
+    """A damaged result (any kind) is refused by name; an incomplete map store is drawn."""
+    from ..results.store import store_kind, verify_store
+    from .results import verify_result
 
-    if not (p / ".zgroup").is_file():
+    if p.is_dir() and store_kind(p) is not None:
+        rep = verify_store(p)
+        if rep.damaged or rep.problems:
+            raise ValueError(rep.describe())
         return
-    rep = verify_map_store(p)
-    if rep.damaged or (rep.problems and "not a librate map store (no librate_store marker" not in rep.problems[0]):
-        raise ValueError(rep.describe())
+    ok, report = verify_result(p)
+    if not ok:
+        raise ValueError(report)
 
 
 @main.command(context_settings=_CONTEXT, short_help="Check a saved result for damage, without recomputing it.")

@@ -193,10 +193,8 @@ def run_map(study: Study, out: str | Path | None = None, *, scheduler=None, prog
 
     A store of the same inputs (finished or interrupted) is resumed; one of other inputs
     raises :class:`~librate.app.results.ResultExists` naming the changed keys, unless
-    ``force``: then it is removed (after ``say`` names it) and the map recomputed.
+    ``force``: then it is replaced (after ``say`` names it) once the new map is complete.
     ``progress``: progress bars on stderr (None: only when stderr is a terminal)."""
-    import shutil
-
     from .results import check_output, run_map_3d_to, run_map_to
 
     folder = study.output_dir(out)
@@ -208,12 +206,12 @@ def run_map(study: Study, out: str | Path | None = None, *, scheduler=None, prog
     # validated before the store is touched: a study error never costs an existing map
     orbits = study.build_orbits()
     srp = study.build_srp()
-    if check_output(store, "map", study.to_json(), force=force, say=say) == "replace":
-        shutil.rmtree(store)
+    # nothing is removed here: a replaced map gives way only to a complete new one, under its lock
+    replace = check_output(store, "map", study.to_json(), force=force, say=say) == "replace"
     ds, path = run_map_to(
         orbits, store, kz=study.kz_values(), wz0=study.wz0_values(), phi0=study.solver.phi0, n_periods=study.n_periods(),
         srp=srp, rtol=study.solver.rtol, atol=study.solver.atol, resume=True, scheduler=scheduler, progress=progress,
-        attrs=study.result_attrs("map", "map"),
+        attrs=study.result_attrs("map", "map"), replace=replace,
     )
     if study.output.format == "netcdf":
         from .results import save_dataset

@@ -18,45 +18,34 @@ from typing import Any
 
 import numpy as np
 
-from .._integrity import write_atomically
+from ..results.files import is_zarr as _is_zarr
+from ..results.files import open_dataset as _open_dataset
+from ..results.files import verify_dataset, write_dataset
+from ..results.kinds import KINDS, kind_of
+from ..results.lock import writer_lock
+from ..results.store import STORE_ATTRS, store_kind, verify_store
 
 __all__ = ["RESULT_INPUTS", "RESULT_KINDS", "RESULT_STEMS", "ResultExists", "check_output", "describe_result", "open_result", "multipliers_3d", "read_attrs", "result_kind", "run_map_3d_to", "run_map_to", "save_dataset", "save_family", "solution_3d",
            "solutions_3d_dataset", "solutions_dataset",
            "study_changes", "verify_result"]
 
 #: The kinds of result, as stored in the ``librate_result`` attribute.
-RESULT_KINDS = ("family", "solutions", "solutions_3d", "map", "map_3d")
+RESULT_KINDS = tuple(KINDS)
 #: The file each command writes its result to (``<stem>.zarr`` or ``<stem>.nc``): the name says
 #: which command made it. Its figures are ``<stem>_<figure>.png`` beside it.
 RESULT_STEMS = {"family": "family", "solve": "solve", "map": "map", "demo": "demo"}
 #: The study sections each kind of result depends on: a change elsewhere (e.g. ``output``, or
 #: ``body`` for a family) leaves the result valid, so it is resumed rather than refused.
-RESULT_INPUTS = {"family": ("system", "orbits"), "solutions": ("system", "orbits", "body", "torques", "rates", "attitude", "solver"),
-                 "solutions_3d": ("system", "orbits", "body", "torques", "rates", "attitude", "solver"),
-                 "map": ("system", "orbits", "body", "torques", "rates", "attitude", "solver"),
-                 "map_3d": ("system", "orbits", "body", "torques", "rates", "attitude", "solver")}
+RESULT_INPUTS = {k: c.inputs for k, c in KINDS.items()}
 # older names, still read: solutions.* (librate solve before 0.2), dro_map_kz*.nc (librate demo)
 _NAMES = tuple(f"{stem}{ext}" for stem in (*RESULT_STEMS.values(), "solutions") for ext in (".zarr", ".nc"))
 
 
-def _is_zarr(p: Path) -> bool:
-    return p.is_dir() and any((p / n).exists() for n in (".zgroup", ".zattrs", ".zmetadata", "zarr.json"))
-
-
 def result_kind(ds) -> str | None:
-    """"family", "solutions" or "map" for a librate result Dataset (from its ``librate_result``
-    attribute, or recognised from its variables for files written by ``OrbitFamily.save`` or
-    ``periodicity_map``), else None."""
-    k = ds.attrs.get("librate_result")
-    if k in RESULT_KINDS:
-        return str(k)
-    if "state0" in ds.variables and "kind" in ds.attrs:
-        return "family"
-    if "dwz" in ds.variables:
-        return "map"
-    if "sol_wz0" in ds.variables:
-        return "solutions"
-    return None
+    """The kind of a librate result Dataset (``librate_result``, or recognised from its
+    variables for files written without it, see :func:`librate.results.kinds.kind_of`), else None."""
+    cls = kind_of(ds)
+    return None if cls is None else cls.kind
 
 
 def resolve_result_path(path: str | Path) -> Path:
@@ -118,12 +107,8 @@ def describe_result(path: str | Path) -> str:
     except ValueError:
         return f"{path} (unreadable)"
     try:
-        kind = result_kind(ds) or "unknown"
-        sizes = ", ".join(f"{k} {v}" for k, v in ds.sizes.items() if k in ("member", "orbit", "kz", "wz0", "solution"))
-        if not sizes and "complete" in ds.attrs:
-            sizes = "unfinished"
-        version = ds.attrs.get("librate_version")
-        return f"{path} (a librate {kind}{': ' + sizes if sizes else ''}{', librate ' + str(version) if version else ''})"
+        cls = kind_of(ds)
+        return f"{path} ({cls(ds).summary() if cls is not None else 'a librate result of unknown kind'})"
     finally:
         ds.close()
 
@@ -177,8 +162,9 @@ def _existing_result(p: Path) -> tuple[str | None, dict] | None:
             attrs = dict(zarr.open_group(str(p), mode="r", use_consolidated=False).attrs)
         except Exception:  # noqa: BLE001 - foreign or damaged: judged below
             attrs = {}
-        if attrs.get("librate_store") == "periodicity_map":
-            return "map", attrs
+        marker = attrs.get("librate_store")
+        if marker in ("periodicity_map", "map_3d"):
+            return ("map" if marker == "periodicity_map" else "map_3d"), attrs
     try:
         ds = _open_dataset(p)
     except ValueError:
@@ -188,19 +174,6 @@ def _existing_result(p: Path) -> tuple[str | None, dict] | None:
         return None if kind is None else (kind, dict(ds.attrs))
     finally:
         ds.close()
-
-
-def _open_dataset(p: Path):
-    import xarray as xr
-
-    try:
-        if p.is_file() and p.suffix == ".nc":
-            return xr.open_dataset(p, engine="scipy")
-        if _is_zarr(p):
-            return xr.open_dataset(p, engine="zarr", chunks=None)
-    except (OSError, TypeError, ValueError, KeyError) as err:
-        raise ValueError(f"{str(p)!r} cannot be read as a librate result: {type(err).__name__}: {str(err).splitlines()[0]}") from None
-    raise ValueError(f"{str(p)!r} is neither a netCDF file (.nc) nor a Zarr store (.zarr folder)")
 
 
 def read_attrs(path: str | Path) -> dict:
@@ -241,79 +214,44 @@ def open_result(path: str | Path, *, verify: bool = False):
         if p.suffix not in (".zarr", ".nc"):
             raise ValueError(f"{str(p)!r}: a saved family must be a .zarr folder or a .nc file")
         return OrbitFamily.load(p)
-    if "row_checksum" in ds.variables:  # the map store's integrity data, not a result
-        ds = ds.drop_vars("row_checksum")
-    return ds
+    drop = [v for v in ("row_checksum", "done") if v in ds.variables and store_kind(p) is not None]
+    if drop:  # the part store's bookkeeping, not the result
+        ds = ds.drop_vars(drop)
+    return KINDS[kind].from_dataset(ds).dataset
 
 
 def verify_result(path: str | Path) -> tuple[bool, str]:
-    """Check a saved result without recomputing it. A map store written by ``librate map``:
-    every row against its checksum and ``done`` flag, the coordinates and the solutions (see
-    :func:`librate.app.store.verify_map_store`). Other results: every variable is read (a
-    missing, truncated or garbled chunk is named) and compared with the digests stored in
-    its ``librate_checksums`` attribute when it has them. Returns ``(ok, report)``: the report
-    names every damaged row or variable."""
-    from .._integrity import array_digest, missing_zarr_chunks
-    from .store import verify_map_store
-
+    """Check a saved result without recomputing it. A part store (``librate map``, planar or
+    3-D): every part against its digests and ``done`` flag, every array's metadata, the root
+    attributes, the coordinates and the solutions (:func:`librate.results.verify_store`).
+    Other results: every chunk is checked before it is decoded (missing, truncated or garbled
+    ones named), every variable read and compared with its digests, and the names, dtypes and
+    attributes of the variables and the root attributes (the system constants) with theirs.
+    Returns ``(ok, report)``; never raises for damage."""
     p = resolve_result_path(path)
-    if _is_zarr(p):
-        import zarr
-
-        try:
-            marker = zarr.open_group(str(p), mode="r", use_consolidated=False).attrs.get("librate_store")
-        except Exception:  # noqa: BLE001 - judged below, by reading it as a result
-            marker = None
-        if marker == "periodicity_map":
-            rep = verify_map_store(p)
-            return rep.ok, rep.describe()
     try:
+        if _is_zarr(p) and store_kind(p) is not None:
+            rep = verify_store(p)
+            return rep.ok, rep.describe()
         ds = _open_dataset(p)
     except ValueError as err:
         return False, str(err)
-    problems = []
+    except Exception as err:  # noqa: BLE001 - whatever a damaged file raises: a report, never a traceback
+        return False, f"{p}: damaged librate result ({type(err).__name__}: {err})"
     try:
         kind = result_kind(ds)
         if kind is None:
             return False, f"{str(p)!r} is not a librate result (no librate_result attribute; neither a family, a map nor solutions)"
-        sums = _stored_checksums(ds)
-        from .store import quiet_zarr
-
-        for name in ds.variables:
-            try:
-                with quiet_zarr():
-                    values = np.asarray(ds[name].values)
-            except Exception as err:  # noqa: BLE001 - named, never a traceback
-                problems.append(f"variable {name} is unreadable ({type(err).__name__}: {str(err).splitlines()[0] if str(err) else ''})")
-                continue
-            if _is_zarr(p):
-                chunks_missing = missing_zarr_chunks(p, str(name))
-                if chunks_missing:
-                    problems.append(f"variable {name}: chunk(s) {', '.join(chunks_missing)} missing")
-            if sums is not None and name in sums and array_digest(values) != sums[name]:
-                problems.append(f"variable {name} does not match its checksum")
-        if sums is None:
-            note = " (no checksums stored: written by an older librate; only readability was checked)"
-        else:
-            note = ", every variable matches its checksum"
+        try:
+            problems, checked, _ = verify_dataset(ds, p)
+        except Exception as err:  # noqa: BLE001
+            problems, checked = [f"unreadable ({type(err).__name__}: {err})"], True
     finally:
         ds.close()
     if problems:
         return False, f"{p}: damaged librate result\n" + "\n".join(f"  {q}" for q in problems)
+    note = ", every variable matches its checksum" if checked else " (no checksums stored: written by an older librate; only readability was checked)"
     return True, f"{p}: ok: a librate {kind} result{note}"
-
-
-def _stored_checksums(ds) -> dict | None:
-    import json
-
-    raw = ds.attrs.get("librate_checksums")
-    if not isinstance(raw, str):
-        return None
-    try:
-        sums = json.loads(raw)
-    except ValueError:
-        return None
-    return sums if isinstance(sums, dict) else None
 
 
 def _check_target(p: Path) -> None:
@@ -331,35 +269,32 @@ def _check_target(p: Path) -> None:
         ds.close()
 
 
-def save_dataset(ds, path: str | Path) -> Path:
+def save_dataset(ds, path: str | Path, *, lock=None, wait: float = 0.0) -> Path:
     """Write ``ds`` to ``path`` (``.zarr``: Zarr v2 folder, consolidated; ``.nc``: netCDF 3 via
-    scipy), creating the folder. All or nothing: written to a temporary sibling and renamed.
-    An existing ``path`` is replaced only if it is a librate result. Returns the path."""
+    scipy), creating the folder, with its digests (:func:`librate.results.write_dataset`:
+    all or nothing, fsynced, the old result removed only after the new one took its name).
+    An existing ``path`` is replaced only if it is a librate result. ``lock``: the writer lock
+    of ``path`` when the caller holds it; else it is taken here (waiting up to ``wait``
+    seconds for another writer). Returns the path."""
     p = Path(path)
     if p.suffix not in (".zarr", ".nc"):
         raise ValueError(f"invalid argument `path`: must end in .zarr (Zarr) or .nc (netCDF), got {str(p)!r}")
     p.parent.mkdir(parents=True, exist_ok=True)
+    if lock is None:
+        with writer_lock(p, wait=wait) as held:
+            return save_dataset(ds, p, lock=held)
     _check_target(p)
-    write_atomically(_with_checksums(ds), p)
+    cls = kind_of(ds)
+    write_dataset(cls(ds).to_dataset() if cls is not None and "librate_result" in ds.attrs else ds, p, lock=lock)
     return p
-
-
-def _with_checksums(ds):
-    """``ds`` with the digests of every variable in its ``librate_checksums`` attribute (JSON),
-    which :func:`verify_result` and :meth:`OrbitFamily.load` check."""
-    from .._integrity import CHECKSUM_ATTR, dataset_checksums
-
-    ds = ds.copy()
-    ds.attrs[CHECKSUM_ATTR] = dataset_checksums(ds)
-    return ds
 
 
 def save_family(family, path: str | Path, attrs: dict | None = None) -> Path:
     """Save an :class:`~librate.OrbitFamily` (``family.to_dataset()``) with extra ``attrs``
     (e.g. the study); :meth:`OrbitFamily.load` and :func:`open_result` read it back."""
-    ds = family.to_dataset()
-    ds.attrs.update({"librate_result": "family", **(attrs or {})})
-    return save_dataset(ds, path)
+    p = Path(path)
+    family.save(p, attrs)
+    return p
 
 
 def solutions_dataset(rows, orbits, kz, attrs: dict | None = None):
@@ -474,6 +409,23 @@ def solution_3d(ds, member: int = 0):
                                 tol=float(a.get("attitude_tol", 1e-12)))
 
 
+def _fingerprint_3d(olist, grid, n_periods: int, tol: float) -> str:
+    import hashlib
+    import json
+
+    from .._core import __version__
+
+    h = hashlib.sha256()
+    for o in olist:
+        h.update(np.asarray(o.state0, dtype=np.float64).tobytes())
+        h.update(np.float64(o.period).tobytes())
+        h.update(np.float64(o.system.mu).tobytes())
+    for a in grid.rates:
+        h.update(np.asarray(a, dtype=np.float64).tobytes())
+    h.update(json.dumps([[list(b.moments) for b in grid.bodies], [float(v) for v in grid.q0], int(n_periods), float(tol), __version__]).encode())
+    return h.hexdigest()
+
+
 def run_map_3d_to(orbits, store: str | Path, *, body, rates: dict, q0, n_periods: int = 1, tol: float = 1e-12, resume: bool = True,
                   scheduler=None, progress: bool | None = None, attrs: dict[str, Any] | None = None):
     """The 3-D attitude map of a ``[attitude] model = "3d"`` study, written to ``store`` (a
@@ -482,20 +434,21 @@ def run_map_3d_to(orbits, store: str | Path, *, body, rates: dict, q0, n_periods
     grids of ``rates`` (``{"wx0", "wy0", "wz0"}``: arrays or single values) from the attitude
     ``q0``, along a dimension ``orbit`` (coordinates ``x0``, ``z0``, ``period_days``).
 
-    Nothing finished is lost: each orbit's map is saved on its own as it finishes, all or nothing
-    and with checksums, in the folder ``<store>.parts``; a run stopped at any moment (Ctrl-C, a
-    kill) loses at most the orbit in flight, and the same call again reuses the finished orbits
-    (one that fails its checksums, or was made for another study, is named and recomputed). The
-    whole map is then written to ``store`` (all or nothing) and the parts removed. An existing
-    ``store`` of the same study is reused; of another study it is refused unless ``resume`` is
-    False. Returns ``(dataset, store_path)``."""
-    import shutil
+    The map is a part store (:class:`librate.results.PartStore`, one part per orbit, under the
+    writer lock): ``<store>`` itself for ``.zarr``, ``<store>.parts`` for ``.nc`` (exported
+    whole at the end, then removed). A run stopped at any moment (Ctrl-C, a kill) loses at most
+    the orbit in flight, and the same call again reuses the finished orbits (a damaged one is
+    named in a warning and recomputed). An existing ``store`` of the same study is reused; of
+    another study it is refused unless ``resume`` is False: then the new map is computed
+    aside and replaces the old one only once complete. Returns ``(dataset, store_path)``."""
     import warnings
 
-    import xarray as xr
-
-    from ..periodicity.map3d import attitude_map_3d
+    from ..periodicity import map3d as m3
+    from ..periodicity.map3d import COMPONENTS, map3d_dataset, map3d_grid
     from ..periodicity.maps import orbits_of
+    from ..results.atomic import clean_orphans, remove_path, replace_path, temporary_sibling
+    from ..results.kinds import map3d_schema
+    from ..results.store import PartStore
     from .progress import bar as progress_bar
 
     if scheduler is not None:
@@ -506,43 +459,57 @@ def run_map_3d_to(orbits, store: str | Path, *, body, rates: dict, q0, n_periods
     olist, _ = orbits_of(orbits)
     # a rate given as one value is fixed (a number, not a dimension of length 1)
     rates = {k: float(np.ravel(v)[0]) if np.size(v) == 1 else np.asarray(v, dtype=float) for k, v in rates.items()}
+    grid = map3d_grid(body, wx0=rates["wx0"], wy0=rates["wy0"], wz0=rates["wz0"], q0=q0)
     state = check_output(store, "map_3d", study, force=not resume)
-    if state == "resume":
-        ds = open_result(store, verify=True)
-        if int(ds.attrs.get("complete", 0)) == 1:
-            return ds.load(), store
-    parts = store.with_name(store.name + ".parts")
-    parts.mkdir(parents=True, exist_ok=True)
-    maps = []
-    with progress_bar(len(olist), "3-D attitude map", "orbit", progress) as bar:
-        for i, orbit in enumerate(olist):
-            part = parts / f"orbit-{i:05d}.nc"
-            ds_i = None
-            if part.exists():
-                try:
-                    ds_i = open_result(part, verify=True).load()
-                except Exception as err:  # noqa: BLE001 - any damage: named, then recomputed
-                    warnings.warn(f"{part}: damaged ({err}); orbit {i} is recomputed", RuntimeWarning, stacklevel=2)
-                if ds_i is not None and not (ds_i.attrs.get("study") == study and int(ds_i.attrs.get("complete", 0)) == 1):
-                    ds_i = None
-            if ds_i is None:
-                ds_i = attitude_map_3d(orbit, body, wx0=rates["wx0"], wy0=rates["wy0"], wz0=rates["wz0"], q0=q0, n_periods=n_periods, tol=tol)
+    with writer_lock(store) as lock:
+        clean_orphans(store)
+        if state == "resume" and store_kind(store) is None:  # written whole (older librate): reused
+            return open_result(store, verify=True).load(), store
+        parts = store if store.suffix == ".zarr" else store.with_name(store.name + ".parts")
+        if state == "replace" and parts == store:
+            parts = temporary_sibling(store)
+        if state == "replace":
+            remove_path(parts)
+        tpl = map3d_dataset(olist[0], grid, np.full((grid.n_cases, 6), np.nan), np.full(grid.n_cases, 255, dtype=np.uint8),
+                            n_periods=n_periods, tol=tol)
+        coords = {str(k): (tuple(c.dims) if c.ndim != 1 else c.dims[0], np.asarray(c.values), dict(c.attrs)) for k, c in tpl.coords.items()}
+        coords.update({"orbit": ("orbit", np.arange(len(olist)), {}), "x0": ("orbit", np.array([o.state0[0] for o in olist]), {"units": "LU"}),
+                       "z0": ("orbit", np.array([o.state0[2] for o in olist]), {"units": "LU"}),
+                       "period_days": ("orbit", np.array([o.period_days for o in olist]), {"units": "d"})})
+        for k in ("component",):
+            coords[k] = (k, np.array(COMPONENTS), {})
+        schema = map3d_schema(len(olist), grid.shape, grid.dims, coords)
+        pstore, damaged = PartStore.open(parts, schema, _fingerprint_3d(olist, grid, n_periods, tol), attrs=attrs, lock=lock)
+        if damaged:
+            warnings.warn(f"{parts}: {len(damaged)} damaged orbit(s) are recomputed: "
+                          + "; ".join(f"orbit {i}: {why}" for i, why in sorted(damaged.items())), RuntimeWarning, stacklevel=2)
+        done = pstore.done_flags(damaged)
+        with progress_bar(len(olist), "3-D attitude map", "orbit", progress, initial=int(done.sum())) as bar:
+            for i, orbit in enumerate(olist):
+                if done[i]:
+                    continue
+                ds_i = m3.attitude_map_3d(orbit, body, wx0=rates["wx0"], wy0=rates["wy0"], wz0=rates["wz0"], q0=q0, n_periods=n_periods, tol=tol)
                 if int(ds_i.attrs.get("complete", 0)) != 1:  # interrupted: the finished orbits are kept
-                    raise KeyboardInterrupt(f"3-D map interrupted in orbit {i}; {i} finished orbit(s) kept in {parts}")
-                ds_i.attrs.update({"librate_result": "map_3d", "study": study or "", "orbit_index": i})
-                save_dataset(ds_i, part)
-            maps.append(ds_i)
-            bar.update(1)
-    shared = ("mu", "lu_km", "tu_s", "system_name", "n_periods", "tol", "q0", "simd_level", "librate_version")  # the same for every orbit
-    ds = xr.concat([m.drop_attrs() for m in maps], dim="orbit", coords="minimal", compat="override")
-    ds = ds.assign_coords(orbit=np.arange(len(olist)), x0=("orbit", np.array([o.state0[0] for o in olist])),
-                          z0=("orbit", np.array([o.state0[2] for o in olist])), period_days=("orbit", np.array([o.period_days for o in olist])))
-    ds["orbit_state0"] = (("orbit", "state"), np.array([np.asarray(o.state0, dtype=float) for o in olist]))
-    ds.attrs.update({k: maps[0].attrs[k] for k in shared if k in maps[0].attrs})
-    ds.attrs.update({**attrs, "title": "librate 3-D attitude map", "complete": 1})
-    save_dataset(ds, store)  # replaces a librate result at store (check_output allowed it) all or nothing
-    shutil.rmtree(parts, ignore_errors=True)
-    return ds, store
+                    raise KeyboardInterrupt(f"3-D map interrupted in orbit {i}; {int(done.sum())} finished orbit(s) kept in {parts}")
+                pstore.write_part(i, {k: ds_i[k].values for k in schema.variables})
+                done[i] = True
+                bar.update(1)
+        shared = ("mu", "lu_km", "tu_s", "system_name", "n_periods", "tol", "q0", "simd_level", "librate_version")  # the same for every orbit
+        final = {k: tpl.attrs[k] for k in shared if k in tpl.attrs}
+        final.update({"librate_result": "map_3d", **attrs, "title": "librate 3-D attitude map"})
+        state0 = np.array([np.asarray(o.state0, dtype=float) for o in olist])
+        pstore.finalise({"orbit_state0": (("orbit", "state"), state0, {"units": "LU, LU/TU", "long_name": "orbit initial state"})}, final, complete=True)
+        if parts != store:
+            ds = open_result(parts).load()
+            if store.suffix == ".nc":
+                for k in STORE_ATTRS:
+                    ds.attrs.pop(k, None)
+                save_dataset(ds, store, lock=lock)
+            else:
+                lock.check()
+                replace_path(parts, store)
+            remove_path(parts)
+        return open_result(store).load(), store
 
 
 def run_map_to(
@@ -560,6 +527,7 @@ def run_map_to(
     scheduler=None,
     progress: bool | None = None,
     attrs: dict[str, Any] | None = None,
+    replace: bool = False,
 ):
     """A periodicity map written to the Zarr ``store`` (a ``.zarr`` folder). Uses
     ``librate.app.runner.run_map`` (chunked, resumable, optionally on a Dask scheduler) when it is
@@ -567,6 +535,8 @@ def run_map_to(
     ``to_zarr`` (an existing store with the same study and complete is reused; a store of
     another study is refused unless ``resume=False``; a foreign folder is always refused).
     ``progress``: progress bars on stderr (None: only when stderr is a terminal).
+    ``replace``: an existing librate result at ``store`` is replaced all or nothing (the new
+    map is computed aside under the store's lock and takes its name once complete).
     Returns ``(dataset, store_path)``."""
     store = Path(store)
     attrs = dict(attrs or {})
@@ -578,6 +548,8 @@ def run_map_to(
         kw: dict[str, Any] = dict(kz=kz, wz0=wz0, phi0=phi0, n_periods=n_periods, srp=srp, out=str(store), resume=resume,
                                   scheduler=scheduler, progress=progress, solve=True, attrs=attrs)
         params = inspect.signature(run_map).parameters
+        if replace and "replace" in params:
+            kw["replace"] = True
         for name, value in (("rtol", rtol), ("atol", atol)):
             if value is not None and name in params:
                 kw[name] = value
@@ -597,12 +569,12 @@ def run_map_to(
             raise FileExistsError(f"{str(store)!r} exists and is not a librate map: refusing to overwrite it; remove it or choose another --out")
         same = not study_changes(old.attrs.get("study"), attrs.get("study"), RESULT_INPUTS["map"])
         complete = int(old.attrs.get("complete", 0)) == 1
-        if resume and same and complete:
+        if resume and same and complete and not replace:
             ds = old.load()
             old.close()
             return ds, store
         old.close()
-        if resume and not same:
+        if resume and not same and not replace:
             raise ResultExists(f"{store} holds a map of another study (changed: {'; '.join(study_changes(old.attrs.get('study'), attrs.get('study')))}): "
                                "not replaced; pass resume=False (--force) to replace it, or choose another folder")
     kw = {} if rtol is None else {"rtol": rtol}

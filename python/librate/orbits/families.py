@@ -343,10 +343,9 @@ class OrbitFamily:
         if p.suffix.lower() != ".json":
             raise ValueError(f"invalid argument `path`: must end in .json, got {str(path)!r}")
         doc = jpl_document(self.system, self.kind, self.parameters, self.state0, self.jacobi, self.period, jpl_stability(self.eigenvalues), __version__)
-        p.parent.mkdir(parents=True, exist_ok=True)
-        tmp = p.with_name(p.name + ".tmp")
-        tmp.write_text(json.dumps(doc), encoding="utf-8")
-        tmp.replace(p)
+        from ..results.atomic import atomic_write_text
+
+        atomic_write_text(p, json.dumps(doc))
 
     # --- I/O -------------------------------------------------------------------------------
     def to_dataset(self):
@@ -394,30 +393,36 @@ class OrbitFamily:
             return "planar"
         return "jpl" if "jpl_family" in self.parameters else "hemisphere"
 
-    def save(self, path) -> None:
-        """Write to netCDF (``.nc``) or Zarr (``.zarr``), with a digest of every variable
-        (attribute ``librate_checksums``) that :meth:`load` checks.
+    def save(self, path, attrs: dict | None = None) -> None:
+        """Write to netCDF (``.nc``) or Zarr (``.zarr``) through librate's result store
+        (:mod:`librate.results`), with digests of every variable's values, names, dtypes and
+        attributes and of the root attributes (the system constants) that :meth:`load` checks.
+        ``attrs``: extra root attributes (e.g. the study).
 
-        All or nothing: written to a temporary sibling, then renamed. An existing ``path`` is
-        replaced only when it is a librate family file; anything else there (a foreign file,
-        a folder with other files) is refused with ``FileExistsError``, never overwritten."""
+        All or nothing, under the path's writer lock (a second process saving to the same path
+        waits for the first, up to 30 s): written to a temporary sibling, flushed, and moved
+        onto ``path``; an old file is removed only once the new one holds the name. An existing
+        ``path`` is replaced only when it is a librate family file; anything else there (a
+        foreign file, a folder with other files) is refused with ``FileExistsError``."""
         from pathlib import Path
 
-        from .._integrity import CHECKSUM_ATTR, dataset_checksums, write_atomically
+        from ..results.files import write_dataset
+        from ..results.lock import writer_lock
 
         p = Path(path)
         if p.suffix not in (".zarr", ".nc"):
             raise ValueError(f"invalid argument `path`: must end in .nc (netCDF) or .zarr (Zarr), got {str(path)!r}")
-        if (p.exists() or p.is_symlink()) and not (p.is_dir() and not any(p.iterdir())):
-            try:
-                OrbitFamily.load(p)
-            except (ValueError, OSError) as err:
-                raise FileExistsError(f"{str(p)!r} exists and is not a valid librate family file ({err}): refusing to overwrite it; "
-                                      "remove it or choose another path") from None
         ds = self.to_dataset()
-        ds.attrs[CHECKSUM_ATTR] = dataset_checksums(ds)
+        ds.attrs.update({"librate_result": "family", **(attrs or {})})
         p.parent.mkdir(parents=True, exist_ok=True)
-        write_atomically(ds, p)
+        with writer_lock(p, wait=30.0) as lock:
+            if (p.exists() or p.is_symlink()) and not (p.is_dir() and not any(p.iterdir())):
+                try:
+                    OrbitFamily.load(p)
+                except (ValueError, OSError) as err:
+                    raise FileExistsError(f"{str(p)!r} exists and is not a valid librate family file ({err}): refusing to overwrite it; "
+                                          "remove it or choose another path") from None
+            write_dataset(ds, p, lock=lock)
 
     @classmethod
     def load(cls, path) -> OrbitFamily:
@@ -434,12 +439,11 @@ class OrbitFamily:
         ``parameters["state0_converted"]`` records). A spatial family without a known branch
         cannot be converted and is refused with ``ValueError``."""
         import ast
-        import json
         from pathlib import Path
 
-        import xarray as xr
-
-        from .._integrity import CHECKSUM_ATTR, array_digest, missing_zarr_chunks
+        from ..results.checksum import CHECKSUM_ATTR, check_dataset
+        from ..results.files import open_dataset
+        from ..results.zarrcheck import chunk_problems, quiet_zarr
 
         p = Path(path)
         name = str(path)
@@ -452,13 +456,14 @@ class OrbitFamily:
             if p.suffix == ".zarr":
                 if not p.is_dir():
                     raise ValueError("a .zarr family must be a folder")
-                ds = xr.open_zarr(p, consolidated=None, chunks=None)
+                if not any((p / n).exists() for n in (".zgroup", ".zattrs", ".zmetadata")):
+                    raise ValueError("no Zarr group metadata (.zgroup) in the folder")
             else:
                 if not p.is_file():
                     raise ValueError("a .nc family must be a file")
                 if p.stat().st_size == 0:
                     raise ValueError("the file is empty")
-                ds = xr.open_dataset(p, engine="scipy")
+            ds = open_dataset(p)
         except Exception as err:  # noqa: BLE001 - whatever the reader says, it is not a family file
             raise ValueError(f"{not_family}: it cannot be read as {'Zarr' if p.suffix == '.zarr' else 'netCDF 3'} "
                              f"({type(err).__name__}: {str(err).strip().splitlines()[0] if str(err).strip() else 'no details'})") from None
@@ -473,22 +478,24 @@ class OrbitFamily:
             if miss:
                 raise ValueError(f"{not_family}: missing {', '.join(miss)}")
             if p.suffix == ".zarr":
-                gone = [c for v in ds.variables for c in missing_zarr_chunks(p, str(v))]
+                gone = [c.split()[1] for v in ds.variables for c in chunk_problems(p, str(v)) if c.endswith(" is missing")]
                 if gone:
                     raise ValueError(f"{name!r} is a damaged librate family file: chunk(s) {', '.join(gone)} missing")
+                bad = [c for v in ds.variables for c in chunk_problems(p, str(v))]
+                if bad:  # checked before a codec sees it (a truncated Blosc chunk may crash it)
+                    raise ValueError(f"{name!r} is a damaged librate family file: {'; '.join(bad)}")
             try:
-                values = {v: np.asarray(ds[v].values) for v in ds.variables}
+                with quiet_zarr():
+                    values = {v: np.asarray(ds[v].values) for v in ds.variables}
             except Exception as err:  # noqa: BLE001 - a garbled chunk: named, never a decompressor traceback
                 raise ValueError(f"{name!r} is a damaged librate family file: a variable cannot be read ({type(err).__name__}: {err})") from None
-            sums = a.get(CHECKSUM_ATTR)
-            if isinstance(sums, str):
-                try:
-                    sums = json.loads(sums)
-                except ValueError:
-                    raise ValueError(f"{name!r} is a damaged librate family file: attribute {CHECKSUM_ATTR} is not valid JSON") from None
-                bad = [v for v, want in sums.items() if v in values and array_digest(values[v]) != want]
+            if isinstance(a.get(CHECKSUM_ATTR), str):
+                problems, _ = check_dataset(ds, values)
+                bad = [q.split()[1] for q in problems if q.startswith("variable ") and q.endswith("does not match its checksum")]
                 if bad:
                     raise ValueError(f"{name!r} is a damaged librate family file: {', '.join(bad)} do(es) not match the stored checksum(s)")
+                if problems:
+                    raise ValueError(f"{name!r} is a damaged librate family file: {'; '.join(problems)}")
             n = values["period"].shape[0] if values["period"].ndim == 1 else -1
             shapes = {"state0": (n, 6), "state_half": (n, 6), "period": (n,), "jacobi": (n,), "eigenvalues_real": (n, 6), "eigenvalues_imag": (n, 6),
                       "stability_real": (n, 2), "stability_imag": (n, 2)}

@@ -30,6 +30,7 @@ from .._checks import as_count, as_float_array, as_number
 from .._core import __version__
 from ..attitude.body import RigidBody
 from ..orbits.periodic import PeriodicOrbit
+from ..results.kinds import MAP_3D_VARIABLES
 from .attitude3d import SOLVE_RTOL, AttitudeSolution3D, verified_solution_3d
 
 __all__ = ["attitude_map_3d", "find_periodic_attitudes_3d", "Map3DGrid", "map3d_grid", "map3d_chunk", "map3d_dataset", "tidal_table",
@@ -181,9 +182,9 @@ def map3d_dataset(orbit: PeriodicOrbit, grid: Map3DGrid, residual: np.ndarray, s
         coords["body"] = ("body", np.arange(len(grid.bodies)))
     s = orbit.system
     return xr.Dataset(
-        {"residual": ((*dims, "component"), res, {"long_name": "(rotation vector of R(0)' R(KT) in body axes, w(KT) - w0)", "units": "rad, 1/TU"}),
-         "residual_norm": (dims, norm, {"long_name": "max |residual component|"}),
-         "status": (dims, st, {"flag_values": "0 ok, 1 max steps, 2 failed, 255 not computed"})},
+        {"residual": ((*dims, "component"), res, dict(MAP_3D_VARIABLES["residual"])),
+         "residual_norm": (dims, norm, dict(MAP_3D_VARIABLES["residual_norm"])),
+         "status": (dims, st, dict(MAP_3D_VARIABLES["status"]))},
         coords=coords,
         attrs={"title": "librate 3-D attitude map", "mu": s.mu, "lu_km": s.lu_km, "tu_s": s.tu_s, "system_name": s.name,
                "orbit_state0": [float(v) for v in orbit.state0], "orbit_period": float(orbit.period), "orbit_period_days": float(orbit.period_days),

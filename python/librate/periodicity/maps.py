@@ -20,6 +20,7 @@ from .._core import __version__
 from .._errors import LibrateError
 from ..orbits.families import OrbitFamily
 from ..orbits.periodic import PeriodicOrbit
+from ..results.kinds import MAP_VARIABLES
 from .solutions import MAP_ATOL, MAP_RTOL, AttitudeSolution, candidates, check_orbit, check_srp, is_symmetric, orbit_forcing, refine, sweep
 
 __all__ = ["periodicity_map", "zero_contours", "orbits_of", "map_grid", "map_coords", "map_dataset", "solutions_from_row",
@@ -160,10 +161,8 @@ def map_dataset(olist, family, kzs, wz, grid, done, *, phi0, n_periods, rtol, at
     return xr.Dataset(
         {
             **(solution_variables(solutions) if solutions is not None else {}),
-            "dwz": (dims, grid["dwz"], {"units": "1/TU", "long_name": "wz(T) - wz(0)"}),
-            "dphi": (dims, grid["dphi"], {"units": "rad", "long_name": "phi(T) - phi0 wrapped to (-pi, pi]"}),
-            "phi_T": (dims, grid["phi_T"], {"units": "rad", "long_name": "phi(T), unwrapped"}),
-            "status": (dims, grid["status"], {"flag_values": "0 ok, 1 max steps, 2 failed, 255 not computed"}),
+            # units and long names: one place, shared with the map store (librate.results.kinds)
+            **{k: (dims, grid[k], dict(MAP_VARIABLES[k])) for k in ("dwz", "dphi", "phi_T", "status")},
             "computed": ("orbit", np.asarray(done, dtype=bool).copy()),
         },
         coords=map_coords(olist, kzs, wz),
