@@ -22,6 +22,7 @@ import numpy as np
 
 from .. import _core
 from .._checks import as_count, as_real
+from .._display import fmt, html_summary, short_repr
 from .._errors import ConvergenceError, LibrateError
 from ..constants import SUN_SYNODIC_PERIOD
 from ..solving.continuation import sign_changes
@@ -73,6 +74,26 @@ class OrbitFamily:
     bifurcations: list[dict] = field(default_factory=list)
     parameters: dict = field(default_factory=dict)
     import_report: object = field(default=None, repr=False, compare=False)
+
+    # --- display (librate._display) -----------------------------------------------------------
+    def _rows(self):
+        n = len(self)
+        return [("kind", self.kind, ""), ("members", n, ""), ("x0", self.x0, "LU"), ("period_days", self.period_days, "d"),
+                ("stable", int(np.count_nonzero(self.stable)), f"of {n}"), ("bifurcations", len(self.bifurcations), "")]
+
+    def __repr__(self) -> str:
+        return short_repr("OrbitFamily", self._rows(), digits=4)
+
+    def _repr_html_(self) -> str:
+        arrays = [("state0", self.state0, "LU, LU/TU"), ("period", self.period, "TU"), ("jacobi", self.jacobi, ""),
+                  ("stability_indices", self.stability_indices, "")]
+        bif = [(f"member {b.get('member', '')}", ", ".join(f"{k}={fmt(v)}" for k, v in b.items() if k != "member"), "")
+               for b in self.bifurcations]
+        title = f"librate.OrbitFamily {self.kind} ({len(self)} members, {'spatial' if self.spatial else 'planar'})"
+        return html_summary(title, self._rows() + [("end_reason", self.end_reason, "")],
+                            {"arrays": arrays, "bifurcations": bif, "parameters": [(str(k), v, "") for k, v in self.parameters.items()],
+                             "system": [("system", repr(self.system), "")]})
+
 
     # --- construction ----------------------------------------------------------------------
     @classmethod

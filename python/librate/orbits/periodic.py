@@ -10,6 +10,7 @@ import numpy as np
 
 from .. import _core
 from .._checks import as_count, as_number, as_real
+from .._display import html_summary, short_repr
 from .system import System, resolve_system
 
 __all__ = ["PeriodicOrbit", "correct_symmetric", "correct_periodic", "real_if_real", "INDEX_TESTS", "index_tests", "symmetric_monodromy"]
@@ -53,6 +54,21 @@ class PeriodicOrbit:
     iterations: int = 0
     residual: float = 0.0
     _evaluation: _core.ShootingEvaluation | None = field(default=None, repr=False, compare=False)
+
+    # --- display (librate._display) -----------------------------------------------------------
+    def _rows(self):
+        return [("family", self.family, ""), ("x0", self.x0, "LU"), ("z0", self.z0, "LU"), ("period", self.period, "TU"),
+                ("period_days", self.period_days, "d"), ("jacobi", self.jacobi, "")]
+
+    def __repr__(self) -> str:
+        return short_repr("PeriodicOrbit", self._rows())
+
+    def _repr_html_(self) -> str:
+        fit = [("iterations", self.iterations, ""), ("residual", self.residual, "")]
+        if "stability_indices" in self.__dict__:  # already computed: shown, never computed for display
+            fit.append(("stability_indices", self.__dict__["stability_indices"], ""))
+        return html_summary(f"librate.PeriodicOrbit ({self.family}, {self.period_days:.4g} d)", self._rows(),
+                            {"initial state": [("state0", self.state0, "LU, LU/TU")], "correction": fit, "system": [("system", repr(self.system), "")]})
 
     @property
     def x0(self) -> float:

@@ -210,26 +210,52 @@ def propagate(
 
     Parameters
     ----------
-    system: a :class:`System` or a preset name.
-    state: (6,) initial state (x, y, z, xd, yd, zd), nondimensional.
-    t_span: final time tf, or (t0, tf); tf < t0 integrates backward.
-    rtol, atol: error tolerances per step (> 0).
-    stm: also integrate the 6x6 state transition matrix (returned at the final time and at events).
-    events: :class:`Event` objects to locate.
-    t_eval: output times (monotonic, inside the span) instead of every accepted step.
-    h0, h_min, h_max, max_steps, safety: step control; ``fixed_step`` switches to fixed steps.
-    collision: reaching a primary stops the integration with :class:`librate.CollisionError`:
-        ``"radius"`` (default): within the system's radius of either primary (``r1_km``,
-        ``r2_km``; a primary of radius 0 counts as a point, 1e-8 LU); ``"point"``: point masses
-        (only that tiny sphere about each primary); ``None``: no check (the bare point-mass
-        model, singular at the primaries).
+    system : System or str
+        The system, or a preset name (``"earth-moon"``).
+    state : array_like, shape (6,)
+        Initial state (x, y, z, xd, yd, zd), nondimensional.
+    t_span : float or (float, float)
+        Final time tf, or (t0, tf); tf < t0 integrates backward.
+    rtol, atol : float
+        Error tolerances per step (> 0).
+    stm : bool
+        Also integrate the 6x6 state transition matrix (returned at the final time and at events).
+    events : list of Event, optional
+        Events to locate.
+    t_eval : array_like, optional
+        Output times (monotonic, inside the span) instead of every accepted step.
+    h0, h_min, h_max, max_steps, safety : float
+        Step control; ``fixed_step`` switches to fixed steps.
+    collision : {"radius", "point", None}
+        Reaching a primary stops the integration with `librate.CollisionError`: ``"radius"``
+        (default): within the system's radius of either primary (``r1_km``, ``r2_km``; a primary
+        of radius 0 counts as a point, 1e-8 LU); ``"point"``: point masses (only that tiny sphere
+        about each primary); ``None``: no check (the bare point-mass model, singular at the
+        primaries).
 
-    Raises ``ValueError`` for bad arguments, :class:`librate.CollisionError` (a subclass of
-    :class:`librate.IntegrationError`, with ``t``, ``primary`` (1 or 2), ``distance``,
-    ``radius`` and ``trajectory``: the trajectory up to the collision sphere, status
-    ``"collision"``) when the trajectory reaches a primary, also for a state starting inside
-    one (then at t0), and :class:`librate.IntegrationError` (with ``t`` and ``steps``) when the
-    integration cannot reach tf.
+    Returns
+    -------
+    Trajectory
+        The states at every accepted step (or at ``t_eval``), the final state, the STM, the
+        event hits and the step statistics.
+
+    Raises
+    ------
+    ValueError
+        Bad arguments, naming the parameter.
+    CollisionError
+        The trajectory reaches a primary, also for a state starting inside one (then at t0). A
+        subclass of `IntegrationError`, with ``t``, ``primary`` (1 or 2), ``distance``, ``radius``
+        and ``trajectory`` (the trajectory up to the collision sphere, status ``"collision"``).
+    IntegrationError
+        The integration cannot reach tf (with ``t`` and ``steps``).
+
+    Examples
+    --------
+    >>> import librate
+    >>> tr = librate.propagate("earth-moon", [0.85, 0, 0, 0, 0.49, 0], 1.0, stm=True)
+    >>> tr.stm.shape
+    (6, 6)
     """
     sys_ = resolve_system(system)
     s = as_state(state)

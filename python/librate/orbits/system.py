@@ -8,6 +8,7 @@ import numpy as np
 
 from .. import _core
 from .._checks import as_real, as_states
+from .._display import html_summary, short_repr
 
 __all__ = ["System"]
 
@@ -40,6 +41,19 @@ class System:
         c = _core.system_validate(self.name, *nums)
         for field in ("mu", "lu_km", "tu_s", "r1_km", "r2_km"):
             object.__setattr__(self, field, getattr(c, field))
+
+    # --- display (librate._display) -----------------------------------------------------------
+    def _rows(self):
+        return [("name", self.name, ""), ("mu", self.mu, ""), ("lu_km", self.lu_km, "km"), ("tu_s", self.tu_s, "s")]
+
+    def __repr__(self) -> str:
+        return short_repr("System", self._rows())
+
+    def _repr_html_(self) -> str:
+        radii = [("r1_km", self.r1_km, "km"), ("r2_km", self.r2_km, "km"), ("tu_days", self.tu_days, "d"),
+                 ("vu_km_s", self.vu_km_s, "km/s")]
+        points = [(f"L{i + 1}", p, "LU") for i, p in enumerate(self.lagrange_points())]
+        return html_summary(f"librate.System {self.name!r}", self._rows(), {"units and radii": radii, "Lagrange points": points})
 
     @classmethod
     def preset(cls, name: str = "earth-moon") -> System:

@@ -40,6 +40,7 @@ import numpy as np
 
 from .. import _core
 from .._checks import as_count, as_number
+from .._display import fmt, html_summary, short_repr
 from .._errors import ConvergenceError
 from ..attitude.body import RigidBody
 from ..attitude.propagate import propagate_attitude
@@ -103,6 +104,26 @@ class AttitudeSolution3D:
     residual_rate: float = math.nan
     turns: float | None = None
     iterations: int = 0
+
+    # --- display (librate._display): the orbit and body by their key numbers ------------------
+    def _rows(self):
+        return [("n_periods", self.n_periods, ""), ("turns", self.turns, ""), ("planar", self.planar, ""), ("stable", self.stable, ""),
+                ("residual", self.residual, "")]
+
+    def __repr__(self) -> str:
+        return short_repr("AttitudeSolution3D", self._rows() + [("orbit_period_days", self.orbit.period_days, "d")])
+
+    def _repr_html_(self) -> str:
+        b = self.body
+        details = {"initial attitude": [("q0", self.q0, "scalar last"), ("w0", self.w0, "rad/TU")],
+                   "stability": [("multipliers", self.multipliers, ""), ("|multipliers|", np.abs(self.multipliers), ""),
+                                 ("monodromy", self.monodromy, "")],
+                   "correction": [("residual_rotation", self.residual_rotation, "rad"), ("residual_rate", self.residual_rate, "rad/TU"),
+                                  ("iterations", self.iterations, "")],
+                   "orbit and body": [("orbit", repr(self.orbit), ""), ("body", f"{type(b).__name__}(ix={fmt(b.ix)}, iy={fmt(b.iy)}, iz={fmt(b.iz)})", "")]}
+        title = f"librate.AttitudeSolution3D over {self.n_periods} period(s) ({'stable' if self.stable else 'unstable'})"
+        return html_summary(title, self._rows(), details)
+
 
     @property
     def residual(self) -> float:

@@ -28,6 +28,7 @@ import numpy as np
 from .. import _core
 from .._checks import as_count, as_float_array, as_number
 from .._core import __version__
+from .._display import fmt, html_summary, short_repr
 from ..attitude.body import RigidBody
 from ..orbits.periodic import PeriodicOrbit
 from ..results.kinds import MAP_3D_VARIABLES
@@ -56,6 +57,18 @@ class Map3DGrid:
     rates: tuple[np.ndarray, np.ndarray, np.ndarray]
     rate_dims: tuple[bool, bool, bool]
     q0: np.ndarray
+
+    # --- display (librate._display): the rates by size and range, not in full -------------------
+    def _rows(self):
+        return [("dims", ", ".join(self.dims) or "none", ""), ("shape", self.shape, ""), ("n_cases", self.n_cases, ""),
+                ("bodies", len(self.bodies), "")] + [(n, r, "rad/TU") for n, r in zip(_RATES, self.rates)]
+
+    def __repr__(self) -> str:
+        return short_repr("Map3DGrid", self._rows(), digits=4)
+
+    def _repr_html_(self) -> str:
+        bodies = [(f"body {i}", f"ix={fmt(b.ix)}, iy={fmt(b.iy)}, iz={fmt(b.iz)}", "") for i, b in enumerate(self.bodies)]
+        return html_summary(f"librate.Map3DGrid ({self.n_cases} cases)", self._rows(), {"bodies": bodies, "initial attitude": [("q0", self.q0, "scalar last")]})
 
     @property
     def dims(self) -> tuple[str, ...]:

@@ -22,6 +22,7 @@ import numpy as np
 
 from .. import _core
 from .._checks import as_count, as_number
+from .._display import fmt, html_summary, short_repr
 from ..attitude.body import RigidBody
 from ..attitude.propagate import propagate_attitude
 from ..attitude.srp import FlatPlate
@@ -158,6 +159,24 @@ class AttitudeSolution:
     iterations: int = 0
     srp: object = None
     n_periods: int = 1
+
+    # --- display (librate._display): the orbit by its key numbers, never nested whole ----------
+    def _rows(self):
+        return [("kind", self.kind, ""), ("kz", self.kz, ""), ("n", self.n, "turns/orbit"), ("phi0", self.phi0, "rad"),
+                ("phidot0", self.phidot0, "1/TU"), ("stable", self.stable, ""), ("residual", self.residual, "")]
+
+    def __repr__(self) -> str:
+        return short_repr("AttitudeSolution", self._rows() + [("orbit_period_days", self.orbit.period_days, "d")])
+
+    def _repr_html_(self) -> str:
+        details = {"stability": [("trace", self.trace, ""), ("multipliers", self.multipliers, ""), ("monodromy", self.monodromy, "")],
+                   "correction": [("n_total", self.n_total, ""), ("n_periods", self.n_periods, ""), ("wz0", self.wz0, "1/TU"),
+                                  ("residual_dphi", self.residual_dphi, "rad"), ("residual_dwz", self.residual_dwz, "1/TU"),
+                                  ("iterations", self.iterations, "")],
+                   "orbit": [("orbit", repr(self.orbit), ""), ("srp", "none" if self.srp is None else repr(self.srp), "")]}
+        title = f"librate.AttitudeSolution N = {fmt(self.n)} {self.kind} (Kz = {fmt(self.kz)}, {'stable' if self.stable else 'unstable'})"
+        return html_summary(title, self._rows(), details)
+
 
     @property
     def n(self) -> int | float:
