@@ -864,3 +864,13 @@ SRP_BAD = [
 def test_bad_arguments_srp_figures(eps_map, sun12_orbit, call, text):
     with pytest.raises(ValueError, match=text):
         call(eps_map, sun12_orbit)
+
+
+def test_solution_legend_prints_integer_n():
+    """Issue 23 #7: ``sol_n`` stored as float64 must not show as "4.0" in a legend; exact
+    string check on the legend labels (no tolerance)."""
+    from librate.plotting import _style
+
+    labels = [h.get_label() for h in _style.solution_legend(np.array([4.0, 13.0, 7.0, 0.0]), np.array(["periodic"] * 4), np.array([True] * 4))]
+    assert "other $N$ (4 ... 13)" in labels and "$N$ = 0" in labels
+    assert not any(".0" in lab for lab in labels)

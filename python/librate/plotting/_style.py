@@ -209,11 +209,11 @@ def draw_solutions(a, x, y, n, kind, stable, *, markersize: float = 6.5) -> None
 def solution_legend(n, kind, stable) -> list:
     """Legend proxies explaining the solution markers."""
     out = []
-    ns = sorted(set(np.asarray(n).tolist()), reverse=True)
+    ns = sorted({int(v) for v in np.asarray(n).tolist()}, reverse=True)  # integer N: legends never print "4.0"
     others = [nn for nn in ns if nn not in N_COLORS]
     for nn in ns:
         if nn in N_COLORS or len(others) == 1:
-            out.append(Line2D([], [], linestyle="none", marker="s", color=n_color(nn), markersize=7, label=f"$N$ = {nn:g}"))
+            out.append(Line2D([], [], linestyle="none", marker="s", color=n_color(nn), markersize=7, label=f"$N$ = {nn}"))
     if len(others) > 1:
         out.append(Line2D([], [], linestyle="none", marker="s", color=N_OTHER, markersize=7,
                           label=f"other $N$ ({min(others)} ... {max(others)})"))
