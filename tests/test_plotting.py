@@ -32,6 +32,7 @@ import numpy as np  # noqa: E402
 import pytest  # noqa: E402
 from helpers import dro_with_period  # noqa: E402
 from librate.constants import SUN_SYNODIC_PERIOD  # noqa: E402
+from librate.plotting import _solutions as lp_solutions  # noqa: E402
 
 
 @pytest.fixture(scope="module")
@@ -429,7 +430,7 @@ def test_plot_map_fig24(small_map, tmp_path):
     assert [p[2] for p in pts] == [bool(w[2]) for w in want]
     for h in gid(ax, "solutions"):  # one colour per N
         ns = {int(n) for o, r, n in zip(orb, rate, ds.sol_n.values[periodic]) if abs(r - h.get_ydata()[0]) < 1e-12}
-        assert len(ns) == 1 and h.get_color() == lp._n_color(ns.pop())
+        assert len(ns) == 1 and h.get_color() == lp.n_color(ns.pop())
     legend = [t.get_text() for t in ax.get_legend().get_texts()]
     assert "$N$ = -1" in legend and "$N$ = 0" in legend
     assert ax.get_xlabel() == "orbit period $T$ (days)" and "relative to the synodic frame" in ax.get_ylabel()
@@ -499,9 +500,9 @@ def test_solution_branches_follow_the_nearest_rate():
     follows the nearest rate; a gap in the orbits ends a branch; ``max_jump`` cuts a long step."""
     orbit = np.array([0, 0, 1, 1, 2, 2, 4])
     rate = np.array([0.0, 1.0, 0.1, 0.9, 0.25, 0.8, 0.3])
-    br = sorted(lp._branches(orbit, rate, None))
+    br = sorted(lp_solutions._branches(orbit, rate, None))
     assert br == [[0, 2, 4], [1, 3, 5], [6]]
-    assert sorted(lp._branches(np.array([0, 1]), np.array([0.0, 2.0]), 1.0)) == [[0], [1]]
+    assert sorted(lp_solutions._branches(np.array([0, 1]), np.array([0.0, 2.0]), 1.0)) == [[0], [1]]
 
 
 def test_plot_attitude_motion_fig30_31(dro1266, tmp_path):
@@ -522,7 +523,7 @@ def test_plot_attitude_motion_fig30_31(dro1266, tmp_path):
         assert y[-1] == pytest.approx(math.degrees(s.phi0 + 2 * math.pi * s.n), abs=1e-6)
         r = hr.get_ydata()
         assert r[0] == pytest.approx(s.phidot0, abs=1e-12) and r[-1] == pytest.approx(s.phidot0, abs=1e-8)
-        assert ha.get_color() == lp._n_color(s.n) and f"$N$ = {s.n}" in ha.get_label()
+        assert ha.get_color() == lp.n_color(s.n) and f"$N$ = {s.n}" in ha.get_label()
     assert "relative to the synodic frame" in a_rate.get_ylabel() and "orbital periods" in a_ang.get_xlabel()
     fig2 = lp.plot_attitude_motion(sols[2], n_periods=2, rate="inertial", degrees=False)
     a2, r2 = fig2.axes
@@ -863,3 +864,13 @@ SRP_BAD = [
 def test_bad_arguments_srp_figures(eps_map, sun12_orbit, call, text):
     with pytest.raises(ValueError, match=text):
         call(eps_map, sun12_orbit)
+
+
+def test_solution_legend_prints_integer_n():
+    """Issue 23 #7: ``sol_n`` stored as float64 must not show as "4.0" in a legend; exact
+    string check on the legend labels (no tolerance)."""
+    from librate.plotting import _style
+
+    labels = [h.get_label() for h in _style.solution_legend(np.array([4.0, 13.0, 7.0, 0.0]), np.array(["periodic"] * 4), np.array([True] * 4))]
+    assert "other $N$ (4 ... 13)" in labels and "$N$ = 0" in labels
+    assert not any(".0" in lab for lab in labels)

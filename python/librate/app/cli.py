@@ -745,11 +745,16 @@ def _figures(result, path: Path, names, quiet: bool, extra: dict | None = None) 
                 for j, kz in enumerate(kzs):
                     jobs.append((fname("map", "" if kzs.size == 1 else f"_kz{kz:g}"), lambda j=j: lp.plot_map(result, kz_index=j)))
             elif name == "residuals":
-                jobs.append((fname("residuals"), lambda: lp.plot_residuals(result, orbit_index=0, kz=float(kzs[0]))))
+                # thesis Fig. 23 is drawn on the 12.66-day DRO: the orbit nearest that period
+                near = int(np.argmin(np.abs(np.asarray(result["period_days"].values, dtype=float) - 12.66)))
+                jobs.append((fname("residuals"), lambda near=near: lp.plot_residuals(result, orbit_index=near, kz=float(kzs[0]))))
             elif name == "solutions" and "sol_wz0" in result.variables:
                 if result.sizes["orbit"] < 2 or result.sizes.get("solution", 0) == 0:
                     continue
-                jobs.append((fname("solutions"), lambda: lp.plot_solution_families(result)))
+                # the thesis families N = 1, 0, -1 (Figs. 27-29) as panels; a rate jump over 1/TU
+                # between consecutive orbits starts a new branch (never a line joining two solutions)
+                ns = [k for k in (1, 0, -1) if np.any(np.asarray(result["sol_n"].values) == k)] or None
+                jobs.append((fname("solutions"), lambda ns=ns: lp.plot_solution_families(result, n=ns, max_jump=1.0)))
     elif "sol_wz0" in result.variables and "solutions" in names and result.sizes.get("solution", 0):
         jobs.append((fname("solutions"), lambda: _solutions_scatter(result)))
     for name, make in (extra or {}).items():

@@ -10,6 +10,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ._style import figure_axes
+
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
@@ -25,7 +27,6 @@ def plot_equilibrium_stability(ds, ax=None, *, boundaries: bool = True) -> Figur
     from matplotlib.colors import ListedColormap
     from matplotlib.patches import Patch
 
-    from . import figure_axes
 
     if not all(v in getattr(ds, "data_vars", {}) for v in ("stable", "pitch_stable", "roll_yaw", "b", "c")):
         raise ValueError("invalid argument `ds`: must be the Dataset of librate.equilibrium_stability")
@@ -74,7 +75,6 @@ def plot_out_of_plane_stability(datasets, ax=None, *, against: str = "period") -
     out of it (gids ``"class-<in>-<out>"``, e.g. ``"class-1-0"``: stable in the plane, unstable
     out of it). The bottom row shows the largest |roll/yaw multiplier| on a log scale (gid
     ``"out-of-plane-modulus"``). Returns the Figure."""
-    from . import figure_axes
 
     dss = [datasets] if hasattr(datasets, "data_vars") else list(datasets)
     if not dss or not all("out_of_plane_modulus" in getattr(d, "data_vars", {}) for d in dss):
@@ -124,7 +124,6 @@ def plot_family_multipliers(ds, ax=None, *, against: str = "period") -> Figure:
 
     from matplotlib.patches import Circle
 
-    from . import figure_axes
 
     if "multipliers" not in getattr(ds, "data_vars", {}) or "period_days" not in getattr(ds, "data_vars", {}):
         raise ValueError("invalid argument `ds`: must be the Dataset of librate.attitude_family_3d")
@@ -166,7 +165,6 @@ def plot_body_axes(solution, ax=None, *, samples: int = 16, planes=("xy", "xz"))
     evenly spaced times, the projections of the body x, y and z axes as arrows (gids
     ``"axis-x"``, ``"axis-y"``, ``"axis-z"``; red, green, blue), scaled to 6 % of the orbit's
     extent. Returns the Figure."""
-    from . import figure_axes
 
     if not all(hasattr(solution, a) for a in ("q0", "w0", "orbit", "propagate", "n_periods")):
         raise ValueError(f"invalid argument `solution`: must be a librate.AttitudeSolution3D, got {type(solution).__name__}")
@@ -207,7 +205,6 @@ def plot_map_3d(ds, ax=None, *, orbits=None) -> Figure:
     grids, one panel per orbit (``orbits``: the indices to draw, default the first three), the
     smallest residual marked (gid ``"minimum"``; where the 3-D corrector's seeds come from).
     Returns the Figure."""
-    from . import figure_axes
 
     if "residual_norm" not in getattr(ds, "data_vars", {}):
         raise ValueError("invalid argument `ds`: must be a 3-D attitude map (librate.attitude_map_3d)")

@@ -1,0 +1,220 @@
+"""Figures of periodic attitude motions: the solution families across an orbit family (thesis
+Figs. 27-29) and phi(t) of periodic motions (Figs. 30-31)."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable, Sequence
+from typing import TYPE_CHECKING
+
+import matplotlib
+import numpy as np
+from matplotlib.lines import Line2D
+from matplotlib.ticker import MultipleLocator
+
+from ..periodicity.solutions import AttitudeSolution, check_kinds
+from ._style import KZ_STYLES, check_map, figure_axes, kz_mask, n_color, orbit_axis, rate_axis, solution_table
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
+
+
+def _branches(orbit: np.ndarray, rate: np.ndarray, max_jump: float | None) -> list[list[int]]:
+    """Solutions (orbit index, rate) joined into branches across consecutive orbits: each
+    solution continues the branch ending on the previous orbit nearest in rate (greedy, closest
+    pairs first, at most ``max_jump`` apart), else starts a new one."""
+    branches: list[list[int]] = []
+    for o in np.unique(orbit):
+        cur = [int(c) for c in np.flatnonzero(orbit == o)]
+        cur.sort(key=lambda c: rate[c])
+        ends = [b for b in branches if orbit[b[-1]] == o - 1]
+        pairs = sorted((abs(rate[b[-1]] - rate[c]), bi, ci) for bi, b in enumerate(ends) for ci, c in enumerate(cur))
+        used_b: set[int] = set()
+        used_c: set[int] = set()
+        for d, bi, ci in pairs:
+            if bi in used_b or ci in used_c or (max_jump is not None and d > max_jump):
+                continue
+            ends[bi].append(cur[ci])
+            used_b.add(bi)
+            used_c.add(ci)
+        branches += [[c] for ci, c in enumerate(cur) if ci not in used_c]
+    return branches
+
+
+def plot_solution_families(
+    ds,
+    ax=None,
+    *,
+    n: int | Iterable[int] | None = None,
+    kinds: Sequence[str] = ("periodic",),
+    against: str = "period",
+    rate: str = "relative",
+    separate: bool = True,
+    stability: bool = True,
+    max_jump: float | None = None,
+) -> Figure:
+    """Families of periodic attitude solutions across an orbit family (thesis Figs. 27-29): the
+    initial rate of the solutions with N net turns per orbit against the orbit's period (or x0),
+    one curve per Kz of the Dataset.
+
+    ``ds``: a Dataset from :func:`librate.periodicity_map` with solutions (any number of Kz).
+    Solutions of one (kind, N, Kz) are joined across consecutive orbits into branches
+    (nearest rate, at most ``max_jump`` apart; None: no limit), each a line with
+    ``gid="family-{kind}-N{N:+d}-kz{Kz:g}"`` (e.g. ``"family-periodic-N-1-kz0.8"``) whose points
+    are exactly the Dataset's solutions; with ``stability`` the linearly stable ones are
+    overdrawn filled (``gid="family-stable"``). ``n``: the N values to show (default: all in
+    the Dataset), ``kinds``: ``"periodic"`` (default) and/or ``"half-turn"``. ``separate``: one
+    panel per (kind, N), N descending, Kz by colour (``ax``: that many Axes); else a single
+    panel, N by colour and Kz by line style. ``against``: ``"period"`` (days) or ``"x0"``;
+    ``rate``: ``"relative"`` (phidot(0) = wz(0) - 1, default) or ``"inertial"``. Returns the
+    Figure.
+    """
+    ds = check_map(ds)
+    tab = solution_table(ds)
+    if tab is None:
+        raise ValueError("invalid argument `ds`: the map holds no solutions (compute it with solve=True)")
+    kinds = check_kinds(kinds)
+    xv, xlabel = orbit_axis(ds, against)
+    offset, ylabel = rate_axis(rate)
+    if max_jump is not None and not (isinstance(max_jump, (int, float, np.integer, np.floating)) and max_jump > 0):
+        raise ValueError(f"invalid argument `max_jump`: must be a number > 0 or None, got {max_jump!r}")
+    if n is None:
+        ns = sorted(set(tab["n"][np.isin(tab["kind"], kinds)].tolist()), reverse=True)
+    else:
+        ns = [n] if isinstance(n, (int, np.integer)) else list(n)
+        if not ns or not all(isinstance(v, (int, np.integer)) and not isinstance(v, bool) for v in ns):
+            raise ValueError(f"invalid argument `n`: must be an integer, a sequence of integers or None, got {n!r}")
+    groups = [(k, int(v)) for v in ns for k in kinds]
+    if n is None:
+        groups = [(k, v) for k, v in groups if np.any((tab["kind"] == k) & (tab["n"] == v))]
+    if not groups:
+        raise ValueError(f"invalid argument `ds`: it holds no solutions of kinds {list(kinds)}")
+    kzs = np.asarray(ds["kz"].values, dtype=float)
+    kz_colors = (["k"] if kzs.size == 1 else
+                 [matplotlib.colormaps["viridis"](v) for v in np.linspace(0.0, 0.85, kzs.size)])
+
+    created = ax is None
+    npanels = len(groups) if separate else 1
+    fig, axs = figure_axes(ax, npanels, figsize=(7.4, 5.2) if npanels == 1 else None)
+    for g, (kind, nn) in enumerate(groups):
+        a = axs[g] if separate else axs[0]
+        drawn = False
+        for jk, kz in enumerate(kzs):
+            sel = np.flatnonzero((tab["kind"] == kind) & (tab["n"] == nn) & kz_mask(tab, kz))
+            if not sel.size:
+                continue
+            color = kz_colors[jk] if separate else n_color(nn)
+            style = "-" if separate else KZ_STYLES[jk % len(KZ_STYLES)]
+            name = f"$K_z$ = {kz:g}" if separate else f"$N$ = {nn:g}{' half-turn' if kind == 'half-turn' else ''}, $K_z$ = {kz:g}"
+            orb, w = tab["orbit"][sel], tab["wz0"][sel]
+            for b_i, br in enumerate(_branches(orb, w, max_jump)):
+                idx = sel[br]
+                (h,) = a.plot(xv[tab["orbit"][idx]], tab["wz0"][idx] - offset, color=color, linestyle=style, linewidth=1.4,
+                              marker=".", markersize=4, label=name if b_i == 0 else "_nolegend_")
+                h.set_gid(f"family-{kind}-N{nn:+d}-kz{kz:g}")
+            st = sel[tab["stable"][sel]]
+            if stability and st.size:
+                (h,) = a.plot(xv[tab["orbit"][st]], tab["wz0"][st] - offset, linestyle="none", marker="o", markersize=5,
+                              color=color, label="_nolegend_")
+                h.set_gid("family-stable")
+            drawn = True
+        if separate or g == len(groups) - 1:
+            handles = list(a.get_legend_handles_labels()[0])
+            if stability and any(h.get_gid() == "family-stable" for h in a.get_lines()):
+                handles.append(Line2D([], [], linestyle="none", marker="o", markersize=5, color="0.3",
+                                      label="linearly stable ($|\\mathrm{tr}\\,M| < 2$)"))
+            if handles and separate:
+                a.legend(handles=handles, fontsize=7.5, loc="best")
+            elif handles:  # one entry per (N, Kz): beside the panel
+                a.legend(handles=handles, fontsize=7.5, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)
+        if separate:
+            turns = {0: "", 1: " + 2\\pi", -1: " - 2\\pi"}.get(nn, f" {'+' if nn > 0 else '-'} {2 * abs(nn)}\\pi")
+            if kind == "half-turn":
+                turns += " + \\pi"
+            a.set_title(f"$N$ = {nn:g}{' (half-turn)' if kind == 'half-turn' else ''}: $\\varphi(T) = \\varphi_0{turns}$", fontsize=10)
+            if not drawn:
+                a.text(0.5, 0.5, "no solutions in the map", transform=a.transAxes, ha="center", va="center", color="0.4")
+    lo, hi = float(np.nanmin(xv)), float(np.nanmax(xv))
+    pad = 0.02 * (hi - lo)
+    for a in axs:
+        a.set_xlim(lo - pad, hi + pad)  # the whole orbit family on every panel
+        a.set_xlabel(xlabel)
+        a.set_ylabel(ylabel)
+        a.grid(True, linewidth=0.3, alpha=0.5)
+    if created:
+        fam = ds.attrs.get("family", "") or "orbit"
+        fig.suptitle(f"periodic attitude solution families along the {fam.upper() if fam == 'dro' else fam} family")
+    return fig
+
+
+def plot_attitude_motion(
+    solutions,
+    ax=None,
+    *,
+    n_periods: float = 1,
+    rate: str = "relative",
+    degrees: bool = True,
+    samples: int = 400,
+) -> Figure:
+    """Rotation angle phi(t) (left, ``gid="angle"``) and angular velocity (right,
+    ``gid="rate"``) of periodic attitude motions against time in orbital periods t / T (thesis
+    Figs. 30-31), one line per solution in the given order, coloured by N (dashed: half-turn).
+
+    ``solutions``: an :class:`~librate.AttitudeSolution` or a list of them (e.g. from
+    :func:`librate.find_periodic_attitudes`); each is propagated with
+    ``solution.propagate(n_periods)``, ``samples`` points per period. phi is measured from the
+    synodic X axis (unwrapped, in degrees unless ``degrees=False``): a periodic motion reaches
+    phi0 + 360 N deg after each period. ``rate``: ``"relative"`` (phidot = wz - 1, relative to
+    the synodic frame, default) or ``"inertial"`` (wz). ``ax``: two Axes. Returns the Figure.
+    """
+    offset, ylabel = rate_axis(rate, initial=False)
+    sols = [solutions] if isinstance(solutions, AttitudeSolution) else solutions
+    try:
+        sols = list(sols)
+    except TypeError:
+        sols = []
+    if not sols or not all(isinstance(s, AttitudeSolution) for s in sols):
+        raise ValueError("invalid argument `solutions`: must be a librate.AttitudeSolution or a non-empty list of them, "
+                         f"got {type(solutions).__name__}")
+    number = isinstance(n_periods, (int, float, np.integer, np.floating)) and not isinstance(n_periods, bool)
+    if not (number and math.isfinite(n_periods) and n_periods > 0):
+        raise ValueError(f"invalid argument `n_periods`: must be a number > 0, got {n_periods!r}")
+    if isinstance(samples, bool) or not isinstance(samples, (int, np.integer)) or samples < 2:
+        raise ValueError(f"invalid argument `samples`: must be an integer >= 2, got {samples!r}")
+    k = 180.0 / math.pi if degrees else 1.0
+    keys = [(s.n, s.kind) for s in sols]
+    by_n = len(set(keys)) == len(keys)  # colour by N unless two motions share (N, kind)
+    cycle = matplotlib.rcParams["axes.prop_cycle"].by_key().get("color", ["tab:blue"])
+
+    created = ax is None
+    fig, (a_ang, a_rate) = figure_axes(ax, 2, figsize=(12.0, 4.6))
+    for i, s in enumerate(sols):
+        T = s.orbit.period
+        m = max(2, int(math.ceil(samples * n_periods)) + 1)
+        tr = s.propagate(n_periods, t_eval=np.linspace(0.0, n_periods * T, m))
+        color = n_color(s.n) if by_n else cycle[i % len(cycle)]
+        ls = "--" if s.kind == "half-turn" else "-"
+        label = (f"$N$ = {s.n:g}{' half-turn' if s.kind == 'half-turn' else ''}, "
+                 f"$\\dot\\varphi(0)$ = {s.phidot0:.4f} ($\\omega_z(0)$ = {s.wz0:.4f}), {'stable' if s.stable else 'unstable'}")
+        (h,) = a_ang.plot(tr.t / T, k * tr.phi, color=color, linestyle=ls, linewidth=1.4, label=label)
+        h.set_gid("angle")
+        (h,) = a_rate.plot(tr.t / T, tr.wz - offset, color=color, linestyle=ls, linewidth=1.4, label=label)
+        h.set_gid("rate")
+    a_ang.set_ylabel(f"rotation angle $\\varphi$ from the synodic $X$ axis ({'deg' if degrees else 'rad'})")
+    a_rate.set_ylabel(ylabel.replace(", relative", "\nrelative"))
+    for a in (a_ang, a_rate):
+        a.set_xlabel("time $t/T$ (orbital periods)")
+        a.set_xlim(0.0, float(n_periods))
+        a.margins(y=0.22)  # room for the legend
+        a.grid(True, linewidth=0.3, alpha=0.5)
+        a.legend(fontsize=7.5, loc="best")
+    if degrees:
+        a_ang.yaxis.set_major_locator(MultipleLocator(90.0 if np.ptp(a_ang.get_ylim()) <= 1080 else 360.0))
+    if created:
+        orbs = {id(s.orbit) for s in sols}
+        kzs = sorted({s.kz for s in sols})
+        where = f"orbit T = {sols[0].orbit.period_days:.2f} d" if len(orbs) == 1 else f"{len(orbs)} orbits"
+        fig.suptitle(f"periodic attitude motions, {where}, $K_z$ = {', '.join(f'{v:g}' for v in kzs)}")
+    return fig
+
+
