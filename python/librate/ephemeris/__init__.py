@@ -1,0 +1,1 @@
+"""The Earth-Moon-Sun ephemeris model: SPK files (spk), epochs (epochs)."""
