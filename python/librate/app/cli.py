@@ -102,7 +102,8 @@ def info() -> None:
 
 
 _FORCE_HELP = ("--resume (default): continue or reuse the result in the output folder when it was made from the same inputs "
-               "(a result of other inputs is refused, naming what changed). --force: recompute and replace it, saying what it replaces.")
+               "(a result of other inputs is refused, naming what changed). --force: recompute and replace it, saying what it replaces; "
+               "for solve and map it also lifts the size limits (trajectory-periods, memory) printed before the run.")
 _PRESET = click.Choice(System.presets())
 
 # the demo's options, as the study keys its result records (for "changed: --kz 0.8 -> 0.5")
@@ -286,16 +287,21 @@ def _overrides(sets: tuple[str, ...]) -> dict:
     return out
 
 
-def _load_study(path: str | None, purpose: str, overrides: dict):
-    """The validated study, or a StudyInvalid listing every problem."""
+def _load_study(path: str | None, purpose: str, overrides: dict, force: bool = False, quiet: bool = True):
+    """The validated study, or a StudyInvalid listing every problem. ``force``: lift the size
+    limits of a solve or a map; unless ``quiet``, say its size (trajectories, memory) first."""
     from .study import Study, StudyError, apply_overrides
 
     try:
         if path is None:
-            return Study.from_dict(apply_overrides({}, overrides), purpose=purpose, base_dir=Path.cwd(), source="(command-line options)")
-        return Study.from_toml(path, purpose=purpose, overrides=overrides)
+            st = Study.from_dict(apply_overrides({}, overrides), purpose=purpose, base_dir=Path.cwd(), source="(command-line options)", force=force)
+        else:
+            st = Study.from_toml(path, purpose=purpose, overrides=overrides, force=force)
     except StudyError as err:
         raise StudyInvalid(str(err)) from None
+    if purpose in ("solve", "map") and not quiet:
+        _say(f"{purpose}: {st.estimate(purpose).text()}")
+    return st
 
 
 def _show(quiet: bool) -> bool | None:
@@ -456,7 +462,7 @@ def solve(study, sets, out_dir, resume, quiet) -> None:
     """
     from .progress import reporter
 
-    st = _load_study(study, "solve", _overrides(sets))
+    st = _load_study(study, "solve", _overrides(sets), force=not resume, quiet=quiet)
     _check_writable(st.output_dir(out_dir), "--out" if out_dir else "output.folder")
     three_d = st.attitude.model == "3d"
     t0 = time.perf_counter()
@@ -548,7 +554,7 @@ def map_(study, out_dir, quiet, scheduler, resume, sets) -> None:
     With [attitude] model = "3d": the six 3-D closure residuals over (orbit, two rate grids)
     in map.zarr (or .nc), saved orbit by orbit (resumable), and map_residual_norm.png.
     """
-    st = _load_study(study, "map", _overrides(sets))
+    st = _load_study(study, "map", _overrides(sets), force=not resume, quiet=quiet)
     _check_writable(st.output_dir(out_dir), "--out" if out_dir else "output.folder")
     t0 = time.perf_counter()
     try:

@@ -101,17 +101,19 @@ def _number_grid_tag(v: Any) -> str | None:
 
 _GRID_MSG = "must be a list of numbers or a table {start, stop, num}"
 _RATE_MSG = "must be a number (a fixed rate, 3-D maps), a list of numbers or a table {start, stop, num}"
+#: The most values of one grid (a list, or a table's ``num``).
+MAX_GRID = 1_000_000
 Grid = Annotated[
-    Annotated[list[float], Field(min_length=1), Tag("list")] | Annotated[Range, Tag("range")],
+    Annotated[list[float], Field(min_length=1, max_length=MAX_GRID), Tag("list")] | Annotated[Range, Tag("range")],
     Discriminator(_grid_tag, custom_error_type="grid", custom_error_message=_GRID_MSG),
 ]
 KzValue = Annotated[float, Field(ge=-1, le=1)]
 KzGrid = Annotated[
-    Annotated[KzValue, Tag("number")] | Annotated[list[KzValue], Field(min_length=1), Tag("list")] | Annotated[Range, Tag("range")],
+    Annotated[KzValue, Tag("number")] | Annotated[list[KzValue], Field(min_length=1, max_length=MAX_GRID), Tag("list")] | Annotated[Range, Tag("range")],
     Discriminator(_number_grid_tag, custom_error_type="grid", custom_error_message="must be a number, a list of numbers or a table {start, stop, num}"),
 ]
 RateGrid = Annotated[
-    Annotated[float, Tag("number")] | Annotated[list[float], Field(min_length=1), Tag("list")] | Annotated[Range, Tag("range")],
+    Annotated[float, Tag("number")] | Annotated[list[float], Field(min_length=1, max_length=MAX_GRID), Tag("list")] | Annotated[Range, Tag("range")],
     Discriminator(_number_grid_tag, custom_error_type="grid", custom_error_message=_RATE_MSG),
 ]
 _TAGS = {"list", "range", "number"}
@@ -137,8 +139,8 @@ class OrbitsSection(_Table):
     x0: Grid | None = None
     z0: Grid | None = None
     period_days: Grid | None = None
-    resonance: list[Annotated[int, Field(ge=1, le=100)]] | None = Field(None, min_length=1)
-    sun_resonance: list[Annotated[int, Field(ge=1, le=100)]] | None = Field(None, min_length=1)
+    resonance: list[Annotated[int, Field(ge=1, le=100)]] | None = Field(None, min_length=1, max_length=100)
+    sun_resonance: list[Annotated[int, Field(ge=1, le=100)]] | None = Field(None, min_length=1, max_length=100)
     members: int | None = Field(None, ge=1, le=10_000)
     max_members: int | None = Field(None, ge=2, le=5_000)
 
@@ -731,11 +733,14 @@ class Study(BaseModel):
 
     # --- construction --------------------------------------------------------------------------
     @classmethod
-    def from_dict(cls, data: Any, *, purpose: str | None = None, base_dir: str | Path | None = None, source: str | None = None) -> Study:
+    def from_dict(cls, data: Any, *, purpose: str | None = None, base_dir: str | Path | None = None, source: str | None = None,
+                  force: bool = False) -> Study:
         """Validate ``data`` (the parsed TOML: a dict of tables) and return the study.
 
         ``purpose``: also check what a command needs ("family", "solve" or "map"; e.g. a map needs
-        [body] and [rates] and a planar family). Raises :class:`StudyError` listing every problem.
+        [body] and [rates] and a planar family), and, for "solve" and "map", that its size is
+        within :data:`librate.app.budget.MAX_WORK` and ``MAX_MAP_BYTES`` (``force=True`` lifts
+        that). Raises :class:`StudyError` listing every problem.
         """
         if purpose is not None and purpose not in PURPOSES:
             raise ValueError(f"invalid argument `purpose`: must be one of {', '.join(PURPOSES)} or None, got {purpose!r}")
@@ -769,10 +774,17 @@ class Study(BaseModel):
         if problems:
             raise StudyError(problems, source)
         kwargs = {k: v for k, v in data.items() if k in ("title", "description")}
-        return cls.model_construct(**kwargs, **valid, base_dir=str(base_dir if base_dir is not None else "."))
+        study = cls.model_construct(**kwargs, **valid, base_dir=str(base_dir if base_dir is not None else "."))
+        if purpose in ("solve", "map") and not force:
+            from .budget import estimate, refusal
+
+            too_large = refusal(estimate(study, purpose), purpose)
+            if too_large:
+                raise StudyError([too_large], source)
+        return study
 
     @classmethod
-    def from_toml(cls, path: str | Path, *, purpose: str | None = None, overrides: dict | None = None) -> Study:
+    def from_toml(cls, path: str | Path, *, purpose: str | None = None, overrides: dict | None = None, force: bool = False) -> Study:
         """Read and validate a TOML study file (relative output folders are taken from its
         folder). ``overrides``: a dict of dotted keys to values applied on top (e.g.
         ``{"rates.wz0.num": 50}``), as the command line's ``--set``. Raises :class:`StudyError`."""
@@ -789,12 +801,20 @@ class Study(BaseModel):
             raise StudyError([f"not valid TOML: {err}"], str(p)) from None
         if overrides:
             data = apply_overrides(data, overrides)
-        return cls.from_dict(data, purpose=purpose, base_dir=p.resolve().parent, source=str(p))
+        return cls.from_dict(data, purpose=purpose, base_dir=p.resolve().parent, source=str(p), force=force)
 
-    def check(self, purpose: str) -> Study:
-        """Check that the study has what a command needs ("family", "solve", "map"); returns
-        itself, or raises :class:`StudyError`."""
-        return Study.from_dict(self.to_dict(), purpose=purpose, base_dir=self.base_dir)
+    def check(self, purpose: str, force: bool = False) -> Study:
+        """Check that the study has what a command needs ("family", "solve", "map") and, for
+        "solve" and "map", a size within the limits (``force=True`` lifts them); returns itself,
+        or raises :class:`StudyError`."""
+        return Study.from_dict(self.to_dict(), purpose=purpose, base_dir=self.base_dir, force=force)
+
+    def estimate(self, purpose: str):
+        """The size of this study run as ``purpose`` ("solve" or "map"): trajectories, orbit
+        periods, memory (:class:`librate.app.budget.Estimate`; ``.text()`` says it)."""
+        from .budget import estimate
+
+        return estimate(self, purpose)
 
     # --- serialisation -------------------------------------------------------------------------
     def to_dict(self) -> dict:
