@@ -1,6 +1,6 @@
 """Studies (TOML, validated by pydantic before any work) and results on disk (open_result).
 
-Reference for the error paths: the rules written in ``librate.app.study.ALLOWED`` and the module
+Reference for the error paths: the rules written on the schema's fields (``Field(description=...)`` in librate.app.study) and the module
 docstring; every message must name the key (dotted), the value given and what is allowed.
 Round trips are checked for exact equality of the saved numbers.
 """

@@ -54,6 +54,8 @@ __all__ = ["EXAMPLE_STUDY", "FIGURES", "PURPOSES", "Study", "StudyError"]
 PURPOSES = ("family", "solve", "map")
 #: Figure names accepted in ``output.figures`` ("multipliers" and "body_axes": 3-D solves).
 FIGURES = ("family", "period", "stability", "map", "residuals", "solutions", "multipliers", "body_axes")
+#: What output.figures accepts (its field's description).
+FIGURES_TEXT = "a list of figure names among " + ", ".join(repr(f) for f in FIGURES)
 
 
 class StudyError(ValueError):
@@ -77,9 +79,9 @@ class _Table(BaseModel):
 class Range(_Table):
     """``num`` evenly spaced values from ``start`` to ``stop`` (both included)."""
 
-    start: float
-    stop: float
-    num: int = Field(ge=1, le=1_000_000)
+    start: float = Field(description="a finite number, the first value")
+    stop: float = Field(description="a finite number, the last value")
+    num: int = Field(ge=1, le=1_000_000, description="an integer in [1, 1000000], the number of values (both ends included)")
 
     def values(self) -> np.ndarray:
         return np.linspace(self.start, self.stop, self.num)
@@ -122,27 +124,27 @@ _TAGS = {"list", "range", "number"}
 class SystemSection(_Table):
     """[system]: a preset, or a custom system from mu, lu_km, tu_s (and radii_km)."""
 
-    preset: str | None = None
-    mu: float | None = Field(None, gt=0, le=0.5)
-    lu_km: float | None = Field(None, gt=0)
-    tu_s: float | None = Field(None, gt=0)
-    radii_km: list[Annotated[float, Field(ge=0)]] | None = Field(None, min_length=2, max_length=2)
-    name: str | None = None
+    preset: str | None = Field(None, description="one of the presets ({presets})")
+    mu: float | None = Field(None, gt=0, le=0.5, description="a number in (0, 0.5], the mass ratio m2 / (m1 + m2)")
+    lu_km: float | None = Field(None, gt=0, description="a number > 0, the length unit (distance between the primaries) in km")
+    tu_s: float | None = Field(None, gt=0, description="a number > 0, the time unit (1 / mean motion) in s")
+    radii_km: list[Annotated[float, Field(ge=0)]] | None = Field(None, min_length=2, max_length=2, description="two numbers >= 0, the primaries' radii in km")
+    name: str | None = Field(None, description="a string")
 
 
 class OrbitsSection(_Table):
     """[orbits]: the family and the members wanted."""
 
-    kind: Literal["dro", "lyapunov", "halo"] = "dro"
-    point: Literal[1, 2] | None = None
-    branch: Literal["north", "south"] | None = None
-    x0: Grid | None = None
-    z0: Grid | None = None
-    period_days: Grid | None = None
-    resonance: list[Annotated[int, Field(ge=1, le=100)]] | None = Field(None, min_length=1, max_length=100)
-    sun_resonance: list[Annotated[int, Field(ge=1, le=100)]] | None = Field(None, min_length=1, max_length=100)
-    members: int | None = Field(None, ge=1, le=10_000)
-    max_members: int | None = Field(None, ge=2, le=5_000)
+    kind: Literal["dro", "lyapunov", "halo"] = Field("dro", description="'dro', 'lyapunov' or 'halo'")
+    point: Literal[1, 2] | None = Field(None, description="1 (L1) or 2 (L2), for lyapunov and halo families")
+    branch: Literal["north", "south"] | None = Field(None, description="'north' or 'south', for halo families")
+    x0: Grid | None = Field(None, description="a list of x0 values (LU) or a table {start, stop, num}")
+    z0: Grid | None = Field(None, description="a list of z0 values (LU) or a table {start, stop, num}, for halo families")
+    period_days: Grid | None = Field(None, description="a list of periods (days) or a table {start, stop, num}")
+    resonance: list[Annotated[int, Field(ge=1, le=100)]] | None = Field(None, min_length=1, max_length=100, description="a list of integers k >= 1 (synodic 1:k members, T = 2 pi / k)")
+    sun_resonance: list[Annotated[int, Field(ge=1, le=100)]] | None = Field(None, min_length=1, max_length=100, description="a list of integers k >= 1 (Sun-resonant members, T = Ts / k)")
+    members: int | None = Field(None, ge=1, le=10_000, description="an integer >= 1: that many members evenly spread along the family")
+    max_members: int | None = Field(None, ge=2, le=5_000, description="an integer in [2, 5000], the continuation's length (lyapunov and halo)")
 
 
 FLEXIBLE_PRESETS = ("sample-station", "sample-station-low-frequency")
@@ -154,24 +156,24 @@ class BodySection(_Table):
     """[body]: Kz, or the principal moments of inertia in kg m^2, or a flexible spacecraft
     (``flexible``: a preset name or the path of a FlexibleBody TOML file)."""
 
-    kz: KzGrid | None = None
-    ix: float | None = Field(None, gt=0)
-    iy: float | None = Field(None, gt=0)
-    iz: float | None = Field(None, gt=0)
-    mass_kg: float | None = Field(None, gt=0)
+    kz: KzGrid | None = Field(None, description="a number in [-1, 1] (Kz = (Iy - Ix) / Iz), a list of them or a table {start, stop, num}")
+    ix: float | None = Field(None, gt=0, description="a number > 0, principal moment of inertia about x in kg m^2")
+    iy: float | None = Field(None, gt=0, description="a number > 0, principal moment of inertia about y in kg m^2")
+    iz: float | None = Field(None, gt=0, description="a number > 0, principal moment of inertia about z in kg m^2")
+    mass_kg: float | None = Field(None, gt=0, description="a number > 0, the mass in kg")
     flexible: str | None = None
 
 
 class SrpSection(_Table):
     """[torques.srp]: the flat plate, by its amplitude eps or by its geometry."""
 
-    eps: float | None = None
-    area_m2: float | None = Field(None, gt=0)
-    offset_m: float | None = None
-    cs: float = Field(0.0, ge=0, le=1)
-    cd: float = Field(0.0, ge=0, le=1)
-    theta_sun0: float = 0.0
-    pressure: float | None = Field(None, ge=0)
+    eps: float | None = Field(None, description="a finite number, the nondimensional plate amplitude P A d TU^2 / Iz")
+    area_m2: float | None = Field(None, gt=0, description="a number > 0, the plate's area in m^2")
+    offset_m: float | None = Field(None, description="a finite number, the centre-of-pressure offset along y_B in m")
+    cs: float = Field(0.0, ge=0, le=1, description="a number in [0, 1], the specular reflection fraction (cs + cd <= 1)")
+    cd: float = Field(0.0, ge=0, le=1, description="a number in [0, 1], the diffuse reflection fraction (cs + cd <= 1)")
+    theta_sun0: float = Field(0.0, description="a finite number, the Sun's phase at t = 0 in rad")
+    pressure: float | None = Field(None, ge=0, description="a number >= 0, the solar pressure in N/m^2 (default 4.56e-6)")
 
     @model_validator(mode="before")
     @classmethod
@@ -189,7 +191,7 @@ class SrpSection(_Table):
 class TorquesSection(_Table):
     """[torques]: gravity gradient of the primaries, and solar radiation pressure."""
 
-    gravity_gradient: list[Literal["earth", "moon"]] = Field(default_factory=lambda: ["earth", "moon"])
+    gravity_gradient: list[Literal["earth", "moon"]] = Field(default_factory=lambda: ["earth", "moon"], description="a list of primaries among 'earth' and 'moon'")
     srp: SrpSection | None = None
 
 
@@ -197,38 +199,38 @@ class RatesSection(_Table):
     """[rates]: the initial rates, inertial wz0 or relative phidot0 = wz0 - 1 (1/TU); for a 3-D
     map also wx0 and wy0 (inertial, body axes): two grids and one fixed number."""
 
-    wz0: RateGrid | None = None
-    phidot0: RateGrid | None = None
-    wx0: RateGrid | None = None
-    wy0: RateGrid | None = None
+    wz0: RateGrid | None = Field(None, description="a list of inertial initial rates (1/TU), strictly increasing, or a table {start, stop, num} with start < stop, num >= 2")
+    phidot0: RateGrid | None = Field(None, description="a list of initial rates relative to the synodic frame (1/TU), strictly increasing, or a table {start, stop, num} with start < stop, num >= 2")
+    wx0: RateGrid | None = Field(None, description="for attitude.model = '3d' maps: a number (fixed) or a grid of inertial initial rates about body x (1/TU): a strictly increasing list or a table {start, stop, num} with start < stop, num >= 2")
+    wy0: RateGrid | None = Field(None, description="for attitude.model = '3d' maps: a number (fixed) or a grid of inertial initial rates about body y (1/TU): a strictly increasing list or a table {start, stop, num} with start < stop, num >= 2")
 
 
 class AttitudeSection(_Table):
     """[attitude]: the attitude model ("planar" or "3d") and how a 3-D solve starts."""
 
-    model: Literal["planar", "3d"] = "planar"
-    start: Literal["planar", "spin", "given"] | None = None
-    n: int | None = Field(None, ge=-100, le=100)
-    q0: list[float] | None = Field(None, min_length=4, max_length=4)
-    w0: list[float] | None = Field(None, min_length=3, max_length=3)
-    tol: float | None = Field(None, ge=1e-14, le=1e-6)
+    model: Literal["planar", "3d"] = Field("planar", description="'planar' (the default: the planar model, phi and wz) or '3d' (the 3-D rigid body, quaternion and three rates)")
+    start: Literal["planar", "spin", "given"] | None = Field(None, description="'planar' (the planar N-family solution on the first member, planar families), 'spin' (the torque-free spin wz0 = 1 + 2 pi n / (K T) about synodic Z) or 'given' (attitude.q0 and attitude.w0), with attitude.model = '3d'")
+    n: int | None = Field(None, ge=-100, le=100, description="an integer in [-100, 100], net turns about synodic Z per attitude period, with attitude.start = 'planar' or 'spin'")
+    q0: list[float] | None = Field(None, min_length=4, max_length=4, description="four numbers, a unit quaternion (scalar last): the body relative to the synodic frame at t = 0, with attitude.start = 'given' or 'spin'")
+    w0: list[float] | None = Field(None, min_length=3, max_length=3, description="three numbers, the inertial rate in body axes (1/TU), with attitude.start = 'given'")
+    tol: float | None = Field(None, ge=1e-14, le=1e-6, description="a number in [1e-14, 1e-6], the 3-D corrector's tolerance on the closure (default 1e-12; 1e-10 for NRHOs)")
 
 
 class SolverSection(_Table):
     """[solver]: tolerances, periods per solution, initial angle."""
 
-    rtol: float = Field(1e-12, ge=1e-15, le=1e-3)
-    atol: float = Field(1e-12, ge=1e-15, le=1e-3)
-    n_periods: int | None = Field(None, ge=1, le=1000)
-    phi0: float = Field(0.0, ge=-2 * math.pi, le=2 * math.pi)
+    rtol: float = Field(1e-12, ge=1e-15, le=1e-3, description="a number in [1e-15, 1e-3]")
+    atol: float = Field(1e-12, ge=1e-15, le=1e-3, description="a number in [1e-15, 1e-3]")
+    n_periods: int | None = Field(None, ge=1, le=1000, description="an integer in [1, 1000], orbit periods per attitude period")
+    phi0: float = Field(0.0, ge=-2 * math.pi, le=2 * math.pi, description="a number in [-2 pi, 2 pi], the initial attitude angle in rad")
 
 
 class OutputSection(_Table):
     """[output]: where and how results are written."""
 
-    folder: str = Field("librate-out", min_length=1)
-    format: Literal["zarr", "netcdf"] = "zarr"
-    figures: list[Literal["family", "period", "stability", "map", "residuals", "solutions", "multipliers", "body_axes"]] | None = None
+    folder: str = Field("librate-out", min_length=1, description="a non-empty path (relative paths are taken from the study file's folder)")
+    format: Literal["zarr", "netcdf"] = Field("zarr", description="'zarr' or 'netcdf'")
+    figures: list[Literal["family", "period", "stability", "map", "residuals", "solutions", "multipliers", "body_axes"]] | None = Field(None, description=FIGURES_TEXT)
 
 
 _SECTIONS: dict[str, type[_Table]] = {
@@ -244,71 +246,19 @@ _SECTIONS: dict[str, type[_Table]] = {
 _TABLES: dict[str, type[_Table]] = {**_SECTIONS, "torques.srp": SrpSection}
 _TOP_KEYS = ("title", "description", *_SECTIONS)
 
-#: What each key accepts (used in the error messages).
-ALLOWED: dict[str, str] = {
-    "title": "a string",
-    "description": "a string",
-    "system.preset": "one of the presets ({presets})",
-    "system.mu": "a number in (0, 0.5], the mass ratio m2 / (m1 + m2)",
-    "system.lu_km": "a number > 0, the length unit (distance between the primaries) in km",
-    "system.tu_s": "a number > 0, the time unit (1 / mean motion) in s",
-    "system.radii_km": "two numbers >= 0, the primaries' radii in km",
-    "system.name": "a string",
-    "orbits.kind": "'dro', 'lyapunov' or 'halo'",
-    "orbits.point": "1 (L1) or 2 (L2), for lyapunov and halo families",
-    "orbits.branch": "'north' or 'south', for halo families",
-    "orbits.x0": "a list of x0 values (LU) or a table {start, stop, num}",
-    "orbits.z0": "a list of z0 values (LU) or a table {start, stop, num}, for halo families",
-    "orbits.period_days": "a list of periods (days) or a table {start, stop, num}",
-    "orbits.resonance": "a list of integers k >= 1 (synodic 1:k members, T = 2 pi / k)",
-    "orbits.sun_resonance": "a list of integers k >= 1 (Sun-resonant members, T = Ts / k)",
-    "orbits.members": "an integer >= 1: that many members evenly spread along the family",
-    "orbits.max_members": "an integer in [2, 5000], the continuation's length (lyapunov and halo)",
-    "body.kz": "a number in [-1, 1] (Kz = (Iy - Ix) / Iz), a list of them or a table {start, stop, num}",
-    "body.ix": "a number > 0, principal moment of inertia about x in kg m^2",
-    "body.iy": "a number > 0, principal moment of inertia about y in kg m^2",
-    "body.iz": "a number > 0, principal moment of inertia about z in kg m^2",
-    "body.mass_kg": "a number > 0, the mass in kg",
-    "torques.gravity_gradient": "a list of primaries among 'earth' and 'moon'",
-    "torques.srp.eps": "a finite number, the nondimensional plate amplitude P A d TU^2 / Iz",
-    "torques.srp.area_m2": "a number > 0, the plate's area in m^2",
-    "torques.srp.offset_m": "a finite number, the centre-of-pressure offset along y_B in m",
-    "torques.srp.cs": "a number in [0, 1], the specular reflection fraction (cs + cd <= 1)",
-    "torques.srp.cd": "a number in [0, 1], the diffuse reflection fraction (cs + cd <= 1)",
-    "torques.srp.theta_sun0": "a finite number, the Sun's phase at t = 0 in rad",
-    "torques.srp.pressure": "a number >= 0, the solar pressure in N/m^2 (default 4.56e-6)",
-    "rates.wz0": "a list of inertial initial rates (1/TU), strictly increasing, or a table {start, stop, num} with start < stop, num >= 2",
-    "rates.phidot0": "a list of initial rates relative to the synodic frame (1/TU), strictly increasing, or a table {start, stop, num} with start < stop, num >= 2",
-    "rates.wx0": "for attitude.model = '3d' maps: a number (fixed) or a grid of inertial initial rates about body x (1/TU): a strictly increasing list or a table {start, stop, num} with start < stop, num >= 2",
-    "rates.wy0": "for attitude.model = '3d' maps: a number (fixed) or a grid of inertial initial rates about body y (1/TU): a strictly increasing list or a table {start, stop, num} with start < stop, num >= 2",
-    "attitude.model": "'planar' (the default: the planar model, phi and wz) or '3d' (the 3-D rigid body, quaternion and three rates)",
-    "attitude.start": "'planar' (the planar N-family solution on the first member, planar families), 'spin' (the torque-free spin wz0 = 1 + 2 pi n / (K T) about synodic Z) or 'given' (attitude.q0 and attitude.w0), with attitude.model = '3d'",
-    "attitude.n": "an integer in [-100, 100], net turns about synodic Z per attitude period, with attitude.start = 'planar' or 'spin'",
-    "attitude.q0": "four numbers, a unit quaternion (scalar last): the body relative to the synodic frame at t = 0, with attitude.start = 'given' or 'spin'",
-    "attitude.w0": "three numbers, the inertial rate in body axes (1/TU), with attitude.start = 'given'",
-    "attitude.tol": "a number in [1e-14, 1e-6], the 3-D corrector's tolerance on the closure (default 1e-12; 1e-10 for NRHOs)",
-    "solver.rtol": "a number in [1e-15, 1e-3]",
-    "solver.atol": "a number in [1e-15, 1e-3]",
-    "solver.n_periods": "an integer in [1, 1000], orbit periods per attitude period",
-    "solver.phi0": "a number in [-2 pi, 2 pi], the initial attitude angle in rad",
-    "output.folder": "a non-empty path (relative paths are taken from the study file's folder)",
-    "output.format": "'zarr' or 'netcdf'",
-    "output.figures": "a list of figure names among " + ", ".join(repr(f) for f in FIGURES),
-}
-_RANGE_ALLOWED = {
-    "start": "a finite number, the first value",
-    "stop": "a finite number, the last value",
-    "num": "an integer in [1, 1000000], the number of values (both ends included)",
-}
+def _described(model: type[BaseModel], name: str) -> str | None:
+    f = model.model_fields.get(name)
+    return f.description if f is not None else None
 
 
 def _allowed(key: str) -> str | None:
+    """What ``key`` accepts: the description on its field (a grid's start, stop, num: Range's)."""
     base = re.sub(r"\[\d+\]", "", key)
-    if key in ALLOWED or base in ALLOWED:
-        text = ALLOWED.get(key) or ALLOWED[base]
-    else:
-        last = key.rsplit(".", 1)[-1]
-        text = _RANGE_ALLOWED.get(last)
+    parent, _, name = base.rpartition(".")
+    model = Study if parent == "" else _TABLES.get(parent)
+    text = _described(model, name) if model is not None else None
+    if text is None:
+        text = _described(Range, name)
     if text and "{presets}" in text:
         from ..orbits.system import System
 
@@ -719,8 +669,8 @@ class Study(BaseModel):
 
     model_config = ConfigDict(extra="forbid", strict=True, frozen=True, allow_inf_nan=False)
 
-    title: str | None = None
-    description: str | None = None
+    title: str | None = Field(None, description="a string")
+    description: str | None = Field(None, description="a string")
     system: SystemSection = Field(default_factory=SystemSection)
     orbits: OrbitsSection = Field(default_factory=OrbitsSection)
     body: BodySection | None = None
