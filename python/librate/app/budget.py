@@ -68,7 +68,7 @@ def _count(g) -> int:
 
 def estimate(study, purpose: str) -> Estimate:
     """The size of ``study`` run as ``purpose`` ("solve" or "map")."""
-    from .study import member_count
+    from .rules import member_count
 
     o = study.orbits
     sel = member_count(o)
