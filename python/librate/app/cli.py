@@ -17,8 +17,6 @@ import numpy as np
 
 from .._core import __version__
 from .._errors import LibrateError
-from ..orbits.families import correct_dro
-from ..orbits.propagation import propagate
 from ..orbits.system import System
 from .jobs import run_family, run_map, run_solve
 
@@ -217,31 +215,31 @@ def dros(system_name: str, x0_values: tuple[float, ...]) -> None:
     Each DRO is corrected by half-period shooting with the STM, continued from the previous one
     (its ydot0 seeds the next), then propagated over a whole period to show that it closes.
     """
+    from .commands import dro_closures
+
     system = System.preset(system_name)
     xs = x0_values or (0.96, 0.93, 0.90, 0.87, 0.84, 0.81)
-    lo, hi = -system.mu, 1.0 - system.mu
-    for x0 in xs:
-        if not lo < x0 < hi:
-            raise UserError(f"--x0 {x0:g}: a DRO starts between the primaries, {lo:.6g} < x0 < {hi:.6g} LU (Earth at -mu, Moon at 1 - mu)")
+    rows = dro_closures(system, xs)
+    try:
+        first = next(rows, None)
+    except ValueError as err:  # an x0 outside the primaries (named), or the first correction's
+        raise UserError(str(err) if str(err).startswith("--x0") else f"--x0 {xs[0]:g}: {err}") from None
+    except LibrateError as err:
+        raise click.ClickException(f"--x0 {xs[0]:g}: {type(err).__name__}: {str(err).splitlines()[0]}") from None
     click.echo(f"Distant retrograde orbits in {system.name} (mu = {system.mu}), corrected by half-period shooting:")
     click.echo(f"{'x0':>8} {'ydot0':>18} {'period [TU]':>16} {'period [d]':>11} {'Jacobi':>17} {'iter':>4} {'closure':>9} {'time':>7}")
-    guess = None
-    for x0 in xs:
-        t_start = time.perf_counter()
+    row, i = first, 0
+    while row is not None:
+        x0, orbit, closure, elapsed = row
+        click.echo(f"{x0:8.4f} {orbit.state0[4]:18.15f} {orbit.period:16.12f} {orbit.period_days:11.6f} "
+                   f"{orbit.jacobi:17.14f} {orbit.iterations:4d} {closure:9.1e} {elapsed * 1e3:5.1f}ms")
+        i += 1
         try:
-            orbit = correct_dro(system, x0, guess)
-            one = propagate(system, orbit.state0, orbit.period, rtol=1e-13, atol=1e-13, t_eval=[orbit.period], collision="point")
+            row = next(rows, None)
         except ValueError as err:
-            raise UserError(f"--x0 {x0:g}: {err}") from None
+            raise UserError(f"--x0 {xs[i]:g}: {err}") from None
         except LibrateError as err:
-            raise click.ClickException(f"--x0 {x0:g}: {type(err).__name__}: {str(err).splitlines()[0]}") from None
-        closure = float(np.max(np.abs(one.y[-1] - orbit.state0)))
-        elapsed = time.perf_counter() - t_start
-        click.echo(
-            f"{x0:8.4f} {orbit.state0[4]:18.15f} {orbit.period:16.12f} {orbit.period_days:11.6f} "
-            f"{orbit.jacobi:17.14f} {orbit.iterations:4d} {closure:9.1e} {elapsed * 1e3:5.1f}ms"
-        )
-        guess = orbit.state0[4]
+            raise click.ClickException(f"--x0 {xs[i]:g}: {type(err).__name__}: {str(err).splitlines()[0]}") from None
     click.echo("closure = max |state(T) - state(0)| after one full period at rtol = atol = 1e-13.")
 
 
