@@ -92,6 +92,7 @@ def test_init_map_plot_end_to_end(run, tmp_path, no_runner):
     res = run("map", "study.toml", *TINY)
     out = tmp_path / "librate-out"
     assert "periodicity map: 3 orbits x 1 Kz x 50 rates = 150 attitude trajectories" in res.output
+    assert "map: 3 (orbits.x0) x 1 (body.kz) x 50 (rates.wz0) = 150 trajectories of 1 orbit period" in res.output  # the size, before the run
     assert "solutions (wz(T) = wz0" in res.output
     store = out / "map.zarr"
     ds = librate.open_result(store)
@@ -412,3 +413,13 @@ def test_demo_summary_says_what_it_omits(run, tmp_path):
     assert sum(int(line.split()[2]) for line in rows) == listed
     res = run("demo", "--orbits", "4", "--rates", "50", "--out", "d", "--kz", "0.5", code=2)
     assert "changed: --kz 0.8 -> 0.5" in res.stderr and "--force" in res.stderr
+
+
+def test_a_giant_map_is_refused_with_the_keys_and_exit_2(run, tmp_path):
+    """Issue 24 #7: 1000 Kz x 1e6 rates is refused before anything is computed or written
+    (exit 2, the keys and the limit named, --force offered), never a numpy MemoryError."""
+    run("init")
+    res = run("map", "study.toml", "--set", "body.kz={start = -1, stop = 1, num = 1000}", "--set", "rates.wz0.num=1000000", code=2)
+    for text in ("orbits.x0 = 12 values", "body.kz = 1,000 values", "rates.wz0 = 1,000,000 values", "too large", "--force"):
+        assert text in res.output, (text, res.output)
+    assert "MemoryError" not in res.output and not (tmp_path / "librate-out").exists()

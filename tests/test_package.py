@@ -44,3 +44,17 @@ def test_cli_info_dros_and_demo(tmp_path):
     assert float(ds.sol_residual.max()) < 1e-9
     bad = runner.invoke(main, ["demo", "--kz", "2"])
     assert bad.exit_code != 0 and "kz" in bad.output.lower()
+
+
+def test_import_librate_leaves_the_application_layer_unloaded():
+    """`import librate` loads neither the app package nor its dependencies (pydantic, click,
+    tqdm); `librate.Study` loads them on first use (issue 20: the root is the bottom layer)."""
+    import subprocess
+    import sys
+
+    code = ("import sys, librate; heavy = ('librate.app', 'pydantic', 'click', 'tqdm');"
+            "print(sorted({m.split('.')[0] if not m.startswith('librate') else 'librate.app' for m in sys.modules if m.startswith(heavy)}));"
+            "librate.Study; print('librate.app.study' in sys.modules, 'Study' in dir(librate))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.split("\n")
+    assert out[0] == "[]", out
+    assert out[1] == "True True"

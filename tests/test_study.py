@@ -1,6 +1,6 @@
 """Studies (TOML, validated by pydantic before any work) and results on disk (open_result).
 
-Reference for the error paths: the rules written in ``librate.app.study.ALLOWED`` and the module
+Reference for the error paths: the rules written on the schema's fields (``Field(description=...)`` in librate.app.study) and the module
 docstring; every message must name the key (dotted), the value given and what is allowed.
 Round trips are checked for exact equality of the saved numbers.
 """
@@ -401,3 +401,50 @@ def test_study_changes_names_the_keys_a_result_depends_on():
     assert study_changes(a, b, RESULT_INPUTS["family"]) == ["orbits.x0.num: 3 -> 4"]  # the body does not change a family
     assert 'output.folder: "librate-out" -> "elsewhere"' in study_changes(a, b)
     assert study_changes(None, a) == ["(study): none recorded in the existing result"]
+
+
+# --- giant studies (issue 24 #7) ---------------------------------------------------------------
+def _giant(kz_num: int, wz_num: int, x0_num: int = 12) -> dict:
+    return {"orbits": {"x0": {"start": 0.9, "stop": 0.3, "num": x0_num}}, "body": {"kz": {"start": -1.0, "stop": 1.0, "num": kz_num}},
+            "rates": {"wz0": {"start": -3.0, "stop": 2.0, "num": wz_num}}}
+
+
+def test_giant_map_is_refused_naming_the_keys_before_any_allocation():
+    """1000 Kz x 1e6 rates x 12 orbits: 1.2e10 trajectories and ~300 GB of map arrays (25 bytes
+    a cell), refused by the schema with a StudyError naming the keys, never a MemoryError."""
+    from librate.app.budget import MAX_MAP_BYTES, MAX_WORK
+
+    with pytest.raises(StudyError) as e:
+        Study.from_dict(_giant(1000, 1_000_000), purpose="map")
+    (msg,) = e.value.problems
+    for text in ("orbits.x0 = 12 values", "body.kz = 1,000 values", "rates.wz0 = 1,000,000 values", "12,000,000,000 trajectories",
+                 f"limit of {MAX_WORK:.3g}", "300 GB", "--force"):
+        assert text in msg, (text, msg)
+    assert 12e9 * 25 > MAX_MAP_BYTES
+    # force=True lifts the limit: the study validates (nothing is allocated by validation)
+    st = Study.from_dict(_giant(1000, 1_000_000), purpose="map", force=True)
+    est = st.estimate("map")
+    assert est.trajectories == 12_000_000_000 and est.bytes == 12_000_000_000 * 25
+    with pytest.raises(StudyError, match="too large"):
+        st.check("map")
+    assert st.check("map", force=True) is not None
+    # a solve of the same grid is refused for its work (no map arrays)
+    with pytest.raises(StudyError, match="trajectory-periods exceed"):
+        Study.from_dict(_giant(1000, 1_000_000), purpose="solve")
+
+
+def test_ordinary_studies_pass_and_grid_sizes_are_bounded():
+    """The example study (12 orbits x 1 Kz x 300 rates) is far within the limits; every grid is
+    bounded at 1e6 values (a table's num and a list's length)."""
+    st = Study.from_dict(_giant(1, 300), purpose="map")
+    est = st.estimate("map")
+    assert est.trajectories == 3600 and est.periods == 1 and est.bytes == 3600 * 25
+    assert "3,600 trajectories" in est.text()
+    with pytest.raises(StudyError, match=r"rates\.wz0\.num = 2000000: .*1000000"):
+        Study.from_dict(_giant(1, 2_000_000), purpose="map")
+    with pytest.raises(StudyError, match=r"body\.kz = .*at most 1000000"):
+        Study.from_dict({**_giant(1, 300), "body": {"kz": [0.5] * 1_000_001}})
+    # n_periods counts in the work: 1000 periods of 1e6 trajectories is past the limit
+    data = {**_giant(1, 100_000, 10), "solver": {"n_periods": 1000}}
+    with pytest.raises(StudyError, match="1e\\+09 trajectory-periods"):
+        Study.from_dict(data, purpose="map")

@@ -1,7 +1,7 @@
 """Studies in the 3-D attitude model (issue 15, item 6): ``[attitude] model = "3d"``.
 
 Validation: every problem names the key (dotted), the value given and what is allowed, as the
-rules in ``librate.app.study.ALLOWED`` and ``_check_3d`` state (the reference for the error
+rules on the schema's fields (their descriptions) and ``_check_3d`` state (the reference for the error
 paths). ``librate solve`` end to end on examples/study_3d_dro.toml (three DROs) and on a short
 L2 southern halo family, the result re-opened and checked:
 

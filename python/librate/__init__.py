@@ -10,7 +10,6 @@ import warnings as _warnings
 from ._build import build_info
 from ._core import __version__
 from ._errors import CollisionError, ConvergenceError, IntegrationError, LibrateError
-from .app import Study, StudyError, open_result, run_map
 from .attitude import (
     Appendage,
     AttitudeEquilibrium,
@@ -155,11 +154,24 @@ __all__ = [
 
 #: Old names kept importable for a while: ``librate.<old>`` warns and returns the new object.
 _DEPRECATED = {"FlatPlateSRP": ("FlatPlate", FlatPlate), "SunModel": ("Sun", Sun)}
+#: The application layer (pydantic, tqdm; studies, result files, the map runner) is loaded on
+#: first use only, so that ``import librate`` stays light: ``librate.Study`` imports it.
+_APP = {"Study": "study", "StudyError": "study", "open_result": "results", "run_map": "runner"}
 
 
 def __getattr__(name: str):
+    if name in _APP:
+        import importlib
+
+        obj = getattr(importlib.import_module(f"librate.app.{_APP[name]}"), name)
+        globals()[name] = obj
+        return obj
     if name in _DEPRECATED:
         new, obj = _DEPRECATED[name]
         _warnings.warn(f"librate.{name} is deprecated; use librate.{new}", DeprecationWarning, stacklevel=2)
         return obj
     raise AttributeError(f"module 'librate' has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(__all__))

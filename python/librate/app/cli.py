@@ -17,8 +17,6 @@ import numpy as np
 
 from .._core import __version__
 from .._errors import LibrateError
-from ..orbits.families import correct_dro
-from ..orbits.propagation import propagate
 from ..orbits.system import System
 from .jobs import run_family, run_map, run_solve
 
@@ -102,7 +100,8 @@ def info() -> None:
 
 
 _FORCE_HELP = ("--resume (default): continue or reuse the result in the output folder when it was made from the same inputs "
-               "(a result of other inputs is refused, naming what changed). --force: recompute and replace it, saying what it replaces.")
+               "(a result of other inputs is refused, naming what changed). --force: recompute and replace it, saying what it replaces; "
+               "for solve and map it also lifts the size limits (trajectory-periods, memory) printed before the run.")
 _PRESET = click.Choice(System.presets())
 
 # the demo's options, as the study keys its result records (for "changed: --kz 0.8 -> 0.5")
@@ -216,31 +215,31 @@ def dros(system_name: str, x0_values: tuple[float, ...]) -> None:
     Each DRO is corrected by half-period shooting with the STM, continued from the previous one
     (its ydot0 seeds the next), then propagated over a whole period to show that it closes.
     """
+    from .commands import dro_closures
+
     system = System.preset(system_name)
     xs = x0_values or (0.96, 0.93, 0.90, 0.87, 0.84, 0.81)
-    lo, hi = -system.mu, 1.0 - system.mu
-    for x0 in xs:
-        if not lo < x0 < hi:
-            raise UserError(f"--x0 {x0:g}: a DRO starts between the primaries, {lo:.6g} < x0 < {hi:.6g} LU (Earth at -mu, Moon at 1 - mu)")
+    rows = dro_closures(system, xs)
+    try:
+        first = next(rows, None)
+    except ValueError as err:  # an x0 outside the primaries (named), or the first correction's
+        raise UserError(str(err) if str(err).startswith("--x0") else f"--x0 {xs[0]:g}: {err}") from None
+    except LibrateError as err:
+        raise click.ClickException(f"--x0 {xs[0]:g}: {type(err).__name__}: {str(err).splitlines()[0]}") from None
     click.echo(f"Distant retrograde orbits in {system.name} (mu = {system.mu}), corrected by half-period shooting:")
     click.echo(f"{'x0':>8} {'ydot0':>18} {'period [TU]':>16} {'period [d]':>11} {'Jacobi':>17} {'iter':>4} {'closure':>9} {'time':>7}")
-    guess = None
-    for x0 in xs:
-        t_start = time.perf_counter()
+    row, i = first, 0
+    while row is not None:
+        x0, orbit, closure, elapsed = row
+        click.echo(f"{x0:8.4f} {orbit.state0[4]:18.15f} {orbit.period:16.12f} {orbit.period_days:11.6f} "
+                   f"{orbit.jacobi:17.14f} {orbit.iterations:4d} {closure:9.1e} {elapsed * 1e3:5.1f}ms")
+        i += 1
         try:
-            orbit = correct_dro(system, x0, guess)
-            one = propagate(system, orbit.state0, orbit.period, rtol=1e-13, atol=1e-13, t_eval=[orbit.period], collision="point")
+            row = next(rows, None)
         except ValueError as err:
-            raise UserError(f"--x0 {x0:g}: {err}") from None
+            raise UserError(f"--x0 {xs[i]:g}: {err}") from None
         except LibrateError as err:
-            raise click.ClickException(f"--x0 {x0:g}: {type(err).__name__}: {str(err).splitlines()[0]}") from None
-        closure = float(np.max(np.abs(one.y[-1] - orbit.state0)))
-        elapsed = time.perf_counter() - t_start
-        click.echo(
-            f"{x0:8.4f} {orbit.state0[4]:18.15f} {orbit.period:16.12f} {orbit.period_days:11.6f} "
-            f"{orbit.jacobi:17.14f} {orbit.iterations:4d} {closure:9.1e} {elapsed * 1e3:5.1f}ms"
-        )
-        guess = orbit.state0[4]
+            raise click.ClickException(f"--x0 {xs[i]:g}: {type(err).__name__}: {str(err).splitlines()[0]}") from None
     click.echo("closure = max |state(T) - state(0)| after one full period at rtol = atol = 1e-13.")
 
 
@@ -286,16 +285,21 @@ def _overrides(sets: tuple[str, ...]) -> dict:
     return out
 
 
-def _load_study(path: str | None, purpose: str, overrides: dict):
-    """The validated study, or a StudyInvalid listing every problem."""
+def _load_study(path: str | None, purpose: str, overrides: dict, force: bool = False, quiet: bool = True):
+    """The validated study, or a StudyInvalid listing every problem. ``force``: lift the size
+    limits of a solve or a map; unless ``quiet``, say its size (trajectories, memory) first."""
     from .study import Study, StudyError, apply_overrides
 
     try:
         if path is None:
-            return Study.from_dict(apply_overrides({}, overrides), purpose=purpose, base_dir=Path.cwd(), source="(command-line options)")
-        return Study.from_toml(path, purpose=purpose, overrides=overrides)
+            st = Study.from_dict(apply_overrides({}, overrides), purpose=purpose, base_dir=Path.cwd(), source="(command-line options)", force=force)
+        else:
+            st = Study.from_toml(path, purpose=purpose, overrides=overrides, force=force)
     except StudyError as err:
         raise StudyInvalid(str(err)) from None
+    if purpose in ("solve", "map") and not quiet:
+        _say(f"{purpose}: {st.estimate(purpose).text()}")
+    return st
 
 
 def _show(quiet: bool) -> bool | None:
@@ -456,7 +460,7 @@ def solve(study, sets, out_dir, resume, quiet) -> None:
     """
     from .progress import reporter
 
-    st = _load_study(study, "solve", _overrides(sets))
+    st = _load_study(study, "solve", _overrides(sets), force=not resume, quiet=quiet)
     _check_writable(st.output_dir(out_dir), "--out" if out_dir else "output.folder")
     three_d = st.attitude.model == "3d"
     t0 = time.perf_counter()
@@ -548,7 +552,7 @@ def map_(study, out_dir, quiet, scheduler, resume, sets) -> None:
     With [attitude] model = "3d": the six 3-D closure residuals over (orbit, two rate grids)
     in map.zarr (or .nc), saved orbit by orbit (resumable), and map_residual_norm.png.
     """
-    st = _load_study(study, "map", _overrides(sets))
+    st = _load_study(study, "map", _overrides(sets), force=not resume, quiet=quiet)
     _check_writable(st.output_dir(out_dir), "--out" if out_dir else "output.folder")
     t0 = time.perf_counter()
     try:

@@ -28,697 +28,58 @@ inertia in kg m^2, areas in m^2, lengths in m, the solar pressure in N/m^2, peri
 from __future__ import annotations
 
 import copy
-import difflib
 import json
 import math
-import re
 import sys
-import warnings
 from collections.abc import Callable
 from pathlib import Path
-from typing import Annotated, Any, Literal
+from typing import Any
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Discriminator, Field, Tag, ValidationError, model_validator
+from pydantic import ConfigDict, Field, ValidationError
 
 from .._errors import LibrateError
+from .rules import check_sections, member_count, start_of
+from .schema import (
+    ATTITUDE_TOL,
+    FIGURES,
+    FLEXIBLE_PRESETS,
+    PURPOSES,
+    SECTIONS,
+    AttitudeSection,
+    BodySection,
+    Header,
+    OrbitsSection,
+    OutputSection,
+    RatesSection,
+    SolverSection,
+    StudyError,
+    SystemSection,
+    Table,
+    TorquesSection,
+    grid_raw,
+    grid_values,
+    problem,
+    pydantic_problems,
+    unknown_key,
+)
 
 if sys.version_info >= (3, 11):
     import tomllib
 else:  # pragma: no cover - Python 3.10
     import tomli as tomllib
 
-__all__ = ["EXAMPLE_STUDY", "FIGURES", "PURPOSES", "Study", "StudyError"]
-
-#: What a study can be checked for (the commands that run it).
-PURPOSES = ("family", "solve", "map")
-#: Figure names accepted in ``output.figures`` ("multipliers" and "body_axes": 3-D solves).
-FIGURES = ("family", "period", "stability", "map", "residuals", "solutions", "multipliers", "body_axes")
-
-
-class StudyError(ValueError):
-    """An invalid study: ``problems`` lists one message per problem, each naming the key (dotted
-    path), the value given and what is allowed. ``str(err)`` shows them all."""
-
-    def __init__(self, problems: list[str], source: str | None = None):
-        self.problems = list(problems)
-        self.source = source
-        where = f" {source}" if source else ""
-        n = len(self.problems)
-        head = f"invalid study{where}: {n} problem{'s' if n != 1 else ''}"
-        super().__init__(head + "".join(f"\n  - {p}" for p in self.problems))
-
-
-# --- schema ------------------------------------------------------------------------------------
-class _Table(BaseModel):
-    model_config = ConfigDict(extra="forbid", strict=True, frozen=True, allow_inf_nan=False)
-
-
-class Range(_Table):
-    """``num`` evenly spaced values from ``start`` to ``stop`` (both included)."""
-
-    start: float
-    stop: float
-    num: int = Field(ge=1, le=1_000_000)
-
-    def values(self) -> np.ndarray:
-        return np.linspace(self.start, self.stop, self.num)
-
-
-def _grid_tag(v: Any) -> str | None:
-    if isinstance(v, (dict, Range)):
-        return "range"
-    if isinstance(v, (list, tuple)):
-        return "list"
-    return None
-
-
-def _number_grid_tag(v: Any) -> str | None:
-    if isinstance(v, (int, float)) and not isinstance(v, bool):
-        return "number"
-    return _grid_tag(v)
-
-
-_GRID_MSG = "must be a list of numbers or a table {start, stop, num}"
-_RATE_MSG = "must be a number (a fixed rate, 3-D maps), a list of numbers or a table {start, stop, num}"
-Grid = Annotated[
-    Annotated[list[float], Field(min_length=1), Tag("list")] | Annotated[Range, Tag("range")],
-    Discriminator(_grid_tag, custom_error_type="grid", custom_error_message=_GRID_MSG),
-]
-KzValue = Annotated[float, Field(ge=-1, le=1)]
-KzGrid = Annotated[
-    Annotated[KzValue, Tag("number")] | Annotated[list[KzValue], Field(min_length=1), Tag("list")] | Annotated[Range, Tag("range")],
-    Discriminator(_number_grid_tag, custom_error_type="grid", custom_error_message="must be a number, a list of numbers or a table {start, stop, num}"),
-]
-RateGrid = Annotated[
-    Annotated[float, Tag("number")] | Annotated[list[float], Field(min_length=1), Tag("list")] | Annotated[Range, Tag("range")],
-    Discriminator(_number_grid_tag, custom_error_type="grid", custom_error_message=_RATE_MSG),
-]
-_TAGS = {"list", "range", "number"}
-
-
-class SystemSection(_Table):
-    """[system]: a preset, or a custom system from mu, lu_km, tu_s (and radii_km)."""
-
-    preset: str | None = None
-    mu: float | None = Field(None, gt=0, le=0.5)
-    lu_km: float | None = Field(None, gt=0)
-    tu_s: float | None = Field(None, gt=0)
-    radii_km: list[Annotated[float, Field(ge=0)]] | None = Field(None, min_length=2, max_length=2)
-    name: str | None = None
-
-
-class OrbitsSection(_Table):
-    """[orbits]: the family and the members wanted."""
-
-    kind: Literal["dro", "lyapunov", "halo"] = "dro"
-    point: Literal[1, 2] | None = None
-    branch: Literal["north", "south"] | None = None
-    x0: Grid | None = None
-    z0: Grid | None = None
-    period_days: Grid | None = None
-    resonance: list[Annotated[int, Field(ge=1, le=100)]] | None = Field(None, min_length=1)
-    sun_resonance: list[Annotated[int, Field(ge=1, le=100)]] | None = Field(None, min_length=1)
-    members: int | None = Field(None, ge=1, le=10_000)
-    max_members: int | None = Field(None, ge=2, le=5_000)
-
-
-FLEXIBLE_PRESETS = ("sample-station", "sample-station-low-frequency")
-#: The 3-D corrector's default tolerance (``attitude.tol``).
-ATTITUDE_TOL = 1e-12
-
-
-class BodySection(_Table):
-    """[body]: Kz, or the principal moments of inertia in kg m^2, or a flexible spacecraft
-    (``flexible``: a preset name or the path of a FlexibleBody TOML file)."""
-
-    kz: KzGrid | None = None
-    ix: float | None = Field(None, gt=0)
-    iy: float | None = Field(None, gt=0)
-    iz: float | None = Field(None, gt=0)
-    mass_kg: float | None = Field(None, gt=0)
-    flexible: str | None = None
-
-
-class SrpSection(_Table):
-    """[torques.srp]: the flat plate, by its amplitude eps or by its geometry."""
-
-    eps: float | None = None
-    area_m2: float | None = Field(None, gt=0)
-    offset_m: float | None = None
-    cs: float = Field(0.0, ge=0, le=1)
-    cd: float = Field(0.0, ge=0, le=1)
-    theta_sun0: float = 0.0
-    pressure: float | None = Field(None, ge=0)
-
-    @model_validator(mode="before")
-    @classmethod
-    def _old_theta0(cls, data: Any) -> Any:
-        """The Sun's phase was `theta0` before it became `theta_sun0`: still read, with a warning."""
-        if isinstance(data, dict) and "theta0" in data:
-            if "theta_sun0" in data:
-                raise ValueError("theta0 is the old name of theta_sun0; give only theta_sun0")
-            warnings.warn("[torques.srp] theta0 is deprecated and will be removed: write theta_sun0 "
-                          "(the same Sun phase at t = 0, rad)", FutureWarning, stacklevel=2)
-            data = {("theta_sun0" if k == "theta0" else k): v for k, v in data.items()}
-        return data
-
-
-class TorquesSection(_Table):
-    """[torques]: gravity gradient of the primaries, and solar radiation pressure."""
-
-    gravity_gradient: list[Literal["earth", "moon"]] = Field(default_factory=lambda: ["earth", "moon"])
-    srp: SrpSection | None = None
-
-
-class RatesSection(_Table):
-    """[rates]: the initial rates, inertial wz0 or relative phidot0 = wz0 - 1 (1/TU); for a 3-D
-    map also wx0 and wy0 (inertial, body axes): two grids and one fixed number."""
-
-    wz0: RateGrid | None = None
-    phidot0: RateGrid | None = None
-    wx0: RateGrid | None = None
-    wy0: RateGrid | None = None
-
-
-class AttitudeSection(_Table):
-    """[attitude]: the attitude model ("planar" or "3d") and how a 3-D solve starts."""
-
-    model: Literal["planar", "3d"] = "planar"
-    start: Literal["planar", "spin", "given"] | None = None
-    n: int | None = Field(None, ge=-100, le=100)
-    q0: list[float] | None = Field(None, min_length=4, max_length=4)
-    w0: list[float] | None = Field(None, min_length=3, max_length=3)
-    tol: float | None = Field(None, ge=1e-14, le=1e-6)
-
-
-class SolverSection(_Table):
-    """[solver]: tolerances, periods per solution, initial angle."""
-
-    rtol: float = Field(1e-12, ge=1e-15, le=1e-3)
-    atol: float = Field(1e-12, ge=1e-15, le=1e-3)
-    n_periods: int | None = Field(None, ge=1, le=1000)
-    phi0: float = Field(0.0, ge=-2 * math.pi, le=2 * math.pi)
-
-
-class OutputSection(_Table):
-    """[output]: where and how results are written."""
-
-    folder: str = Field("librate-out", min_length=1)
-    format: Literal["zarr", "netcdf"] = "zarr"
-    figures: list[Literal["family", "period", "stability", "map", "residuals", "solutions", "multipliers", "body_axes"]] | None = None
-
-
-_SECTIONS: dict[str, type[_Table]] = {
-    "system": SystemSection,
-    "orbits": OrbitsSection,
-    "body": BodySection,
-    "torques": TorquesSection,
-    "rates": RatesSection,
-    "attitude": AttitudeSection,
-    "solver": SolverSection,
-    "output": OutputSection,
-}
-_TABLES: dict[str, type[_Table]] = {**_SECTIONS, "torques.srp": SrpSection}
-_TOP_KEYS = ("title", "description", *_SECTIONS)
-
-#: What each key accepts (used in the error messages).
-ALLOWED: dict[str, str] = {
-    "title": "a string",
-    "description": "a string",
-    "system.preset": "one of the presets ({presets})",
-    "system.mu": "a number in (0, 0.5], the mass ratio m2 / (m1 + m2)",
-    "system.lu_km": "a number > 0, the length unit (distance between the primaries) in km",
-    "system.tu_s": "a number > 0, the time unit (1 / mean motion) in s",
-    "system.radii_km": "two numbers >= 0, the primaries' radii in km",
-    "system.name": "a string",
-    "orbits.kind": "'dro', 'lyapunov' or 'halo'",
-    "orbits.point": "1 (L1) or 2 (L2), for lyapunov and halo families",
-    "orbits.branch": "'north' or 'south', for halo families",
-    "orbits.x0": "a list of x0 values (LU) or a table {start, stop, num}",
-    "orbits.z0": "a list of z0 values (LU) or a table {start, stop, num}, for halo families",
-    "orbits.period_days": "a list of periods (days) or a table {start, stop, num}",
-    "orbits.resonance": "a list of integers k >= 1 (synodic 1:k members, T = 2 pi / k)",
-    "orbits.sun_resonance": "a list of integers k >= 1 (Sun-resonant members, T = Ts / k)",
-    "orbits.members": "an integer >= 1: that many members evenly spread along the family",
-    "orbits.max_members": "an integer in [2, 5000], the continuation's length (lyapunov and halo)",
-    "body.kz": "a number in [-1, 1] (Kz = (Iy - Ix) / Iz), a list of them or a table {start, stop, num}",
-    "body.ix": "a number > 0, principal moment of inertia about x in kg m^2",
-    "body.iy": "a number > 0, principal moment of inertia about y in kg m^2",
-    "body.iz": "a number > 0, principal moment of inertia about z in kg m^2",
-    "body.mass_kg": "a number > 0, the mass in kg",
-    "torques.gravity_gradient": "a list of primaries among 'earth' and 'moon'",
-    "torques.srp.eps": "a finite number, the nondimensional plate amplitude P A d TU^2 / Iz",
-    "torques.srp.area_m2": "a number > 0, the plate's area in m^2",
-    "torques.srp.offset_m": "a finite number, the centre-of-pressure offset along y_B in m",
-    "torques.srp.cs": "a number in [0, 1], the specular reflection fraction (cs + cd <= 1)",
-    "torques.srp.cd": "a number in [0, 1], the diffuse reflection fraction (cs + cd <= 1)",
-    "torques.srp.theta_sun0": "a finite number, the Sun's phase at t = 0 in rad",
-    "torques.srp.pressure": "a number >= 0, the solar pressure in N/m^2 (default 4.56e-6)",
-    "rates.wz0": "a list of inertial initial rates (1/TU), strictly increasing, or a table {start, stop, num} with start < stop, num >= 2",
-    "rates.phidot0": "a list of initial rates relative to the synodic frame (1/TU), strictly increasing, or a table {start, stop, num} with start < stop, num >= 2",
-    "rates.wx0": "for attitude.model = '3d' maps: a number (fixed) or a grid of inertial initial rates about body x (1/TU): a strictly increasing list or a table {start, stop, num} with start < stop, num >= 2",
-    "rates.wy0": "for attitude.model = '3d' maps: a number (fixed) or a grid of inertial initial rates about body y (1/TU): a strictly increasing list or a table {start, stop, num} with start < stop, num >= 2",
-    "attitude.model": "'planar' (the default: the planar model, phi and wz) or '3d' (the 3-D rigid body, quaternion and three rates)",
-    "attitude.start": "'planar' (the planar N-family solution on the first member, planar families), 'spin' (the torque-free spin wz0 = 1 + 2 pi n / (K T) about synodic Z) or 'given' (attitude.q0 and attitude.w0), with attitude.model = '3d'",
-    "attitude.n": "an integer in [-100, 100], net turns about synodic Z per attitude period, with attitude.start = 'planar' or 'spin'",
-    "attitude.q0": "four numbers, a unit quaternion (scalar last): the body relative to the synodic frame at t = 0, with attitude.start = 'given' or 'spin'",
-    "attitude.w0": "three numbers, the inertial rate in body axes (1/TU), with attitude.start = 'given'",
-    "attitude.tol": "a number in [1e-14, 1e-6], the 3-D corrector's tolerance on the closure (default 1e-12; 1e-10 for NRHOs)",
-    "solver.rtol": "a number in [1e-15, 1e-3]",
-    "solver.atol": "a number in [1e-15, 1e-3]",
-    "solver.n_periods": "an integer in [1, 1000], orbit periods per attitude period",
-    "solver.phi0": "a number in [-2 pi, 2 pi], the initial attitude angle in rad",
-    "output.folder": "a non-empty path (relative paths are taken from the study file's folder)",
-    "output.format": "'zarr' or 'netcdf'",
-    "output.figures": "a list of figure names among " + ", ".join(repr(f) for f in FIGURES),
-}
-_RANGE_ALLOWED = {
-    "start": "a finite number, the first value",
-    "stop": "a finite number, the last value",
-    "num": "an integer in [1, 1000000], the number of values (both ends included)",
-}
-
-
-def _allowed(key: str) -> str | None:
-    base = re.sub(r"\[\d+\]", "", key)
-    if key in ALLOWED or base in ALLOWED:
-        text = ALLOWED.get(key) or ALLOWED[base]
-    else:
-        last = key.rsplit(".", 1)[-1]
-        text = _RANGE_ALLOWED.get(last)
-    if text and "{presets}" in text:
-        from ..orbits.system import System
-
-        text = text.format(presets=", ".join(repr(p) for p in System.presets()))
-    return text
-
-
-def _show(value: Any) -> str:
-    if isinstance(value, dict):
-        return "{" + ", ".join(f"{k} = {_show(v)}" for k, v in value.items()) + "}"
-    if isinstance(value, list):
-        return "[" + ", ".join(_show(v) for v in value) + "]"
-    if isinstance(value, str):
-        return json.dumps(value)
-    if isinstance(value, bool):
-        return "true" if value else "false"
-    return repr(value)
-
-
-def problem(key: str, value: Any, message: str, allowed: str | None = None) -> str:
-    allowed = _allowed(key) if allowed is None else allowed
-    text = f"{key} = {_show(value)}: {message}"
-    return text + (f"; allowed: {allowed}" if allowed else "")
-
-
-def _missing(key: str, message: str) -> str:
-    allowed = _allowed(key)
-    return f"{key}: {message}" + (f"; allowed: {allowed}" if allowed else "")
-
-
-def _dotted(prefix: str, loc: tuple) -> str:
-    key = prefix
-    for part in loc:
-        if isinstance(part, int):
-            key += f"[{part}]"
-        elif part in _TAGS:
-            continue
-        else:
-            key = f"{key}.{part}" if key else str(part)
-    return key
-
-
-def _keys_of(parent: str) -> list[str] | None:
-    base = re.sub(r"\[\d+\]", "", parent)
-    if base == "":
-        return list(_TOP_KEYS)
-    if base in _TABLES:
-        return list(_TABLES[base].model_fields)
-    last = base.rsplit(".", 1)[-1]
-    if last in ("x0", "z0", "period_days", "wz0", "phidot0", "wx0", "wy0", "kz"):
-        return list(Range.model_fields)
-    return None
-
-
-def _unknown(key: str, value: Any) -> str:
-    parent, _, name = key.rpartition(".")
-    keys = _keys_of(parent) or []
-    where = f"[{parent}]" if parent else "the top level"
-    hint = difflib.get_close_matches(name, keys, n=1)
-    text = f"{key} = {_show(value)}: unknown key; allowed keys in {where}: {', '.join(keys)}"
-    return text + (f" (did you mean `{(parent + '.') if parent else ''}{hint[0]}`?)" if hint else "")
-
-
-def _pydantic_problems(prefix: str, err: ValidationError) -> list[str]:
-    out = []
-    for e in err.errors():
-        key = _dotted(prefix, e["loc"])
-        if e["type"] == "extra_forbidden":
-            out.append(_unknown(key, e["input"]))
-        elif e["type"] == "missing":
-            out.append(_missing(key, "missing (required)"))
-        else:
-            msg = e["msg"]
-            msg = msg[0].lower() + msg[1:]
-            msg = msg.removeprefix("value error, ")
-            if e["type"] == "model_type":
-                msg = "must be a table"
-            out.append(problem(key, e["input"], msg))
-    return out
-
-
-# --- checks beyond the types -------------------------------------------------------------------
-def _grid_values(g) -> np.ndarray | None:
-    if g is None:
-        return None
-    if isinstance(g, Range):
-        return g.values()
-    if isinstance(g, (int, float)):
-        return np.array([float(g)])
-    return np.asarray(g, dtype=float)
-
-
-def grid_raw(g) -> Any:
-    if isinstance(g, Range):
-        return g.model_dump()
-    return g
-
-
-def _check_increasing(key: str, g, problems: list[str]) -> None:
-    if isinstance(g, Range):
-        if g.num < 2:
-            problems.append(problem(f"{key}.num", g.num, "a rate grid needs at least 2 values", "an integer in [2, 1000000]"))
-        if not g.start < g.stop:
-            problems.append(problem(f"{key}.stop", g.stop, f"must be greater than {key}.start = {_show(g.start)} (rates increase)",
-                                     f"a number > {key}.start"))
-    else:
-        v = np.asarray(g, dtype=float)
-        if v.size < 2:
-            problems.append(problem(key, g, "a rate grid needs at least 2 values"))
-        elif np.any(np.diff(v) <= 0):
-            problems.append(problem(key, g, "must be strictly increasing"))
-
-
-def _check_sections(s: dict[str, _Table], given: dict, purpose: str | None) -> list[str]:
-    """Consistency checks on the sections that passed type validation (``s``); ``given`` is the
-    raw study as written (to tell a missing section from a defaulted one)."""
-    from ..orbits.system import System
-
-    problems: list[str] = []
-    # [system]
-    mu = None
-    sysc = s.get("system")
-    if sysc is not None:
-        custom = [k for k in ("mu", "lu_km", "tu_s", "radii_km") if getattr(sysc, k) is not None]
-        if sysc.preset is not None:
-            if sysc.preset not in System.presets():
-                problems.append(problem("system.preset", sysc.preset, "unknown preset"))
-            else:
-                mu = System.preset(sysc.preset).mu
-            for k in custom:
-                problems.append(problem(f"system.{k}", getattr(sysc, k), "cannot be combined with system.preset (a preset fixes the constants)",
-                                         "either system.preset alone, or system.mu, system.lu_km and system.tu_s (and optionally system.radii_km)"))
-        elif custom:
-            for k in ("mu", "lu_km", "tu_s"):
-                if getattr(sysc, k) is None:
-                    problems.append(_missing(f"system.{k}", f"missing: a custom system (given {', '.join('system.' + c for c in custom)}) needs system.mu, system.lu_km and system.tu_s"))
-            if sysc.mu is not None:
-                mu = sysc.mu
-        else:
-            mu = System.preset("earth-moon").mu
-
-    # [orbits]
-    orb = s.get("orbits")
-    if orb is not None:
-        if orb.kind == "dro":
-            for k in ("point", "branch", "max_members"):
-                if getattr(orb, k) is not None:
-                    problems.append(problem(f"orbits.{k}", getattr(orb, k), "does not apply to orbits.kind = \"dro\"",
-                                             "orbits.point and orbits.max_members for 'lyapunov' and 'halo', orbits.branch for 'halo'"))
-        if orb.kind == "lyapunov" and orb.branch is not None:
-            problems.append(problem("orbits.branch", orb.branch, "does not apply to orbits.kind = \"lyapunov\" (planar)", "orbits.branch only with orbits.kind = 'halo'"))
-        if orb.kind != "halo" and orb.z0 is not None:
-            problems.append(problem("orbits.z0", grid_raw(orb.z0), f"does not apply to orbits.kind = \"{orb.kind}\" (planar: z0 = 0)", "orbits.z0 only with orbits.kind = 'halo'"))
-        sel = [k for k in ("x0", "z0", "period_days", "resonance", "sun_resonance", "members") if getattr(orb, k) is not None]
-        if len(sel) > 1:
-            for k in sel[1:]:
-                problems.append(problem(f"orbits.{k}", grid_raw(getattr(orb, k)), f"cannot be combined with orbits.{sel[0]}: choose the members one way",
-                                         "at most one of orbits.x0, z0, period_days, resonance, sun_resonance, members"))
-        for k in ("x0", "z0", "period_days"):
-            v = _grid_values(getattr(orb, k))
-            if v is None:
-                continue
-            if k == "x0" and mu is not None and orb.kind == "dro" and (np.any(v <= -mu) or np.any(v >= 1 - mu)):
-                problems.append(problem("orbits.x0", grid_raw(orb.x0), f"DROs start between the primaries, -mu < x0 < 1 - mu = ({-mu:.6g}, {1 - mu:.6g})",
-                                         "values in (-mu, 1 - mu)"))
-            if k == "period_days" and np.any(v <= 0):
-                problems.append(problem("orbits.period_days", grid_raw(orb.period_days), "periods must be > 0 days"))
-
-    # [body]
-    body = s.get("body")
-    if body is not None:
-        moments = {k: getattr(body, k) for k in ("ix", "iy", "iz") if getattr(body, k) is not None}
-        if body.flexible is not None and (body.kz is not None or moments):
-            for k in ["kz", *moments]:
-                if getattr(body, k) is not None:
-                    problems.append(problem(f"body.{k}", grid_raw(body.kz) if k == "kz" else getattr(body, k),
-                                             "cannot be combined with body.flexible (the flexible body defines its inertia)",
-                                             "either body.flexible, or body.kz, or body.ix/iy/iz"))
-        elif body.kz is not None and moments:
-            for k, v in moments.items():
-                problems.append(problem(f"body.{k}", v, "cannot be combined with body.kz (Kz follows from the moments)",
-                                         "either body.kz, or body.ix, body.iy and body.iz"))
-        elif body.flexible is not None:
-            if body.flexible not in FLEXIBLE_PRESETS and not body.flexible.endswith(".toml"):
-                problems.append(problem("body.flexible", body.flexible, "not a flexible-body preset or TOML file",
-                                         f"one of {', '.join(FLEXIBLE_PRESETS)}, or the path of a FlexibleBody TOML file (*.toml)"))
-        elif body.kz is None and not moments:
-            problems.append(_missing("body.kz", "missing: give body.kz, or body.ix, body.iy and body.iz in kg m^2 (or body.flexible)"))
-        elif moments and len(moments) < 3:
-            for k in ("ix", "iy", "iz"):
-                if k not in moments:
-                    problems.append(_missing(f"body.{k}", f"missing: the inertia needs all three of body.ix, body.iy, body.iz (given: {', '.join('body.' + m for m in moments)})"))
-        elif len(moments) == 3:
-            ix, iy, iz = moments["ix"], moments["iy"], moments["iz"]
-            for k, a, b, c in (("ix", ix, iy, iz), ("iy", iy, ix, iz), ("iz", iz, ix, iy)):
-                if a > b + c:
-                    problems.append(problem(f"body.{k}", a, f"violates the triangle inequality: {k} must not exceed the sum of the other two moments ({b + c:g} kg m^2)",
-                                             "principal moments with each <= the sum of the other two"))
-                    break
-        if isinstance(body.kz, Range):
-            for k in ("start", "stop"):
-                v = getattr(body.kz, k)
-                if not -1 <= v <= 1:
-                    problems.append(problem(f"body.kz.{k}", v, "Kz must be in [-1, 1]", "a number in [-1, 1]"))
-
-    # [torques]
-    tq = s.get("torques")
-    if tq is not None:
-        if len(set(tq.gravity_gradient)) != len(tq.gravity_gradient):
-            problems.append(problem("torques.gravity_gradient", tq.gravity_gradient, "a primary is listed twice"))
-        srp = tq.srp
-        if srp is not None:
-            geo = [k for k in ("area_m2", "offset_m") if getattr(srp, k) is not None]
-            if srp.eps is not None and geo:
-                for k in geo:
-                    problems.append(problem(f"torques.srp.{k}", getattr(srp, k), "cannot be combined with torques.srp.eps (eps follows from the geometry)",
-                                             "either torques.srp.eps, or torques.srp.area_m2 and torques.srp.offset_m"))
-            elif srp.eps is None and len(geo) < 2:
-                missing = [k for k in ("area_m2", "offset_m") if k not in geo] if geo else ["eps"]
-                for k in missing:
-                    problems.append(_missing(f"torques.srp.{k}", "missing: the plate needs torques.srp.eps, or torques.srp.area_m2 and torques.srp.offset_m"))
-            if srp.cs + srp.cd > 1 + 1e-12:
-                problems.append(problem("torques.srp.cd", srp.cd, f"cs + cd = {srp.cs + srp.cd:g} exceeds 1 (the absorbed fraction is 1 - cs - cd)"))
-            if srp.pressure is not None and srp.eps is not None:
-                problems.append(problem("torques.srp.pressure", srp.pressure, "only used with the geometry (area_m2, offset_m); eps already includes it"))
-            if srp.eps is None and len(geo) == 2 and body is not None and body.iz is None and body.kz is not None:
-                problems.append(problem("torques.srp.area_m2", srp.area_m2, "the plate's geometry needs the body's Iz in kg m^2 (body.ix, body.iy, body.iz); with body.kz alone give torques.srp.eps",
-                                         "torques.srp.eps with body.kz, or the geometry with body.ix/iy/iz"))
-
-    # [attitude] (a section that failed type validation counts as the default planar model)
-    att = s.get("attitude")
-    three_d = att is not None and att.model == "3d"
-    start = _start_of(att, orb) if three_d else None
-
-    # [rates]
-    rates = s.get("rates")
-    if rates is not None:
-        if rates.wz0 is not None and rates.phidot0 is not None:
-            problems.append(problem("rates.phidot0", grid_raw(rates.phidot0), "cannot be combined with rates.wz0 (phidot0 = wz0 - 1)", "either rates.wz0 or rates.phidot0"))
-        elif rates.wz0 is None and rates.phidot0 is None and not three_d:
-            problems.append(_missing("rates.wz0", "missing: give rates.wz0 (inertial) or rates.phidot0 (relative to the synodic frame)"))
-        if not three_d:
-            for k in ("wx0", "wy0"):
-                if getattr(rates, k) is not None:
-                    problems.append(problem(f"rates.{k}", grid_raw(getattr(rates, k)), "applies only to attitude.model = \"3d\" (the planar model has the one rate wz)",
-                                             "rates.wz0 or rates.phidot0 with the planar model; rates.wx0 and rates.wy0 with [attitude] model = '3d'"))
-        for k in ("wz0", "phidot0", "wx0", "wy0"):
-            g = getattr(rates, k)
-            # a number is a fixed rate of a 3-D map; every grid increases
-            if g is not None and not (three_d and isinstance(g, (int, float))) and (k in ("wz0", "phidot0") or three_d):
-                _check_increasing(f"rates.{k}", g, problems)
-
-    if att is not None and not three_d:
-        for k in ("start", "n", "q0", "w0", "tol"):
-            if getattr(att, k) is not None:
-                problems.append(problem(f"attitude.{k}", getattr(att, k), "applies only to attitude.model = \"3d\"", "attitude.model = '3d' with it, or leave it out"))
-    if three_d:
-        problems += _check_3d(att, start, s, given)
-
-    # what the command needs
-    if purpose in ("solve", "map") and three_d:
-        problems += _needs_3d(purpose, start, s, given)
-    elif purpose in ("solve", "map"):
-        what, need = ("periodic solutions", "need") if purpose == "solve" else ("a periodicity map", "needs")
-        if "body" not in given:
-            problems.append(_missing("body", f"missing section [body]: {what} {need} the body (body.kz, or body.ix/iy/iz)"))
-        if "rates" not in given:
-            problems.append(_missing("rates", f"missing section [rates]: {what} {need} the initial rates (rates.wz0 or rates.phidot0)"))
-        if orb is not None and orb.kind == "halo":
-            problems.append(problem("orbits.kind", orb.kind, f"{what} use{'s' if need == 'needs' else ''} the planar attitude model, which needs a planar family",
-                                     "'dro' or 'lyapunov' with the planar model, or any family with [attitude] model = '3d'"))
-        if purpose == "map" and body is not None and body.flexible is not None:
-            problems.append(problem("body.flexible", body.flexible, "the periodicity-map engine integrates rigid bodies; "
-                                     "`librate solve` reports how flexibility moves each periodic solution", "body.kz or body.ix/iy/iz for a map"))
-        if body is not None and body.flexible is not None and tq is not None and tq.srp is not None:
-            problems.append(problem("torques.srp", "[torques.srp]", "the flexible model has no solar radiation pressure yet", "no [torques.srp] with body.flexible"))
-        if tq is not None and sorted(tq.gravity_gradient) != ["earth", "moon"]:
-            problems.append(problem("torques.gravity_gradient", tq.gravity_gradient,
-                                     f"the planar engine behind {what} models the gravity gradient of both primaries", "[\"earth\", \"moon\"]"))
-        if tq is not None and tq.srp is not None and orb is not None:
-            why = "with torques.srp the forcing is periodic only on a Sun-resonant orbit (T = Ts / k): select exactly one"
-            if orb.sun_resonance is None:
-                problems.append(_missing("orbits.sun_resonance", f"missing: {why}, e.g. orbits.sun_resonance = [2]"))
-            elif len(orb.sun_resonance) != 1:
-                problems.append(problem("orbits.sun_resonance", orb.sun_resonance, why, "a list of one integer k >= 1, e.g. [2]"))
-            else:
-                k = orb.sun_resonance[0]
-                sol = s.get("solver")
-                if sol is not None and sol.n_periods is not None and sol.n_periods % k:
-                    problems.append(problem("solver.n_periods", sol.n_periods, f"with torques.srp on the 1:{k} Sun-resonant orbit the attitude period must cover whole Sun periods",
-                                             f"a multiple of {k}"))
-    return problems
-
-
-def _start_of(att, orb) -> str:
-    """How a 3-D solve starts: ``attitude.start``, else "given" with attitude.w0, else "spin"
-    on a halo family, else "planar"."""
-    if att.start is not None:
-        return att.start
-    if att.w0 is not None:
-        return "given"
-    return "spin" if orb is not None and orb.kind == "halo" else "planar"
-
-
-_NOT_3D = "not modelled in 3-D yet (the 3-D model has the gravity gradient of both primaries on a rigid body)"
-
-
-def _check_3d(att, start: str, s: dict, given: dict) -> list[str]:
-    """The checks of ``[attitude] model = "3d"`` on the sections that passed type validation."""
-    problems: list[str] = []
-    orb, body, tq, sol = s.get("orbits"), s.get("body"), s.get("torques"), s.get("solver")
-    if start == "planar":
-        if orb is not None and orb.kind == "halo":
-            problems.append(problem("attitude.start", start, "the planar start takes a planar solution, which needs a planar family (orbits.kind = 'dro' or 'lyapunov')",
-                                     "'spin' or 'given' on a halo family"))
-        for k in ("q0", "w0"):
-            if getattr(att, k) is not None:
-                problems.append(problem(f"attitude.{k}", getattr(att, k), "cannot be combined with attitude.start = \"planar\" (the start is the planar solution: "
-                                         "phi0 = solver.phi0 about Z, wz0 from the rates.wz0 scan)", "attitude.q0 and attitude.w0 with attitude.start = 'given'"))
-    elif start == "spin" and att.w0 is not None:
-        problems.append(problem("attitude.w0", att.w0, "cannot be combined with attitude.start = \"spin\" (the spin is w = (1 + 2 pi n / (K T)) e_Z)",
-                                 "attitude.w0 with attitude.start = 'given'"))
-    if start in ("planar", "spin") and att.n is None:
-        problems.append(_missing("attitude.n", f"missing: attitude.start = \"{start}\" needs the net turns n per attitude period"))
-    if start == "given":
-        if att.w0 is None:
-            problems.append(_missing("attitude.w0", "missing: attitude.start = \"given\" starts from attitude.w0 (and attitude.q0, default the identity)"))
-        if att.n is not None:
-            problems.append(problem("attitude.n", att.n, "does not apply to attitude.start = \"given\" (the start is attitude.q0, attitude.w0)",
-                                     "attitude.n with attitude.start = 'planar' or 'spin'"))
-    if att.q0 is not None and abs(math.hypot(*att.q0) - 1) > 1e-6:  # finite: the schema refuses inf and nan
-        problems.append(problem("attitude.q0", att.q0, f"must be a unit quaternion (|q0| = {math.hypot(*att.q0):.6g})"))
-    if att.q0 is not None and sol is not None and "phi0" in (given.get("solver") or {}):
-        problems.append(problem("solver.phi0", sol.phi0, "cannot be combined with attitude.q0 (q0 is the whole initial attitude)",
-                                 "solver.phi0 (a rotation about Z) or attitude.q0, not both"))
-    if body is not None:
-        if body.flexible is not None:
-            problems.append(problem("body.flexible", body.flexible, f"flexible bodies are {_NOT_3D}", "body.ix, body.iy and body.iz (kg m^2) with attitude.model = '3d'"))
-        elif body.kz is not None and body.ix is None and body.iy is None and body.iz is None:
-            problems.append(problem("body.kz", grid_raw(body.kz), "the 3-D attitude model needs the full inertia, not Kz alone (Kz fixes only (Iy - Ix) / Iz)",
-                                     "body.ix, body.iy and body.iz in kg m^2 (principal moments, each <= the sum of the other two)"))
-    if tq is not None:
-        if tq.srp is not None:
-            problems.append(problem("torques.srp", "[torques.srp]", f"solar radiation pressure is {_NOT_3D}", "no [torques.srp] with attitude.model = '3d'"))
-        if sorted(tq.gravity_gradient) != ["earth", "moon"]:
-            problems.append(problem("torques.gravity_gradient", tq.gravity_gradient, "the 3-D attitude model has the gravity gradient of both primaries",
-                                     "[\"earth\", \"moon\"]"))
-    return problems
-
-
-def member_count(orb) -> tuple[str, Any, int] | None:
-    """(key, value, count) of the members [orbits] selects, None for the whole family."""
-    for k in ("x0", "z0", "period_days"):
-        g = getattr(orb, k)
-        if g is not None:
-            return k, grid_raw(g), int(_grid_values(g).size)
-    for k in ("resonance", "sun_resonance"):
-        if getattr(orb, k) is not None:
-            return k, getattr(orb, k), len(getattr(orb, k))
-    if orb.members is not None:
-        return "members", orb.members, orb.members
-    return None
-
-
-def _needs_3d(purpose: str, start: str, s: dict, given: dict) -> list[str]:
-    """What ``librate solve`` or ``librate map`` needs from a 3-D study."""
-    problems: list[str] = []
-    rates = s.get("rates")
-    what = "a 3-D solve" if purpose == "solve" else "a 3-D map"
-    if "body" not in given:
-        problems.append(_missing("body", f"missing section [body]: {what} needs the body's principal moments (body.ix, body.iy, body.iz)"))
-    if purpose == "solve":
-        if start == "planar":
-            if "rates" not in given:
-                problems.append(_missing("rates", "missing section [rates]: the planar start scans rates.wz0 (or rates.phidot0) for the planar solution"))
-            elif rates is not None:
-                if rates.wz0 is None and rates.phidot0 is None:
-                    problems.append(_missing("rates.wz0", "missing: the planar start scans rates.wz0 (or rates.phidot0) for the planar solution"))
-                for k in ("wz0", "phidot0"):
-                    g = getattr(rates, k)
-                    if isinstance(g, (int, float)):
-                        problems.append(problem(f"rates.{k}", g, "the planar start scans a grid of rates for the planar solution, not one value"))
-        return problems
-    if "rates" not in given:
-        problems.append(_missing("rates", "missing section [rates]: a 3-D map needs rates.wx0, rates.wy0 and rates.wz0 (or rates.phidot0): two grids and one fixed number"))
-        return problems
-    if rates is None:
-        return problems
-    comp = {"wx0": rates.wx0, "wy0": rates.wy0, "wz0": rates.wz0 if rates.wz0 is not None else rates.phidot0}
-    for k, v in comp.items():
-        if v is None:
-            problems.append(_missing(f"rates.{k}", "missing: a 3-D map needs rates.wx0, rates.wy0 and rates.wz0 (or rates.phidot0): two grids and one fixed number"))
-    fixed = [k for k, v in comp.items() if isinstance(v, (int, float))]
-    if all(v is not None for v in comp.values()) and len(fixed) != 1:
-        key = fixed[-1] if fixed else "wz0"
-        name = key if key != "wz0" or rates.wz0 is not None else "phidot0"
-        problems.append(problem(f"rates.{name}", grid_raw(getattr(rates, name)), f"a 3-D map has grids over two rate components and one fixed number; "
-                                 f"given {len(fixed)} fixed ({', '.join('rates.' + f for f in fixed) or 'none'})",
-                                 "exactly one of rates.wx0, rates.wy0, rates.wz0 (or rates.phidot0) a number, the other two grids"))
-    return problems
-
+# ATTITUDE_TOL, grid_raw, member_count and problem: the jobs (librate.app.jobs) read them from here.
+__all__ = ["ATTITUDE_TOL", "EXAMPLE_STUDY", "FIGURES", "PURPOSES", "Study", "StudyError", "grid_raw", "member_count", "problem"]
 
 # --- the study -----------------------------------------------------------------------------------
-class Study(BaseModel):
+class Study(Header):
     """A validated study (see the module docstring). Build it with :meth:`from_toml` or
     :meth:`from_dict`; it is immutable. ``base_dir`` is the folder relative output paths are
     taken from (the study file's folder, or the working directory)."""
 
     model_config = ConfigDict(extra="forbid", strict=True, frozen=True, allow_inf_nan=False)
 
-    title: str | None = None
-    description: str | None = None
     system: SystemSection = Field(default_factory=SystemSection)
     orbits: OrbitsSection = Field(default_factory=OrbitsSection)
     body: BodySection | None = None
@@ -731,48 +92,58 @@ class Study(BaseModel):
 
     # --- construction --------------------------------------------------------------------------
     @classmethod
-    def from_dict(cls, data: Any, *, purpose: str | None = None, base_dir: str | Path | None = None, source: str | None = None) -> Study:
+    def from_dict(cls, data: Any, *, purpose: str | None = None, base_dir: str | Path | None = None, source: str | None = None,
+                  force: bool = False) -> Study:
         """Validate ``data`` (the parsed TOML: a dict of tables) and return the study.
 
         ``purpose``: also check what a command needs ("family", "solve" or "map"; e.g. a map needs
-        [body] and [rates] and a planar family). Raises :class:`StudyError` listing every problem.
+        [body] and [rates] and a planar family), and, for "solve" and "map", that its size is
+        within :data:`librate.app.budget.MAX_WORK` and ``MAX_MAP_BYTES`` (``force=True`` lifts
+        that). Raises :class:`StudyError` listing every problem.
         """
         if purpose is not None and purpose not in PURPOSES:
             raise ValueError(f"invalid argument `purpose`: must be one of {', '.join(PURPOSES)} or None, got {purpose!r}")
         if not isinstance(data, dict):
             raise StudyError([f"the study must be a table of sections, got {type(data).__name__}"], source)
         problems: list[str] = []
-        sections: dict[str, _Table] = {}
+        sections: dict[str, Table] = {}
         for key, value in data.items():
             if key in ("title", "description"):
                 if not isinstance(value, str):
                     problems.append(problem(key, value, "must be a string"))
-            elif key in _SECTIONS:
+            elif key in SECTIONS:
                 if not isinstance(value, dict):
-                    problems.append(problem(key, value, f"must be a table [{key}]", f"a table [{key}] with keys {', '.join(_SECTIONS[key].model_fields)}"))
+                    problems.append(problem(key, value, f"must be a table [{key}]", f"a table [{key}] with keys {', '.join(SECTIONS[key].model_fields)}"))
                     continue
                 try:
-                    sections[key] = _SECTIONS[key].model_validate(value)
+                    sections[key] = SECTIONS[key].model_validate(value)
                 except ValidationError as err:
-                    problems += _pydantic_problems(key, err)
+                    problems += pydantic_problems(key, err)
             else:
-                problems.append(_unknown(key, value))
+                problems.append(unknown_key(key, value))
         # Sections left out take their defaults ([body] and [rates] have none); a section that
         # failed type validation is left out of the checks that involve it.
-        valid: dict[str, _Table] = {}
-        for k, model in _SECTIONS.items():
+        valid: dict[str, Table] = {}
+        for k, model in SECTIONS.items():
             if k in sections:
                 valid[k] = sections[k]
             elif k not in data and k not in ("body", "rates"):
                 valid[k] = model()
-        problems += _check_sections(valid, data, purpose)
+        problems += check_sections(valid, data, purpose)
         if problems:
             raise StudyError(problems, source)
         kwargs = {k: v for k, v in data.items() if k in ("title", "description")}
-        return cls.model_construct(**kwargs, **valid, base_dir=str(base_dir if base_dir is not None else "."))
+        study = cls.model_construct(**kwargs, **valid, base_dir=str(base_dir if base_dir is not None else "."))
+        if purpose in ("solve", "map") and not force:
+            from .budget import estimate, refusal
+
+            too_large = refusal(estimate(study, purpose), purpose)
+            if too_large:
+                raise StudyError([too_large], source)
+        return study
 
     @classmethod
-    def from_toml(cls, path: str | Path, *, purpose: str | None = None, overrides: dict | None = None) -> Study:
+    def from_toml(cls, path: str | Path, *, purpose: str | None = None, overrides: dict | None = None, force: bool = False) -> Study:
         """Read and validate a TOML study file (relative output folders are taken from its
         folder). ``overrides``: a dict of dotted keys to values applied on top (e.g.
         ``{"rates.wz0.num": 50}``), as the command line's ``--set``. Raises :class:`StudyError`."""
@@ -789,12 +160,20 @@ class Study(BaseModel):
             raise StudyError([f"not valid TOML: {err}"], str(p)) from None
         if overrides:
             data = apply_overrides(data, overrides)
-        return cls.from_dict(data, purpose=purpose, base_dir=p.resolve().parent, source=str(p))
+        return cls.from_dict(data, purpose=purpose, base_dir=p.resolve().parent, source=str(p), force=force)
 
-    def check(self, purpose: str) -> Study:
-        """Check that the study has what a command needs ("family", "solve", "map"); returns
-        itself, or raises :class:`StudyError`."""
-        return Study.from_dict(self.to_dict(), purpose=purpose, base_dir=self.base_dir)
+    def check(self, purpose: str, force: bool = False) -> Study:
+        """Check that the study has what a command needs ("family", "solve", "map") and, for
+        "solve" and "map", a size within the limits (``force=True`` lifts them); returns itself,
+        or raises :class:`StudyError`."""
+        return Study.from_dict(self.to_dict(), purpose=purpose, base_dir=self.base_dir, force=force)
+
+    def estimate(self, purpose: str):
+        """The size of this study run as ``purpose`` ("solve" or "map"): trajectories, orbit
+        periods, memory (:class:`librate.app.budget.Estimate`; ``.text()`` says it)."""
+        from .budget import estimate
+
+        return estimate(self, purpose)
 
     # --- serialisation -------------------------------------------------------------------------
     def to_dict(self) -> dict:
@@ -848,7 +227,7 @@ class Study(BaseModel):
             if o.x0 is None:
                 return dro_family(system, progress=progress)
             try:
-                return dro_family(system, x0=_grid_values(o.x0), progress=progress)
+                return dro_family(system, x0=grid_values(o.x0), progress=progress)
             except LibrateError as err:
                 missing = getattr(err, "missing", None)
                 if not missing:
@@ -880,7 +259,7 @@ class Study(BaseModel):
             sel = getattr(o, key)
             if sel is None:
                 continue
-            values = _grid_values(sel) if key in ("x0", "z0", "period_days") else sel
+            values = grid_values(sel) if key in ("x0", "z0", "period_days") else sel
             out = []
             for v in values:
                 try:
@@ -909,7 +288,7 @@ class Study(BaseModel):
         if b.flexible is not None:
             return np.array([self.build_flexible().rigid_body().kz])
         if b.kz is not None:
-            return _grid_values(b.kz)
+            return grid_values(b.kz)
         return np.array([(b.iy - b.ix) / b.iz])
 
     def build_flexible(self):
@@ -959,8 +338,8 @@ class Study(BaseModel):
         if r is None:
             raise ValueError("the study has no [rates]")
         if r.wz0 is not None:
-            return _grid_values(r.wz0)
-        return _grid_values(r.phidot0) + 1.0
+            return grid_values(r.wz0)
+        return grid_values(r.phidot0) + 1.0
 
     def n_periods(self) -> int:
         """Orbit periods per attitude period: ``solver.n_periods``, else k for an SRP study on
@@ -974,7 +353,7 @@ class Study(BaseModel):
     def attitude_start(self) -> str | None:
         """How a 3-D solve starts ("planar", "spin" or "given"; see ``attitude.start``), None
         with the planar model."""
-        return _start_of(self.attitude, self.orbits) if self.attitude.model == "3d" else None
+        return start_of(self.attitude, self.orbits) if self.attitude.model == "3d" else None
 
     def q0_3d(self) -> np.ndarray:
         """The initial attitude of a 3-D study (scalar-last quaternion, body relative to the
@@ -991,8 +370,8 @@ class Study(BaseModel):
         r = self.rates
         if r is None:
             raise ValueError("the study has no [rates]")
-        wz = _grid_values(r.wz0) if r.wz0 is not None else (None if r.phidot0 is None else _grid_values(r.phidot0) + 1.0)
-        out = {"wx0": _grid_values(r.wx0), "wy0": _grid_values(r.wy0), "wz0": wz}
+        wz = grid_values(r.wz0) if r.wz0 is not None else (None if r.phidot0 is None else grid_values(r.phidot0) + 1.0)
+        out = {"wx0": grid_values(r.wx0), "wy0": grid_values(r.wy0), "wz0": wz}
         return {k: v for k, v in out.items() if v is not None}
 
     def output_dir(self, out: str | Path | None = None) -> Path:

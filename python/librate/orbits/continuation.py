@@ -17,6 +17,7 @@ import numpy as np
 
 from .. import _core
 from .._errors import LibrateError
+from .._progress import as_progress
 from ..solving.continuation import Bifurcation, Branch, Constraint, Point, StepRules, arclength, natural
 from .periodic import SHOOT_ATOL, SHOOT_RTOL, PeriodicOrbit, index_tests, orbit_from_core, symmetric_monodromy
 from .system import System
@@ -208,6 +209,7 @@ def continue_natural(
     success; the members returned are exactly at ``values``. Ends after the last value, at a
     ``stop`` reason, or when the step falls below ``min_step`` (with the reason).
     """
+    progress = as_progress(progress, f"{family} family", "member")
     problem = SymmetricFamilyProblem(system, spatial=spatial, family=family, t_max=t_max, check_geometry=check_geometry, parameter=var)
     total = int(np.size(values))
     br = natural(problem, problem.point(first), values, rules=StepRules(ds_min=min_step, ds_max=max(min_step, 1.0)), name=var,
@@ -240,6 +242,7 @@ def continue_arclength(
     the step falls below ``ds_min``, at ``max_members``, or when ``stop`` returns a reason.
     ``progress(done, total)`` after each member (total: ``max_members``, the found count at the end).
     """
+    progress = as_progress(progress, f"{family} family", "member")
     problem = SymmetricFamilyProblem(system, spatial=spatial, family=family, t_max=t_max, check_geometry=check_geometry)
     rules = StepRules(ds=ds, ds_min=ds_min, ds_max=ds_max, jump=0.5, max_turn=0.5)
     br = arclength(problem, problem.point(first), direction=np.asarray(orient, dtype=float), rules=rules, max_points=max_members,

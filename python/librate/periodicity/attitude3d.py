@@ -42,6 +42,7 @@ from .. import _core
 from .._checks import as_count, as_number
 from .._display import fmt, html_summary, short_repr
 from .._errors import ConvergenceError
+from .._progress import as_progress
 from ..attitude.body import RigidBody
 from ..attitude.propagate import propagate_attitude
 from ..orbits.periodic import PeriodicOrbit
@@ -446,7 +447,8 @@ def attitude_family_3d(orbits, body: RigidBody, *, guess, period_days, n_periods
     corrector's tolerance (NRHOs pass within a few thousand km of the Moon, where the tidal torque
     is some 1e4 times the Earth's at the Moon's distance; their attitude closure is reached to
     ~1e-11, so pass tol=1e-10 there). Every member is re-propagated independently to 1e-9.
-    ``progress(done, total)``: called with the number of requested periods reached so far.
+    ``progress``: True for a bar on stderr, or ``progress(done, total)``, called with the number
+    of requested periods reached so far.
     One period gives the one-member family of that orbit (no continuation).
 
     ``method``: "arclength" (the default) follows the family by pseudo-arclength continuation
@@ -485,6 +487,7 @@ def attitude_family_3d(orbits, body: RigidBody, *, guess, period_days, n_periods
     from ..orbits.families import OrbitFamily
     from ..solving.continuation import Constraint, CorrectionFailed, StepRules, arclength, natural
 
+    progress = as_progress(progress, "3-D attitude family", "member")
     if not isinstance(orbits, OrbitFamily):
         raise ValueError(f"invalid argument `orbits`: must be a librate.OrbitFamily, got {type(orbits).__name__}")
     if method not in ("arclength", "natural"):

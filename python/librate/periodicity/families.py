@@ -10,6 +10,7 @@ import numpy as np
 from .. import _core
 from .._checks import as_count, as_number
 from .._errors import ConvergenceError
+from .._progress import as_progress
 from ..orbits.families import OrbitFamily
 from ..orbits.periodic import PeriodicOrbit
 from ..solving.continuation import Constraint, CorrectionFailed, Point, StepRules, arclength
@@ -94,6 +95,7 @@ def attitude_family(
     ds_max: float = 0.25,
     max_points: int = 400,
     direction: int = -1,
+    progress=None,
 ) -> AttitudeFamily:
     """Continue the symmetric periodic attitude motion with ``n`` turns (``kind``) through folds.
 
@@ -106,8 +108,11 @@ def attitude_family(
     pick the first solution: by default the family's first member (or ``kz``) and, there, the
     solution continued in Kz from Kz = 0 (as :func:`periodic_attitude`); ``direction`` the
     initial sense in p. Folds (p turning back) are located to 1e-8 and the curve is followed
-    past them; ``bifurcations`` lists where the monodromy trace crosses +-2.
+    past them; ``bifurcations`` lists where the monodromy trace crosses +-2. ``progress``: True
+    for a bar on stderr, or ``progress(done, total)`` after each point (total: ``max_points``, the
+    points found at the end).
     """
+    progress = as_progress(progress, f"attitude family N = {n}", "point")
     if kind not in KINDS:
         raise ValueError(f"invalid argument `kind`: must be 'periodic' or 'half-turn', got {kind!r}")
     if isinstance(n, bool) or not isinstance(n, (int, np.integer)):
@@ -151,7 +156,16 @@ def attitude_family(
         first = problem.correct(np.array([p0, w]), Constraint.fix(2, 0, p0))
     except CorrectionFailed as e:
         raise ConvergenceError(f"attitude family (N = {n}, {kind}): no starting solution at {name} = {p0}: {e}") from None
-    br = arclength(problem, first, direction=direction, rules=rules, max_points=max_points, bounds=(lo, hi), name=name)
+    count = [1]
+
+    def report(_point) -> None:  # the driver's per-point hook
+        count[0] += 1
+        progress(min(count[0], max_points), max_points)
+
+    br = arclength(problem, first, direction=direction, rules=rules, max_points=max_points, bounds=(lo, hi), name=name,
+                   stop=None if progress is None else report)
+    if progress is not None:
+        progress(len(br.points), len(br.points))
     ps = np.array([p.x[0] for p in br.points])
     ws = np.array([p.x[1] for p in br.points])
     traces = np.array([p.data["trace"] for p in br.points])

@@ -29,6 +29,7 @@ from .. import _core
 from .._checks import as_count, as_float_array, as_number
 from .._core import __version__
 from .._display import fmt, html_summary, short_repr
+from .._progress import as_progress
 from ..attitude.body import RigidBody
 from ..orbits.periodic import PeriodicOrbit
 from ..results.kinds import MAP_3D_VARIABLES
@@ -207,7 +208,7 @@ def map3d_dataset(orbit: PeriodicOrbit, grid: Map3DGrid, residual: np.ndarray, s
 
 
 def attitude_map_3d(orbit: PeriodicOrbit, body, *, wx0, wy0, wz0, q0=None, n_periods: int = 1, tol: float = 1e-10,
-                    progress: Callable[[int, int], None] | None = None, threads: int | None = None):
+                    progress: Callable[[int, int], None] | bool | None = None, threads: int | None = None):
     """The 3-D attitude map of ``body`` along ``orbit`` (planar or spatial).
 
     ``wx0``, ``wy0``, ``wz0``: each a number or a strictly increasing 1-D array of initial inertial
@@ -221,6 +222,7 @@ def attitude_map_3d(orbit: PeriodicOrbit, body, *, wx0, wy0, wz0, q0=None, n_per
     chunks (``progress(done, total)`` after each); on KeyboardInterrupt the finished chunks are
     kept, with ``attrs["complete"] = 0``. Results are bit-identical for any ``threads``.
     """
+    progress = as_progress(progress, "3-D map", "case")
     n_periods, tol = _check(orbit, n_periods, tol)
     grid = map3d_grid(body, wx0=wx0, wy0=wy0, wz0=wz0, q0=q0)
     n = grid.n_cases

@@ -18,6 +18,7 @@ import numpy as np
 from .._checks import as_count, as_float_array, as_number
 from .._core import __version__
 from .._errors import LibrateError
+from .._progress import as_progress
 from ..orbits.families import OrbitFamily
 from ..orbits.periodic import PeriodicOrbit
 from ..results.kinds import MAP_VARIABLES
@@ -49,7 +50,7 @@ def periodicity_map(
     phi0: float = 0.0,
     n_periods: int = 1,
     solve: bool = True,
-    progress: Callable[[int, int], None] | None = None,
+    progress: Callable[[int, int], None] | bool | None = None,
     rtol: float = MAP_RTOL,
     atol: float = MAP_ATOL,
     chunk: int = 64,
@@ -73,6 +74,7 @@ def periodicity_map(
     """
 
 
+    progress = as_progress(progress, "periodicity map", "orbit")
     olist, family = orbits_of(orbits)
     for o in olist:
         check_orbit(o)

@@ -23,6 +23,7 @@ import numpy as np
 from .. import _core
 from .._checks import as_count, as_number
 from .._display import fmt, html_summary, short_repr
+from .._progress import as_progress
 from ..attitude.body import RigidBody
 from ..attitude.propagate import propagate_attitude
 from ..attitude.srp import FlatPlate
@@ -366,6 +367,7 @@ def find_periodic_attitudes(
     n_grid: int | None = None,
     n_periods: int = 1,
     srp=None,
+    progress=None,
 ) -> list[AttitudeSolution]:
     """Every periodic (and half-turn) attitude motion with inertial wz0 in ``wz0_range``.
 
@@ -380,7 +382,11 @@ def find_periodic_attitudes(
     merged within each scan, not across them (a motion found from two starts is listed twice,
     possibly with different phi0 in the symmetric case), and the list is sorted by wz0, scans
     in the given order where wz0 ties.
+
+    ``progress``: True for a bar on stderr, or ``progress(done, total)`` after the scan and after
+    the refinement of each closure (symmetric, full).
     """
+    progress = as_progress(progress, "periodic attitudes", "step")
     orbit = check_orbit(orbit)
     kz = check_kz(kz)
     try:
@@ -400,14 +406,19 @@ def find_periodic_attitudes(
     T = n_periods * orbit.period
     wz = _grid_for(T, lo, hi, n_grid)
     found: list[list[AttitudeSolution]] = [[] for _ in seeds]
-    for symmetric in (True, False):
-        idx = [i for i, p in enumerate(seeds) if (is_symmetric(orbit, p) and (srp is None or srp.eps == 0.0)) == symmetric]
+    closures = [[i for i, p in enumerate(seeds) if (is_symmetric(orbit, p) and (srp is None or srp.eps == 0.0)) == symmetric]
+                for symmetric in (True, False)]
+    total, done = 2 * sum(1 for idx in closures if idx), 0
+    for symmetric, idx in zip((True, False), closures):
         if not idx:
             continue
         t_scan, level = (0.5 * T, 0.5 * math.pi) if symmetric else (T, math.pi)
         p_grid = np.array([seeds[i] for i in idx])[:, None]
         r = sweep(orbit_forcing(orbit), t_scan, p_grid, wz[None, :], kz, srp=srp)
         phi_t = np.asarray(r["phi_t"]).reshape(len(idx), wz.size)
+        if progress is not None:
+            done += 1
+            progress(done, total)
         # symmetric: phi(T/2) - phi0 = k pi/2 -> turns = k/2; else phi(T) - phi0 = k pi -> turns = k/2
         cands, start, group = [], [], []
         for j, i in enumerate(idx):
@@ -418,5 +429,8 @@ def find_periodic_attitudes(
         for g, s_ in refine_groups(orbit, kz, np.array(start), cands, n_periods=n_periods, srp=srp, closure="half" if symmetric else "full",
                                    window=(lo, hi), kinds=kinds, group=group):
             found[g].append(s_)
+        if progress is not None:
+            done += 1
+            progress(done, total)
     # each scan sorted by wz0, then all (a stable sort: scans in order where wz0 ties)
     return sorted((s_ for f in found for s_ in sorted(f, key=lambda s_: s_.wz0)), key=lambda s_: s_.wz0)

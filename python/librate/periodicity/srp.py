@@ -15,6 +15,7 @@ import numpy as np
 from .. import _core
 from .._checks import as_count, as_number
 from .._core import __version__
+from .._progress import as_progress
 from ..attitude.srp import FacetBody, FlatPlate, Sun, force_torque
 from ..constants import SOLAR_PRESSURE_1AU, SUN_SYNODIC_PERIOD
 from ..orbits.periodic import PeriodicOrbit
@@ -107,8 +108,7 @@ def srp_map(
     """
     import xarray as xr
 
-    if progress is not None and not callable(progress):
-        raise ValueError(f"invalid argument `progress`: must be a callable progress(done, total) or None, got {progress!r}")
+    progress = as_progress(progress, "SRP map", "step")
     counts = {"done": 0, "total": 2}  # the sweep, one per branch (added as found), the assembly
 
     def advance(done: int = 1, more: int = 0) -> None:

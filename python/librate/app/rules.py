@@ -1,0 +1,224 @@
+"""The rules between sections of a study (and what each command needs from it), on the section
+models that passed type validation; the rules within one section are its model's ``problems()``
+(:mod:`librate.app.schema`)."""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from .schema import Range, Table, grid_raw, grid_values, missing, problem, show_value
+
+
+def _check_increasing(key: str, g, problems: list[str]) -> None:
+    if isinstance(g, Range):
+        if g.num < 2:
+            problems.append(problem(f"{key}.num", g.num, "a rate grid needs at least 2 values", "an integer in [2, 1000000]"))
+        if not g.start < g.stop:
+            problems.append(problem(f"{key}.stop", g.stop, f"must be greater than {key}.start = {show_value(g.start)} (rates increase)",
+                                     f"a number > {key}.start"))
+    else:
+        v = np.asarray(g, dtype=float)
+        if v.size < 2:
+            problems.append(problem(key, g, "a rate grid needs at least 2 values"))
+        elif np.any(np.diff(v) <= 0):
+            problems.append(problem(key, g, "must be strictly increasing"))
+
+
+def check_sections(s: dict[str, Table], given: dict, purpose: str | None) -> list[str]:
+    """Consistency checks on the sections that passed type validation (``s``); ``given`` is the
+    raw study as written (to tell a missing section from a defaulted one). The rules within one
+    section are its model's ``problems()``; the rules between sections are here."""
+    sysc = s.get("system")
+    problems, mu = sysc.problems() if sysc is not None else ([], None)
+
+    orb = s.get("orbits")
+    if orb is not None:
+        problems += orb.problems(mu)
+
+    body = s.get("body")
+    if body is not None:
+        problems += body.problems()
+
+    tq = s.get("torques")
+    if tq is not None:
+        problems += tq.problems()
+        srp = tq.srp  # one rule between [torques.srp] and [body]:
+        if srp is not None and srp.eps is None and srp.area_m2 is not None and srp.offset_m is not None \
+                and body is not None and body.iz is None and body.kz is not None:
+            problems.append(problem("torques.srp.area_m2", srp.area_m2, "the plate's geometry needs the body's Iz in kg m^2 (body.ix, body.iy, body.iz); with body.kz alone give torques.srp.eps",
+                                     "torques.srp.eps with body.kz, or the geometry with body.ix/iy/iz"))
+
+    # [attitude] (a section that failed type validation counts as the default planar model)
+    att = s.get("attitude")
+    three_d = att is not None and att.model == "3d"
+    start = start_of(att, orb) if three_d else None
+
+    # [rates]
+    rates = s.get("rates")
+    if rates is not None:
+        if rates.wz0 is not None and rates.phidot0 is not None:
+            problems.append(problem("rates.phidot0", grid_raw(rates.phidot0), "cannot be combined with rates.wz0 (phidot0 = wz0 - 1)", "either rates.wz0 or rates.phidot0"))
+        elif rates.wz0 is None and rates.phidot0 is None and not three_d:
+            problems.append(missing("rates.wz0", "missing: give rates.wz0 (inertial) or rates.phidot0 (relative to the synodic frame)"))
+        if not three_d:
+            for k in ("wx0", "wy0"):
+                if getattr(rates, k) is not None:
+                    problems.append(problem(f"rates.{k}", grid_raw(getattr(rates, k)), "applies only to attitude.model = \"3d\" (the planar model has the one rate wz)",
+                                             "rates.wz0 or rates.phidot0 with the planar model; rates.wx0 and rates.wy0 with [attitude] model = '3d'"))
+        for k in ("wz0", "phidot0", "wx0", "wy0"):
+            g = getattr(rates, k)
+            # a number is a fixed rate of a 3-D map; every grid increases
+            if g is not None and not (three_d and isinstance(g, (int, float))) and (k in ("wz0", "phidot0") or three_d):
+                _check_increasing(f"rates.{k}", g, problems)
+
+    if att is not None and not three_d:
+        for k in ("start", "n", "q0", "w0", "tol"):
+            if getattr(att, k) is not None:
+                problems.append(problem(f"attitude.{k}", getattr(att, k), "applies only to attitude.model = \"3d\"", "attitude.model = '3d' with it, or leave it out"))
+    if three_d:
+        problems += _check_3d(att, start, s, given)
+
+    # what the command needs
+    if purpose in ("solve", "map") and three_d:
+        problems += _needs_3d(purpose, start, s, given)
+    elif purpose in ("solve", "map"):
+        what, need = ("periodic solutions", "need") if purpose == "solve" else ("a periodicity map", "needs")
+        if "body" not in given:
+            problems.append(missing("body", f"missing section [body]: {what} {need} the body (body.kz, or body.ix/iy/iz)"))
+        if "rates" not in given:
+            problems.append(missing("rates", f"missing section [rates]: {what} {need} the initial rates (rates.wz0 or rates.phidot0)"))
+        if orb is not None and orb.kind == "halo":
+            problems.append(problem("orbits.kind", orb.kind, f"{what} use{'s' if need == 'needs' else ''} the planar attitude model, which needs a planar family",
+                                     "'dro' or 'lyapunov' with the planar model, or any family with [attitude] model = '3d'"))
+        if purpose == "map" and body is not None and body.flexible is not None:
+            problems.append(problem("body.flexible", body.flexible, "the periodicity-map engine integrates rigid bodies; "
+                                     "`librate solve` reports how flexibility moves each periodic solution", "body.kz or body.ix/iy/iz for a map"))
+        if body is not None and body.flexible is not None and tq is not None and tq.srp is not None:
+            problems.append(problem("torques.srp", "[torques.srp]", "the flexible model has no solar radiation pressure yet", "no [torques.srp] with body.flexible"))
+        if tq is not None and sorted(tq.gravity_gradient) != ["earth", "moon"]:
+            problems.append(problem("torques.gravity_gradient", tq.gravity_gradient,
+                                     f"the planar engine behind {what} models the gravity gradient of both primaries", "[\"earth\", \"moon\"]"))
+        if tq is not None and tq.srp is not None and orb is not None:
+            why = "with torques.srp the forcing is periodic only on a Sun-resonant orbit (T = Ts / k): select exactly one"
+            if orb.sun_resonance is None:
+                problems.append(missing("orbits.sun_resonance", f"missing: {why}, e.g. orbits.sun_resonance = [2]"))
+            elif len(orb.sun_resonance) != 1:
+                problems.append(problem("orbits.sun_resonance", orb.sun_resonance, why, "a list of one integer k >= 1, e.g. [2]"))
+            else:
+                k = orb.sun_resonance[0]
+                sol = s.get("solver")
+                if sol is not None and sol.n_periods is not None and sol.n_periods % k:
+                    problems.append(problem("solver.n_periods", sol.n_periods, f"with torques.srp on the 1:{k} Sun-resonant orbit the attitude period must cover whole Sun periods",
+                                             f"a multiple of {k}"))
+    return problems
+
+
+def start_of(att, orb) -> str:
+    """How a 3-D solve starts: ``attitude.start``, else "given" with attitude.w0, else "spin"
+    on a halo family, else "planar"."""
+    if att.start is not None:
+        return att.start
+    if att.w0 is not None:
+        return "given"
+    return "spin" if orb is not None and orb.kind == "halo" else "planar"
+
+
+_NOT_3D = "not modelled in 3-D yet (the 3-D model has the gravity gradient of both primaries on a rigid body)"
+
+
+def _check_3d(att, start: str, s: dict, given: dict) -> list[str]:
+    """The checks of ``[attitude] model = "3d"`` on the sections that passed type validation."""
+    problems: list[str] = []
+    orb, body, tq, sol = s.get("orbits"), s.get("body"), s.get("torques"), s.get("solver")
+    if start == "planar":
+        if orb is not None and orb.kind == "halo":
+            problems.append(problem("attitude.start", start, "the planar start takes a planar solution, which needs a planar family (orbits.kind = 'dro' or 'lyapunov')",
+                                     "'spin' or 'given' on a halo family"))
+        for k in ("q0", "w0"):
+            if getattr(att, k) is not None:
+                problems.append(problem(f"attitude.{k}", getattr(att, k), "cannot be combined with attitude.start = \"planar\" (the start is the planar solution: "
+                                         "phi0 = solver.phi0 about Z, wz0 from the rates.wz0 scan)", "attitude.q0 and attitude.w0 with attitude.start = 'given'"))
+    elif start == "spin" and att.w0 is not None:
+        problems.append(problem("attitude.w0", att.w0, "cannot be combined with attitude.start = \"spin\" (the spin is w = (1 + 2 pi n / (K T)) e_Z)",
+                                 "attitude.w0 with attitude.start = 'given'"))
+    if start in ("planar", "spin") and att.n is None:
+        problems.append(missing("attitude.n", f"missing: attitude.start = \"{start}\" needs the net turns n per attitude period"))
+    if start == "given":
+        if att.w0 is None:
+            problems.append(missing("attitude.w0", "missing: attitude.start = \"given\" starts from attitude.w0 (and attitude.q0, default the identity)"))
+        if att.n is not None:
+            problems.append(problem("attitude.n", att.n, "does not apply to attitude.start = \"given\" (the start is attitude.q0, attitude.w0)",
+                                     "attitude.n with attitude.start = 'planar' or 'spin'"))
+    if att.q0 is not None and abs(math.hypot(*att.q0) - 1) > 1e-6:  # finite: the schema refuses inf and nan
+        problems.append(problem("attitude.q0", att.q0, f"must be a unit quaternion (|q0| = {math.hypot(*att.q0):.6g})"))
+    if att.q0 is not None and sol is not None and "phi0" in (given.get("solver") or {}):
+        problems.append(problem("solver.phi0", sol.phi0, "cannot be combined with attitude.q0 (q0 is the whole initial attitude)",
+                                 "solver.phi0 (a rotation about Z) or attitude.q0, not both"))
+    if body is not None:
+        if body.flexible is not None:
+            problems.append(problem("body.flexible", body.flexible, f"flexible bodies are {_NOT_3D}", "body.ix, body.iy and body.iz (kg m^2) with attitude.model = '3d'"))
+        elif body.kz is not None and body.ix is None and body.iy is None and body.iz is None:
+            problems.append(problem("body.kz", grid_raw(body.kz), "the 3-D attitude model needs the full inertia, not Kz alone (Kz fixes only (Iy - Ix) / Iz)",
+                                     "body.ix, body.iy and body.iz in kg m^2 (principal moments, each <= the sum of the other two)"))
+    if tq is not None:
+        if tq.srp is not None:
+            problems.append(problem("torques.srp", "[torques.srp]", f"solar radiation pressure is {_NOT_3D}", "no [torques.srp] with attitude.model = '3d'"))
+        if sorted(tq.gravity_gradient) != ["earth", "moon"]:
+            problems.append(problem("torques.gravity_gradient", tq.gravity_gradient, "the 3-D attitude model has the gravity gradient of both primaries",
+                                     "[\"earth\", \"moon\"]"))
+    return problems
+
+
+def member_count(orb) -> tuple[str, Any, int] | None:
+    """(key, value, count) of the members [orbits] selects, None for the whole family."""
+    for k in ("x0", "z0", "period_days"):
+        g = getattr(orb, k)
+        if g is not None:
+            return k, grid_raw(g), int(grid_values(g).size)
+    for k in ("resonance", "sun_resonance"):
+        if getattr(orb, k) is not None:
+            return k, getattr(orb, k), len(getattr(orb, k))
+    if orb.members is not None:
+        return "members", orb.members, orb.members
+    return None
+
+
+def _needs_3d(purpose: str, start: str, s: dict, given: dict) -> list[str]:
+    """What ``librate solve`` or ``librate map`` needs from a 3-D study."""
+    problems: list[str] = []
+    rates = s.get("rates")
+    what = "a 3-D solve" if purpose == "solve" else "a 3-D map"
+    if "body" not in given:
+        problems.append(missing("body", f"missing section [body]: {what} needs the body's principal moments (body.ix, body.iy, body.iz)"))
+    if purpose == "solve":
+        if start == "planar":
+            if "rates" not in given:
+                problems.append(missing("rates", "missing section [rates]: the planar start scans rates.wz0 (or rates.phidot0) for the planar solution"))
+            elif rates is not None:
+                if rates.wz0 is None and rates.phidot0 is None:
+                    problems.append(missing("rates.wz0", "missing: the planar start scans rates.wz0 (or rates.phidot0) for the planar solution"))
+                for k in ("wz0", "phidot0"):
+                    g = getattr(rates, k)
+                    if isinstance(g, (int, float)):
+                        problems.append(problem(f"rates.{k}", g, "the planar start scans a grid of rates for the planar solution, not one value"))
+        return problems
+    if "rates" not in given:
+        problems.append(missing("rates", "missing section [rates]: a 3-D map needs rates.wx0, rates.wy0 and rates.wz0 (or rates.phidot0): two grids and one fixed number"))
+        return problems
+    if rates is None:
+        return problems
+    comp = {"wx0": rates.wx0, "wy0": rates.wy0, "wz0": rates.wz0 if rates.wz0 is not None else rates.phidot0}
+    for k, v in comp.items():
+        if v is None:
+            problems.append(missing(f"rates.{k}", "missing: a 3-D map needs rates.wx0, rates.wy0 and rates.wz0 (or rates.phidot0): two grids and one fixed number"))
+    fixed = [k for k, v in comp.items() if isinstance(v, (int, float))]
+    if all(v is not None for v in comp.values()) and len(fixed) != 1:
+        key = fixed[-1] if fixed else "wz0"
+        name = key if key != "wz0" or rates.wz0 is not None else "phidot0"
+        problems.append(problem(f"rates.{name}", grid_raw(getattr(rates, name)), f"a 3-D map has grids over two rate components and one fixed number; "
+                                 f"given {len(fixed)} fixed ({', '.join('rates.' + f for f in fixed) or 'none'})",
+                                 "exactly one of rates.wx0, rates.wy0, rates.wz0 (or rates.phidot0) a number, the other two grids"))
+    return problems
