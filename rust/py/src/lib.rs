@@ -7,7 +7,7 @@
 use librate_core::cr3bp::{self, SystemConstants, PRESETS};
 use librate_core::error::Error;
 use librate_core::integrate::{Options, Output, Status};
-use librate_core::periodic::{correct_multiple_shooting, MemberCondition, Constraint, Stability, SymmetricShooting, Var};
+use librate_core::orbit::{correct_multiple_shooting, MemberCondition, Constraint, Stability, SymmetricShooting, Var};
 use numpy::Complex64;
 use librate_core::propagation::{self, Collision, EventKind, EventSpec};
 use numpy::ndarray::Array2;

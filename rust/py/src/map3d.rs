@@ -2,7 +2,10 @@
 //! convert (the result arrays are moved into NumPy, not copied).
 
 use librate_core::attitude::RigidBody;
-use librate_core::map::{sweep_3d, Case3d, LaneOptions, TidalTable};
+use librate_core::integrate::forcing::TidalTable;
+use librate_core::integrate::lanes::LaneOptions;
+use librate_core::integrate::lanes3d::Case3d;
+use librate_core::map::sweep_3d;
 use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::exceptions::PyValueError;
@@ -125,7 +128,7 @@ fn map_sweep_3d<'py>(
     let opts = LaneOptions { rtol, atol, max_steps, ..LaneOptions::default() };
     let f = &table.inner;
     let out = py.detach(|| sweep_3d(f, t_final, &cases, &opts, chunk, threads)).map_err(to_py)?;
-    let flat = |k: usize, g: &dyn Fn(&librate_core::map::Outcome3d) -> Vec<f64>| -> PyResult<Py<PyAny>> {
+    let flat = |k: usize, g: &dyn Fn(&librate_core::integrate::lanes3d::Outcome3d) -> Vec<f64>| -> PyResult<Py<PyAny>> {
         let v: Vec<f64> = out.iter().flat_map(g).collect();
         Ok(Array2::from_shape_vec((n, k), v).map_err(|e| PyValueError::new_err(e.to_string()))?.into_pyarray(py).into_any().unbind())
     };

@@ -17,7 +17,7 @@ use super::body::FlexibleBody;
 use super::propagate::propagate_flexible;
 use crate::error::{check_finite, check_positive, invalid, Result};
 use crate::integrate::{Options, Output};
-use crate::periodic::StopReason;
+use crate::attitude::StopReason;
 use crate::propagation::with_threads;
 
 /// The outcome of [`correct_flexible_periodic`].

@@ -30,7 +30,7 @@ use rayon::prelude::*;
 
 use super::newton::{self, Eval, Problem, Settings, StopReason};
 use crate::attitude::linear::reduce;
-use super::symmetric::{Constraint as SymConstraint, Evaluation, SymmetricOrbit, SymmetricShooting};
+use crate::orbit::{Constraint as SymConstraint, Evaluation, SymmetricOrbit, SymmetricShooting};
 use crate::attitude::{propagate_attitude, Coupled, GravityGradient, OrbitMode, RigidBody, Torque};
 use crate::integrate::System;
 use crate::cr3bp::check_mu;
@@ -827,7 +827,7 @@ mod tests {
         // the DRO of x0 = 0.5385 and its period, from symmetric shooting with x0 fixed
         let mut sh = SymmetricShooting::new(mu, false, Options::with_tolerances(1e-13, 1e-13));
         sh.tol = 1e-12;
-        let dro = sh.correct([0.5385453306274934, 0.0, 0.6], SymConstraint::Fix(super::super::symmetric::Var::X0, 0.5385453306274934)).unwrap();
+        let dro = sh.correct([0.5385453306274934, 0.0, 0.6], SymConstraint::Fix(crate::orbit::Var::X0, 0.5385453306274934)).unwrap();
         let t0 = dro.period;
         let start = Start3d { q: [0.0, 0.0, 0.0, 1.0], w: [0.0, 0.0, 3.9254597] };
         let plain = &correct_attitudes_3d(mu, body, &dro.state0, t0, &[start], &opts).unwrap()[0];
