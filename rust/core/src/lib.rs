@@ -11,10 +11,6 @@
 //! - [`fourier`]: periodic orbits as truncated Fourier series, with analytic derivatives.
 //! - [`simd`]: runtime CPU dispatch of the hot kernels (baseline, AVX2, AVX-512, NEON).
 
-// Intentional patterns: `!(x <= tol)` is the NaN-safe test (a NaN must fail it); numerical
-// kernels take many scalar arguments; dual-number products contain sums by definition.
-#![allow(clippy::neg_cmp_op_on_partial_ord, clippy::too_many_arguments, clippy::suspicious_arithmetic_impl, clippy::type_complexity)]
-
 pub mod attitude;
 pub mod constants;
 pub mod cr3bp;

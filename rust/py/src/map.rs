@@ -135,7 +135,6 @@ fn per_case(a: &Option<PyReadonlyArray1<'_, f64>>, name: &str, n: usize) -> PyRe
 /// Integrate planar attitude trajectories (phi0, wz0, kz arrays of one length) over t_final.
 #[pyfunction]
 #[pyo3(signature = (forcing, t_final, phi0, wz0, kz, *, rtol, atol, max_steps, stm, chunk, threads, eps=None, cs=None, cd=None, theta_sun0=None, method="rkf78"))]
-#[allow(clippy::too_many_arguments)]
 fn map_sweep<'py>(
     py: Python<'py>,
     forcing: PyRef<'py, PyOrbitForcing>,
@@ -282,7 +281,6 @@ impl PyCorrectionBatch {
 #[pyo3(signature = (forcing, phi0, wz0, kz, turns, *, t_final, closure, free="phi0", eps=None, cs=None, cd=None, theta_sun0=None,
     tol=1e-12, max_iter=40, rtol=1e-13, atol=1e-13, max_steps=200_000, max_wz_step=0.5, max_angle_step=0.5, threads=None, chunk=64,
     parameter=None, condition=None, parameter_step=1e-6, max_parameter_step=0.5, monodromy=true, max_halvings=10, conditions=None))]
-#[allow(clippy::too_many_arguments)]
 fn attitude_correct<'py>(
     py: Python<'py>,
     forcing: PyRef<'py, PyOrbitForcing>,
@@ -414,7 +412,6 @@ impl PyPlanarFamily {
 #[pyfunction]
 #[pyo3(signature = (family, wz0, kz, turns, x0, *, condition, phi0=0.0, tol=1e-12, max_iter=40, rtol=1e-13, atol=1e-13, max_steps=200_000,
     max_wz_step=0.5, parameter_step=1e-6, max_parameter_step=0.05, threads=None, max_halvings=10))]
-#[allow(clippy::too_many_arguments)]
 fn attitude_correct_across<'py>(
     py: Python<'py>,
     family: PyRef<'py, PyPlanarFamily>,
@@ -491,7 +488,6 @@ impl PyPlanarVerification {
 /// alongside, rtol = atol = 1e-14) in parallel; a plate where eps is given and non-zero.
 #[pyfunction]
 #[pyo3(signature = (mu, orbit_state0, t_final, kz, phi0, wz0, *, eps=None, cs=None, cd=None, theta_sun0=None, primaries=[true, true], threads=None))]
-#[allow(clippy::too_many_arguments)]
 fn planar_verify<'py>(
     py: Python<'py>,
     mu: f64,

@@ -108,7 +108,6 @@ impl PySweep3DResult {
 /// steps, 2 failed), steps (n, 2) accepted and rejected.
 #[pyfunction]
 #[pyo3(signature = (table, t_final, q0, w0, inertia, *, rtol, atol, max_steps=200_000, chunk=64, threads=None))]
-#[allow(clippy::too_many_arguments)]
 fn map_sweep_3d<'py>(
     py: Python<'py>,
     table: PyRef<'py, PyTidalTable>,

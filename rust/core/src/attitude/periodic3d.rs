@@ -591,7 +591,6 @@ fn qexp_about(qr: &Quat, theta: &[f64; 3]) -> (Quat, [[f64; 3]; 4]) {
 
 /// The full-period closure rows (Log(q0* (x) qT), wT - w0), their Jacobian in (theta, w0) and
 /// the 6x6 monodromy, from the end state and 13x13 STM (the same algebra as [`Form3d`]).
-#[allow(clippy::type_complexity)]
 fn closure_rows(q0: &Quat, dq0: &[[f64; 3]; 4], w0: &[f64; 3], yt: &[f64], stm: &[f64]) -> Option<([f64; 6], [[f64; 6]; 6], [[f64; 6]; 6])> {
     if !(yt.iter().all(|v| v.is_finite()) && stm.iter().all(|v| v.is_finite())) {
         return None;

@@ -35,7 +35,6 @@ pub struct FlexiblePeriodic {
 
 /// Correct `x0` = (phi0, wz0, q0, qdot0) to a periodic motion of the coupled model along the
 /// planar orbit `orbit0` of period `period` (see the module documentation).
-#[allow(clippy::too_many_arguments)]
 pub fn correct_flexible_periodic(
     mu: f64,
     body: &FlexibleBody,
