@@ -15,8 +15,10 @@
 use std::time::Instant;
 
 use librate_core::integrate::Options;
-use librate_core::map::{sweep, Case, LaneOptions, OrbitForcing, Outcome};
-use librate_core::periodic::correct_planar_symmetric;
+use librate_core::integrate::forcing::OrbitForcing;
+use librate_core::integrate::lanes::{Case, LaneOptions, Outcome};
+use librate_core::map::sweep;
+use librate_core::orbit::correct_planar_symmetric;
 
 const MU: f64 = 0.01215;
 

@@ -145,7 +145,6 @@ impl CollisionHit {
 /// [`propagate`] with collisions: reaching the sphere of `collision` about either primary is a
 /// terminal event. The trajectory then ends on that sphere with `collision` set (its `events`
 /// hold only the caller's events). A state that starts inside a sphere collides at t0.
-#[allow(clippy::too_many_arguments)]
 pub fn propagate_checked(
     mu: f64,
     state: &[f64; 6],
@@ -196,7 +195,6 @@ pub fn propagate_checked(
 }
 
 /// Propagate one CR3BP state from t0 to tf (either direction).
-#[allow(clippy::too_many_arguments)]
 pub fn propagate(
     mu: f64,
     state: &[f64; 6],
@@ -268,7 +266,6 @@ pub fn with_threads<R: Send>(threads: Option<usize>, f: impl FnOnce() -> R + Sen
 /// One member failing does not lose the others: each carries its own `Result`. With
 /// `collision`, a member that reaches a primary's sphere is an
 /// [`IntegrationError::Collision`] (see [`propagate_checked`]).
-#[allow(clippy::too_many_arguments)]
 pub fn propagate_many(
     mu: f64,
     states: &[[f64; 6]],

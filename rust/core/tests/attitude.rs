@@ -3,8 +3,8 @@
 
 use librate_core::attitude::{dcm, forcing_sc, propagate_attitude, propagate_planar, Coupled, GravityGradient, OrbitMode, PlanarForced, RigidBody, Torque};
 use librate_core::integrate::{solve, Options, Output, System};
-use librate_core::map::OrbitForcing;
-use librate_core::periodic::correct_planar_symmetric;
+use librate_core::integrate::forcing::OrbitForcing;
+use librate_core::orbit::correct_planar_symmetric;
 
 const MU: f64 = 0.01215;
 

@@ -1,16 +1,19 @@
-//! The batched planar attitude corrector (periodic::correct_planar_attitudes) and verifier
-//! (periodic::verify_planar_attitudes): analytic cases, the thesis's Fig. 23 solution, the
+//! The batched planar attitude corrector (attitude::correct_planar_attitudes) and verifier
+//! (attitude::verify_planar_attitudes): analytic cases, the thesis's Fig. 23 solution, the
 //! agreement of its forms, batching, threads, globalisation and the Sun-phase form with SRP.
 //! Each test names its reference and its tolerance.
 
 use librate_core::attitude::srp::N_SUN;
 use librate_core::attitude::{FlatPlate, Sun};
 use librate_core::integrate::Options;
-use librate_core::map::{sweep, Case, LaneOptions, LaneStatus, OrbitForcing};
-use librate_core::periodic::{
-    correct_bordered, correct_planar_attitudes, correct_planar_symmetric, verify_planar_attitudes, Bordered, Candidate, Closure, Constraint, Correction, CorrectorOptions,
-    Free, Parameter, PlanarStart, StopReason, SymmetricShooting,
+use librate_core::integrate::forcing::OrbitForcing;
+use librate_core::integrate::lanes::{Case, LaneOptions, LaneStatus};
+use librate_core::map::sweep;
+use librate_core::attitude::{
+    correct_bordered, correct_planar_attitudes, verify_planar_attitudes, Bordered, Candidate, Closure, Correction, CorrectorOptions,
+    Free, Parameter, PlanarStart, StopReason,
 };
+use librate_core::orbit::{correct_planar_symmetric, Constraint, SymmetricShooting};
 use std::f64::consts::PI;
 
 const MU: f64 = 0.01215;
@@ -309,7 +312,7 @@ fn val_corrector_rejects_invalid_arguments() {
     assert!(correct_planar_attitudes(&f, t, Closure::Full, Free::Phi0, &[], &o).unwrap().is_empty());
     // the verifier
     let item = PlanarStart { kz: 0.8, phi0: 0.0, wz0: -1.4, plate: None };
-    let vname = |r: librate_core::Result<Vec<librate_core::periodic::PlanarEnd>>| match r {
+    let vname = |r: librate_core::Result<Vec<librate_core::attitude::PlanarEnd>>| match r {
         Err(librate_core::Error::InvalidArgument { name, .. }) => name,
         other => panic!("expected an invalid argument, got {other:?}"),
     };
@@ -406,7 +409,7 @@ fn val_per_candidate_conditions_batch_branches() {
 /// noise); (3) x0 outside the members' range fails cleanly.
 #[test]
 fn val_correction_across_the_orbit_family() {
-    use librate_core::periodic::{correct_across_family, PlanarFamily};
+    use librate_core::attitude::{correct_across_family, PlanarFamily};
     let members: Vec<([f64; 6], f64)> = [0.80, 0.83, 0.86, 0.89].iter().map(|&x| dro_x0(x)).collect();
     let x0s: Vec<f64> = members.iter().map(|m| m.0[0]).collect();
     let vy0s: Vec<f64> = members.iter().map(|m| m.0[4]).collect();
@@ -446,7 +449,7 @@ fn val_correction_across_the_orbit_family() {
 /// 1e-12, grown along the orbit), not the linearisation's O(dx^2) ~ 1e-12.
 #[test]
 fn val_linearised_family_orbit_is_second_order() {
-    use librate_core::periodic::PlanarFamily;
+    use librate_core::attitude::PlanarFamily;
     let members: Vec<([f64; 6], f64)> = [0.80, 0.83, 0.86, 0.89].iter().map(|&x| dro_x0(x)).collect();
     let x0s: Vec<f64> = members.iter().map(|m| m.0[0]).collect();
     let vy0s: Vec<f64> = members.iter().map(|m| m.0[4]).collect();

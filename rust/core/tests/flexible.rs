@@ -6,7 +6,7 @@
 use librate_core::attitude::{forcing_sc, gravity_gradient_wzdot, propagate_planar};
 use librate_core::flexible::{tidal_field, BodyField, evaluate_energies, propagate_flexible, propagate_quasi_static, quasi_static_point, Appendage, FlexibleBody};
 use librate_core::integrate::{Options, Output};
-use librate_core::periodic::correct_planar_symmetric;
+use librate_core::orbit::correct_planar_symmetric;
 
 const MU: f64 = 0.01215;
 
@@ -225,8 +225,8 @@ fn val_one_tidal_field() {
 #[test]
 fn val_flexible_periodic_corrector() {
     use librate_core::flexible::correct_flexible_periodic;
-    use librate_core::map::OrbitForcing;
-    use librate_core::periodic::{correct_planar_attitudes, Candidate, Closure, CorrectorOptions, Free, StopReason};
+    use librate_core::integrate::forcing::OrbitForcing;
+    use librate_core::attitude::{correct_planar_attitudes, Candidate, Closure, CorrectorOptions, Free, StopReason};
     let (s0, t) = dro(0.8);
     let body = station(300.0, 400.0, 0.0);
     let f = OrbitForcing::new(MU, &s0, t, [true, true], 1e-13).unwrap();

@@ -3,9 +3,11 @@
 
 use librate_core::attitude::{forcing_sc, propagate_planar};
 use librate_core::integrate::{Options, Output};
-use librate_core::map::{residuals, sweep, sweep_at, Case, LaneOptions, LaneStatus, Method, OrbitForcing};
+use librate_core::integrate::forcing::OrbitForcing;
+use librate_core::integrate::lanes::{Case, LaneOptions, LaneStatus, Method};
+use librate_core::map::{residuals, sweep, sweep_at};
 use librate_core::simd;
-use librate_core::periodic::correct_planar_symmetric;
+use librate_core::orbit::correct_planar_symmetric;
 use librate_core::propagation::propagate;
 
 const MU: f64 = 0.01215;
@@ -68,7 +70,7 @@ fn val_engine_is_deterministic() {
     let mut cases = grid(37, 0.8);
     cases.extend(grid(11, 0.3));
     // bit for bit (NaN fields, such as dparam without a sensitivity, compare by their bits)
-    let bits = |r: &[librate_core::map::Outcome]| -> Vec<_> {
+    let bits = |r: &[librate_core::integrate::lanes::Outcome]| -> Vec<_> {
         r.iter().map(|o| (o.phi_t.to_bits(), o.wz_t.to_bits(), o.stm.map(f64::to_bits), o.dparam.map(f64::to_bits), o.accepted, o.rejected, o.status)).collect()
     };
     let base = bits(&sweep(&f, period, &cases, &LaneOptions::default(), true, 64, Some(1)).unwrap());
@@ -160,7 +162,7 @@ fn val_engine_srp_matches_scalar_model() {
         assert!(e < 1e-8, "{c:?}: STM relative difference {e:e}");
     }
     // With SRP (terminator cuts) results are still the same for any chunking and thread count.
-    let key = |o: &librate_core::map::Outcome| (o.phi_t.to_bits(), o.wz_t.to_bits(), o.accepted, o.rejected);
+    let key = |o: &librate_core::integrate::lanes::Outcome| (o.phi_t.to_bits(), o.wz_t.to_bits(), o.accepted, o.rejected);
     let a: Vec<_> = sweep(&f, tf, &cases, &LaneOptions::default(), false, 1, Some(1)).unwrap().iter().map(key).collect();
     let b: Vec<_> = sweep(&f, tf, &cases, &LaneOptions::default(), false, 64, Some(2)).unwrap().iter().map(key).collect();
     assert_eq!(a, b);
@@ -174,7 +176,7 @@ fn val_engine_srp_matches_scalar_model() {
 /// the same operations and agree bit for bit. Both lane methods (RKF7(8) and RKN8(6)).
 #[test]
 fn val_engine_levels_agree() {
-    let bits = |r: &[librate_core::map::Outcome]| -> Vec<_> { r.iter().map(|o| (o.phi_t.to_bits(), o.wz_t.to_bits(), o.stm.map(f64::to_bits), o.accepted, o.rejected)).collect() };
+    let bits = |r: &[librate_core::integrate::lanes::Outcome]| -> Vec<_> { r.iter().map(|o| (o.phi_t.to_bits(), o.wz_t.to_bits(), o.stm.map(f64::to_bits), o.accepted, o.rejected)).collect() };
     let (s0, period) = dro(0.7);
     let f = OrbitForcing::new(MU, &s0, period, [true, true], 1e-13).unwrap();
     let mut cases = grid(200, 0.8);
@@ -187,7 +189,7 @@ fn val_engine_levels_agree() {
         let opts = LaneOptions { method, ..LaneOptions::default() };
         // the trajectories' sensitivity: max(1, max |d(phi, wz)(T) / d(phi0, wz0)|)
         let sens: Vec<f64> = sweep_at(levels[0], &f, period, &cases, &opts, true, 64, None).unwrap().iter().map(|o| o.stm.iter().fold(1f64, |m, v| m.max(v.abs()))).collect();
-        let mut runs: Vec<(simd::Level, Vec<librate_core::map::Outcome>)> = Vec::new();
+        let mut runs: Vec<(simd::Level, Vec<librate_core::integrate::lanes::Outcome>)> = Vec::new();
         for &level in &levels {
             let base = sweep_at(level, &f, period, &cases, &opts, stm, 64, Some(1)).unwrap();
             for (chunk, threads) in [(1, Some(2)), (24, None)] {
@@ -253,7 +255,7 @@ fn val_nystrom_lanes_match_scalar_model() {
             let e = (0..4).map(|i| (m[i] - o.stm[i]).powi(2)).sum::<f64>().sqrt() / n;
             assert!(e < 1e-8, "{c:?}: STM relative difference {e:e}");
         }
-        let key = |o: &librate_core::map::Outcome| (o.phi_t.to_bits(), o.wz_t.to_bits(), o.stm.map(f64::to_bits), o.accepted, o.rejected);
+        let key = |o: &librate_core::integrate::lanes::Outcome| (o.phi_t.to_bits(), o.wz_t.to_bits(), o.stm.map(f64::to_bits), o.accepted, o.rejected);
         let a: Vec<_> = sweep(&f, tf, &cases, &opts, true, 1, Some(1)).unwrap().iter().map(key).collect();
         let b: Vec<_> = sweep(&f, tf, &cases, &opts, true, 64, Some(2)).unwrap().iter().map(key).collect();
         assert_eq!(a, b);
@@ -269,7 +271,7 @@ fn val_nystrom_lanes_match_scalar_model() {
 /// continuation's start, where no plate acts yet).
 #[test]
 fn val_parameter_sensitivity_matches_differences() {
-    use librate_core::map::Sensitivity;
+    use librate_core::integrate::lanes::Sensitivity;
     let (s0, period) = dro(0.8);
     let f = OrbitForcing::new(MU, &s0, period, [true, true], 1e-13).unwrap();
     let tf = 2.0 * period;

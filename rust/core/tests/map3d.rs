@@ -5,8 +5,12 @@
 
 use librate_core::attitude::{propagate_attitude, tidal_tensor, GravityGradient, OrbitMode, RigidBody, Torque};
 use librate_core::integrate::{Options, Output};
-use librate_core::map::{residuals, sweep, sweep_3d, Case, Case3d, LaneOptions, LaneStatus, OrbitForcing, TidalTable};
-use librate_core::periodic::{attitude_residual, correct_planar_symmetric, Constraint, SymmetricShooting, Var};
+use librate_core::integrate::forcing::{OrbitForcing, TidalTable};
+use librate_core::integrate::lanes::{Case, LaneOptions, LaneStatus};
+use librate_core::integrate::lanes3d::Case3d;
+use librate_core::map::{residuals, sweep, sweep_3d};
+use librate_core::attitude::attitude_residual;
+use librate_core::orbit::{correct_planar_symmetric, Constraint, SymmetricShooting, Var};
 use librate_core::propagation::propagate;
 
 const MU: f64 = 0.01215;
@@ -144,7 +148,7 @@ fn val_determinism_across_threads_and_chunks() {
     let (s0, period) = halo();
     let f = TidalTable::tidal(MU, &s0, period, [true, true], 1e-12).unwrap();
     let cases = cases3d();
-    let bits = |o: &[librate_core::map::Outcome3d]| o.iter().flat_map(|x| x.q_t.iter().chain(&x.w_t).chain(&x.residual).map(|v| v.to_bits()).collect::<Vec<_>>()).collect::<Vec<_>>();
+    let bits = |o: &[librate_core::integrate::lanes3d::Outcome3d]| o.iter().flat_map(|x| x.q_t.iter().chain(&x.w_t).chain(&x.residual).map(|v| v.to_bits()).collect::<Vec<_>>()).collect::<Vec<_>>();
     let base = bits(&sweep_3d(&f, period, &cases, &LaneOptions::default(), 8, Some(1)).unwrap());
     for (chunk, threads) in [(1, Some(2)), (24, Some(2)), (1000, None), (9, Some(3))] {
         assert_eq!(bits(&sweep_3d(&f, period, &cases, &LaneOptions::default(), chunk, threads).unwrap()), base, "chunk {chunk}, threads {threads:?}");

@@ -4,7 +4,7 @@
 use librate_core::cr3bp::{jacobi, lagrange_points, Cr3bp, Cr3bpStm, SystemConstants, STM_DIM};
 use librate_core::error::{Error, IntegrationError};
 use librate_core::integrate::{solve, Event, Options, Output, Status, System};
-use librate_core::periodic::{correct_planar_symmetric, SymmetricOrbit};
+use librate_core::orbit::{correct_planar_symmetric, SymmetricOrbit};
 use librate_core::propagation::{propagate, propagate_many, EventKind, EventSpec};
 use nalgebra::Matrix6;
 use std::f64::consts::PI;
@@ -370,7 +370,7 @@ fn val_bad_arguments_name_the_parameter() {
 /// constant (imposed) and the same period to 1e-9; every patch lies on that orbit.
 #[test]
 fn val_multiple_shooting_recovers_a_dro() {
-    use librate_core::periodic::{correct_multiple_shooting, MemberCondition};
+    use librate_core::orbit::{correct_multiple_shooting, MemberCondition};
     let orbit = dro(0.8);
     let opts = Options::with_tolerances(1e-13, 1e-13);
     let n = 4;

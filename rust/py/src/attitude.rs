@@ -84,7 +84,6 @@ impl PyPlanarTrajectory {
 /// Coupled 3-D orbit-attitude propagation.
 #[pyfunction]
 #[pyo3(signature = (mu, inertia, torques, orbit_mode, state0, t0, tf, *, options, stm, t_eval, inertia_nd=None, facets=None, sun=(0.0, librate_core::constants::OMEGA_SUN, librate_core::constants::SOLAR_PRESSURE_1AU), tu_s=1.0, srp_force=None))]
-#[allow(clippy::too_many_arguments)]
 fn attitude_propagate<'py>(
     py: Python<'py>,
     mu: f64,
@@ -150,7 +149,6 @@ fn attitude_propagate<'py>(
 /// Planar reduced attitude model along an integrated (or held) orbit.
 #[pyfunction]
 #[pyo3(signature = (mu, kz, primaries, held, orbit0, phi0, wz0, t0, tf, *, options, stm, t_eval, plate=None))]
-#[allow(clippy::too_many_arguments)]
 fn planar_propagate<'py>(
     py: Python<'py>,
     mu: f64,

@@ -2,7 +2,7 @@
 //! released, convert.
 
 use librate_core::attitude::{collinear_equilibrium, RigidBody};
-use librate_core::periodic::{correct_attitudes_3d, correct_attitudes_3d_across, Options3d, Start3d, StartAcross3d};
+use librate_core::attitude::{correct_attitudes_3d, correct_attitudes_3d_across, Options3d, Start3d, StartAcross3d};
 use numpy::ndarray::{Array2, Array3};
 use numpy::{IntoPyArray, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::exceptions::PyValueError;
@@ -31,7 +31,7 @@ impl PyLinearisedEquilibrium {
 }
 
 /// The outcome of a batch of 3-D periodic-attitude corrections, one row per candidate
-/// (librate_core::periodic::correct_attitudes_3d).
+/// (librate_core::attitude::correct_attitudes_3d).
 #[pyclass(frozen, get_all, name = "CorrectionBatch3D", module = "librate._core")]
 pub struct PyCorrectionBatch3D {
     /// Initial attitude relative to the synodic frame, scalar last, (n, 4).
@@ -120,7 +120,7 @@ fn attitude_correct_3d<'py>(
 }
 
 /// The outcome of a batch of bordered 3-D corrections across an orbit family, one row per
-/// candidate (librate_core::periodic::correct_attitudes_3d_across).
+/// candidate (librate_core::attitude::correct_attitudes_3d_across).
 #[pyclass(frozen, get_all, name = "CorrectionAcross3D", module = "librate._core")]
 pub struct PyCorrectionAcross3D {
     /// Initial attitude (n, 4), scalar last, and inertial rate in body axes (n, 3).

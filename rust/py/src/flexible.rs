@@ -181,7 +181,6 @@ fn flexible_body_check(py: Python<'_>, body_arg: BodyArg) -> PyResult<PyFlexible
 /// Coupled flexible propagation along an integrated (or held) orbit.
 #[pyfunction]
 #[pyo3(signature = (mu, body_arg, primaries, held, orbit0, phi0, wz0, q0, qdot0, t0, tf, *, options, t_eval))]
-#[allow(clippy::too_many_arguments)]
 fn flexible_propagate<'py>(
     py: Python<'py>,
     mu: f64,
@@ -219,7 +218,6 @@ fn flexible_propagate<'py>(
 /// Rigid composite solution, closed-form deflections along it and the first-order attitude perturbation.
 #[pyfunction]
 #[pyo3(signature = (mu, body_arg, primaries, held, orbit0, phi0, wz0, t0, tf, *, options, t_eval))]
-#[allow(clippy::too_many_arguments)]
 fn flexible_quasi_static<'py>(
     py: Python<'py>,
     mu: f64,
@@ -280,7 +278,6 @@ impl PyQuasiStaticPoint {
 
 /// The closed form at one state.
 #[pyfunction]
-#[allow(clippy::too_many_arguments)]
 fn flexible_quasi_static_point(mu: f64, body_arg: BodyArg, primaries: [bool; 2], held: bool, orbit: [f64; 6], phi: f64, wz: f64) -> PyResult<PyQuasiStaticPoint> {
     let b = body(body_arg)?;
     let p = flexible::quasi_static_point(mu, &b, primaries, held, &orbit, phi, wz).map_err(to_py)?;
@@ -289,7 +286,6 @@ fn flexible_quasi_static_point(mu: f64, body_arg: BodyArg, primaries: [bool; 2],
 
 /// Energies, momentum, torque and inertia of states (orbit (m, 6), phi, wz (m,), q, qdot (m, n)).
 #[pyfunction]
-#[allow(clippy::too_many_arguments)]
 fn flexible_energies<'py>(
     py: Python<'py>,
     mu: f64,
@@ -321,7 +317,6 @@ fn flexible_energies<'py>(
 
 /// The right-hand side at one state (orbit held): (wzdot, qddot).
 #[pyfunction]
-#[allow(clippy::too_many_arguments)]
 fn flexible_rates(mu: f64, body_arg: BodyArg, primaries: [bool; 2], orbit: [f64; 6], phi: f64, wz: f64, q: Vec<f64>, qdot: Vec<f64>) -> PyResult<(f64, Vec<f64>)> {
     let b = body(body_arg)?;
     if q.len() != b.n() || qdot.len() != b.n() {
@@ -356,7 +351,6 @@ impl PyFlexiblePeriodicCorrection {
 /// orbit period (librate_core::flexible::correct_flexible_periodic).
 #[pyfunction]
 #[pyo3(signature = (mu, body_arg, primaries, orbit0, period, x0, turns, scale, *, options, tol, max_iter, threads=None))]
-#[allow(clippy::too_many_arguments)]
 fn flexible_correct_periodic<'py>(
     py: Python<'py>,
     mu: f64,

@@ -2,12 +2,11 @@
 //! calls the core with the GIL released, and converts the result; no numerics live here.
 //! The public, documented API is the `librate` Python package, which wraps these.
 
-#![allow(clippy::too_many_arguments, clippy::type_complexity)]
 
 use librate_core::cr3bp::{self, SystemConstants, PRESETS};
 use librate_core::error::Error;
 use librate_core::integrate::{Options, Output, Status};
-use librate_core::periodic::{correct_multiple_shooting, MemberCondition, Constraint, Stability, SymmetricShooting, Var};
+use librate_core::orbit::{correct_multiple_shooting, MemberCondition, Constraint, Stability, SymmetricShooting, Var};
 use numpy::Complex64;
 use librate_core::propagation::{self, Collision, EventKind, EventSpec};
 use numpy::ndarray::Array2;
@@ -131,7 +130,6 @@ fn event_specs(events: Vec<(String, Vec<f64>, i8, bool)>) -> PyResult<Vec<EventS
 /// Propagate one CR3BP state (see `librate.propagate`).
 #[pyfunction]
 #[pyo3(signature = (mu, state, t0, tf, *, options, stm, t_eval, events, collision=None))]
-#[allow(clippy::too_many_arguments)]
 fn propagate<'py>(
     py: Python<'py>,
     mu: f64,
@@ -189,7 +187,6 @@ fn propagate<'py>(
 /// Propagate many states to their final times on all cores; failed members are reported, not raised.
 #[pyfunction]
 #[pyo3(signature = (mu, states, t0, t_final, *, options, stm, threads, collision=None))]
-#[allow(clippy::too_many_arguments)]
 fn propagate_many<'py>(
     py: Python<'py>,
     mu: f64,
@@ -319,7 +316,6 @@ fn shooting(mu: f64, spatial: bool, tol: f64, max_iter: usize, t_max: f64, rtol:
 /// Newton correction of an x-z-symmetric orbit from p = (x0, z0, vy0) under one extra constraint.
 #[pyfunction]
 #[pyo3(signature = (mu, p, *, spatial, constraint, values, tol, max_iter, t_max, rtol, atol))]
-#[allow(clippy::too_many_arguments)]
 fn symmetric_correct<'py>(
     py: Python<'py>,
     mu: f64,
@@ -364,7 +360,6 @@ fn stability<'py>(py: Python<'py>, m: PyReadonlyArray2<'py, f64>, planar: bool) 
 /// Multiple shooting: patches (n, 6), period guess, member condition ("jacobi" or "period", value).
 #[pyfunction]
 #[pyo3(signature = (mu, patches, period, *, condition, value, tol, max_iter, rtol, atol))]
-#[allow(clippy::too_many_arguments)]
 fn multiple_shooting<'py>(
     py: Python<'py>,
     mu: f64,

@@ -1,8 +1,10 @@
 //! Bindings of the periodicity-map engine.
 
 use librate_core::attitude::{FlatPlate, Sun};
-use librate_core::map::{self, Case, LaneOptions};
-use librate_core::periodic::{
+use librate_core::integrate::forcing::OrbitForcing;
+use librate_core::integrate::lanes::{Case, LaneOptions, Method};
+use librate_core::map;
+use librate_core::attitude::{
     correct_across_family, correct_bordered, correct_planar_attitudes, verify_planar_attitudes, Bordered, Candidate, Closure, CorrectorOptions, Free, Parameter, PlanarFamily,
     PlanarStart,
 };
@@ -16,7 +18,7 @@ use crate::to_py;
 /// Chebyshev) and shared by every attitude trajectory on that orbit.
 #[pyclass(frozen, name = "OrbitForcing", module = "librate._core")]
 pub struct PyOrbitForcing {
-    inner: map::OrbitForcing,
+    inner: OrbitForcing,
 }
 
 #[pymethods]
@@ -24,7 +26,7 @@ impl PyOrbitForcing {
     #[new]
     #[pyo3(signature = (mu, state0, period, *, primaries=[true, true], tol=1e-12))]
     fn new(py: Python<'_>, mu: f64, state0: [f64; 6], period: f64, primaries: [bool; 2], tol: f64) -> PyResult<Self> {
-        let inner = py.detach(|| map::OrbitForcing::new(mu, &state0, period, primaries, tol)).map_err(to_py)?;
+        let inner = py.detach(|| OrbitForcing::new(mu, &state0, period, primaries, tol)).map_err(to_py)?;
         Ok(Self { inner })
     }
     #[getter]
@@ -133,7 +135,6 @@ fn per_case(a: &Option<PyReadonlyArray1<'_, f64>>, name: &str, n: usize) -> PyRe
 /// Integrate planar attitude trajectories (phi0, wz0, kz arrays of one length) over t_final.
 #[pyfunction]
 #[pyo3(signature = (forcing, t_final, phi0, wz0, kz, *, rtol, atol, max_steps, stm, chunk, threads, eps=None, cs=None, cd=None, theta_sun0=None, method="rkf78"))]
-#[allow(clippy::too_many_arguments)]
 fn map_sweep<'py>(
     py: Python<'py>,
     forcing: PyRef<'py, PyOrbitForcing>,
@@ -153,7 +154,7 @@ fn map_sweep<'py>(
     theta_sun0: Option<PyReadonlyArray1<'py, f64>>,
     method: &str,
 ) -> PyResult<PySweepResult> {
-    let method = map::Method::parse(method).ok_or_else(|| PyValueError::new_err(format!("invalid argument `method`: must be 'rkf78' or 'rkn86', got {method:?}")))?;
+    let method = Method::parse(method).ok_or_else(|| PyValueError::new_err(format!("invalid argument `method`: must be 'rkf78' or 'rkn86', got {method:?}")))?;
     let (p, w, k) = (phi0.as_array(), wz0.as_array(), kz.as_array());
     if p.len() != w.len() || k.len() != w.len() {
         return Err(PyValueError::new_err(format!("invalid argument: phi0, wz0 and kz must have one length, got {}, {}, {}", p.len(), w.len(), k.len())));
@@ -275,12 +276,11 @@ impl PyCorrectionBatch {
 }
 
 /// Correct many candidates at once to periodic planar attitude motions along the forcing's orbit
-/// (one Rust call for all Newton iterations; see librate_core::periodic::correct_planar_attitudes).
+/// (one Rust call for all Newton iterations; see librate_core::attitude::correct_planar_attitudes).
 #[pyfunction]
 #[pyo3(signature = (forcing, phi0, wz0, kz, turns, *, t_final, closure, free="phi0", eps=None, cs=None, cd=None, theta_sun0=None,
     tol=1e-12, max_iter=40, rtol=1e-13, atol=1e-13, max_steps=200_000, max_wz_step=0.5, max_angle_step=0.5, threads=None, chunk=64,
     parameter=None, condition=None, parameter_step=1e-6, max_parameter_step=0.5, monodromy=true, max_halvings=10, conditions=None))]
-#[allow(clippy::too_many_arguments)]
 fn attitude_correct<'py>(
     py: Python<'py>,
     forcing: PyRef<'py, PyOrbitForcing>,
@@ -364,9 +364,9 @@ fn attitude_correct<'py>(
     batch_from(py, &out)
 }
 
-fn batch_from(py: Python<'_>, out: &[librate_core::periodic::Correction]) -> PyResult<PyCorrectionBatch> {
+fn batch_from(py: Python<'_>, out: &[librate_core::attitude::Correction]) -> PyResult<PyCorrectionBatch> {
     let n = out.len();
-    let col = |g: &dyn Fn(&librate_core::periodic::Correction) -> f64| out.iter().map(g).collect::<Vec<f64>>();
+    let col = |g: &dyn Fn(&librate_core::attitude::Correction) -> f64| out.iter().map(g).collect::<Vec<f64>>();
     Ok(PyCorrectionBatch {
         phi0: col(&|c| c.phi0).into_pyarray(py).into_any().unbind(),
         wz0: col(&|c| c.wz0).into_pyarray(py).into_any().unbind(),
@@ -408,11 +408,10 @@ impl PyPlanarFamily {
 }
 
 /// The half-period correction with the orbit's x0 freed across a planar family, closed by the
-/// linear condition a_wz0 wz0 + a_x0 x0 = b (librate_core::periodic::correct_across_family).
+/// linear condition a_wz0 wz0 + a_x0 x0 = b (librate_core::attitude::correct_across_family).
 #[pyfunction]
 #[pyo3(signature = (family, wz0, kz, turns, x0, *, condition, phi0=0.0, tol=1e-12, max_iter=40, rtol=1e-13, atol=1e-13, max_steps=200_000,
     max_wz_step=0.5, parameter_step=1e-6, max_parameter_step=0.05, threads=None, max_halvings=10))]
-#[allow(clippy::too_many_arguments)]
 fn attitude_correct_across<'py>(
     py: Python<'py>,
     family: PyRef<'py, PyPlanarFamily>,
@@ -489,7 +488,6 @@ impl PyPlanarVerification {
 /// alongside, rtol = atol = 1e-14) in parallel; a plate where eps is given and non-zero.
 #[pyfunction]
 #[pyo3(signature = (mu, orbit_state0, t_final, kz, phi0, wz0, *, eps=None, cs=None, cd=None, theta_sun0=None, primaries=[true, true], threads=None))]
-#[allow(clippy::too_many_arguments)]
 fn planar_verify<'py>(
     py: Python<'py>,
     mu: f64,

@@ -2,7 +2,10 @@
 //! convert (the result arrays are moved into NumPy, not copied).
 
 use librate_core::attitude::RigidBody;
-use librate_core::map::{sweep_3d, Case3d, LaneOptions, TidalTable};
+use librate_core::integrate::forcing::TidalTable;
+use librate_core::integrate::lanes::LaneOptions;
+use librate_core::integrate::lanes3d::Case3d;
+use librate_core::map::sweep_3d;
 use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::exceptions::PyValueError;
@@ -105,7 +108,6 @@ impl PySweep3DResult {
 /// steps, 2 failed), steps (n, 2) accepted and rejected.
 #[pyfunction]
 #[pyo3(signature = (table, t_final, q0, w0, inertia, *, rtol, atol, max_steps=200_000, chunk=64, threads=None))]
-#[allow(clippy::too_many_arguments)]
 fn map_sweep_3d<'py>(
     py: Python<'py>,
     table: PyRef<'py, PyTidalTable>,
@@ -125,7 +127,7 @@ fn map_sweep_3d<'py>(
     let opts = LaneOptions { rtol, atol, max_steps, ..LaneOptions::default() };
     let f = &table.inner;
     let out = py.detach(|| sweep_3d(f, t_final, &cases, &opts, chunk, threads)).map_err(to_py)?;
-    let flat = |k: usize, g: &dyn Fn(&librate_core::map::Outcome3d) -> Vec<f64>| -> PyResult<Py<PyAny>> {
+    let flat = |k: usize, g: &dyn Fn(&librate_core::integrate::lanes3d::Outcome3d) -> Vec<f64>| -> PyResult<Py<PyAny>> {
         let v: Vec<f64> = out.iter().flat_map(g).collect();
         Ok(Array2::from_shape_vec((n, k), v).map_err(|e| PyValueError::new_err(e.to_string()))?.into_pyarray(py).into_any().unbind())
     };

@@ -1,7 +1,7 @@
 //! Typed records returned by the CR3BP bindings of `lib.rs` (propagation, symmetric and multiple
 //! shooting): frozen classes holding NumPy arrays (moved from Rust without copies) and scalars.
 
-use librate_core::periodic::Evaluation;
+use librate_core::orbit::Evaluation;
 use numpy::ndarray::Array2;
 use numpy::IntoPyArray;
 use pyo3::prelude::*;
@@ -126,7 +126,7 @@ impl PyBatchResult {
 }
 
 /// The half-period shooting functions of an x-z-symmetric orbit at p = (x0, z0, vy0) and their
-/// derivatives (librate_core::periodic::Evaluation).
+/// derivatives (librate_core::orbit::Evaluation).
 #[pyclass(frozen, get_all, name = "ShootingEvaluation", module = "librate._core")]
 pub struct PyShootingEvaluation {
     /// The unknowns (x0, z0, vy0), (3,).

@@ -21,7 +21,6 @@ pub struct AttitudeTrajectory {
 }
 
 /// Propagate the coupled 3-D model.
-#[allow(clippy::too_many_arguments)]
 pub fn propagate_attitude(
     mu: f64,
     body: RigidBody,
@@ -101,7 +100,6 @@ fn check_kz(kz: f64) -> Result<()> {
 }
 
 /// Planar attitude (phi, wz) with the orbit integrated alongside (or held at its start).
-#[allow(clippy::too_many_arguments)]
 pub fn propagate_planar(
     mu: f64,
     kz: f64,

@@ -67,7 +67,7 @@ impl GravityGradient {
 /// M = sum_i 3 mu_i / r_i^5 r_i r_i' (synodic axes, r_i from primary i, mu_1 = 1 - mu,
 /// mu_2 = mu; `primaries` switches either off), as (xx, yy, zz, xy, xz, yz). The gravity-gradient
 /// torque depends on the orbit only through M ([`gravity_gradient_torque`]); the 3-D map
-/// tabulates it once per orbit ([`crate::map::TidalTable`]).
+/// tabulates it once per orbit ([`crate::integrate::forcing::TidalTable`]).
 #[inline(always)]
 pub fn tidal_tensor<R: Real>(mu: f64, pos: &[R; 3], primaries: [bool; 2]) -> [R; 6] {
     let mut m = [R::cst(0.0); 6];

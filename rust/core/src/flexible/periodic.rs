@@ -17,7 +17,7 @@ use super::body::FlexibleBody;
 use super::propagate::propagate_flexible;
 use crate::error::{check_finite, check_positive, invalid, Result};
 use crate::integrate::{Options, Output};
-use crate::periodic::StopReason;
+use crate::attitude::StopReason;
 use crate::propagation::with_threads;
 
 /// The outcome of [`correct_flexible_periodic`].
@@ -35,7 +35,6 @@ pub struct FlexiblePeriodic {
 
 /// Correct `x0` = (phi0, wz0, q0, qdot0) to a periodic motion of the coupled model along the
 /// planar orbit `orbit0` of period `period` (see the module documentation).
-#[allow(clippy::too_many_arguments)]
 pub fn correct_flexible_periodic(
     mu: f64,
     body: &FlexibleBody,

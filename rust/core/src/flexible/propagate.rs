@@ -31,7 +31,6 @@ fn check_orbit(orbit0: &[f64; 6]) -> Result<()> {
 
 /// Propagate the coupled flexible model (phi, wz, q, qdot) with the orbit integrated alongside
 /// (or held at its initial position).
-#[allow(clippy::too_many_arguments)]
 pub fn propagate_flexible(
     mu: f64,
     body: &FlexibleBody,
@@ -127,7 +126,6 @@ pub fn quasi_static_point(mu: f64, body: &FlexibleBody, primaries: [bool; 2], he
 
 /// Propagate the rigid composite model with the first-order flexible perturbation, and
 /// evaluate the closed-form deflections at the output times.
-#[allow(clippy::too_many_arguments)]
 pub fn propagate_quasi_static(
     mu: f64,
     body: &FlexibleBody,
@@ -184,7 +182,6 @@ pub fn propagate_quasi_static(
 
 /// Energies of each state of a trajectory (rows of the orbit, phi, wz, q, qdot as returned by
 /// [`propagate_flexible`]), for the enabled primaries.
-#[allow(clippy::too_many_arguments)]
 pub fn evaluate_energies(mu: f64, body: &FlexibleBody, primaries: [bool; 2], orbit: &[f64], phi: &[f64], wz: &[f64], q: &[f64], qdot: &[f64]) -> Result<Vec<Energies>> {
     check_mu(mu)?;
     let m = phi.len();
@@ -202,7 +199,6 @@ pub fn evaluate_energies(mu: f64, body: &FlexibleBody, primaries: [bool; 2], orb
 }
 
 /// The right-hand side at one state, for tests and diagnostics: (wzdot, qddot).
-#[allow(clippy::too_many_arguments)]
 pub fn flexible_rates(mu: f64, body: &FlexibleBody, primaries: [bool; 2], orbit: &[f64; 6], phi: f64, wz: f64, q: &[f64], qdot: &[f64]) -> (f64, Vec<f64>) {
     let sys = FlexibleAlongOrbit { mu, body, primaries, held: true };
     let mut y = orbit.to_vec();

@@ -80,7 +80,6 @@ fn dtau(body: &FlexibleBody, w: &[Complex<f64>; 3], wzk: &[f64; 3]) -> f64 {
 impl FlexibleBody {
     /// The closed form at a point of a rigid solution: orbit position, velocity and
     /// acceleration (synodic; zero velocity and acceleration for a held orbit), phi, wz.
-    #[allow(clippy::too_many_arguments)]
     pub fn quasi_static(&self, mu: f64, primaries: [bool; 2], pos: &[f64], vel: &[f64], acc: &[f64], phi: f64, wz: f64) -> QuasiStaticPoint {
         let wsyn = tidal_field_derivatives(mu, pos, vel, acc, primaries);
         let (w, wzk) = chain(self, wsyn, phi, wz);

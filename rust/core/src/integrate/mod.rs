@@ -11,6 +11,9 @@
 pub mod controller;
 pub mod driver;
 pub mod events;
+pub mod forcing;
+pub mod lanes;
+pub mod lanes3d;
 pub mod stepper;
 pub mod rkn;
 pub mod tableau;

@@ -1,16 +1,13 @@
 //! The periodicity-map engine (thesis sec. 3.3, docs/physics.md, periodic attitude motions): planar attitude
 //! trajectories along one orbit for many (phi0, wz0, Kz), integrated over one period (or K
 //! periods) in SIMD lanes on all cores, with the orbit forcing computed once per orbit; and its
-//! 3-D counterpart ([`lanes3d`]): the rigid body's (q, w) along any periodic orbit for many
+//! 3-D counterpart ([`sweep_3d`]): the rigid body's (q, w) along any periodic orbit for many
 //! initial rates and bodies, over the orbit's tidal tensor tabulated once.
 
-pub mod forcing;
-pub mod lanes;
-pub mod lanes3d;
+pub use crate::integrate::lanes3d::{sweep_3d, sweep_3d_at};
 
-pub use forcing::{OrbitForcing, OrbitTable, TidalTable};
-pub use lanes3d::{sweep_3d, sweep_3d_at, Case3d, Outcome3d};
-pub use lanes::{integrate_cases, Case, LaneOptions, LaneStatus, Method, Outcome, Sensitivity};
+use crate::integrate::forcing::OrbitForcing;
+use crate::integrate::lanes::{self, integrate_cases, Case, LaneOptions, Outcome};
 
 use rayon::prelude::*;
 

@@ -731,7 +731,7 @@ mod tests {
     use super::*;
     use crate::attitude::PlanarForced;
     use crate::integrate::{Options, System};
-    use crate::periodic::correct_planar_symmetric;
+    use crate::orbit::correct_planar_symmetric;
     use crate::simd::Baseline;
 
     type I = Baseline;

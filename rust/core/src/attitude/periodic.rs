@@ -23,7 +23,7 @@
 //! the steps in wz0 and in the angle unknown are capped, and a backtracking line search (Armijo-type sufficient decrease
 //! of the residual's 2-norm, step halved up to `max_halvings` times) evaluates the trial
 //! points of all candidates together in the next sweep (the driver, [`super::newton`], is shared
-//! with the 3-D corrector, [`super::attitude3d`]). Each candidate reports why it stopped
+//! with the 3-D corrector, [`super::periodic3d`]). Each candidate reports why it stopped
 //! ([`StopReason`]); nothing panics and a non-finite result is never labelled converged.
 //!
 //! Determinism: candidates keep their order; the sweep of each iteration is bit-identical for
@@ -38,12 +38,14 @@ use std::collections::HashMap;
 use std::sync::{Arc, Mutex};
 
 use super::newton::{self, Eval, Problem, Settings, Track};
-use super::symmetric::{Constraint, SymmetricOrbit, SymmetricShooting, Var};
+use crate::orbit::{Constraint, SymmetricOrbit, SymmetricShooting, Var};
 use crate::attitude::{propagate_planar, FlatPlate, OMEGA_SUN};
 use crate::cr3bp::check_mu;
 use crate::error::{check_finite, check_positive, invalid, Error, Result};
 use crate::integrate::{Options, Output};
-use crate::map::{self, Case, LaneOptions, LaneStatus, OrbitForcing, Outcome, Sensitivity};
+use crate::integrate::forcing::OrbitForcing;
+use crate::integrate::lanes::{Case, LaneOptions, LaneStatus, Outcome, Sensitivity};
+use crate::map;
 use crate::propagation::with_threads;
 
 use std::f64::consts::{FRAC_PI_2, PI};

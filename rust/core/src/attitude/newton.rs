@@ -1,5 +1,5 @@
-//! The one batched, globalised Newton driver of the attitude correctors (planar: [`super::attitude`];
-//! 3-D: [`super::attitude3d`]). A problem form ([`Problem`]) says which trajectories a point of
+//! The one batched, globalised Newton driver of the attitude correctors (planar: [`super::periodic`];
+//! 3-D: [`super::periodic3d`]). A problem form ([`Problem`]) says which trajectories a point of
 //! the unknowns needs and how its residual and Jacobian follow from their outcomes; the driver
 //! integrates the pending points of every candidate in ONE call per iteration and runs, per
 //! candidate, capped Newton steps (minimum-norm when the Jacobian is rank-deficient) with a

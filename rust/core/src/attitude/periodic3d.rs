@@ -30,7 +30,7 @@ use rayon::prelude::*;
 
 use super::newton::{self, Eval, Problem, Settings, StopReason};
 use crate::attitude::linear::reduce;
-use super::symmetric::{Constraint as SymConstraint, Evaluation, SymmetricOrbit, SymmetricShooting};
+use crate::orbit::{Constraint as SymConstraint, Evaluation, SymmetricOrbit, SymmetricShooting};
 use crate::attitude::{propagate_attitude, Coupled, GravityGradient, OrbitMode, RigidBody, Torque};
 use crate::integrate::System;
 use crate::cr3bp::check_mu;
@@ -591,7 +591,6 @@ fn qexp_about(qr: &Quat, theta: &[f64; 3]) -> (Quat, [[f64; 3]; 4]) {
 
 /// The full-period closure rows (Log(q0* (x) qT), wT - w0), their Jacobian in (theta, w0) and
 /// the 6x6 monodromy, from the end state and 13x13 STM (the same algebra as [`Form3d`]).
-#[allow(clippy::type_complexity)]
 fn closure_rows(q0: &Quat, dq0: &[[f64; 3]; 4], w0: &[f64; 3], yt: &[f64], stm: &[f64]) -> Option<([f64; 6], [[f64; 6]; 6], [[f64; 6]; 6])> {
     if !(yt.iter().all(|v| v.is_finite()) && stm.iter().all(|v| v.is_finite())) {
         return None;
@@ -827,7 +826,7 @@ mod tests {
         // the DRO of x0 = 0.5385 and its period, from symmetric shooting with x0 fixed
         let mut sh = SymmetricShooting::new(mu, false, Options::with_tolerances(1e-13, 1e-13));
         sh.tol = 1e-12;
-        let dro = sh.correct([0.5385453306274934, 0.0, 0.6], SymConstraint::Fix(super::super::symmetric::Var::X0, 0.5385453306274934)).unwrap();
+        let dro = sh.correct([0.5385453306274934, 0.0, 0.6], SymConstraint::Fix(crate::orbit::Var::X0, 0.5385453306274934)).unwrap();
         let t0 = dro.period;
         let start = Start3d { q: [0.0, 0.0, 0.0, 1.0], w: [0.0, 0.0, 3.9254597] };
         let plain = &correct_attitudes_3d(mu, body, &dro.state0, t0, &[start], &opts).unwrap()[0];

@@ -18,7 +18,7 @@ use super::forcing::TidalTable;
 use super::lanes::{lane, run_steps, LaneOptions, LaneStatus, NoCut, Rhs, Run, Scheme, Stages, LANES};
 use crate::attitude::{dcm_with, euler_rate, gravity_gradient_torque, quat_rate, RigidBody};
 use crate::error::{check_finite, check_positive, invalid, Result};
-use crate::periodic::attitude_residual;
+use crate::attitude::attitude_residual;
 use crate::propagation::with_threads;
 use crate::scalar::F8;
 use crate::simd::{Isa, Kernel, Level};
