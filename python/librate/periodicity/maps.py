@@ -20,7 +20,19 @@ from .._core import __version__
 from .._errors import LibrateError
 from ..orbits.families import OrbitFamily
 from ..orbits.periodic import PeriodicOrbit
-from .solutions import MAP_ATOL, MAP_METHOD, MAP_RTOL, AttitudeSolution, candidates, check_orbit, check_srp, is_symmetric, orbit_forcing, refine, sweep
+from .solutions import (
+    MAP_ATOL,
+    MAP_METHOD,
+    MAP_RTOL,
+    AttitudeSolution,
+    candidates,
+    check_orbit,
+    check_srp,
+    is_symmetric,
+    orbit_forcing,
+    refine,
+    sweep,
+)
 
 __all__ = ["periodicity_map", "zero_contours", "orbits_of", "map_grid", "map_coords", "map_dataset", "solutions_from_row",
            "solutions_from_rows", "map_solutions_dataset", "solution_variables"]
