@@ -22,7 +22,19 @@ from .._progress import as_progress
 from ..orbits.families import OrbitFamily
 from ..orbits.periodic import PeriodicOrbit
 from ..results.kinds import MAP_VARIABLES
-from .solutions import MAP_ATOL, MAP_RTOL, AttitudeSolution, candidates, check_orbit, check_srp, is_symmetric, orbit_forcing, refine, sweep
+from .solutions import (
+    MAP_ATOL,
+    MAP_METHOD,
+    MAP_RTOL,
+    AttitudeSolution,
+    candidates,
+    check_orbit,
+    check_srp,
+    is_symmetric,
+    orbit_forcing,
+    refine,
+    sweep,
+)
 
 __all__ = ["periodicity_map", "zero_contours", "orbits_of", "map_grid", "map_coords", "map_dataset", "solutions_from_row",
            "solutions_from_rows", "map_solutions_dataset", "solution_variables"]
@@ -56,6 +68,7 @@ def periodicity_map(
     chunk: int = 64,
     threads: int | None = None,
     srp=None,
+    method: str = MAP_METHOD,
 ):
     """Residual grids over (orbit, Kz, wz0) and the periodic solutions they contain.
 
@@ -71,6 +84,8 @@ def periodicity_map(
     T = Ts / K); its parameters are stored as attributes. A list of plates (e.g. several eps or
     Cs) adds an ``srp`` dimension (orbit, srp, kz, wz0) with their parameters as coordinates. With SRP the mirror symmetry is broken
     and solutions are refined in (phi0, wz0) together (docs/physics.md, solar radiation pressure).
+    ``method``: the lanes' integrator ("rkf78", "dp87" or "rkn86": see :func:`sweep`), stored as
+    ``attrs["integrator"]``.
     """
 
 
@@ -83,7 +98,7 @@ def periodicity_map(
             raise ValueError("invalid argument `srp`: an empty list of plates")
         plates = [check_srp(p) for p in srp]
         maps = [periodicity_map(olist if family is None else family, kz=kz, wz0=wz0, phi0=phi0, n_periods=n_periods, solve=solve,
-                                progress=progress, rtol=rtol, atol=atol, chunk=chunk, threads=threads, srp=p) for p in plates]
+                                progress=progress, rtol=rtol, atol=atol, chunk=chunk, threads=threads, srp=p, method=method) for p in plates]
         return _stack_srp(maps, plates)
     srp = check_srp(srp)
     kzs, wz = map_grid(kz, wz0, n_periods)
@@ -109,7 +124,7 @@ def periodicity_map(
                 complete = False
                 warnings.warn(f"periodicity_map: orbit {i} (x0 = {o.x0:.10g}) skipped, its row left uncomputed: {err}", stacklevel=2)
                 continue
-            r = sweep(forcing, n_periods * o.period, phi0, wz_grid, kz_grid, rtol=rtol, atol=atol, chunk=chunk, threads=threads, srp=srp)
+            r = sweep(forcing, n_periods * o.period, phi0, wz_grid, kz_grid, rtol=rtol, atol=atol, chunk=chunk, threads=threads, srp=srp, method=method)
             dwz[i], dphi[i], phi_t[i] = (r[k].reshape(nk, nw) for k in ("dwz", "dphi", "phi_t"))
             status[i] = r["status"].reshape(nk, nw)
             if solve:
@@ -122,7 +137,7 @@ def periodicity_map(
         warnings.warn(f"periodicity_map interrupted: {int(done.sum())} of {no} orbits finished and kept", stacklevel=2)
     grid = {"dwz": dwz, "dphi": dphi, "phi_T": phi_t, "status": status}
     return map_dataset(olist, family, kzs, wz, grid, done, phi0=phi0, n_periods=n_periods, rtol=rtol, atol=atol, srp=srp, complete=complete,
-                       solutions=sols if solve else None)
+                       solutions=sols if solve else None, attrs={"integrator": str(method)})
 
 
 

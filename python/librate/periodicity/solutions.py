@@ -70,7 +70,7 @@ def sweep(forcing, t_final, phi0, wz0, kz, *, stm=False, rtol=MAP_RTOL, atol=MAP
           method=MAP_METHOD):
     """The engine over broadcast (phi0, wz0, kz[, eps]) arrays; ``srp`` a FlatPlate (its eps
     overridden per case by ``eps`` when given); ``method`` "rkf78" (Runge-Kutta-Fehlberg 7(8),
-    the default) or "rkn86" (Runge-Kutta-Nyström 8(6) on phi'' = wzdot(t, phi); its embedded
+    the default), "dp87" (Prince and Dormand's RK8(7)13M on the same states) or "rkn86" (Runge-Kutta-Nyström 8(6) on phi'' = wzdot(t, phi); its embedded
     error estimate is of sixth order, so the same accuracy comes at a looser rtol: see
     bench/bench_lanes.py)."""
     chunk = as_count(chunk, "chunk", 1)

@@ -154,7 +154,7 @@ fn map_sweep<'py>(
     theta_sun0: Option<PyReadonlyArray1<'py, f64>>,
     method: &str,
 ) -> PyResult<PySweepResult> {
-    let method = Method::parse(method).ok_or_else(|| PyValueError::new_err(format!("invalid argument `method`: must be 'rkf78' or 'rkn86', got {method:?}")))?;
+    let method = Method::parse(method).ok_or_else(|| PyValueError::new_err(format!("invalid argument `method`: must be 'rkf78', 'rkn86' or 'dp87', got {method:?}")))?;
     let (p, w, k) = (phi0.as_array(), wz0.as_array(), kz.as_array());
     if p.len() != w.len() || k.len() != w.len() {
         return Err(PyValueError::new_err(format!("invalid argument: phi0, wz0 and kz must have one length, got {}, {}, {}", p.len(), w.len(), k.len())));

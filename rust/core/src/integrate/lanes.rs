@@ -29,6 +29,7 @@ use super::forcing::OrbitForcing;
 use crate::attitude::{flat_plate_wzdot, gravity_gradient_wzdot, FlatPlate, Sun};
 use crate::constants::SOLAR_PRESSURE_1AU;
 use crate::integrate::rkn::{A as RKN_A, B as RKN_B, BP as RKN_BP, BPT as RKN_BPT, BT as RKN_BT, C as RKN_C, ERROR_ORDER as RKN_ERROR_ORDER, STAGES as RKN_STAGES};
+use crate::integrate::tableau::dp87::{dp87_stages, A as DP_A, B8 as DP_B8, C as DP_C, E as DP_E};
 use crate::integrate::tableau::{rkf78_stages, A, B8, C, ERR};
 use crate::integrate::Controller;
 use crate::scalar::F8;
@@ -131,15 +132,28 @@ pub enum Method {
     Rkf78,
     /// Runge-Kutta-Nyström 8(6) on phi'' = wzdot(t, phi) ([`crate::integrate::rkn`]).
     Rkn86,
+    /// Prince and Dormand's RK8(7)13M on the RKF7(8) states
+    /// ([`crate::integrate::tableau::dp87`]).
+    Dp87,
 }
 
 impl Method {
-    /// "rkf78" or "rkn86".
+    /// "rkf78", "rkn86" or "dp87".
     pub fn parse(name: &str) -> Option<Self> {
         match name {
             "rkf78" => Some(Self::Rkf78),
             "rkn86" => Some(Self::Rkn86),
+            "dp87" => Some(Self::Dp87),
             _ => None,
+        }
+    }
+
+    /// The name [`Self::parse`] reads.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Rkf78 => "rkf78",
+            Self::Rkn86 => "rkn86",
+            Self::Dp87 => "dp87",
         }
     }
 }
@@ -280,16 +294,23 @@ impl<I: Isa, const D: usize, const SRP: bool> Rhs<I, D> for Planar<'_, I, SRP> {
     }
 }
 
-/// RKF7(8) stages of D states.
-pub(crate) struct Stages<I, const D: usize> {
+/// The 13 stages of D states of an explicit pair ([`Fehlberg`]'s RKF7(8) or [`PrinceDormand`]'s
+/// RK8(7)13M, both 13 stages, both propagating their 8th-order solution).
+pub(crate) struct Stages<I, const D: usize, T = Fehlberg> {
     k: [[F8<I>; D]; 13],
     tmp: [F8<I>; D],
+    tableau: std::marker::PhantomData<T>,
 }
 
+/// The RKF7(8) tableau ([`crate::integrate::tableau`]).
+pub(crate) struct Fehlberg;
+/// The RK8(7)13M tableau ([`crate::integrate::tableau::dp87`]).
+pub(crate) struct PrinceDormand;
+
 macro_rules! stage {
-    ($st:ident, $m:ident, $t:ident, $y:ident, $h:ident, $s:literal; $($j:literal),+) => {{
-        lincomb(&mut $st.tmp, $y, F8::splat($y[0].isa(), $h), [$(A[$s][$j]),+], [$(&$st.k[$j]),+]);
-        $m.eval(C[$s].mul_add($h, $t), &$st.tmp, &mut $st.k[$s]);
+    ($a:ident, $c:ident, $st:ident, $m:ident, $t:ident, $y:ident, $h:ident, $s:literal; $($j:literal),+) => {{
+        lincomb(&mut $st.tmp, $y, F8::splat($y[0].isa(), $h), [$($a[$s][$j]),+], [$(&$st.k[$j]),+]);
+        $m.eval($c[$s].mul_add($h, $t), &$st.tmp, &mut $st.k[$s]);
     }};
 }
 
@@ -352,16 +373,16 @@ impl<I: Isa, const D: usize> PlanarY<I> for [F8<I>; D] {
     }
 }
 
-impl<I: Isa, const D: usize, M: Rhs<I, D>> Scheme<I, M> for Stages<I, D> {
+impl<I: Isa, const D: usize, M: Rhs<I, D>> Scheme<I, M> for Stages<I, D, Fehlberg> {
     type Y = [F8<I>; D];
     const CONTROLLER: Controller = CONTROLLER;
 
     fn new(isa: I) -> Self {
-        Stages { k: [[F8::splat(isa, 0.0); D]; 13], tmp: [F8::splat(isa, 0.0); D] }
+        Stages { k: [[F8::splat(isa, 0.0); D]; 13], tmp: [F8::splat(isa, 0.0); D], tableau: std::marker::PhantomData }
     }
 
     fn finite(y: &[F8<I>; D]) -> bool {
-        (0..D).all(|i| y[i].to_array().iter().all(|v| v.is_finite()))
+        finite_lanes(y)
     }
 
     /// One RKF7(8) step: the 8th-order solution and the scaled max-norm error per lane.
@@ -369,7 +390,7 @@ impl<I: Isa, const D: usize, M: Rhs<I, D>> Scheme<I, M> for Stages<I, D> {
     fn step(&mut self, m: &M, t: f64, y: &[F8<I>; D], h: f64, out: &mut [F8<I>; D], rtol: F8<I>, atol: F8<I>) -> F8<I> {
         let isa = y[0].isa();
         m.eval(t, y, &mut self.k[0]);
-        rkf78_stages!(stage!(self, m, t, y, h));
+        rkf78_stages!(stage!(A, C, self, m, t, y, h));
         let k = &self.k;
         let hv = F8::splat(isa, h);
         lincomb(out, y, hv, [B8[5], B8[6], B8[7], B8[8], B8[9], B8[11], B8[12]], [&k[5], &k[6], &k[7], &k[8], &k[9], &k[11], &k[12]]);
@@ -377,6 +398,51 @@ impl<I: Isa, const D: usize, M: Rhs<I, D>> Scheme<I, M> for Stages<I, D> {
         let mut err = F8::splat(isa, 0.0);
         for i in 0..D {
             err = fold_error(err, he * ((k[0][i] + k[10][i]) - (k[11][i] + k[12][i])), y[i], out[i], rtol, atol);
+        }
+        err
+    }
+}
+
+/// Every lane of every component finite.
+#[inline(always)]
+fn finite_lanes<I: Isa, const D: usize>(y: &[F8<I>; D]) -> bool {
+    (0..D).all(|i| y[i].to_array().iter().all(|v| v.is_finite()))
+}
+
+/// Prince and Dormand's RK8(7)13M on the lanes: the same stage loop (the tableau's sparsity from
+/// `dp87_stages!`), the 8th-order solution propagated, the error from the embedded 7th-order one
+/// (nine non-zero weights), the RKF7(8) controller (both estimates are of order 7).
+impl<I: Isa, const D: usize, M: Rhs<I, D>> Scheme<I, M> for Stages<I, D, PrinceDormand> {
+    type Y = [F8<I>; D];
+    const CONTROLLER: Controller = Controller::new(0.8, 0.2, 5.0, crate::integrate::tableau::dp87::ERROR_ORDER);
+
+    fn new(isa: I) -> Self {
+        Stages { k: [[F8::splat(isa, 0.0); D]; 13], tmp: [F8::splat(isa, 0.0); D], tableau: std::marker::PhantomData }
+    }
+
+    fn finite(y: &[F8<I>; D]) -> bool {
+        finite_lanes(y)
+    }
+
+    #[inline(always)]
+    fn step(&mut self, m: &M, t: f64, y: &[F8<I>; D], h: f64, out: &mut [F8<I>; D], rtol: F8<I>, atol: F8<I>) -> F8<I> {
+        let isa = y[0].isa();
+        m.eval(t, y, &mut self.k[0]);
+        dp87_stages!(stage!(DP_A, DP_C, self, m, t, y, h));
+        let k = &self.k;
+        let hv = F8::splat(isa, h);
+        let w = DP_B8;
+        lincomb(out, y, hv, [w[0], w[5], w[6], w[7], w[8], w[9], w[10], w[11], w[12]], [&k[0], &k[5], &k[6], &k[7], &k[8], &k[9], &k[10], &k[11], &k[12]]);
+        let e = DP_E;
+        let ec = [e[0], e[5], e[6], e[7], e[8], e[9], e[10], e[11], e[12]];
+        let ek = [&k[0], &k[5], &k[6], &k[7], &k[8], &k[9], &k[10], &k[11], &k[12]];
+        let mut err = F8::splat(isa, 0.0);
+        for i in 0..D {
+            let mut acc = F8::splat(isa, 0.0);
+            for m in 0..9 {
+                acc = F8::splat(isa, ec[m]).mul_add(ek[m][i], acc);
+            }
+            err = fold_error(err, hv * acc, y[i], out[i], rtol, atol);
         }
         err
     }
@@ -702,8 +768,10 @@ impl<const D: usize, const SRP: bool> Kernel for Groups<'_, D, SRP> {
     #[inline(always)]
     fn run<I: Isa>(self, isa: I) -> Vec<Outcome> {
         match (self.opts.method, D == 8) {
+            (Method::Dp87, true) if self.opts.sensitivity != Sensitivity::None => self.with::<I, Stages<I, 10, PrinceDormand>>(isa),
             (_, true) if self.opts.sensitivity != Sensitivity::None => self.with::<I, Stages<I, 10>>(isa),
             (Method::Rkf78, _) => self.with::<I, Stages<I, D>>(isa),
+            (Method::Dp87, _) => self.with::<I, Stages<I, D, PrinceDormand>>(isa),
             (Method::Rkn86, true) => self.with::<I, Nystrom<I, 3>>(isa),
             (Method::Rkn86, false) => self.with::<I, Nystrom<I, 1>>(isa),
         }

@@ -15,7 +15,7 @@
 use rayon::prelude::*;
 
 use super::forcing::TidalTable;
-use super::lanes::{lane, run_steps, LaneOptions, LaneStatus, NoCut, Rhs, Run, Scheme, Stages, LANES};
+use super::lanes::{lane, run_steps, Fehlberg, LaneOptions, LaneStatus, Method, NoCut, PrinceDormand, Rhs, Run, Scheme, Stages, LANES};
 use crate::attitude::{dcm_with, euler_rate, gravity_gradient_torque, quat_rate, RigidBody};
 use crate::error::{check_finite, check_positive, invalid, Result};
 use crate::attitude::attitude_residual;
@@ -76,7 +76,7 @@ impl<I: Isa> Rhs<I, D> for Rigid<'_, I> {
 
 /// Integrate one group of up to LANES trajectories; missing lanes repeat the last.
 #[inline(always)]
-fn integrate_group<I: Isa>(isa: I, table: &TidalTable, t_final: f64, group: &[Case3d], opts: &LaneOptions, st: &mut Stages<I, D>) -> [Outcome3d; LANES] {
+fn integrate_group<'a, I: Isa, S: Scheme<I, Rigid<'a, I>, Y = [F8<I>; D]>>(isa: I, table: &'a TidalTable, t_final: f64, group: &[Case3d], opts: &LaneOptions, st: &mut S) -> [Outcome3d; LANES] {
     let n = group.len();
     let pick = |l: usize| group[l.min(n - 1)];
     let moments = |i: usize| F8::new(isa, std::array::from_fn(|l| pick(l).body.moments()[i]));
@@ -84,7 +84,7 @@ fn integrate_group<I: Isa>(isa: I, table: &TidalTable, t_final: f64, group: &[Ca
     let one = F8::splat(isa, 1.0);
     let model = Rigid { table, inertia, inv: inertia.map(|v| one / v), one };
     let mut y: [F8<I>; D] = std::array::from_fn(|i| F8::new(isa, std::array::from_fn(|l| if i < 4 { pick(l).q0[i] } else { pick(l).w0[i - 4] })));
-    <Stages<I, D> as Scheme<I, Rigid<'_, I>>>::begin(st);
+    st.begin();
     let Run { accepted, rejected, status } = run_steps(isa, st, &model, &mut y, t_final, opts, &mut NoCut);
     std::array::from_fn(|l| {
         if status != LaneStatus::Ok {
@@ -109,10 +109,20 @@ impl Kernel for Groups3d<'_> {
     type Output = Vec<Outcome3d>;
     #[inline(always)]
     fn run<I: Isa>(self, isa: I) -> Vec<Outcome3d> {
-        let mut st = <Stages<I, D> as Scheme<I, Rigid<'_, I>>>::new(isa);
+        match self.opts.method {
+            Method::Dp87 => self.with::<I, Stages<I, D, PrinceDormand>>(isa),
+            _ => self.with::<I, Stages<I, D, Fehlberg>>(isa),
+        }
+    }
+}
+
+impl<'a> Groups3d<'a> {
+    #[inline(always)]
+    fn with<I: Isa, S: Scheme<I, Rigid<'a, I>, Y = [F8<I>; D]>>(self, isa: I) -> Vec<Outcome3d> {
+        let mut st = S::new(isa);
         let mut out = Vec::with_capacity(self.cases.len());
         for group in self.cases.chunks(LANES) {
-            let r = integrate_group(isa, self.table, self.t_final, group, self.opts, &mut st);
+            let r = integrate_group::<I, S>(isa, self.table, self.t_final, group, self.opts, &mut st);
             out.extend_from_slice(&r[..group.len()]);
         }
         out
@@ -121,8 +131,9 @@ impl Kernel for Groups3d<'_> {
 
 /// Integrate every case from t = 0 to `t_final` along the tabulated orbit on `threads` workers
 /// (None: all cores), `chunk` cases per task, at the active SIMD level. Results are in case
-/// order and bit-identical for any `chunk` and thread count. Only `opts.rtol`, `opts.atol` and
-/// `opts.max_steps` apply (RKF7(8)).
+/// order and bit-identical for any `chunk` and thread count. Only `opts.rtol`, `opts.atol`,
+/// `opts.max_steps` and `opts.method` apply (RKF7(8) or RK8(7)13M; the Nyström method is planar
+/// only: an error).
 pub fn sweep_3d(table: &TidalTable, t_final: f64, cases: &[Case3d], opts: &LaneOptions, chunk: usize, threads: Option<usize>) -> Result<Vec<Outcome3d>> {
     sweep_3d_at(crate::simd::active()?, table, t_final, cases, opts, chunk, threads)
 }
@@ -133,6 +144,9 @@ pub fn sweep_3d_at(level: Level, table: &TidalTable, t_final: f64, cases: &[Case
     crate::integrate::check_tolerances(opts.rtol, opts.atol)?;
     if chunk == 0 {
         return Err(invalid("chunk", "must be >= 1"));
+    }
+    if opts.method == Method::Rkn86 {
+        return Err(invalid("method", "the 3-D map integrates with 'rkf78' or 'dp87' ('rkn86' is planar only)"));
     }
     if threads == Some(0) {
         return Err(invalid("threads", "must be >= 1 (or None for all cores)"));
