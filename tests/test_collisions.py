@@ -77,8 +77,9 @@ def test_propagate_many_reports_collisions_per_row(em):
 
 def test_dro_near_the_moon_is_still_a_point_mass_orbit(em):
     """The DRO family starts inside the Moon's radius (x0 = 0.985): periodic orbits are
-    propagated as point-mass solutions (collision="point") by their own methods."""
-    o = librate.correct_dro(em, 0.985)
+    propagated as point-mass solutions (collision="point") by their own methods. Issue 24 #8:
+    correct_dro refuses it by default (see test_families), collision=None keeps it."""
+    o = librate.correct_dro(em, 0.985, collision=None)
     assert o.propagate().status == "completed"
     assert np.all(np.isfinite(o.monodromy))
     with pytest.raises(librate.CollisionError):

@@ -249,3 +249,89 @@ def test_family_progress(em):
         fam = build(record)
         assert calls and all(d <= t for d, t in calls) and all(a[0] <= b[0] for a, b in zip(calls, calls[1:]))
         assert calls[-1] == (len(fam), len(fam))
+
+
+# --- issue 24 #8: orbits through a primary are refused or flagged ----------------------------------
+
+
+def test_single_orbits_through_a_primary_are_refused(em):
+    """Issue 24 #8: the DRO at x0 = 0.985 never leaves the Moon's radius (1737.4 km) and the one
+    at x0 = 0 starts 4670 km from the Earth's centre (radius 6371.0084 km), yet both were
+    returned as valid while propagate() of the same states raises CollisionError. Reference
+    (analytic): both start on the x axis at their closest approach, |x0 - x_primary| * lu_km:
+    (1 - mu - 0.985) * 384400 = 1095.54 km and mu * 384400 = 4670.46 km (tolerance 1 km: the
+    closest approach is sampled at the integrator's steps)."""
+    for x0, k, closest, radius in ((0.985, 2, (1 - em.mu - 0.985) * em.lu_km, em.r2_km), (0.0, 1, em.mu * em.lu_km, em.r1_km)):
+        with pytest.raises(librate.CollisionError, match=rf"{['Earth', 'Moon'][k - 1]}'s radius.*closest approach.*km.*{radius} km") as info:
+            librate.correct_dro(em, x0)
+        err = info.value
+        assert err.primary == k and err.radius_km == radius and err.closest_km == pytest.approx(closest, abs=1.0)
+        kept = librate.correct_dro(em, x0, collision=None)  # the point-mass orbit, on request
+        np.testing.assert_array_equal(kept.state0, err.orbit.state0)
+        with pytest.raises(librate.CollisionError):  # the same verdict as propagate's collision check
+            librate.propagate(em, kept.state0, kept.period)
+    guess = librate.correct_dro(em, 0.985, collision=None).state0
+    with pytest.raises(librate.CollisionError, match="Moon"):
+        librate.correct_symmetric(em, guess)
+    with pytest.raises(librate.CollisionError, match="Moon"):
+        librate.correct_periodic(em, guess, librate.correct_dro(em, 0.985, collision=None).period)
+    with pytest.raises(librate.CollisionError, match="Moon"):
+        librate.dro(em, x0=0.985)
+    with pytest.raises(ValueError, match="`collision`"):
+        librate.correct_dro(em, 0.9, collision="surface")
+    assert librate.correct_dro(em, 0.98).x0 == 0.98  # 3018 km from the Moon's centre: outside
+
+
+def test_point_mass_systems_never_collide(em):
+    """Issue 24 #8: a system with radii 0 (point masses) keeps the orbit: only a real radius refuses it."""
+    pm = librate.System(em.mu, em.lu_km, em.tu_s, name="earth-moon point masses")
+    o = librate.correct_dro(pm, 0.985)
+    np.testing.assert_allclose(o.state0, librate.correct_dro(em, 0.985, collision=None).state0, rtol=0, atol=1e-12)
+
+
+def test_families_flag_members_through_a_primary(dros, em):
+    """Issue 24 #8: a default family call still works and flags the members that pass within a
+    primary's radius, by the collision check propagate() uses (checked member by member):
+    the DRO family's first member (x0 = 0.985, inside the Moon), the last member of the L2
+    Lyapunov and L2 halo families (their continuation stops there, at the Moon's surface).
+    member() refuses a value in a flagged stretch."""
+    ip = dros.inside_primary
+    assert ip[0] == 2 and np.all(ip[1:] == 0) and not dros.outside_primaries[0]
+    assert dros.closest_km[0, 1] == pytest.approx((1 - em.mu - 0.985) * em.lu_km, abs=1.0)
+    for i in (0, 1, 2, len(dros) - 1):
+        o = dros[i]
+        try:
+            librate.propagate(em, o.state0, o.period, rtol=1e-13, atol=1e-13)
+            assert ip[i] == 0
+        except librate.CollisionError as err:
+            assert ip[i] == err.primary
+    with pytest.raises(librate.CollisionError, match="Moon's radius"):
+        dros.member(x0=0.984)
+    assert dros.member(x0=0.98).x0 == pytest.approx(0.98, abs=1e-12)
+    lyap = librate.lyapunov_family(em, 2)
+    assert lyap.end_reason.startswith("collision") and lyap.inside_primary[-1] == 2 and np.all(lyap.inside_primary[:-1] == 0)
+    with pytest.raises(librate.CollisionError, match="Moon"):
+        librate.lyapunov(em, 2, x0=float(lyap.x0[-1]))
+
+
+# --- issue 24 #9: requested DRO members are reachable whenever the default family reaches them -----
+
+
+def test_requested_dro_members_reach_what_the_default_family_reaches(dros, em):
+    """Issue 24 #9: dro_family(em, x0=[0.01]) failed ("step floor ... past x0 = 0.5975") while the
+    default family reaches x0 = 0.01. Reference: the default family's members (the same
+    correction at the same x0, tolerance 1e-10 on the state and period, the corrector's 1e-12
+    closure amplified near the Earth), and its located out-of-plane bifurcation (1e-8, the
+    driver's location tolerance) for a request that brackets it."""
+    for req in ([0.01], [0.01, 0.5], [0.5, 0.01], [0.0123]):
+        fam = librate.dro_family(em, x0=req)
+        assert fam.x0.tolist() == req
+        for o in fam:
+            i = np.flatnonzero(dros.x0 == o.x0)
+            if i.size:
+                np.testing.assert_allclose(o.state0, dros.state0[i[0]], rtol=0, atol=1e-10)
+                assert o.period == pytest.approx(dros.period[i[0]], rel=1e-10)
+    ref = [b for b in dros.bifurcations if b["index"] == "out-of-plane"]
+    fam = librate.dro_family(em, x0=[0.3, 0.25])
+    got = [b for b in fam.bifurcations if b["index"] == "out-of-plane"]
+    assert len(got) == 1 and got[0]["member"] == 0 and got[0]["x0"] == pytest.approx(ref[0]["x0"], abs=1e-8) and got[0]["located"]

@@ -291,6 +291,24 @@ def test_correct_symmetric_valid(g, spatial):
         assert math.isfinite(o.period) and np.all(np.isfinite(o.state0))
 
 
+@settings(FEW, max_examples=12)
+@given(x0=st.one_of(st.floats(0.976, 0.987), st.floats(-0.005, 0.02)))
+def test_corrected_orbits_agree_with_propagate_on_collisions(x0):
+    """Issue 24 #8: a corrected DRO near a primary is returned only when propagate()'s collision
+    check (the system's radii) passes over its period; otherwise CollisionError names the
+    primary, and propagate() of the orbit it refuses raises too (the same verdict)."""
+    try:
+        o = librate.correct_dro(EM, x0)
+    except librate.CollisionError as err:
+        assert err.primary in (1, 2) and err.closest_km < err.radius_km
+        with pytest.raises(librate.CollisionError):
+            librate.propagate(EM, err.orbit.state0, err.orbit.period, rtol=1e-13, atol=1e-13)
+        return
+    except librate.LibrateError:
+        return  # no DRO found there (a typed error)
+    assert librate.propagate(EM, o.state0, o.period, rtol=1e-13, atol=1e-13).status == "completed"
+
+
 LOOKUP_BAD = [
     ("point", lambda v: librate.lyapunov(EM, v, x0=0.8), st.one_of(st.integers().filter(lambda k: k not in (1, 2)), st.text(max_size=2), st.none(), st.booleans())),
     ("point", lambda v: librate.halo(EM, v, z0=0.05), st.one_of(st.integers().filter(lambda k: k not in (1, 2)), st.text(max_size=2), st.none())),

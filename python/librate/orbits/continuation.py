@@ -9,7 +9,6 @@ continuity, winding numbers).
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
@@ -19,34 +18,12 @@ from .. import _core
 from .._errors import LibrateError
 from .._progress import as_progress
 from ..solving.continuation import Bifurcation, Branch, Constraint, Point, StepRules, arclength, natural
-from .periodic import SHOOT_ATOL, SHOOT_RTOL, PeriodicOrbit, index_tests, orbit_from_core, symmetric_monodromy
+from .periodic import SHOOT_ATOL, SHOOT_RTOL, Geometry, PeriodicOrbit, geometry, index_tests, orbit_from_core, symmetric_monodromy
 from .system import System
 
 __all__ = ["Geometry", "geometry", "continue_natural", "continue_arclength", "ContinuationResult"]
 
 _VAR_INDEX = {"x0": 0, "z0": 1, "vy0": 2}
-
-
-@dataclass(frozen=True)
-class Geometry:
-    """Winding numbers of an orbit about each primary and its closest approach to each."""
-
-    winding: tuple[int, int]
-    min_distance: tuple[float, float]
-
-
-def geometry(orbit: PeriodicOrbit) -> Geometry:
-    """Winding numbers (signed turns of the projected position about each primary over one
-    period) and closest approaches, from the integrated orbit."""
-    tr = orbit.propagate(rtol=1e-11, atol=1e-11)
-    y = tr.y
-    wind, dmin = [], []
-    for c in orbit.system.primary_positions():
-        rel = y[:, :3] - c
-        ang = np.unwrap(np.arctan2(rel[:, 1], rel[:, 0]))
-        wind.append(int(round((ang[-1] - ang[0]) / (2 * math.pi))))
-        dmin.append(float(np.min(np.linalg.norm(rel, axis=1))))
-    return Geometry((wind[0], wind[1]), (dmin[0], dmin[1]))
 
 
 @dataclass

@@ -14,6 +14,7 @@ southern halo at its crossing with z < 0 (apolune for the NRHOs), a northern one
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import math
 from dataclasses import dataclass, field
@@ -24,10 +25,23 @@ from .. import _core
 from .._checks import as_count, as_real
 from .._display import fmt, html_summary, short_repr
 from .._errors import ConvergenceError, LibrateError
+from .._progress import as_progress
 from ..constants import SUN_SYNODIC_PERIOD
 from ..solving.continuation import sign_changes
 from .continuation import continue_arclength, continue_natural, geometry
-from .periodic import INDEX_TESTS, SHOOT_ATOL, SHOOT_RTOL, PeriodicOrbit, correct_symmetric, index_tests, real_if_real
+from .periodic import (
+    INDEX_TESTS,
+    SHOOT_ATOL,
+    SHOOT_RTOL,
+    PeriodicOrbit,
+    check_outside_primaries,
+    collision_mode,
+    correct_symmetric,
+    index_tests,
+    inside_primary_index,
+    primary_passes,
+    real_if_real,
+)
 from .propagation import propagate_many
 from .system import System, resolve_system
 
@@ -177,6 +191,28 @@ class OrbitFamily:
     def period_days(self) -> np.ndarray:
         return self.system.period_days(self.period)
 
+    @functools.cached_property
+    def inside_primary(self) -> np.ndarray:
+        """(n,) int8 per member: 1 or 2 when the orbit passes within that primary's radius over
+        its period (a solution of the point-mass model only, not a valid orbit of a body of
+        that size), 0 when it stays outside both (always 0 in a point-mass system, radii 0);
+        -1 if its propagation failed. The one collision check of :func:`librate.propagate_many`
+        with the system's radii (:func:`librate.orbits.periodic.primary_passes`), as
+        :meth:`from_jpl` flags catalog rows; computed on first use. :meth:`member` refuses a
+        value in a flagged stretch with :class:`librate.CollisionError`."""
+        return inside_primary_index(primary_passes(self.system, self.state0, self.period).status)
+
+    @functools.cached_property
+    def closest_km(self) -> np.ndarray:
+        """(n, 2) closest approach of each member to the larger and the smaller primary's
+        centre (km, from :func:`librate.orbits.continuation.geometry`); computed on first use."""
+        return np.array([geometry(o).min_distance for o in self]) * self.system.lu_km
+
+    @property
+    def outside_primaries(self) -> np.ndarray:
+        """(n,) bool: the members that stay outside both primaries' radii (``inside_primary == 0``)."""
+        return self.inside_primary == 0
+
     @property
     def stable(self) -> np.ndarray:
         """Linearly stable members (both indices real with |nu| <= 1)."""
@@ -199,8 +235,13 @@ class OrbitFamily:
         (x0, z0 and the Jacobi constant are not monotonic along a halo family), ``ValueError``
         lists them with their periods and ``which`` (an index into that list) picks one; with a
         single candidate ``which`` may be omitted or 0. Raises ``ValueError`` when the value is
-        outside the family's range.
+        outside the family's range. A member that passes within a primary's radius (see
+        :attr:`inside_primary`) raises :class:`librate.CollisionError` naming the primary, the
+        closest approach and the radius.
         """
+        return check_outside_primaries(self._member(x0=x0, z0=z0, period=period, period_days=period_days, jacobi=jacobi, which=which))
+
+    def _member(self, *, x0, z0, period, period_days, jacobi, which) -> PeriodicOrbit:
         given = {k: v for k, v in dict(x0=x0, z0=z0, period=period, period_days=period_days, jacobi=jacobi).items() if v is not None}
         if len(given) != 1:
             raise ValueError("invalid argument: give exactly one of x0, z0, period, period_days, jacobi")
@@ -254,7 +295,7 @@ class OrbitFamily:
         # The correction left the bracket (near a fold of the quantity the two solutions are
         # close) or failed: continue the family finely from member i past member i + 1 (the
         # continuation driver, pseudo-arclength) and correct from the fine bracket.
-        start = correct_symmetric(self.system, a, spatial=self.spatial, fix="x0", family=self.kind)
+        start = correct_symmetric(self.system, a, spatial=self.spatial, fix="x0", family=self.kind, collision=None)
         pa, chord = a[[0, 2, 4]], b[[0, 2, 4]] - a[[0, 2, 4]]
         length = float(np.linalg.norm(chord))
 
@@ -285,7 +326,7 @@ class OrbitFamily:
             g[0] = value
         elif name == "z0":
             g[2] = value
-        return correct_symmetric(self.system, g, spatial=self.spatial, family=self.kind, **kw)
+        return correct_symmetric(self.system, g, spatial=self.spatial, family=self.kind, collision=None, **kw)
 
     def resonant(self, k: int, kind: str = "synodic") -> PeriodicOrbit:
         """The 1:k resonant member: synodic T = 2 pi / k, or Sun-resonant T = Ts / k
@@ -604,6 +645,7 @@ def correct_dro(
     max_iter: int = 30,
     rtol: float = SHOOT_RTOL,
     atol: float = SHOOT_ATOL,
+    collision: str | None = "radius",
 ) -> PeriodicOrbit:
     """Correct the distant retrograde orbit through (x0, 0, 0) with ydot0 > 0 (docs/physics.md, periodic orbits).
 
@@ -617,9 +659,15 @@ def correct_dro(
     The result is always a DRO: it winds once clockwise about the Moon and not about the Earth
     (winding numbers (0, -1)); a correction that lands on another orbit (e.g. one about the
     Earth, from a poor ``ydot0``) raises :class:`librate.ConvergenceError` naming what it found.
+
+    ``collision`` as in :func:`librate.correct_symmetric`: by default a DRO that passes within a
+    primary's radius (in the Earth-Moon system the Moon's for x0 near 0.985, the Earth's for
+    x0 near 0) raises :class:`librate.CollisionError` naming the primary, the closest approach
+    and the radius; ``None`` returns the point-mass orbit anyway.
     """
     sys_ = resolve_system(system)
     mu = sys_.mu
+    collision_mode(collision)
     if not (isinstance(x0, (int, float, np.integer, np.floating)) and not isinstance(x0, (bool, np.bool_)) and math.isfinite(x0) and -mu < x0 < 1.0 - mu):
         raise ValueError(f"invalid argument `x0`: a DRO starts between the primaries, -mu < x0 < 1 - mu = ({-mu}, {1 - mu}), got {x0!r}")
     x0 = float(x0)
@@ -644,14 +692,18 @@ def correct_dro(
             f"DRO correction at x0 = {x0} converged to an orbit that is not a DRO: ydot0 = {orbit.vy0:.6g}, period {orbit.period:.6g} TU, "
             f"winding numbers about (Earth, Moon) {g.winding} instead of {DRO_WINDING}; omit ydot0 (the family is then continued) "
             "or use librate.dro(system, x0=...)")
-    return orbit
+    return check_outside_primaries(orbit, collision)
 
 
 def _correct_dro_at(sys_, x0, ydot0, tol, max_iter, rtol, atol) -> PeriodicOrbit:
     if ydot0 is None:
         d = 1.0 - sys_.mu - x0
         ydot0 = math.sqrt(sys_.mu / d) + d
-    return correct_symmetric(sys_, (x0, 0.0, ydot0), fix="x0", family="dro", tol=tol, max_iter=max_iter, rtol=rtol, atol=atol)
+    return correct_symmetric(sys_, (x0, 0.0, ydot0), fix="x0", family="dro", tol=tol, max_iter=max_iter, rtol=rtol, atol=atol, collision=None)
+
+
+#: The default DRO family's members: x0 from 0.985 near the Moon to 0.005 near the Earth, every 0.005.
+DRO_DEFAULT_X0 = np.round(np.arange(0.985, 0.0049, -0.005), 10)
 
 
 def dro_family(system: System | str = "earth-moon", x0=None, *, check_geometry: bool = True, allow_partial: bool = False,
@@ -659,43 +711,76 @@ def dro_family(system: System | str = "earth-moon", x0=None, *, check_geometry: 
     """The planar DRO family by natural-parameter continuation in x0 (thesis eq. 20-22).
 
     ``x0``: the members wanted (any order along the family; default the whole family from
-    0.985 near the Moon to 0.005 near the Earth, every 0.005). Each step is guarded against
-    silent jumps (Jacobi constant and period continuity, winding numbers about both primaries)
-    and halved when needed; the run ends cleanly, with ``end_reason``, at a collision with the
-    Earth's surface or a step floor, keeping every member found.
+    0.985 near the Moon to 0.005 near the Earth, every 0.005, :data:`DRO_DEFAULT_X0`). Each
+    step is guarded against silent jumps (Jacobi constant and period continuity, winding
+    numbers about both primaries) and halved when needed; the run ends cleanly, with
+    ``end_reason``, at a collision with the Earth's surface or a step floor, keeping every
+    member found. Members that pass within a primary's radius (near the Moon, x0 = 0.985 in
+    the Earth-Moon system) are kept and flagged (:attr:`OrbitFamily.inside_primary`).
 
-    When ``x0`` is given, every requested member must be reached: otherwise
-    :class:`librate.LibrateError` lists the missing x0 values and why the continuation ended
-    (attributes ``missing``, ``found`` and ``end_reason``), unless ``allow_partial=True``, which
-    returns the members found (``parameters["missing_x0"]`` lists the others). ``progress(done,
-    total)`` is called after each member.
+    Requested members are reached the default way: the continuation starts at x0 = 0.985 (or
+    the largest requested x0 above it) and walks the default members down to the smallest
+    requested x0, with every requested x0 inserted as a target and corrected exactly there; the
+    family holds the requested members only, in the requested order. So every member the
+    default family reaches is reachable on request. When ``x0`` is given, every requested
+    member must be reached: otherwise :class:`librate.LibrateError` lists the missing x0 values
+    and why the continuation ended (attributes ``missing``, ``found`` and ``end_reason``),
+    unless ``allow_partial=True``, which returns the members found
+    (``parameters["missing_x0"]`` lists the others). ``progress(done, total)`` is called as the
+    requested members are reached (total: their number).
     """
     sys_ = resolve_system(system)
     mu = sys_.mu
-    xs = np.round(np.arange(0.985, 0.0049, -0.005), 10) if x0 is None else np.atleast_1d(np.asarray(x0, dtype=float))
+    xs = DRO_DEFAULT_X0.copy() if x0 is None else np.atleast_1d(np.asarray(x0, dtype=float)).ravel()
     if xs.size == 0 or not np.all(np.isfinite(xs)) or np.any(xs <= -mu) or np.any(xs >= 1 - mu):
         raise ValueError(f"invalid argument `x0`: DROs start between the primaries, -mu < x0 < 1 - mu = ({-mu}, {1 - mu}); got {x0!r}")
-    start = 0.95 if xs[0] < 0.9 else float(xs[0])
-    first = correct_dro(sys_, start)
+    progress = as_progress(progress, "dro family", "member")
+    top = max(float(xs.max()), float(DRO_DEFAULT_X0[0]))
+    ds_min = 1e-6  # the natural continuation's step floor: default members closer to a request are left out
+    grid = [g for g in DRO_DEFAULT_X0 if float(xs.min()) < g <= top and np.min(np.abs(xs - g)) > ds_min]
+    path = np.array(sorted(set(float(v) for v in xs) | set(float(g) for g in grid), reverse=True))
+    wanted = np.isin(path, xs)
+    n_wanted = int(np.unique(xs).size)
+    counted = np.concatenate([[0], np.cumsum(wanted)])
+
+    def along(done, total):  # the run's progress over the path, as requested members reached
+        if progress is not None:
+            progress(int(counted[min(int(done), path.size)]), n_wanted)
+
+    first = correct_dro(sys_, float(path[0]), collision=None)
     stop = _collision_stop(sys_, (sys_.r1_km, 0.0))
-    if start != xs[0]:
-        lead = continue_natural(sys_, first, "x0", np.linspace(start, xs[0], 9)[1:], family="dro", check_geometry=False)
-        if len(lead.members) < 8:
-            raise LibrateError(f"could not reach the first requested DRO at x0 = {xs[0]}: {lead.end_reason}")
-        first = lead.members[-1]
-    res = continue_natural(sys_, first, "x0", xs, family="dro", check_geometry=check_geometry, stop=stop, progress=progress)
+    res = continue_natural(sys_, first, "x0", path, family="dro", check_geometry=check_geometry, stop=stop,
+                           progress=along if progress is not None else None)
     params: dict = {"rejected_jumps": res.rejected_jumps}
+    members, bifurcations = res.members, res.bifurcations
     if x0 is not None:
         got = np.array([m.x0 for m in res.members])
-        missing = [float(x) for x in xs if not np.any(np.abs(got - x) <= 1e-12 * max(1.0, abs(x)))]
+        pick = [int(np.flatnonzero(got == x)[0]) for x in xs if np.any(got == x)]
+        missing = [float(x) for x in xs if not np.any(got == x)]
         if missing:
             if not allow_partial:
                 err = LibrateError(f"dro_family: {len(missing)} of the {xs.size} requested members were not reached, x0 = {missing} "
-                                   f"(the continuation ended: {res.end_reason}); {len(res.members)} found; pass allow_partial=True to keep them")
-                err.missing, err.found, err.end_reason = missing, [float(v) for v in got], res.end_reason
+                                   f"(the continuation ended: {res.end_reason}); {len(pick)} found; pass allow_partial=True to keep them")
+                err.missing, err.found, err.end_reason = missing, [float(got[i]) for i in pick], res.end_reason
                 raise err
             params["missing_x0"] = missing
-    return OrbitFamily.from_members(sys_, "dro", False, res.members, res.end_reason, params, bifurcations=res.bifurcations)
+        members = [res.members[i] for i in pick]
+        bifurcations = _kept_bifurcations(res.bifurcations, pick)
+    return OrbitFamily.from_members(sys_, "dro", False, members, res.end_reason, params, bifurcations=bifurcations)
+
+
+def _kept_bifurcations(bifurcations, pick: list[int]):
+    """The driver's bifurcations for a family of the members ``pick`` (indices into the run's
+    members): those between two kept members, their ``after`` renumbered, when the kept members
+    are in the run's order; otherwise None (the family then detects them between its members)."""
+    if any(b <= a for a, b in zip(pick, pick[1:])):
+        return None
+    out = []
+    for b in bifurcations:
+        j = int(np.searchsorted(pick, b.after, side="right")) - 1  # the last kept member at or before b.after
+        if 0 <= j < len(pick) - 1:
+            out.append(dataclasses.replace(b, after=j))
+    return out
 
 
 @functools.lru_cache(maxsize=8)
@@ -746,7 +831,7 @@ def _lyapunov_start(sys_: System, point: int, amplitude: float) -> PeriodicOrbit
     w2 = 0.5 * (b + math.sqrt(b * b - 4 * uxx * uyy))
     a = -amplitude
     vy0 = -(w2 + uxx) * a / 2
-    return correct_symmetric(sys_, (xl + a, 0.0, vy0), fix="x0", family=f"lyapunov-L{point}")
+    return correct_symmetric(sys_, (xl + a, 0.0, vy0), fix="x0", family=f"lyapunov-L{point}", collision=None)
 
 
 def lyapunov_family(system: System | str = "earth-moon", point: int = 1, *, max_members: int = 150,
@@ -813,9 +898,9 @@ def halo_family(system: System | str = "earth-moon", point: int = 2, branch: str
     i = bif["member"]
     w = (bif["x0"] - lyap.x0[i]) / (lyap.x0[i + 1] - lyap.x0[i])
     p = lyap.state0[i] + w * (lyap.state0[i + 1] - lyap.state0[i])
-    planar = correct_symmetric(sys_, p, fix="x0", family=f"lyapunov-L{point}")
+    planar = correct_symmetric(sys_, p, fix="x0", family=f"lyapunov-L{point}", collision=None)
     name = f"halo-L{point}-{branch}"
-    first = correct_symmetric(sys_, (planar.x0, 2e-3, planar.vy0), spatial=True, fix="z0", family=name)
+    first = correct_symmetric(sys_, (planar.x0, 2e-3, planar.vy0), spatial=True, fix="z0", family=name, collision=None)
     res = continue_arclength(
         sys_, first, spatial=True, orient=np.array([0.0, 1.0, 0.0]), ds=2e-3, ds_max=ds_max, max_members=max_members,
         family=name, check_geometry=check_geometry, stop=_collision_stop(sys_, (sys_.r1_km, sys_.r2_km)), progress=progress,

@@ -22,7 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .periodic import SHOOT_ATOL, SHOOT_RTOL, PeriodicOrbit, correct_symmetric
+from .periodic import SHOOT_ATOL, SHOOT_RTOL, PeriodicOrbit, correct_symmetric, primary_passes
 from .propagation import propagate_many
 from .system import System
 
@@ -210,7 +210,7 @@ def recorrect(cat: JplCatalog, kind: str, spatial: bool):
     system = cat.system
     n = len(cat.period)
     before = _closures(system, cat.states, cat.period)
-    radius_run = propagate_many(system, cat.states, cat.period, rtol=SHOOT_RTOL, atol=SHOOT_ATOL, on_error="mask", collision="radius")
+    radius_run = primary_passes(system, cat.states, cat.period)
     inside1 = radius_run.status == "collision_primary1"
     inside2 = radius_run.status == "collision_primary2"
     names = ("Earth", "Moon") if system.name.startswith("earth-moon") else ("primary 1", "primary 2")
@@ -238,7 +238,7 @@ def recorrect(cat: JplCatalog, kind: str, spatial: bool):
         why = ""
         for kw in (dict(period=float(cat.period[i])), dict(fix="x0")):
             try:
-                orbit = correct_symmetric(system, s, spatial=spatial, family=kind, tol=1e-12, max_iter=25, **kw)
+                orbit = correct_symmetric(system, s, spatial=spatial, family=kind, tol=1e-12, max_iter=25, collision=None, **kw)
                 break
             except ConvergenceError as err:
                 why = str(err).splitlines()[0]

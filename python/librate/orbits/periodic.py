@@ -11,9 +11,10 @@ import numpy as np
 from .. import _core
 from .._checks import as_count, as_number, as_real
 from .._display import html_summary, short_repr
+from .._errors import CollisionError
 from .system import System, resolve_system
 
-__all__ = ["PeriodicOrbit", "correct_symmetric", "correct_periodic", "real_if_real", "INDEX_TESTS", "index_tests", "symmetric_monodromy"]
+__all__ = ["PeriodicOrbit", "Geometry", "geometry", "primary_passes", "inside_primary_index", "collision_mode", "check_outside_primaries", "correct_symmetric", "correct_periodic", "real_if_real", "INDEX_TESTS", "index_tests", "symmetric_monodromy"]
 
 _VARS = {"x0": 0, "z0": 1, "vy0": 2}
 # Tolerances of the shooting propagations: the 8th-order solution at 1e-13 puts the
@@ -130,6 +131,88 @@ class PeriodicOrbit:
         return propagate(self.system, self.state0, n_periods * self.period, **kwargs)
 
 
+@dataclass(frozen=True)
+class Geometry:
+    """Winding numbers of an orbit about each primary and its closest approach to each."""
+
+    winding: tuple[int, int]
+    min_distance: tuple[float, float]
+
+
+def geometry(orbit: PeriodicOrbit) -> Geometry:
+    """Winding numbers (signed turns of the projected position about each primary over one
+    period) and closest approaches, from the integrated orbit."""
+    tr = orbit.propagate(rtol=1e-11, atol=1e-11)
+    y = tr.y
+    wind, dmin = [], []
+    for c in orbit.system.primary_positions():
+        rel = y[:, :3] - c
+        ang = np.unwrap(np.arctan2(rel[:, 1], rel[:, 0]))
+        wind.append(int(round((ang[-1] - ang[0]) / (2 * math.pi))))
+        dmin.append(float(np.min(np.linalg.norm(rel, axis=1))))
+    return Geometry((wind[0], wind[1]), (dmin[0], dmin[1]))
+
+
+
+def primary_passes(system: System, states, periods, collision: str = "radius"):
+    """Which orbits pass within a primary's radius: each (6,) state of ``states`` propagated over
+    its period by :func:`librate.propagate_many` with its collision check (``collision="radius"``:
+    the system's radii ``r1_km``, ``r2_km``; a primary of radius 0 counts as a point), at the
+    shooting tolerances. Returns the :class:`librate.orbits.propagation.BatchResult`: ``status``
+    "collision_primary1" / "collision_primary2" marks an orbit reaching that primary (the
+    collision located in time), "completed" one that stays outside both. The one check used
+    for imported catalog rows, corrected orbits and family members."""
+    from .propagation import propagate_many
+
+    return propagate_many(system, states, periods, rtol=SHOOT_RTOL, atol=SHOOT_ATOL, on_error="mask", collision=collision)
+
+
+def inside_primary_index(status) -> np.ndarray:
+    """(n,) int8 from the ``status`` of :func:`primary_passes`: 1 or 2 (the primary reached), 0
+    (outside both), -1 (the propagation failed for another reason)."""
+    st = np.asarray(status)
+    out = np.where(st == "collision_primary1", 1, np.where(st == "collision_primary2", 2, np.where(st == "completed", 0, -1)))
+    return out.astype(np.int8)
+
+
+def collision_mode(collision) -> str | None:
+    """``collision`` checked: "radius", "point" or None (ValueError naming it otherwise)."""
+    if collision is not None and (not isinstance(collision, str) or collision not in ("radius", "point")):
+        raise ValueError(f"invalid argument `collision`: must be 'radius' (the system's radii), 'point' (point masses) or None, got {collision!r}")
+    return collision
+
+
+def check_outside_primaries(orbit: PeriodicOrbit, collision: str | None = "radius") -> PeriodicOrbit:
+    """``orbit`` itself when it stays outside both primaries' radii over its period
+    (:func:`primary_passes`); otherwise :class:`librate.CollisionError` naming the primary, the
+    orbit's closest approach to its centre (km, from :func:`geometry`) and the radius, with
+    attributes ``primary`` (1 or 2), ``closest_km``, ``radius_km``, ``t`` (the time it first
+    reaches the radius, TU) and ``orbit`` (the corrected point-mass orbit, for who wants it
+    anyway). ``collision=None`` skips the check; ``"point"`` counts only the singular points.
+    A system with radii 0 (point masses) never collides."""
+    if collision is None:
+        return orbit
+    run = primary_passes(orbit.system, orbit.state0[None, :], orbit.period, collision)
+    k = int(inside_primary_index(run.status)[0])
+    if k <= 0:
+        return orbit
+    sys_ = orbit.system
+    err0 = run.errors.get(0)
+    radius_km = (sys_.r1_km, sys_.r2_km)[k - 1] if collision == "radius" else 0.0
+    closest_km = geometry(orbit).min_distance[k - 1] * sys_.lu_km
+    name = (("the Earth", "the Moon") if sys_.name.startswith("earth-moon") else ("the larger primary", "the smaller primary"))[k - 1]
+    err = CollisionError(
+        f"the corrected {orbit.family} orbit (x0 = {orbit.x0:.10g}, z0 = {orbit.z0:.10g}, period {orbit.period:.10g} TU) passes within "
+        f"{name}'s radius (primary {k}): closest approach {closest_km:.1f} km from its centre, radius {radius_km} km "
+        f"(first reached at t = {getattr(err0, 't', float('nan')):.6g} TU); it is a solution of the point-mass model only: "
+        "pass collision=None to keep it")
+    err.primary, err.closest_km, err.radius_km, err.orbit = k, closest_km, radius_km, orbit
+    for attr in ("t", "steps", "kind", "distance", "radius"):
+        if hasattr(err0, attr):
+            setattr(err, attr, getattr(err0, attr))
+    raise err
+
+
 #: The stability-index test functions of symmetric orbit families: name -> (index, level, type).
 #: nu - level changes sign where a pair of multipliers passes +1 (a family branches off, or a
 #: fold) or -1 (period doubling); undefined (NaN) where the index is complex.
@@ -174,6 +257,7 @@ def correct_symmetric(
     t_max: float = 50.0,
     rtol: float = SHOOT_RTOL,
     atol: float = SHOOT_ATOL,
+    collision: str | None = "radius",
 ) -> PeriodicOrbit:
     """Correct an orbit symmetric about the x-z plane by half-period single shooting.
 
@@ -181,8 +265,15 @@ def correct_symmetric(
     for planar orbits and (x0, z0, vy0) in 3-D; one extra condition closes the Newton system:
     ``fix`` one unknown ("x0", "z0" or "vy0") at its guessed value, or a target ``period`` (TU),
     or a target ``jacobi`` constant. Raises :class:`librate.ConvergenceError` on failure.
+
+    ``collision`` ("radius" by default, as :func:`librate.propagate`): a corrected orbit that
+    passes within a primary's radius over its period raises :class:`librate.CollisionError`
+    naming the primary, the closest approach (km) and the radius
+    (:func:`check_outside_primaries`); ``"point"``: only the singular points count; ``None``:
+    no check (the bare point-mass solution).
     """
     sys_ = resolve_system(system)
+    collision_mode(collision)
     as_number(tol, "tol", positive=True)
     as_count(max_iter, "max_iter", 1)
     for name, v in (("t_max", t_max), ("rtol", rtol), ("atol", atol)):
@@ -219,7 +310,7 @@ def correct_symmetric(
         sys_.mu, [float(v) for v in g], spatial=bool(spatial), constraint=kind, values=values,
         tol=float(tol), max_iter=int(max_iter), t_max=float(t_max), rtol=float(rtol), atol=float(atol),
     )
-    return orbit_from_core(sys_, r, family)
+    return check_outside_primaries(orbit_from_core(sys_, r, family), collision)
 
 
 def orbit_from_core(system: System, r: _core.SymmetricOrbit, family: str) -> PeriodicOrbit:
@@ -238,6 +329,7 @@ def correct_periodic(
     max_iter: int = 25,
     rtol: float = SHOOT_RTOL,
     atol: float = SHOOT_ATOL,
+    collision: str | None = "radius",
 ) -> PeriodicOrbit:
     """Correct a periodic orbit with no symmetry assumed, by single (one state) or multiple
     shooting (patch states equally spaced in time over the period guess).
@@ -247,8 +339,11 @@ def correct_periodic(
     first patch's) or, with ``fixed_period=True``, by the period. Multiple shooting is the
     remedy for long or strongly unstable orbits: each segment's sensitivity stays moderate.
     The least-squares Newton step absorbs the conserved Jacobi constant's redundant equation.
+    ``collision`` as in :func:`correct_symmetric` (default "radius": an orbit through a
+    primary's radius raises :class:`librate.CollisionError`).
     """
     sys_ = resolve_system(system)
+    collision_mode(collision)
     as_number(tol, "tol", positive=True)
     as_count(max_iter, "max_iter", 1)
     for name, v in (("rtol", rtol), ("atol", atol)):
@@ -272,4 +367,4 @@ def correct_periodic(
         cond, value = "jacobi", float(sys_.jacobi(patches[0]) if jacobi is None else jacobi)
     r = _core.multiple_shooting(sys_.mu, patches, float(period), condition=cond, value=value, tol=float(tol),
                                 max_iter=int(max_iter), rtol=float(rtol), atol=float(atol))
-    return PeriodicOrbit(sys_, r.patches[0].copy(), r.period, r.jacobi, family, r.iterations, r.residual)
+    return check_outside_primaries(PeriodicOrbit(sys_, r.patches[0].copy(), r.period, r.jacobi, family, r.iterations, r.residual), collision)
