@@ -20,6 +20,7 @@ use pyo3::types::{PyDict, PyTuple};
 mod attitude;
 mod attitude3d;
 mod build;
+mod ephemeris;
 mod flexible;
 mod fourier;
 mod map;
@@ -411,6 +412,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(stability, m)?)?;
     m.add_function(wrap_pyfunction!(multiple_shooting, m)?)?;
     fourier::register(m)?;
+    ephemeris::register(m)?;
     attitude::register(m)?;
     map::register(m)?;
     flexible::register(m)?;

@@ -103,9 +103,11 @@ impl Segment {
                 out[2][c] += a * en;
             }
         }
-        for c in 0..3 {
-            out[1][c] *= scale;
-            out[2][c] *= scale * scale;
+        for v in out[1].iter_mut() {
+            *v *= scale;
+        }
+        for v in out[2].iter_mut() {
+            *v *= scale * scale;
         }
         out
     }

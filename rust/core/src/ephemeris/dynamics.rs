@@ -15,10 +15,10 @@ use super::chebyshev::{Ephemeris, MoonCentred};
 use crate::error::{check_finite, invalid, Result};
 use crate::integrate::{solve, Options, Output, System};
 
-/// DE440 GM values, km^3/s^2.
+/// DE440 GM values, km^3/s^2 (the Sun's as published, 132712440041.279419).
 pub const GM_EARTH: f64 = 398600.435507;
 pub const GM_MOON: f64 = 4902.800118;
-pub const GM_SUN: f64 = 132712440041.279419;
+pub const GM_SUN: f64 = 132_712_440_041.279_42;
 
 /// The right-hand side. Time is measured from `epoch0` (TDB s) to keep its resolution.
 #[derive(Debug, Clone)]

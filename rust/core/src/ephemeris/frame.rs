@@ -56,11 +56,11 @@ impl RotatingFrame {
     }
 
     /// C v (rotating components -> ICRF).
-    fn to_icrf(&self, v: &[f64; 3]) -> [f64; 3] {
+    fn rot_icrf(&self, v: &[f64; 3]) -> [f64; 3] {
         std::array::from_fn(|i| self.axes[0][i] * v[0] + self.axes[1][i] * v[1] + self.axes[2][i] * v[2])
     }
     /// C^T v.
-    fn to_rot(&self, v: &[f64; 3]) -> [f64; 3] {
+    fn icrf_rot(&self, v: &[f64; 3]) -> [f64; 3] {
         std::array::from_fn(|k| dot(&self.axes[k], v))
     }
 }
@@ -78,8 +78,8 @@ pub fn synodic_to_ephemeris(frame: &RotatingFrame, mu: f64, s: &[f64; 6]) -> Res
     check_finite("state", s)?;
     let (l, ld, th) = (frame.distance_km, frame.distance_rate_km_s, frame.rate_rad_s);
     let rho = [s[0] - (1.0 - mu), s[1], s[2]];
-    let cr = frame.to_icrf(&rho);
-    let cv = frame.to_icrf(&[s[3], s[4], s[5]]);
+    let cr = frame.rot_icrf(&rho);
+    let cv = frame.rot_icrf(&[s[3], s[4], s[5]]);
     let wr = cross(&frame.omega, &cr);
     let r = cr.map(|c| l * c);
     let v: [f64; 3] = std::array::from_fn(|i| ld * cr[i] + l * wr[i] + l * th * cv[i]);
@@ -95,7 +95,7 @@ pub fn ephemeris_to_synodic(frame: &RotatingFrame, mu: f64, e: &[f64; 6]) -> Res
     let cr = r.map(|c| c / l);
     let wr = cross(&frame.omega, &cr);
     let rest: [f64; 3] = std::array::from_fn(|i| (e[3 + i] - ld * cr[i] - l * wr[i]) / (l * th));
-    let rho = frame.to_rot(&cr);
-    let rv = frame.to_rot(&rest);
+    let rho = frame.icrf_rot(&cr);
+    let rv = frame.icrf_rot(&rest);
     Ok([rho[0] + (1.0 - mu), rho[1], rho[2], rv[0], rv[1], rv[2]])
 }
