@@ -1,1 +1,7 @@
-"""The Earth-Moon-Sun ephemeris model: SPK files (spk), epochs (epochs)."""
+"""The Earth-Moon-Sun ephemeris model: JPL SPK files read with jplephem (spk), epochs with a time
+scale (epochs), the Chebyshev segments evaluated in Rust, the Moon-centred ICRF point-mass
+dynamics with the STM, and the instantaneous Earth-Moon frame (model)."""
+
+from .model import Ephemeris, EphemerisTrajectory, RotatingFrame, propagate_ephemeris, sun_phase
+
+__all__ = ["Ephemeris", "EphemerisTrajectory", "RotatingFrame", "propagate_ephemeris", "sun_phase"]

@@ -14,6 +14,7 @@
 pub mod attitude;
 pub mod constants;
 pub mod cr3bp;
+pub mod ephemeris;
 pub mod error;
 pub mod flexible;
 pub mod fourier;

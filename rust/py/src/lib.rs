@@ -19,6 +19,7 @@ use pyo3::types::{PyDict, PyTuple};
 mod attitude;
 mod attitude3d;
 mod build;
+mod ephemeris;
 mod flexible;
 mod fourier;
 mod map;
@@ -406,6 +407,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(stability, m)?)?;
     m.add_function(wrap_pyfunction!(multiple_shooting, m)?)?;
     fourier::register(m)?;
+    ephemeris::register(m)?;
     attitude::register(m)?;
     map::register(m)?;
     flexible::register(m)?;

@@ -1,0 +1,132 @@
+"""The ephemeris, its rotating frame and propagation (the computations run in Rust,
+``librate._core.EphemerisCore``)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from .. import _core
+from .epochs import tdb_seconds
+from .spk import embedded_spk_path, read_spk
+
+__all__ = ["Ephemeris", "EphemerisTrajectory", "RotatingFrame", "propagate_ephemeris", "sun_phase"]
+
+#: NAIF ids
+SUN, EMB, MOON, EARTH = 10, 3, 301, 399
+
+
+def _epoch_seconds(epoch) -> float:
+    """TDB seconds past J2000 of a float or an ISO string with a scale (epochs.tdb_seconds)."""
+    if isinstance(epoch, (int, float, np.floating, np.integer)) and not isinstance(epoch, bool):
+        t = float(epoch)
+        if not np.isfinite(t):
+            raise ValueError(f"invalid argument `epoch`: must be finite, got {epoch!r}")
+        return t
+    return float(tdb_seconds(epoch))
+
+
+@dataclass(frozen=True)
+class RotatingFrame:
+    """The instantaneous Earth-Moon frame at an epoch: x Earth -> Moon, z along the Earth-Moon
+    angular momentum, y = z x x. ``axes`` rows are x, y, z in ICRF; ``omega`` the frame's angular
+    velocity in ICRF (rad/s)."""
+
+    epoch_tdb: float
+    distance_km: float
+    distance_rate_km_s: float
+    rate_rad_s: float
+    axes: np.ndarray
+    omega: np.ndarray
+
+
+@dataclass(frozen=True)
+class EphemerisTrajectory:
+    """A propagated Moon-centred ICRF trajectory: epochs ``t_tdb`` (TDB s past J2000) and
+    ``states_km`` (n, 6) in km and km/s; ``stm`` the 6x6 STM from the first to the last epoch."""
+
+    t_tdb: np.ndarray
+    states_km: np.ndarray
+    stm: np.ndarray | None = None
+
+
+class Ephemeris:
+    """Earth, Moon and Sun from a JPL SPK file (type-2 segments). ``path=None`` uses the embedded
+    DE440 excerpt. ``span`` is the (start, end) coverage in TDB s past J2000."""
+
+    def __init__(self, path: str | Path | None = None, *, segments=None):
+        if segments is None:
+            segments = read_spk(embedded_spk_path() if path is None else Path(path))
+        self.path = path
+        self._core = _core.EphemerisCore(
+            [
+                (
+                    int(s.target),
+                    int(s.center),
+                    float(s.start_s),
+                    float(s.end_s),
+                    float(s.init_s),
+                    float(s.intlen_s),
+                    np.ascontiguousarray(s.coefficients, dtype=float),
+                )
+                for s in segments
+            ]
+        )
+
+    @property
+    def span(self) -> tuple[float, float]:
+        return tuple(self._core.span())
+
+    def state(self, target: int, center: int, epoch) -> np.ndarray:
+        """State of NAIF body ``target`` relative to ``center`` (km, km/s)."""
+        return self._core.state(int(target), int(center), _epoch_seconds(epoch))
+
+    def rotating_frame(self, epoch) -> RotatingFrame:
+        t = _epoch_seconds(epoch)
+        d = self._core.frame(t)
+        return RotatingFrame(t, d["distance_km"], d["distance_rate_km_s"], d["rate_rad_s"], d["axes"], d["omega"])
+
+    def synodic_to_ephemeris(self, state, epoch, mu: float) -> np.ndarray:
+        """A synodic CR3BP state (nondimensional) -> Moon-centred ICRF state (km, km/s) at epoch,
+        with the instantaneous distance, rate and frame rotation."""
+        return self._core.synodic_to_ephemeris(_epoch_seconds(epoch), float(mu), np.ascontiguousarray(state, dtype=float).ravel())
+
+    def ephemeris_to_synodic(self, state_km, epoch, mu: float) -> np.ndarray:
+        """The inverse of :meth:`synodic_to_ephemeris`."""
+        return self._core.ephemeris_to_synodic(_epoch_seconds(epoch), float(mu), np.ascontiguousarray(state_km, dtype=float).ravel())
+
+
+_DEFAULT: list[Ephemeris] = []
+
+
+def _default(ephemeris: Ephemeris | None) -> Ephemeris:
+    if ephemeris is not None:
+        return ephemeris
+    if not _DEFAULT:
+        _DEFAULT.append(Ephemeris())
+    return _DEFAULT[0]
+
+
+def propagate_ephemeris(
+    state_km, epoch, duration_s: float, *, ephemeris: Ephemeris | None = None, stm: bool = False, t_eval=None, rtol: float = 1e-13, atol: float = 1e-9
+) -> EphemerisTrajectory:
+    """Propagate a Moon-centred ICRF state (km, km/s) from ``epoch`` for ``duration_s`` seconds
+    under Earth, Moon and Sun point masses (DE440 GM values). ``t_eval``: offsets from the epoch
+    (s) at which to record (default: every step)."""
+    e = _default(ephemeris)
+    t0 = _epoch_seconds(epoch)
+    te = None if t_eval is None else np.ascontiguousarray(t_eval, dtype=float).ravel()
+    t, y, phi = e._core.propagate(np.ascontiguousarray(state_km, dtype=float).ravel(), t0, float(duration_s), bool(stm), te, float(rtol), float(atol))
+    return EphemerisTrajectory(t, y, phi)
+
+
+def sun_phase(epoch, ephemeris: Ephemeris | None = None) -> float:
+    """The Sun's angle (rad, in [0, 2 pi)) seen from the Earth-Moon barycentre in the rotating
+    frame's x-y plane, from x towards y, at the epoch."""
+    e = _default(ephemeris)
+    t = _epoch_seconds(epoch)
+    f = e.rotating_frame(t)
+    s = e._core.state(SUN, EMB, t)[:3]
+    return float(np.arctan2(f.axes[1] @ s, f.axes[0] @ s) % (2 * np.pi))

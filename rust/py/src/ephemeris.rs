@@ -1,0 +1,115 @@
+//! Thin wrappers of librate_core::ephemeris: an `EphemerisCore` built from SPK type-2 segments
+//! (read in Python), its states, rotating frame, synodic maps and propagation.
+
+use librate_core::ephemeris::{self as eph, Ephemeris, EphemerisDynamics, RotatingFrame, Segment};
+use librate_core::integrate::Options;
+use numpy::ndarray::Array2;
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray3, PyUntypedArrayMethods};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+use crate::to_py;
+
+fn arr6(name: &str, v: &[f64]) -> PyResult<[f64; 6]> {
+    v.try_into().map_err(|_| pyo3::exceptions::PyValueError::new_err(format!("`{name}` must have 6 components, got {}", v.len())))
+}
+
+/// The ephemeris (Chebyshev segments evaluated in Rust).
+#[pyclass(module = "librate._core", frozen)]
+pub struct EphemerisCore {
+    inner: Ephemeris,
+}
+
+#[pymethods]
+impl EphemerisCore {
+    /// segments: list of (target, center, start_s, end_s, init_s, intlen_s, coefficients (n, 3, k)).
+    #[new]
+    fn new(segments: Vec<(i32, i32, f64, f64, f64, f64, PyReadonlyArray3<'_, f64>)>) -> PyResult<Self> {
+        let mut out = Vec::with_capacity(segments.len());
+        for (t, c, s, e, i, l, coef) in segments {
+            let sh = coef.shape();
+            if sh[1] != 3 {
+                return Err(pyo3::exceptions::PyValueError::new_err(format!("`coefficients` must have shape (n_records, 3, n_coef), got {sh:?}")));
+            }
+            let v: Vec<f64> = coef.as_array().iter().copied().collect();
+            out.push(Segment::new(t, c, s, e, i, l, sh[0], sh[2], v).map_err(to_py)?);
+        }
+        Ok(Self { inner: Ephemeris::new(out).map_err(to_py)? })
+    }
+
+    /// (start, end) TDB s past J2000.
+    fn span(&self) -> (f64, f64) {
+        self.inner.span()
+    }
+
+    /// State of target relative to center at t (km, km/s).
+    fn state<'py>(&self, py: Python<'py>, target: i32, center: i32, t: f64) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        Ok(self.inner.state(target, center, t).map_err(to_py)?.to_vec().into_pyarray(py))
+    }
+
+    /// The rotating frame at t: dict distance_km, distance_rate_km_s, rate_rad_s, axes (3x3 rows), omega.
+    fn frame<'py>(&self, py: Python<'py>, t: f64) -> PyResult<Bound<'py, PyDict>> {
+        let f = RotatingFrame::at(&self.inner, t).map_err(to_py)?;
+        let d = PyDict::new(py);
+        d.set_item("distance_km", f.distance_km)?;
+        d.set_item("distance_rate_km_s", f.distance_rate_km_s)?;
+        d.set_item("rate_rad_s", f.rate_rad_s)?;
+        d.set_item("axes", f.axes.iter().flatten().copied().collect::<Vec<f64>>().into_pyarray(py).reshape([3, 3])?)?;
+        d.set_item("omega", f.omega.to_vec().into_pyarray(py))?;
+        Ok(d)
+    }
+
+    /// Synodic (nondimensional) state -> Moon-centred ICRF state at t.
+    fn synodic_to_ephemeris<'py>(&self, py: Python<'py>, t: f64, mu: f64, state: PyReadonlyArray1<'_, f64>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let f = RotatingFrame::at(&self.inner, t).map_err(to_py)?;
+        let s = arr6("state", state.as_slice()?)?;
+        Ok(eph::synodic_to_ephemeris(&f, mu, &s).map_err(to_py)?.to_vec().into_pyarray(py))
+    }
+
+    /// Moon-centred ICRF state at t -> synodic state.
+    fn ephemeris_to_synodic<'py>(&self, py: Python<'py>, t: f64, mu: f64, state_km: PyReadonlyArray1<'_, f64>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let f = RotatingFrame::at(&self.inner, t).map_err(to_py)?;
+        let s = arr6("state_km", state_km.as_slice()?)?;
+        Ok(eph::ephemeris_to_synodic(&f, mu, &s).map_err(to_py)?.to_vec().into_pyarray(py))
+    }
+
+    /// Propagate; returns (t_tdb, states (n, 6), stm (6, 6) or None). `t_eval` are offsets (s)
+    /// from the epoch; None records every step. `gm` (Earth, Moon, Sun) defaults to DE440's.
+    #[pyo3(signature = (state_km, epoch, duration_s, stm=false, t_eval=None, rtol=1e-13, atol=1e-9, gm=None))]
+    fn propagate<'py>(
+        &self,
+        py: Python<'py>,
+        state_km: PyReadonlyArray1<'_, f64>,
+        epoch: f64,
+        duration_s: f64,
+        stm: bool,
+        t_eval: Option<PyReadonlyArray1<'_, f64>>,
+        rtol: f64,
+        atol: f64,
+        gm: Option<[f64; 3]>,
+    ) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray2<f64>>, Option<Bound<'py, PyArray2<f64>>>)> {
+        let s = arr6("state_km", state_km.as_slice()?)?;
+        let te: Option<Vec<f64>> = match &t_eval {
+            Some(a) => Some(a.as_slice()?.to_vec()),
+            None => None,
+        };
+        let dynamics = EphemerisDynamics::with_gm(self.inner.clone(), epoch, gm.unwrap_or([eph::GM_EARTH, eph::GM_MOON, eph::GM_SUN])).map_err(to_py)?;
+        let opts = Options::with_tolerances(rtol, atol);
+        let tr = py.detach(|| eph::propagate_ephemeris(&dynamics, &s, duration_s, stm, te.as_deref(), &opts)).map_err(to_py)?;
+        let n = tr.t_tdb.len();
+        let states = Array2::from_shape_vec((n, 6), tr.states).map_err(|e| pyo3::exceptions::PyRuntimeError::new_err(e.to_string()))?.into_pyarray(py);
+        let phi = match tr.stm {
+            Some(p) => Some(Array2::from_shape_vec((6, 6), p.to_vec()).map_err(|e| pyo3::exceptions::PyRuntimeError::new_err(e.to_string()))?.into_pyarray(py)),
+            None => None,
+        };
+        Ok((tr.t_tdb.into_pyarray(py), states, phi))
+    }
+}
+
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<EphemerisCore>()?;
+    m.add("GM_EARTH", eph::GM_EARTH)?;
+    m.add("GM_MOON", eph::GM_MOON)?;
+    m.add("GM_SUN", eph::GM_SUN)?;
+    Ok(())
+}
