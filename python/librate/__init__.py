@@ -10,6 +10,7 @@ import warnings as _warnings
 from ._build import build_info
 from ._core import __version__
 from ._errors import CollisionError, ConvergenceError, IntegrationError, LibrateError
+from .ephemeris import Ephemeris, EphemerisTrajectory, propagate_ephemeris
 from .attitude import (
     Appendage,
     AttitudeEquilibrium,
@@ -88,6 +89,9 @@ __all__ = [
     "IntegrationError",
     "CollisionError",
     "ConvergenceError",
+    "Ephemeris",
+    "EphemerisTrajectory",
+    "propagate_ephemeris",
     "System",
     "Event",
     "EventHit",

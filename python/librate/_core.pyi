@@ -665,3 +665,27 @@ def map_sweep_3d(
     table: TidalTable, t_final: float, q0: _F64, w0: _F64, inertia: _F64, *, rtol: float, atol: float, max_steps: int = 200000,
     chunk: int = 64, threads: int | None = None,
 ) -> Sweep3DResult: ...
+
+GM_EARTH: float
+GM_MOON: float
+GM_SUN: float
+
+@final
+class EphemerisCore:
+    def __new__(cls, segments: list[tuple[int, int, float, float, float, float, npt.NDArray[np.float64]]]) -> EphemerisCore: ...
+    def span(self) -> tuple[float, float]: ...
+    def state(self, target: int, center: int, t: float) -> npt.NDArray[np.float64]: ...
+    def frame(self, t: float) -> dict[str, Any]: ...
+    def synodic_to_ephemeris(self, t: float, mu: float, state: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]: ...
+    def ephemeris_to_synodic(self, t: float, mu: float, state_km: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]: ...
+    def propagate(
+        self,
+        state_km: npt.NDArray[np.float64],
+        epoch: float,
+        duration_s: float,
+        stm: bool = False,
+        t_eval: npt.NDArray[np.float64] | None = None,
+        rtol: float = 1e-13,
+        atol: float = 1e-9,
+        gm: tuple[float, float, float] | None = None,
+    ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], npt.NDArray[np.float64] | None]: ...

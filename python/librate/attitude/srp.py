@@ -34,6 +34,17 @@ class Sun:
         object.__setattr__(self, "theta0", as_real(self.theta0, "theta0"))
         object.__setattr__(self, "pressure", as_real(self.pressure, "pressure", nonnegative=True))
 
+    @classmethod
+    def at_epoch(cls, epoch, ephemeris=None, pressure: float = SOLAR_PRESSURE_1AU) -> Sun:
+        """The Sun at a calendar epoch (an ISO string with its scale, "2030-01-01T00:00:00 TDB" or
+        "... UTC", or TDB seconds past J2000): ``theta0`` is the Sun's angle seen from the
+        Earth-Moon barycentre in the instantaneous Earth-Moon frame's x-y plane, from x towards y,
+        in the ephemeris model (``ephemeris``: a :class:`librate.Ephemeris`; None, the embedded
+        DE440 excerpt). A Sun-resonant solution found with this phase holds at that date."""
+        from ..ephemeris.model import sun_phase
+
+        return cls(sun_phase(epoch, ephemeris), pressure)
+
     @property
     def omega(self) -> float:
         """Rate of the Sun direction in the synodic frame, 1/TU (clockwise)."""

@@ -1,0 +1,138 @@
+"""The ephemeris model (issue 21, items 1-2): the Rust Chebyshev evaluation of the embedded DE440
+excerpt against jplephem reading the same file, the Earth-Moon rotating frame against its
+definition, and the Moon-centred point-mass propagation against an independent integration
+(scipy DOP853 on jplephem positions: a test reference, written here on purpose)."""
+
+import numpy as np
+import pytest
+
+import librate
+from librate.ephemeris.epochs import tdb_seconds
+from librate.ephemeris.spk import embedded_spk_path
+
+jplephem_spk = pytest.importorskip("jplephem.spk")
+
+DAY = 86400.0
+J2000_JD = 2451545.0
+GM_EARTH, GM_MOON, GM_SUN = 398600.435507, 4902.800118, 132712440041.279419
+
+
+@pytest.fixture(scope="module")
+def kernel():
+    k = jplephem_spk.SPK.open(str(embedded_spk_path()))
+    yield k
+    k.close()
+
+
+@pytest.fixture(scope="module")
+def eph():
+    return librate.Ephemeris()
+
+
+def ref_state(kernel, target, center, t):
+    """(km, km/s) of target relative to center from jplephem, through the SSB/EMB chains."""
+    chains = {10: [(0, 10)], 3: [(0, 3)], 301: [(0, 3), (3, 301)], 399: [(0, 3), (3, 399)], 0: []}
+
+    def ssb(body):
+        p, v = np.zeros(3), np.zeros(3)
+        for c, tg in chains[body]:
+            pos, vel = kernel[c, tg].compute_and_differentiate(J2000_JD, t / DAY)
+            p, v = p + pos, v + vel / DAY
+        return p, v
+
+    (pt, vt), (pc, vc) = ssb(target), ssb(center)
+    return np.concatenate([pt - pc, vt - vc])
+
+
+def test_states_equal_jplephem_on_the_same_file(eph, kernel):
+    """Chebyshev series evaluated in Rust vs jplephem (numpy) on the embedded excerpt, over
+    2020-2070: 1e-6 km in position, 1e-9 km/s in velocity (the same series; round-off only)."""
+    rng = np.random.default_rng(7)
+    lo, hi = eph.span
+    for t in rng.uniform(lo + DAY, hi - DAY, 60):
+        for target, center in ((399, 301), (10, 301), (301, 3), (10, 3)):
+            got, ref = eph.state(target, center, t), ref_state(kernel, target, center, t)
+            assert np.max(np.abs(got[:3] - ref[:3])) < 1e-6, (target, center, t)
+            assert np.max(np.abs(got[3:] - ref[3:])) < 1e-9, (target, center, t)
+
+
+def test_span_covers_2020_to_2070_and_outside_is_a_value_error(eph):
+    lo, hi = eph.span
+    assert lo <= tdb_seconds("2020-01-01T00:00:00 TDB") and hi >= tdb_seconds("2070-01-01T00:00:00 TDB")
+    with pytest.raises(ValueError, match="span|outside|cover"):
+        eph.state(399, 301, hi + 30 * DAY)
+
+
+def test_rotating_frame_is_the_earth_moon_frame(eph, kernel):
+    """Definition (issue 21): x along Earth -> Moon, z along the Earth-Moon angular momentum,
+    y = z x x; distance |r| and rate |r x v| / |r|^2 from jplephem's states, to 1e-9 relative."""
+    t = tdb_seconds("2026-01-01T00:00:00 TDB")
+    f = eph.rotating_frame(t)
+    s = ref_state(kernel, 301, 399, t)
+    r, v = s[:3], s[3:]
+    h = np.cross(r, v)
+    assert np.allclose(f.axes @ f.axes.T, np.eye(3), atol=1e-14)
+    assert np.allclose(f.axes[0], r / np.linalg.norm(r), atol=1e-12)
+    assert np.allclose(f.axes[2], h / np.linalg.norm(h), atol=1e-12)
+    assert np.allclose(f.axes[1], np.cross(f.axes[2], f.axes[0]), atol=1e-12)
+    assert f.distance_km == pytest.approx(np.linalg.norm(r), rel=1e-12)
+    assert f.rate_rad_s == pytest.approx(np.linalg.norm(h) / (r @ r), rel=1e-9)
+    # the issue's figures: 361,026 km on 2026-01-01, rates within 2.58e-6 .. 3.02e-6 rad/s
+    assert abs(f.distance_km - 361026) < 50
+    assert 2.5e-6 < f.rate_rad_s < 3.1e-6
+
+
+def test_sun_at_epoch_is_the_sun_phase_in_the_rotating_frame(eph, kernel):
+    """theta0 = the Sun's angle seen from the Earth-Moon barycentre in the frame's x-y plane."""
+    t = tdb_seconds("2030-06-01T00:00:00 TDB")
+    sun = librate.Sun.at_epoch(t, eph)
+    axes = eph.rotating_frame(t).axes
+    s = ref_state(kernel, 10, 3, t)[:3]
+    assert sun.theta0 == pytest.approx(np.arctan2(axes[1] @ s, axes[0] @ s) % (2 * np.pi), abs=1e-12)
+    # one synodic month later the phase comes back (the Sun's synodic period, 29.53 d) to 1 deg
+    later = librate.Sun.at_epoch(t + 29.530589 * DAY, eph)
+    assert abs((later.theta0 - sun.theta0 + np.pi) % (2 * np.pi) - np.pi) < np.radians(1.0)
+
+
+@pytest.mark.slow
+def test_propagation_matches_scipy_dop853_on_jplephem(eph, kernel):
+    """Reference: scipy DOP853 (rtol 1e-13) on the relative equations with jplephem's Earth and
+    Sun positions about the Moon (test reference). Over one 9:2 NRHO period (6.56 d) from a
+    Moon-centred orbit of 10,000 km: agreement within 1e-3 km (issue 21 acceptance)."""
+    from scipy.integrate import solve_ivp
+
+    t0 = tdb_seconds("2030-01-01T00:00:00 TDB")
+    r0 = 10000.0
+    x0 = np.array([r0, 0.0, 2000.0, 0.0, 0.9 * np.sqrt(GM_MOON / r0), 0.15])
+    duration = 6.56 * DAY
+
+    def third(gm, d, rho):
+        # acceleration of the spacecraft relative to the Moon by a body at d (from the Moon)
+        return gm * ((d - rho) / np.linalg.norm(d - rho) ** 3 - d / np.linalg.norm(d) ** 3)
+
+    def rhs(t, y):
+        rho = y[:3]
+        e = ref_state(kernel, 399, 301, t0 + t)[:3]
+        s = ref_state(kernel, 10, 301, t0 + t)[:3]
+        a = -GM_MOON * rho / np.linalg.norm(rho) ** 3 + third(GM_EARTH, e, rho) + third(GM_SUN, s, rho)
+        return np.concatenate([y[3:], a])
+
+    ref = solve_ivp(rhs, (0.0, duration), x0, method="DOP853", rtol=1e-13, atol=1e-10)
+    tr = librate.propagate_ephemeris(x0, t0, duration, ephemeris=eph)
+    assert tr.t_tdb[0] == pytest.approx(t0) and tr.t_tdb[-1] == pytest.approx(t0 + duration)
+    assert np.max(np.abs(tr.states_km[-1, :3] - ref.y[:3, -1])) < 1e-3
+    assert np.max(np.abs(tr.states_km[-1, 3:] - ref.y[3:, -1])) < 1e-8
+
+
+def test_synodic_maps_round_trip(eph):
+    """CR3BP synodic state -> Moon-centred ICRF at an epoch -> back: the identity to 1e-12."""
+    em = librate.System.preset("earth-moon")
+    d = librate.dro(em, period_days=12.66)
+    t = tdb_seconds("2031-03-15T12:00:00 UTC")
+    x = eph.synodic_to_ephemeris(d.state0, t, em.mu)
+    back = eph.ephemeris_to_synodic(x, t, em.mu)
+    assert np.allclose(back, d.state0, rtol=0, atol=1e-12)
+    # the Moon-centred distance is the synodic distance from the Moon times the Earth-Moon distance
+    f = eph.rotating_frame(t)
+    rho = np.linalg.norm(np.asarray(d.state0[:3]) - [1 - em.mu, 0, 0])
+    assert np.linalg.norm(x[:3]) == pytest.approx(rho * f.distance_km, rel=1e-12)
