@@ -874,3 +874,19 @@ def test_solution_legend_prints_integer_n():
     labels = [h.get_label() for h in _style.solution_legend(np.array([4.0, 13.0, 7.0, 0.0]), np.array(["periodic"] * 4), np.array([True] * 4))]
     assert "other $N$ (4 ... 13)" in labels and "$N$ = 0" in labels
     assert not any(".0" in lab for lab in labels)
+
+
+def test_map_sol_n_is_integer_and_keeps_its_attributes(small_map):
+    """Issue 23 #7: N is a whole number of turns per period with n_periods=1, so the map stores
+    ``sol_n`` as an integer dtype (exact: equal to each AttitudeSolution's ``n_total``), keeps its
+    long_name, and the Fig. 24 legend prints it without a decimal point."""
+    n = small_map["sol_n"]
+    assert n.dtype.kind == "i" and n.attrs["long_name"] == "net body turns per orbit period"
+    assert np.array_equal(n.values, small_map["sol_n_total"].values)
+    from librate.periodicity.solutions import turns_array
+
+    assert turns_array([1, 0.5]).dtype == np.float64 and turns_array([]).dtype == np.int64  # n_total / K not whole: float
+    fig = lp.plot_map(small_map)
+    labels = [t.get_text() for a in fig.axes if a.get_legend() for t in a.get_legend().get_texts()]
+    ns = [lab for lab in labels if lab.startswith("$N$ =")]
+    assert ns and not any(".0" in lab for lab in ns)
