@@ -196,6 +196,25 @@ def test_plot_stability_curves_and_bifurcation(fam, tmp_path):
     np.testing.assert_array_equal(gid(ax_i, "stability-imag-1")[0].get_ydata(), fam.stability_indices[:, 1].imag)
 
 
+def test_plot_stability_halo_indices_follow_continuity(halos, tmp_path):
+    """Issue 23 #7: between members 35 and 36 of the L2 south halos the family lists the two
+    indices in the other order ((0.68, -0.65) then (-0.64, 0.48)); the curves follow each index
+    by nearest value instead: every drawn pair is the member's pair (exact, as a set), at every
+    step the drawn pairing is the nearer of the two (sum of |difference|), and no curve steps by
+    more than 0.25 from member 35 to 36 (the listed order steps by 1.3 there; the neighbouring
+    steps are 0.2-0.6)."""
+    fig = lp.plot_stability(halos)
+    assert_png(fig, tmp_path / "halo_stability.png")
+    ax = fig.axes[0]
+    y = np.column_stack([gid(ax, f"stability-{j}")[0].get_ydata() for j in (0, 1)])
+    nu = np.asarray(halos.stability_indices).real
+    np.testing.assert_array_equal(np.sort(y, axis=1), np.sort(nu, axis=1))
+    d = np.abs(np.diff(y, axis=0)).sum(axis=1)
+    d_swap = np.abs(y[1:, ::-1] - y[:-1]).sum(axis=1)
+    assert np.all(d <= d_swap)
+    assert np.abs(y[36] - y[35]).max() < 0.25
+
+
 def test_plot_stability_symlog_for_large_indices(halos):
     ax = lp.plot_stability(halos, against="jacobi").axes[0]
     assert ax.get_yscale() == "symlog"

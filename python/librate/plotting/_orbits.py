@@ -232,6 +232,19 @@ def plot_period(
 
 
 # --- stability (Fig. 5) ------------------------------------------------------------------------
+def follow_indices(nu: np.ndarray) -> np.ndarray:
+    """The members' index pairs (rows of ``nu``) reordered so that each index continues the
+    nearest one of the previous member (least sum of |difference|, complex), not the order the
+    family lists them in: no line jumps where two indices swap places between members."""
+    out = np.array(nu, copy=True)
+    for i in range(1, out.shape[0]):
+        prev, cur = out[i - 1], out[i]
+        if np.all(np.isfinite(prev)) and np.all(np.isfinite(cur)) and \
+                np.sum(np.abs(cur[::-1] - prev)) < np.sum(np.abs(cur - prev)):
+            out[i] = cur[::-1]
+    return out
+
+
 def plot_stability(
     family: OrbitFamily,
     ax=None,
@@ -244,7 +257,9 @@ def plot_stability(
 ) -> Figure:
     """The two stability indices nu = (lambda + 1/lambda) / 2 of a family's members against x0
     (thesis Fig. 5), real parts: ``gid="stability-0"`` (in-plane for planar families) and
-    ``"stability-1"`` (out-of-plane), their y data equal to ``family.stability_indices.real``.
+    ``"stability-1"`` (out-of-plane), their y data equal to ``family.stability_indices.real``;
+    for spatial families (halos) each member's pair is matched to the previous member's by
+    nearest value, so that a curve follows one index, not the sort order.
     A member is linearly stable when both are real with |nu| <= 1: the band -1 <= nu <= 1 is
     shaded (``band``). For a stable pair lambda = exp(+-i phi), nu = cos phi = Re(lambda), so
     the curves are the real parts of the eigenvalues the thesis plots. ``bifurcations``: a
@@ -256,6 +271,8 @@ def plot_stability(
     fam = check_family(family)
     x, xlabel = family_axis(fam, against)
     nu = np.asarray(fam.stability_indices)
+    if fam.spatial:  # no in-plane / out-of-plane: follow each index from member to member
+        nu = follow_indices(nu)
     names = ("in-plane $\\nu_1$", "out-of-plane $\\nu_2$") if not fam.spatial else ("$\\nu_1$", "$\\nu_2$")
     created = ax is None
     fig, (a,) = figure_axes(ax, 1, figsize=(7.0, 5.0))
