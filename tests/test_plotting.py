@@ -174,6 +174,26 @@ def test_plot_period_resonances(fam, em, tmp_path):
     assert not gid(ax_tu, "resonance-sun-2") and ax_tu.get_ylabel() == "period $T$ (TU)"
 
 
+def test_plot_period_halo_view_fits_the_data(halos, tmp_path):
+    """Issue 23 #7: the L2 south halos' periods (5.9-14.8 d, x0 1.01-1.18) fill the view (at
+    least 60 % of each axis; they filled 15 % of x when the Earth and the 1:1 line at 27.3 d
+    were kept in view), the Moon (within 35 % of the x0 span) stays in view, and every line
+    in the legend is inside the view (the 1:1 resonance is not listed)."""
+    fig = lp.plot_period(halos)
+    assert_png(fig, tmp_path / "halo_period.png")
+    ax = fig.axes[0]
+    (per,) = gid(ax, "period")
+    x, y = per.get_xdata(), per.get_ydata()
+    (x0, x1), (y0, y1) = ax.get_xlim(), ax.get_ylim()
+    assert np.ptp(x) / (x1 - x0) > 0.6 and np.ptp(y) / (y1 - y0) > 0.6
+    assert x0 <= gid(ax, "moon")[0].get_xdata()[0] <= x1
+    legend = [t.get_text() for t in ax.get_legend().get_texts()]
+    assert not any(t.startswith("1:1 ") or t.startswith("Earth") for t in legend)
+    for h in ax.get_lines():
+        if h.get_label() in legend and (h.get_gid() or "").startswith("resonance-"):
+            assert y0 <= h.get_ydata()[0] <= y1
+
+
 def test_plot_stability_curves_and_bifurcation(fam, tmp_path):
     """Thesis Fig. 5: the curves are the family's stability indices (real parts) against x0,
     the stable band is |nu| <= 1, and the out-of-plane +1 crossing near x0 = 0.27 is marked."""

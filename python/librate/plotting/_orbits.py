@@ -185,7 +185,8 @@ def plot_period(
     ``markers``, a labelled dot marks where the family crosses each line (interpolated between
     members). ``units``: ``"days"`` (via the system's TU) or ``"TU"``. ``against``: ``"x0"``,
     ``"z0"`` or ``"jacobi"``; for x0, ``primaries`` draws vertical lines at the Earth (-mu) and
-    the Moon (1 - mu). Returns the Figure.
+    the Moon (1 - mu). The view is the data's range (widened to take in a line within 35 % of
+    that range beyond it); lines out of the view are left out of the legend. Returns the Figure.
     """
     fam = check_family(family)
     sys_ = fam.system
@@ -223,12 +224,34 @@ def plot_period(
             v.set_gid("earth" if name.startswith("Earth") else "moon")
     a.set_xlabel(xlabel)
     a.set_ylabel(f"period $T$ ({tunit})")
-    a.set_ylim(bottom=0)
+    xlim, ylim = _data_view(x, period, [g[1] * tscale for g in groups],
+                            [-sys_.mu, 1 - sys_.mu] if primaries and against == "x0" else [])
+    a.set_xlim(*xlim)
+    a.set_ylim(*ylim)
+    for h in a.get_lines():  # a reference line out of the view is not listed in the legend
+        gid = h.get_gid() or ""
+        if gid.startswith("resonance-") and not ylim[0] <= h.get_ydata()[0] <= ylim[1] or \
+                gid in ("earth", "moon") and not xlim[0] <= h.get_xdata()[0] <= xlim[1]:
+            h.set_label("_nolegend_")
     a.grid(True, linewidth=0.3, alpha=0.5)
-    a.legend(loc="lower left", fontsize=7.5)
+    a.legend(loc="best", fontsize=7.5)
     if created:
         a.set_title(f"{fam.kind} family: period and resonances")
     return fig
+
+
+def _data_view(x, y, levels, positions, reach: float = 0.35, pad: float = 0.05):
+    """(xlim, ylim) of the data (x, y), widened to take in a reference level (y) or position
+    (x) lying within ``reach`` of the data's span beyond it, then padded by ``pad``."""
+    def span(v, refs):
+        v = np.asarray(v, dtype=float)
+        lo, hi = float(np.nanmin(v)), float(np.nanmax(v))
+        w = hi - lo or max(abs(hi), 1.0) * 0.1
+        near = [r for r in refs if lo - reach * w <= r <= hi + reach * w]
+        lo, hi = min([lo, *near]), max([hi, *near])
+        w = hi - lo
+        return lo - pad * w, hi + pad * w
+    return span(x, positions), span(y, levels)
 
 
 # --- stability (Fig. 5) ------------------------------------------------------------------------
