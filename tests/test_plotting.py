@@ -929,3 +929,42 @@ def test_map_sol_n_is_integer_and_keeps_its_attributes(small_map):
     labels = [t.get_text() for a in fig.axes if a.get_legend() for t in a.get_legend().get_texts()]
     ns = [lab for lab in labels if lab.startswith("$N$ =")]
     assert ns and not any(".0" in lab for lab in ns)
+
+
+def test_one_colour_per_n_in_families_and_solve_scatter(kz_map, small_map, tmp_path):
+    """Issue 23 #7: the solution-family lines are coloured by N (``n_color``, exact RGBA), Kz
+    told by line style; the CLI's ``solve`` scatter colours each N as the map figures do and
+    marks periodic (circle) and half-turn (diamond) motions apart, filled exactly when stable."""
+    from librate.app.cli import _solutions_scatter
+    from matplotlib.colors import to_rgba
+
+    fig = lp.plot_solution_families(kz_map, n=(1, 0, -1))
+    for a in fig.axes:
+        lines = [h for h in a.get_lines() if (h.get_gid() or "").startswith("family-periodic-")]
+        assert lines
+        for h in lines:
+            n = int(h.get_gid().split("-N")[1].split("-kz")[0])
+            assert to_rgba(h.get_color()) == to_rgba(lp.n_color(n))
+        styles = {h.get_gid().split("-kz")[1]: h.get_linestyle() for h in lines}
+        assert len(set(styles.values())) == len(styles)  # one line style per Kz
+
+    ds = small_map
+    sols = ds[[v for v in ds.data_vars if v.startswith("sol_")]].drop_vars("orbit", errors="ignore")
+    sols["sol_x0"] = ("solution", ds.x0.values[ds.sol_orbit.values])
+    fig = _solutions_scatter(sols)
+    assert_png(fig, tmp_path / "solve_solutions.png")
+    ax = fig.axes[0]
+    pts = np.column_stack([sols.sol_x0.values, sols.sol_phidot0.values])
+    nverts = {}
+    seen = 0
+    for c in gid(ax, "solutions"):
+        off = c.get_offsets()
+        idx = [int(np.flatnonzero(np.all(np.isclose(pts, p, rtol=0, atol=1e-14), axis=1))[0]) for p in off]
+        seen += len(idx)
+        (n,), (kind,), (stable,) = ({v.item() for v in sols[k].values[idx]} for k in ("sol_n", "sol_kind", "sol_stable"))
+        assert tuple(c.get_edgecolor()[0]) == to_rgba(lp.n_color(n))
+        face = c.get_facecolor()
+        assert (len(face) and tuple(face[0]) == to_rgba(lp.n_color(n))) if stable else (not len(face) or face[0][3] == 0)
+        nverts.setdefault(str(kind), set()).add(len(c.get_paths()[0].vertices))
+    assert seen == sols.sizes["solution"]
+    assert set(nverts) == {"periodic", "half-turn"} and not nverts["periodic"] & nverts["half-turn"]
