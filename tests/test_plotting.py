@@ -968,3 +968,22 @@ def test_one_colour_per_n_in_families_and_solve_scatter(kz_map, small_map, tmp_p
         nverts.setdefault(str(kind), set()).add(len(c.get_paths()[0].vertices))
     assert seen == sols.sizes["solution"]
     assert set(nverts) == {"periodic", "half-turn"} and not nverts["periodic"] & nverts["half-turn"]
+
+
+def test_example_03_legend_tells_gravity_from_srp(tmp_path, monkeypatch):
+    """Issue 23 #7: example 03's figure (run in-process, Agg) labels the gravity-only and the
+    SRP motion apart in each panel's legend (exact label prefixes, the SRP one with its eps)."""
+    import runpy
+    from pathlib import Path
+
+    figs = []
+    save = lp.save_figure
+    monkeypatch.setattr(lp, "save_figure", lambda fig, path, **kw: (figs.append(fig), save(fig, path))[1])
+    monkeypatch.setattr(sys, "argv", ["03_srp_solution.py", str(tmp_path)])
+    runpy.run_path(str(Path(__file__).resolve().parents[1] / "examples" / "03_srp_solution.py"), run_name="__main__")
+    (fig,) = figs
+    assert_png(fig, tmp_path / "srp" / "srp_motion.png")
+    for a in fig.axes:
+        labels = [t.get_text() for t in a.get_legend().get_texts()]
+        assert sum(lab.startswith("gravity only:") for lab in labels) == 1
+        assert sum(lab.startswith("SRP $\\varepsilon$ = 0.02:") for lab in labels) == 1
