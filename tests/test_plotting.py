@@ -222,7 +222,8 @@ def test_plot_stability_halo_indices_follow_continuity(halos, tmp_path):
     by nearest value instead: every drawn pair is the member's pair (exact, as a set), at every
     step the drawn pairing is the nearer of the two (sum of |difference|), and no curve steps by
     more than 0.25 from member 35 to 36 (the listed order steps by 1.3 there; the neighbouring
-    steps are 0.2-0.6)."""
+    steps are 0.2-0.6), and each bifurcation label names the drawn curve crossing its level
+    between the member and the next."""
     fig = lp.plot_stability(halos)
     assert_png(fig, tmp_path / "halo_stability.png")
     ax = fig.axes[0]
@@ -233,6 +234,11 @@ def test_plot_stability_halo_indices_follow_continuity(halos, tmp_path):
     d_swap = np.abs(y[1:, ::-1] - y[:-1]).sum(axis=1)
     assert np.all(d <= d_swap)
     assert np.abs(y[36] - y[35]).max() < 0.25
+    texts = [t.get_text() for t in ax.texts if "at $x_0$" in t.get_text()]  # each names the curve crossing there
+    assert len(texts) == len(halos.bifurcations)
+    for t, b in zip(texts, halos.bifurcations):
+        i, j = int(b["member"]), int("nu_2" in t)
+        assert (y[i, j] - b["level"]) * (y[i + 1, j] - b["level"]) <= 0, t
 
 
 def test_plot_stability_symlog_for_large_indices(halos):

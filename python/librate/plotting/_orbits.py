@@ -322,7 +322,12 @@ def plot_stability(
                 xb = float(x[i] + w * (x[i + 1] - x[i]))
             v = a.axvline(xb, color="0.3", linestyle=":", linewidth=1.0)
             v.set_gid("bifurcation")
-            a.text(xb, 0.02 if n % 2 == 0 else 0.98, f" {b['index']} $\\nu = {b['level']:+g}$ at $x_0$ = {b['x0']:.4f} ",
+            which = b["index"]
+            if fam.spatial:  # the curve that crosses there (the indices are drawn followed, not as listed)
+                ends = nu[i:i + 2].real - b["level"]
+                cost = np.nanmin(np.abs(ends), axis=0) - (np.prod(ends, axis=0) <= 0)  # a sign change first, then nearest
+                which = names[int(np.argmin(cost))]
+            a.text(xb, 0.02 if n % 2 == 0 else 0.98, f" {which} $\\nu = {b['level']:+g}$ at $x_0$ = {b['x0']:.4f} ",
                    transform=trans, rotation=90, ha="right", va="bottom" if n % 2 == 0 else "top", fontsize=7.5, color="0.2")
     finite = np.abs(nu[np.isfinite(nu)])
     if yscale is None:
