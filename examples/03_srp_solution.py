@@ -31,5 +31,6 @@ print(f"continued to eps = {path.eps[-1]:g} in {len(path.eps) - 1} steps ({path.
 print(f"with SRP: wz0 = {srp.wz0:.8f} 1/TU, phi0 = {srp.phi0:.6f} rad, residual {srp.residual:.1e}, "
       f"{'stable' if srp.stable else 'unstable'} (trace {srp.trace:.4f})")
 
-lp.save_figure(lp.plot_attitude_motion([gravity, srp]), out / "srp_motion.png", close=True)
+# The legend tells the gravity-only motion (dashed) from the SRP one (red, with its eps).
+lp.save_figure(lp.plot_srp_comparison(gravity, srp), out / "srp_motion.png", close=True)
 print(f"written: {out}/srp_motion.png")

@@ -174,6 +174,26 @@ def test_plot_period_resonances(fam, em, tmp_path):
     assert not gid(ax_tu, "resonance-sun-2") and ax_tu.get_ylabel() == "period $T$ (TU)"
 
 
+def test_plot_period_halo_view_fits_the_data(halos, tmp_path):
+    """Issue 23 #7: the L2 south halos' periods (5.9-14.8 d, x0 1.01-1.18) fill the view (at
+    least 60 % of each axis; they filled 15 % of x when the Earth and the 1:1 line at 27.3 d
+    were kept in view), the Moon (within 35 % of the x0 span) stays in view, and every line
+    in the legend is inside the view (the 1:1 resonance is not listed)."""
+    fig = lp.plot_period(halos)
+    assert_png(fig, tmp_path / "halo_period.png")
+    ax = fig.axes[0]
+    (per,) = gid(ax, "period")
+    x, y = per.get_xdata(), per.get_ydata()
+    (x0, x1), (y0, y1) = ax.get_xlim(), ax.get_ylim()
+    assert np.ptp(x) / (x1 - x0) > 0.6 and np.ptp(y) / (y1 - y0) > 0.6
+    assert x0 <= gid(ax, "moon")[0].get_xdata()[0] <= x1
+    legend = [t.get_text() for t in ax.get_legend().get_texts()]
+    assert not any(t.startswith("1:1 ") or t.startswith("Earth") for t in legend)
+    for h in ax.get_lines():
+        if h.get_label() in legend and (h.get_gid() or "").startswith("resonance-"):
+            assert y0 <= h.get_ydata()[0] <= y1
+
+
 def test_plot_stability_curves_and_bifurcation(fam, tmp_path):
     """Thesis Fig. 5: the curves are the family's stability indices (real parts) against x0,
     the stable band is |nu| <= 1, and the out-of-plane +1 crossing near x0 = 0.27 is marked."""
@@ -194,6 +214,31 @@ def test_plot_stability_curves_and_bifurcation(fam, tmp_path):
     assert not gid(ax, "stability-imag-0") and ax.get_yscale() == "linear"
     ax_i = lp.plot_stability(fam, imag=True).axes[0]
     np.testing.assert_array_equal(gid(ax_i, "stability-imag-1")[0].get_ydata(), fam.stability_indices[:, 1].imag)
+
+
+def test_plot_stability_halo_indices_follow_continuity(halos, tmp_path):
+    """Issue 23 #7: between members 35 and 36 of the L2 south halos the family lists the two
+    indices in the other order ((0.68, -0.65) then (-0.64, 0.48)); the curves follow each index
+    by nearest value instead: every drawn pair is the member's pair (exact, as a set), at every
+    step the drawn pairing is the nearer of the two (sum of |difference|), and no curve steps by
+    more than 0.25 from member 35 to 36 (the listed order steps by 1.3 there; the neighbouring
+    steps are 0.2-0.6), and each bifurcation label names the drawn curve crossing its level
+    between the member and the next."""
+    fig = lp.plot_stability(halos)
+    assert_png(fig, tmp_path / "halo_stability.png")
+    ax = fig.axes[0]
+    y = np.column_stack([gid(ax, f"stability-{j}")[0].get_ydata() for j in (0, 1)])
+    nu = np.asarray(halos.stability_indices).real
+    np.testing.assert_array_equal(np.sort(y, axis=1), np.sort(nu, axis=1))
+    d = np.abs(np.diff(y, axis=0)).sum(axis=1)
+    d_swap = np.abs(y[1:, ::-1] - y[:-1]).sum(axis=1)
+    assert np.all(d <= d_swap)
+    assert np.abs(y[36] - y[35]).max() < 0.25
+    texts = [t.get_text() for t in ax.texts if "at $x_0$" in t.get_text()]  # each names the curve crossing there
+    assert len(texts) == len(halos.bifurcations)
+    for t, b in zip(texts, halos.bifurcations):
+        i, j = int(b["member"]), int("nu_2" in t)
+        assert (y[i, j] - b["level"]) * (y[i + 1, j] - b["level"]) <= 0, t
 
 
 def test_plot_stability_symlog_for_large_indices(halos):
@@ -874,3 +919,77 @@ def test_solution_legend_prints_integer_n():
     labels = [h.get_label() for h in _style.solution_legend(np.array([4.0, 13.0, 7.0, 0.0]), np.array(["periodic"] * 4), np.array([True] * 4))]
     assert "other $N$ (4 ... 13)" in labels and "$N$ = 0" in labels
     assert not any(".0" in lab for lab in labels)
+
+
+def test_map_sol_n_is_integer_and_keeps_its_attributes(small_map):
+    """Issue 23 #7: N is a whole number of turns per period with n_periods=1, so the map stores
+    ``sol_n`` as an integer dtype (exact: equal to each AttitudeSolution's ``n_total``), keeps its
+    long_name, and the Fig. 24 legend prints it without a decimal point."""
+    n = small_map["sol_n"]
+    assert n.dtype.kind == "i" and n.attrs["long_name"] == "net body turns per orbit period"
+    assert np.array_equal(n.values, small_map["sol_n_total"].values)
+    from librate.periodicity.solutions import turns_array
+
+    assert turns_array([1, 0.5]).dtype == np.float64 and turns_array([]).dtype == np.int64  # n_total / K not whole: float
+    fig = lp.plot_map(small_map)
+    labels = [t.get_text() for a in fig.axes if a.get_legend() for t in a.get_legend().get_texts()]
+    ns = [lab for lab in labels if lab.startswith("$N$ =")]
+    assert ns and not any(".0" in lab for lab in ns)
+
+
+def test_one_colour_per_n_in_families_and_solve_scatter(kz_map, small_map, tmp_path):
+    """Issue 23 #7: the solution-family lines are coloured by N (``n_color``, exact RGBA), Kz
+    told by line style; the CLI's ``solve`` scatter colours each N as the map figures do and
+    marks periodic (circle) and half-turn (diamond) motions apart, filled exactly when stable."""
+    from librate.app.cli import _solutions_scatter
+    from matplotlib.colors import to_rgba
+
+    fig = lp.plot_solution_families(kz_map, n=(1, 0, -1))
+    for a in fig.axes:
+        lines = [h for h in a.get_lines() if (h.get_gid() or "").startswith("family-periodic-")]
+        assert lines
+        for h in lines:
+            n = int(h.get_gid().split("-N")[1].split("-kz")[0])
+            assert to_rgba(h.get_color()) == to_rgba(lp.n_color(n))
+        styles = {h.get_gid().split("-kz")[1]: h.get_linestyle() for h in lines}
+        assert len(set(styles.values())) == len(styles)  # one line style per Kz
+
+    ds = small_map
+    sols = ds[[v for v in ds.data_vars if v.startswith("sol_")]].drop_vars("orbit", errors="ignore")
+    sols["sol_x0"] = ("solution", ds.x0.values[ds.sol_orbit.values])
+    fig = _solutions_scatter(sols)
+    assert_png(fig, tmp_path / "solve_solutions.png")
+    ax = fig.axes[0]
+    pts = np.column_stack([sols.sol_x0.values, sols.sol_phidot0.values])
+    nverts = {}
+    seen = 0
+    for c in gid(ax, "solutions"):
+        off = c.get_offsets()
+        idx = [int(np.flatnonzero(np.all(np.isclose(pts, p, rtol=0, atol=1e-14), axis=1))[0]) for p in off]
+        seen += len(idx)
+        (n,), (kind,), (stable,) = ({v.item() for v in sols[k].values[idx]} for k in ("sol_n", "sol_kind", "sol_stable"))
+        assert tuple(c.get_edgecolor()[0]) == to_rgba(lp.n_color(n))
+        face = c.get_facecolor()
+        assert (len(face) and tuple(face[0]) == to_rgba(lp.n_color(n))) if stable else (not len(face) or face[0][3] == 0)
+        nverts.setdefault(str(kind), set()).add(len(c.get_paths()[0].vertices))
+    assert seen == sols.sizes["solution"]
+    assert set(nverts) == {"periodic", "half-turn"} and not nverts["periodic"] & nverts["half-turn"]
+
+
+def test_example_03_legend_tells_gravity_from_srp(tmp_path, monkeypatch):
+    """Issue 23 #7: example 03's figure (run in-process, Agg) labels the gravity-only and the
+    SRP motion apart in each panel's legend (exact label prefixes, the SRP one with its eps)."""
+    import runpy
+    from pathlib import Path
+
+    figs = []
+    save = lp.save_figure
+    monkeypatch.setattr(lp, "save_figure", lambda fig, path, **kw: (figs.append(fig), save(fig, path))[1])
+    monkeypatch.setattr(sys, "argv", ["03_srp_solution.py", str(tmp_path)])
+    runpy.run_path(str(Path(__file__).resolve().parents[1] / "examples" / "03_srp_solution.py"), run_name="__main__")
+    (fig,) = figs
+    assert_png(fig, tmp_path / "srp" / "srp_motion.png")
+    for a in fig.axes:
+        labels = [t.get_text() for t in a.get_legend().get_texts()]
+        assert sum(lab.startswith("gravity only:") for lab in labels) == 1
+        assert sum(lab.startswith("SRP $\\varepsilon$ = 0.02:") for lab in labels) == 1

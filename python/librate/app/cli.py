@@ -781,17 +781,32 @@ def _figures(result, path: Path, names, quiet: bool, extra: dict | None = None) 
 
 def _solutions_scatter(ds):
     import matplotlib.pyplot as plt
+    from matplotlib.lines import Line2D
+
+    from .. import plotting as lp
 
     fig, ax = plt.subplots(figsize=(6.4, 4.8), layout="constrained")
     n = ds["sol_n"].values
+    kind = ds["sol_kind"].values.astype(str) if "sol_kind" in ds.variables else np.full(n.shape, "periodic")
     stable = ds["sol_stable"].values.astype(bool)
     x, y = ds["sol_x0"].values, ds["sol_phidot0"].values
-    for k in sorted(set(n.tolist())):
-        sel = n == k
-        sc = ax.scatter(x[sel & stable], y[sel & stable], s=18, label=f"N = {k:g}")
-        ax.scatter(x[sel & ~stable], y[sel & ~stable], s=18, facecolors="none", edgecolors=sc.get_facecolor())
+    handles = []
+    for k in sorted(set(n.tolist()), reverse=True):  # the same N, the same colour as in the map figures
+        c = lp.n_color(k)
+        for kd, marker in lp.KIND_MARKERS.items():
+            for st in (True, False):
+                sel = (n == k) & (kind == kd) & (stable == st)
+                if sel.any():
+                    ax.scatter(x[sel], y[sel], s=22, marker=marker, edgecolors=c, facecolors=c if st else "none",
+                               linewidths=1.2, gid="solutions")
+        handles.append(Line2D([], [], linestyle="none", marker="s", color=c, label=f"N = {k:g}"))
+    gray = dict(linestyle="none", color="0.3", markeredgecolor="0.3")
+    for kd, marker in lp.KIND_MARKERS.items():
+        if np.any(kind == kd):
+            handles.append(Line2D([], [], marker=marker, markerfacecolor="0.8", label=kd, **gray))
+    handles.append(Line2D([], [], marker="o", markerfacecolor="none", label="hollow: unstable", **gray))
     ax.set_xlabel("$x_0$ (LU)")
     ax.set_ylabel(r"$\dot\phi(0)$ (1/TU)")
     ax.set_title("periodic attitude solutions (filled: stable)")
-    ax.legend(fontsize="small")
+    ax.legend(handles=handles, fontsize="small")
     return fig

@@ -34,6 +34,7 @@ from .solutions import (
     orbit_forcing,
     refine,
     sweep,
+    turns_array,
 )
 
 __all__ = ["periodicity_map", "zero_contours", "orbits_of", "map_grid", "map_coords", "map_dataset", "solutions_from_row",
@@ -268,7 +269,7 @@ def solution_variables(sols) -> dict:
         "sol_wz0": ("solution", np.array([x.wz0 for x in s], dtype=float), {"units": "1/TU"}),
         "sol_phidot0": ("solution", np.array([x.phidot0 for x in s], dtype=float), {"units": "1/TU"}),
         "sol_phi0": ("solution", np.array([x.phi0 for x in s], dtype=float), {"units": "rad"}),
-        "sol_n": ("solution", np.array([x.n for x in s], dtype=float), {"long_name": "net body turns per orbit period"}),
+        "sol_n": ("solution", turns_array(x.n for x in s), {"long_name": "net body turns per orbit period"}),
         "sol_n_total": ("solution", np.array([x.n_total for x in s], dtype=np.int64),
                         {"long_name": "net body turns over the n_periods orbit periods"}),
         "sol_kind": ("solution", np.array([x.kind for x in s], dtype="<U9")),

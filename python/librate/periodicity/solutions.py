@@ -31,7 +31,7 @@ from ..orbits.periodic import PeriodicOrbit
 
 __all__ = ["AttitudeSolution", "find_periodic_attitudes", "orbit_forcing", "clear_forcing_cache", "sweep", "candidates",
            "check_orbit", "check_kz", "check_kinds", "KINDS", "check_srp", "is_symmetric", "MAP_RTOL", "MAP_ATOL", "correct", "verified", "refine", "refine_groups",
-           "turns_of", "n_total_of", "per_period", "SOLVE_RTOL", "SOLVE_ATOL", "STEP_MAX_ITER", "MAP_METHOD",
+           "turns_of", "n_total_of", "per_period", "turns_array", "SOLVE_RTOL", "SOLVE_ATOL", "STEP_MAX_ITER", "MAP_METHOD",
            "STEP_MAX_HALVINGS"]
 
 MAP_RTOL = 1e-12
@@ -132,6 +132,13 @@ def n_total_of(n, n_periods: int) -> int:
 
 def per_period(n_total: int, n_periods: int) -> int | float:
     return n_total // n_periods if n_total % n_periods == 0 else n_total / n_periods
+
+
+def turns_array(values) -> np.ndarray:
+    """Turns per orbit period (``AttitudeSolution.n`` values) as a stored array: int64 when all
+    are whole numbers (always with ``n_periods=1``), else float64 (n_total / K not whole)."""
+    a = np.asarray(list(values), dtype=float)
+    return a.astype(np.int64) if np.all(a == np.round(a)) else a
 
 
 @dataclass(frozen=True)

@@ -28,6 +28,7 @@ from .solutions import (
     find_periodic_attitudes,
     orbit_forcing,
     sweep,
+    turns_array,
     verified,
 )
 
@@ -249,7 +250,7 @@ def srp_map(
             "sol_phidot0": ("solution", sol_arr(lambda b, e, s: s.phidot0), {"units": "1/TU"}),
             "sol_phi0": ("solution", sol_arr(lambda b, e, s: math.remainder(s.phi0, 2 * math.pi)), {"units": "rad",
                          "long_name": "phi0 wrapped to [-pi, pi]"}),
-            "sol_n": ("solution", sol_arr(lambda b, e, s: s.n), {"long_name": "net body turns per orbit period"}),
+            "sol_n": ("solution", turns_array(s.n for b, e, s in sols), {"long_name": "net body turns per orbit period"}),
             "sol_n_total": ("solution", sol_arr(lambda b, e, s: s.n_total, np.int64), {"long_name": "net body turns over the n_periods periods"}),
             "sol_kind": ("solution", sol_arr(lambda b, e, s: s.kind, "<U9")),
             "sol_trace": ("solution", sol_arr(lambda b, e, s: s.trace)),

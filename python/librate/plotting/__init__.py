@@ -62,7 +62,7 @@ from ._maps import plot_map, plot_residuals
 from ._orbits import plot_attitude, plot_eci, plot_family, plot_period, plot_stability
 from ._solutions import plot_attitude_motion, plot_solution_families
 from ._srp import plot_srp_comparison, plot_srp_map, plot_srp_maps
-from ._style import N_COLORS, figure_axes, n_color, save_figure
+from ._style import KIND_MARKERS, N_COLORS, figure_axes, n_color, save_figure
 from ._sun import plot_sun_motion, plot_sun_pointing, plot_sun_resonant
 
 __all__ = [
@@ -95,5 +95,6 @@ __all__ = [
     "figure_axes",
     "n_color",
     "N_COLORS",
+    "KIND_MARKERS",
     "save_figure",
 ]

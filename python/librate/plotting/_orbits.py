@@ -185,7 +185,8 @@ def plot_period(
     ``markers``, a labelled dot marks where the family crosses each line (interpolated between
     members). ``units``: ``"days"`` (via the system's TU) or ``"TU"``. ``against``: ``"x0"``,
     ``"z0"`` or ``"jacobi"``; for x0, ``primaries`` draws vertical lines at the Earth (-mu) and
-    the Moon (1 - mu). Returns the Figure.
+    the Moon (1 - mu). The view is the data's range (widened to take in a line within 35 % of
+    that range beyond it); lines out of the view are left out of the legend. Returns the Figure.
     """
     fam = check_family(family)
     sys_ = fam.system
@@ -223,15 +224,50 @@ def plot_period(
             v.set_gid("earth" if name.startswith("Earth") else "moon")
     a.set_xlabel(xlabel)
     a.set_ylabel(f"period $T$ ({tunit})")
-    a.set_ylim(bottom=0)
+    xlim, ylim = _data_view(x, period, [g[1] * tscale for g in groups],
+                            [-sys_.mu, 1 - sys_.mu] if primaries and against == "x0" else [])
+    a.set_xlim(*xlim)
+    a.set_ylim(*ylim)
+    for h in a.get_lines():  # a reference line out of the view is not listed in the legend
+        gid = h.get_gid() or ""
+        if gid.startswith("resonance-") and not ylim[0] <= h.get_ydata()[0] <= ylim[1] or \
+                gid in ("earth", "moon") and not xlim[0] <= h.get_xdata()[0] <= xlim[1]:
+            h.set_label("_nolegend_")
     a.grid(True, linewidth=0.3, alpha=0.5)
-    a.legend(loc="lower left", fontsize=7.5)
+    a.legend(loc="best", fontsize=7.5)
     if created:
         a.set_title(f"{fam.kind} family: period and resonances")
     return fig
 
 
+def _data_view(x, y, levels, positions, reach: float = 0.35, pad: float = 0.05):
+    """(xlim, ylim) of the data (x, y), widened to take in a reference level (y) or position
+    (x) lying within ``reach`` of the data's span beyond it, then padded by ``pad``."""
+    def span(v, refs):
+        v = np.asarray(v, dtype=float)
+        lo, hi = float(np.nanmin(v)), float(np.nanmax(v))
+        w = hi - lo or max(abs(hi), 1.0) * 0.1
+        near = [r for r in refs if lo - reach * w <= r <= hi + reach * w]
+        lo, hi = min([lo, *near]), max([hi, *near])
+        w = hi - lo
+        return lo - pad * w, hi + pad * w
+    return span(x, positions), span(y, levels)
+
+
 # --- stability (Fig. 5) ------------------------------------------------------------------------
+def follow_indices(nu: np.ndarray) -> np.ndarray:
+    """The members' index pairs (rows of ``nu``) reordered so that each index continues the
+    nearest one of the previous member (least sum of |difference|, complex), not the order the
+    family lists them in: no line jumps where two indices swap places between members."""
+    out = np.array(nu, copy=True)
+    for i in range(1, out.shape[0]):
+        prev, cur = out[i - 1], out[i]
+        if np.all(np.isfinite(prev)) and np.all(np.isfinite(cur)) and \
+                np.sum(np.abs(cur[::-1] - prev)) < np.sum(np.abs(cur - prev)):
+            out[i] = cur[::-1]
+    return out
+
+
 def plot_stability(
     family: OrbitFamily,
     ax=None,
@@ -244,7 +280,9 @@ def plot_stability(
 ) -> Figure:
     """The two stability indices nu = (lambda + 1/lambda) / 2 of a family's members against x0
     (thesis Fig. 5), real parts: ``gid="stability-0"`` (in-plane for planar families) and
-    ``"stability-1"`` (out-of-plane), their y data equal to ``family.stability_indices.real``.
+    ``"stability-1"`` (out-of-plane), their y data equal to ``family.stability_indices.real``;
+    for spatial families (halos) each member's pair is matched to the previous member's by
+    nearest value, so that a curve follows one index, not the sort order.
     A member is linearly stable when both are real with |nu| <= 1: the band -1 <= nu <= 1 is
     shaded (``band``). For a stable pair lambda = exp(+-i phi), nu = cos phi = Re(lambda), so
     the curves are the real parts of the eigenvalues the thesis plots. ``bifurcations``: a
@@ -256,6 +294,8 @@ def plot_stability(
     fam = check_family(family)
     x, xlabel = family_axis(fam, against)
     nu = np.asarray(fam.stability_indices)
+    if fam.spatial:  # no in-plane / out-of-plane: follow each index from member to member
+        nu = follow_indices(nu)
     names = ("in-plane $\\nu_1$", "out-of-plane $\\nu_2$") if not fam.spatial else ("$\\nu_1$", "$\\nu_2$")
     created = ax is None
     fig, (a,) = figure_axes(ax, 1, figsize=(7.0, 5.0))
@@ -282,7 +322,12 @@ def plot_stability(
                 xb = float(x[i] + w * (x[i + 1] - x[i]))
             v = a.axvline(xb, color="0.3", linestyle=":", linewidth=1.0)
             v.set_gid("bifurcation")
-            a.text(xb, 0.02 if n % 2 == 0 else 0.98, f" {b['index']} $\\nu = {b['level']:+g}$ at $x_0$ = {b['x0']:.4f} ",
+            which = b["index"]
+            if fam.spatial:  # the curve that crosses there (the indices are drawn followed, not as listed)
+                ends = nu[i:i + 2].real - b["level"]
+                cost = np.nanmin(np.abs(ends), axis=0) - (np.prod(ends, axis=0) <= 0)  # a sign change first, then nearest
+                which = names[int(np.argmin(cost))]
+            a.text(xb, 0.02 if n % 2 == 0 else 0.98, f" {which} $\\nu = {b['level']:+g}$ at $x_0$ = {b['x0']:.4f} ",
                    transform=trans, rotation=90, ha="right", va="bottom" if n % 2 == 0 else "top", fontsize=7.5, color="0.2")
     finite = np.abs(nu[np.isfinite(nu)])
     if yscale is None:

@@ -63,9 +63,10 @@ def plot_solution_families(
     ``gid="family-{kind}-N{N:+d}-kz{Kz:g}"`` (e.g. ``"family-periodic-N-1-kz0.8"``) whose points
     are exactly the Dataset's solutions; with ``stability`` the linearly stable ones are
     overdrawn filled (``gid="family-stable"``). ``n``: the N values to show (default: all in
-    the Dataset), ``kinds``: ``"periodic"`` (default) and/or ``"half-turn"``. ``separate``: one
-    panel per (kind, N), N descending, Kz by colour (``ax``: that many Axes); else a single
-    panel, N by colour and Kz by line style. ``against``: ``"period"`` (days) or ``"x0"``;
+    the Dataset), ``kinds``: ``"periodic"`` (default) and/or ``"half-turn"``. Lines are
+    coloured by N (:func:`librate.plotting.n_color`, the same in every figure), Kz told by line
+    style. ``separate``: one panel per (kind, N), N descending (``ax``: that many Axes); else a
+    single panel. ``against``: ``"period"`` (days) or ``"x0"``;
     ``rate``: ``"relative"`` (phidot(0) = wz(0) - 1, default) or ``"inertial"``. Returns the
     Figure.
     """
@@ -90,8 +91,6 @@ def plot_solution_families(
     if not groups:
         raise ValueError(f"invalid argument `ds`: it holds no solutions of kinds {list(kinds)}")
     kzs = np.asarray(ds["kz"].values, dtype=float)
-    kz_colors = (["k"] if kzs.size == 1 else
-                 [matplotlib.colormaps["viridis"](v) for v in np.linspace(0.0, 0.85, kzs.size)])
 
     created = ax is None
     npanels = len(groups) if separate else 1
@@ -103,8 +102,8 @@ def plot_solution_families(
             sel = np.flatnonzero((tab["kind"] == kind) & (tab["n"] == nn) & kz_mask(tab, kz))
             if not sel.size:
                 continue
-            color = kz_colors[jk] if separate else n_color(nn)
-            style = "-" if separate else KZ_STYLES[jk % len(KZ_STYLES)]
+            color = n_color(nn)  # the same N, the same colour in every figure; Kz by line style
+            style = KZ_STYLES[jk % len(KZ_STYLES)]
             name = f"$K_z$ = {kz:g}" if separate else f"$N$ = {nn:g}{' half-turn' if kind == 'half-turn' else ''}, $K_z$ = {kz:g}"
             orb, w = tab["orbit"][sel], tab["wz0"][sel]
             for b_i, br in enumerate(_branches(orb, w, max_jump)):

@@ -124,7 +124,8 @@ def resonance_label(orbit: PeriodicOrbit, tol: float = 1e-6) -> str | None:
 
 
 # --- periodic attitude motions: residuals, maps, families, motions (Figs. 23-31) --------------
-_KIND_MARKER = {"periodic": "o", "half-turn": "D"}
+#: The marker of each kind of periodic attitude motion, in every figure (filled: stable).
+KIND_MARKERS = {"periodic": "o", "half-turn": "D"}
 # Solutions are coloured by N (the same N, the same colour in every figure), |N| > 3 in one grey;
 # blue and orange are left to the residuals Dwz and Dphi (curves in Fig. 23, contours in Fig. 24).
 N_COLORS = {0: "tab:green", 1: "tab:red", -1: "tab:purple", 2: "tab:brown", -2: "tab:pink", 3: "tab:olive", -3: "tab:cyan"}
@@ -200,7 +201,7 @@ def draw_solutions(a, x, y, n, kind, stable, *, markersize: float = 6.5) -> None
                 if not m.any():
                     continue
                 c = n_color(nn)
-                (h,) = a.plot(x[m], y[m], linestyle="none", marker=_KIND_MARKER[k], color=c, markeredgecolor=c,
+                (h,) = a.plot(x[m], y[m], linestyle="none", marker=KIND_MARKERS[k], color=c, markeredgecolor=c,
                               markerfacecolor=c if st else "none", markeredgewidth=1.4, markersize=markersize, zorder=5,
                               label="_nolegend_")
                 h.set_gid("solutions")
