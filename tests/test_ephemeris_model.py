@@ -3,10 +3,9 @@ excerpt against jplephem reading the same file, the Earth-Moon rotating frame ag
 definition, and the Moon-centred point-mass propagation against an independent integration
 (scipy DOP853 on jplephem positions: a test reference, written here on purpose)."""
 
+import librate
 import numpy as np
 import pytest
-
-import librate
 from librate.ephemeris.epochs import tdb_seconds
 from librate.ephemeris.spk import embedded_spk_path
 

@@ -10,7 +10,6 @@ import warnings as _warnings
 from ._build import build_info
 from ._core import __version__
 from ._errors import CollisionError, ConvergenceError, IntegrationError, LibrateError
-from .ephemeris import Ephemeris, EphemerisTrajectory, propagate_ephemeris
 from .attitude import (
     Appendage,
     AttitudeEquilibrium,
@@ -27,6 +26,7 @@ from .attitude import (
     quasi_static,
     quaternion_from_euler,
 )
+from .ephemeris import Ephemeris, EphemerisTrajectory, propagate_ephemeris
 from .orbits import (
     BatchResult,
     Event,
