@@ -666,6 +666,8 @@ def map_sweep_3d(
     chunk: int = 64, threads: int | None = None,
 ) -> Sweep3DResult: ...
 
+__all__ += ["EphemerisCore", "GM_EARTH", "GM_MOON", "GM_SUN"]
+
 GM_EARTH: float
 GM_MOON: float
 GM_SUN: float
