@@ -24,6 +24,19 @@ def _result_path(study: Study, out, command: str) -> Path:
 
     return study.output_dir(out) / (RESULT_STEMS[command] + (".zarr" if study.output.format == "zarr" else ".nc"))
 
+
+def _reused(path: Path, kind: str, study: Study, what: str, force: bool, say: Callable[[str], None] | None):
+    """The existing result at ``path`` when it holds this ``kind`` from the same inputs (said as
+    reused), else None; a result of other inputs raises ResultExists unless ``force``."""
+    from .results import check_output, open_result
+
+    if check_output(path, kind, study.to_json(), force=force, say=say) != "resume":
+        return None
+    if say is not None:
+        say(f"reused: {path} already holds {what} (--force recomputes {'it' if what.startswith('this') else 'them'})")
+    return open_result(path)
+
+
 def run_family(study: Study, out: str | Path | None = None, *, force: bool = False, say: Callable[[str], None] | None = None,
                progress: Callable[[int, int], None] | None = None):
     """Compute the orbit family (and the selected members, when the selection is a
@@ -34,13 +47,11 @@ def run_family(study: Study, out: str | Path | None = None, *, force: bool = Fal
     one of other inputs raises :class:`~librate.app.results.ResultExists` naming the changed
     keys, unless ``force`` (then it is replaced, after ``say`` names it). ``progress(done,
     total)`` after each member of the continuation."""
-    from .results import check_output, open_result, save_family
+    from .results import save_family
 
     path = _result_path(study, out, "family")
-    if check_output(path, "family", study.to_json(), force=force, say=say) == "resume":
-        if say is not None:
-            say(f"reused: {path} already holds this family (--force recomputes it)")
-        return open_result(path), path
+    if (done := _reused(path, "family", study, "this family", force, say)) is not None:
+        return done, path
     fam = study.build_family(progress=progress)
     sel = study.build_orbits(fam)
     if isinstance(sel, list):
@@ -61,13 +72,11 @@ def run_solve(study: Study, out: str | Path | None = None, progress: Callable[[i
     if study.attitude.model == "3d":
         return _run_solve_3d(study, out, progress, force=force, say=say)
     from ..periodicity.solutions import find_periodic_attitudes
-    from .results import check_output, open_result, save_dataset, solutions_dataset
+    from .results import save_dataset, solutions_dataset
 
     path = _result_path(study, out, "solve")
-    if check_output(path, "solutions", study.to_json(), force=force, say=say) == "resume":
-        if say is not None:
-            say(f"reused: {path} already holds these solutions (--force recomputes them)")
-        return open_result(path), path
+    if (done := _reused(path, "solutions", study, "these solutions", force, say)) is not None:
+        return done, path
     orbits = study.build_orbits()
     olist = list(orbits)
     wz = study.wz0_values()
@@ -113,13 +122,11 @@ def _run_solve_3d(study: Study, out: str | Path | None = None, progress: Callabl
     ``progress(done, total)`` after each member reached."""
     from .._errors import ConvergenceError
     from ..periodicity.attitude3d import attitude_family_3d
-    from .results import check_output, open_result, save_dataset, solutions_3d_dataset
+    from .results import save_dataset, solutions_3d_dataset
 
     path = _result_path(study, out, "solve")
-    if check_output(path, "solutions_3d", study.to_json(), force=force, say=say) == "resume":
-        if say is not None:
-            say(f"reused: {path} already holds these 3-D solutions (--force recomputes them)")
-        return open_result(path), path
+    if (done := _reused(path, "solutions_3d", study, "these 3-D solutions", force, say)) is not None:
+        return done, path
     fam = study.build_family()
     members = list(study.build_orbits(fam))
     if not members:
