@@ -5,7 +5,7 @@ import math
 import librate
 import numpy as np
 import pytest
-from librate.orbits.continuation import geometry
+from librate.orbits.orbit_continuation import geometry
 
 
 @pytest.fixture(scope="module")

@@ -96,7 +96,7 @@ def run_solve(study: Study, out: str | Path | None = None, progress: Callable[[i
     flex = study.build_flexible()
     if flex is not None and rows:
         # Flexibility's first-order effect on each rigid solution (the closed quasi-static form).
-        from ..periodicity.flexible import flexible_periodic
+        from ..periodicity.flexible_periodic import flexible_periodic
 
         res = [flexible_periodic(sol, flex, resolve=False) for _, sol in rows]
         ds["flex_dphi0"] = ("solution", np.array([r.shift[0] for r in res]), {"units": "rad", "long_name": "first-order shift of phi0 from flexibility"})

@@ -1,10 +1,10 @@
 """The orbit layer: the CR3BP system, trajectory propagation, periodic orbits, their
 continuation into families, Fourier fits and frame conversions."""
 
-from .continuation import ContinuationResult, Geometry, continue_arclength, continue_natural, geometry
 from .families import OrbitFamily, correct_dro, dro, dro_family, halo, halo_family, lyapunov, lyapunov_family
 from .fourier import FourierOrbit, fit_fourier
 from .frames import MeanElements, OsculatingElements, eci_to_synodic, mean_elements, osculating_elements, synodic_to_eci
+from .orbit_continuation import ContinuationResult, Geometry, continue_arclength, continue_natural, geometry
 from .periodic import PeriodicOrbit, correct_periodic, correct_symmetric
 from .propagation import BatchResult, Event, EventHit, Stats, Trajectory, propagate, propagate_many
 from .system import System

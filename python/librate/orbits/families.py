@@ -1,6 +1,6 @@
 """Families of symmetric periodic orbits: DROs, planar Lyapunov orbits, halos and NRHOs.
 
-A family is computed by continuation (``librate.orbits.continuation``), every member's stability from
+A family is computed by continuation (``librate.orbits.orbit_continuation``), every member's stability from
 its monodromy matrix (batch-propagated on all cores), and bifurcations located where a
 stability index crosses +1 or -1. :class:`OrbitFamily` holds the members, finds members by x0,
 z0, period or Jacobi constant by root finding on the family (returning a corrected orbit),
@@ -28,7 +28,7 @@ from .._errors import ConvergenceError, LibrateError
 from .._progress import as_progress
 from ..constants import SUN_SYNODIC_PERIOD
 from ..solving.continuation import sign_changes
-from .continuation import continue_arclength, continue_natural, geometry
+from .orbit_continuation import continue_arclength, continue_natural, geometry
 from .periodic import (
     INDEX_TESTS,
     SHOOT_ATOL,
@@ -115,7 +115,7 @@ class OrbitFamily:
                      bifurcations=None) -> OrbitFamily:
         """The family of ``members`` (in order along it), with their stability from one batched
         propagation. ``bifurcations``: the continuation driver's (located; see
-        :class:`librate.orbits.continuation.ContinuationResult`); without them (members known
+        :class:`librate.orbits.orbit_continuation.ContinuationResult`); without them (members known
         without a run: an import, a selection) the sign changes of the same test functions
         between consecutive members, interpolated linearly."""
         if not members:
@@ -205,7 +205,7 @@ class OrbitFamily:
     @functools.cached_property
     def closest_km(self) -> np.ndarray:
         """(n, 2) closest approach of each member to the larger and the smaller primary's
-        centre (km, from :func:`librate.orbits.continuation.geometry`); computed on first use."""
+        centre (km, from :func:`librate.orbits.orbit_continuation.geometry`); computed on first use."""
         return np.array([geometry(o).min_distance for o in self]) * self.system.lu_km
 
     @property

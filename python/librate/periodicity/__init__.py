@@ -10,9 +10,9 @@ from .attitude3d import (
     out_of_plane_stability,
     periodic_attitude_3d,
 )
+from .attitude_families import AttitudeFamily, attitude_family
 from .branches import SrpContinuation, continue_srp, periodic_attitude
-from .families import AttitudeFamily, attitude_family
-from .flexible import FlexiblePeriodic, FrequencyScan, flexible_periodic, frequency_scan
+from .flexible_periodic import FlexiblePeriodic, FrequencyScan, flexible_periodic, frequency_scan
 from .map3d import attitude_map_3d, find_periodic_attitudes_3d
 from .maps import periodicity_map, zero_contours
 from .solutions import (
@@ -24,7 +24,7 @@ from .solutions import (
     orbit_forcing,
     sweep,
 )
-from .srp import srp_map, sun_pointing_accelerations
+from .srp_motions import srp_map, sun_pointing_accelerations
 
 __all__ = [
     "AttitudeSolution",

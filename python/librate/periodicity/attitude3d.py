@@ -307,7 +307,7 @@ def out_of_plane_family(orbits, family, *, body: RigidBody | None = None, every:
     import xarray as xr
 
     from ..orbits.families import OrbitFamily
-    from .families import AttitudeFamily
+    from .attitude_families import AttitudeFamily
 
     if not isinstance(orbits, OrbitFamily):
         raise ValueError(f"invalid argument `orbits`: must be a librate.OrbitFamily, got {type(orbits).__name__}")

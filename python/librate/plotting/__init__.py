@@ -55,7 +55,7 @@ try:
 except ImportError as exc:  # pragma: no cover - depends on the environment
     raise ImportError("librate.plotting needs matplotlib >= 3.6, a required dependency of librate: reinstall librate") from exc
 
-from ..periodicity.srp import srp_map, sun_pointing_accelerations
+from ..periodicity.srp_motions import srp_map, sun_pointing_accelerations
 from ._attitude3d import plot_body_axes, plot_equilibrium_stability, plot_family_multipliers, plot_map_3d, plot_out_of_plane_stability
 from ._flexible import plot_flexible_body, plot_flexible_coordinate, plot_flexible_response, plot_frequency_scan
 from ._maps import plot_map, plot_residuals

@@ -10,7 +10,7 @@ import numpy as np
 
 from ..attitude.flexible import FlexibleBody, QuasiStaticResponse
 from ..attitude.propagate import AttitudeTrajectory
-from ..periodicity.flexible import FrequencyScan
+from ..periodicity.flexible_periodic import FrequencyScan
 from ._style import figure_axes
 
 if TYPE_CHECKING:

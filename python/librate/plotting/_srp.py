@@ -12,7 +12,7 @@ from matplotlib.lines import Line2D
 
 from .._checks import as_count, as_number
 from ..periodicity.solutions import KINDS, AttitudeSolution, check_kinds
-from ..periodicity.srp import sun_resonance
+from ..periodicity.srp_motions import sun_resonance
 from ._maps import map_contours, plot_map
 from ._style import GRAVITY_COLOR, SRP_COLOR, check_map, draw_solutions, figure_axes, n_color, rate_axis, solution_legend
 

@@ -18,7 +18,7 @@ from ..constants import OMEGA_SUN, SUN_SYNODIC_PERIOD
 from ..orbits.families import OrbitFamily
 from ..orbits.periodic import PeriodicOrbit
 from ..orbits.system import check_system
-from ..periodicity.srp import sun_angle, sun_pointing_accelerations, sun_resonance
+from ..periodicity.srp_motions import sun_angle, sun_pointing_accelerations, sun_resonance
 from ._style import EARTH, LABEL_OFFSETS, MOON, SRP_COLOR, SUN_COLOR, check_family, draw_primaries, figure_axes, length_scale, time_scale
 
 if TYPE_CHECKING:
