@@ -6,6 +6,30 @@ import math
 
 import numpy as np
 
+#: The allowed range of each tolerance of the public API, by parameter name (issue 24 #6).
+#: Relative tolerances below 1e-15 ask for less than the double-precision round-off of the
+#: state (the step-size control then shrinks the steps to the floor); above 1e-3 the embedded
+#: error estimates of the 7(8) and 8(7) pairs no longer bound the error (rtol = 1000 let the
+#: map integrator take steps of whole periods and never finish). Absolute tolerances go lower:
+#: states that are small by construction (a deflection of 1e-4) are integrated at atol = 1e-16.
+#: Newton and fit tolerances (``tol``, ``jacobi_tol``, ``closure_tol``) are relative too.
+TOLERANCES = {"rtol": (1e-15, 1e-3), "atol": (1e-18, 1e-3), "tol": (1e-15, 1e-3), "jacobi_tol": (1e-15, 1e-1),
+              "closure_tol": (1e-15, 1e-1)}
+#: The largest value of each count of the public API, by parameter name; a count not named here
+#: is bounded by MAX_COUNT (the core's 32-bit counters). ``threads``: more worker threads than
+#: this only queue (1024 is well past any machine's cores; 2**31 hung the thread pool's start).
+#: ``max_iter``: Newton converges quadratically or not at all, 10,000 iterations is far past
+#: either. ``max_steps``: 1e9 integrator steps are hours of work for one trajectory.
+#: ``n_periods``: attitude motions over up to 1000 orbit periods. ``n_harmonics``: a Fourier fit
+#: of N harmonics samples 8 N times (its design matrix: 128 N**2 bytes, 128 MB at N = 1000).
+COUNT_LIMITS = {"threads": 1024, "max_iter": 10_000, "max_steps": 10**9, "n_periods": 1000, "chunk": 1 << 20,
+                "max_members": 100_000, "max_points": 100_000, "steps": 100_000, "max_seeds": 100_000,
+                "n_harmonics": 1000, "max_harmonics": 1000}
+MAX_COUNT = 2**31 - 1
+#: The most memory (bytes) the arrays sized by one grid-size argument may take (the same limit
+#: as a study's map arrays, app/budget.py): 2 GiB.
+MAX_ARRAY_BYTES = 2 * 1024**3
+
 
 def as_real(value, name: str, *, positive: bool = False, nonnegative: bool = False, allow_inf: bool = False) -> float:
     """A real number (Python or numpy; not a bool, a string or an array), not NaN, finite unless
@@ -80,7 +104,68 @@ def as_number(value, name: str, *, positive: bool = False) -> float:
     return float(value)
 
 
-def as_count(value, name: str, minimum: int) -> int:
-    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)) or value < minimum:
-        raise ValueError(f"invalid argument `{name}`: must be an integer >= {minimum}, got {value!r}")
+def as_count(value, name: str, minimum: int, maximum: float | None = None) -> int:
+    """An integer in [minimum, maximum] (``maximum`` by default from COUNT_LIMITS by name, else
+    MAX_COUNT); not a bool, a float or a string. Else a ValueError naming it and the range."""
+    hi = COUNT_LIMITS.get(name, MAX_COUNT) if maximum is None else maximum
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)) or not minimum <= value <= hi:
+        raise ValueError(f"invalid argument `{name}`: must be an integer " + (f">= {minimum}" if hi == math.inf else f"in [{minimum}, {hi:,}]") + f", got {value!r}")
     return int(value)
+
+
+def as_threads(value, name: str = "threads") -> int | None:
+    """A worker-thread count in [1, COUNT_LIMITS["threads"]], or None (all cores)."""
+    if value is None:
+        return None
+    hi = COUNT_LIMITS["threads"]
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)) or not 1 <= value <= hi:
+        raise ValueError(f"invalid argument `{name}`: must be an integer in [1, {hi}] or None (all cores), got {value!r}")
+    return int(value)
+
+
+def as_tolerance(value, name: str) -> float:
+    """A tolerance in its range of TOLERANCES (by name; a Newton tolerance's by default), else a
+    ValueError naming it and the range."""
+    lo, hi = TOLERANCES.get(name, TOLERANCES["tol"])
+    return as_between(value, name, lo, hi)
+
+
+def as_between(value, name: str, lo: float, hi: float) -> float:
+    """A real number in [lo, hi] (not a bool, a string or NaN), else a ValueError naming it."""
+    ok = isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, (bool, np.bool_))
+    v = float(value) if ok else math.nan
+    if not lo <= v <= hi:  # NaN fails too
+        raise ValueError(f"invalid argument `{name}`: must be a number in [{lo:g}, {hi:g}], got {value!r}")
+    return v
+
+
+def _bytes(n: float) -> str:
+    for unit in ("B", "kB", "MB", "GB", "TB", "PB"):
+        if n < 1000 or unit == "PB":
+            return f"{n:.3g} {unit}"
+        n /= 1000
+    return f"{n:.3g} PB"  # pragma: no cover
+
+
+def as_size(value, name: str, minimum: int, *, item_bytes: float, what: str = "arrays") -> int:
+    """A grid size (count of samples, grid points, cases) whose ``what`` take ``item_bytes`` per
+    unit: an integer in [minimum, MAX_ARRAY_BYTES / item_bytes], checked before anything is
+    allocated. Else a ValueError naming it, the range and the memory it would take."""
+    hi = max(int(MAX_ARRAY_BYTES // item_bytes), minimum)
+    n = as_count(value, name, minimum, maximum=math.inf)  # the type and the minimum
+    if n > hi:
+        raise ValueError(f"invalid argument `{name}`: must be an integer in [{minimum}, {hi:,}]: {n:,} would need about "
+                         f"{_bytes(n * item_bytes)} of {what} (limit {_bytes(MAX_ARRAY_BYTES)}), got {value!r}")
+    return n
+
+
+def check_cells(shape, names: str, *, item_bytes: float, what: str = "result arrays") -> int:
+    """The number of cells of a grid of ``shape`` (the product, in Python integers: never
+    overflows), refused with a ValueError naming ``names`` when its ``what`` would take more than
+    MAX_ARRAY_BYTES at ``item_bytes`` per cell."""
+    n = math.prod(int(k) for k in shape)
+    if n * item_bytes > MAX_ARRAY_BYTES:
+        dims = " x ".join(f"{int(k):,}" for k in shape)
+        raise ValueError(f"invalid arguments {names}: a grid of {dims} = {n:,} cases would need about {_bytes(n * item_bytes)} of "
+                         f"{what} (limit {_bytes(MAX_ARRAY_BYTES)}); use fewer values")
+    return n

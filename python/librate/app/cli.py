@@ -8,6 +8,7 @@ and ``info`` need no study.
 
 from __future__ import annotations
 
+import contextlib
 import sys
 import time
 from pathlib import Path
@@ -708,7 +709,9 @@ _FIGURE_FILES = {"family": "orbits", "period": "period", "stability": "stability
 def _figures(result, path: Path, names, quiet: bool, extra: dict | None = None) -> list[Path]:
     """Draw the named figures of the result saved at ``path`` beside it, as
     ``<stem>_<figure>.png``; ``extra``: more figures, ``{name: make(plotting_module)}``. A
-    figure that does not apply or fails is skipped with a note (the result is kept)."""
+    figure that does not apply or fails is skipped with a note (the result is kept); one that
+    cannot be written (a full disk) ends the command in a one-line UserError (exit 2), the
+    partial file removed and the result kept."""
     if not names and not extra:
         return []
     try:
@@ -772,7 +775,14 @@ def _figures(result, path: Path, names, quiet: bool, extra: dict | None = None) 
                 progress.write(f"{name} skipped: {type(err).__name__}: {err}", file=sys.stderr)
                 progress.update(1)
                 continue
-            written.append(lp.save_figure(fig, folder / name))
+            try:
+                written.append(lp.save_figure(fig, folder / name))
+            except OSError as err:  # a full disk (issue 24 #5): one line, exit 2, the result kept
+                plt.close(fig)
+                with contextlib.suppress(OSError):
+                    (folder / name).unlink(missing_ok=True)  # no partial figure left behind
+                raise UserError(f"{folder / name}: cannot write the figure ({err.strerror or type(err).__name__}); "
+                                f"the result {path} is kept, complete") from None
             plt.close(fig)
             progress.update(1)
             progress.write(f"written: {folder / name}", file=sys.stdout)

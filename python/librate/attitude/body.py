@@ -13,6 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import _core
+from .._checks import as_float_array
 
 __all__ = ["RigidBody", "quaternion_from_euler", "TORQUES", "EULER_SEQUENCES", "torque_names"]
 
@@ -103,6 +104,12 @@ def quaternion_from_euler(angles: Sequence[float], sequence: str = "123") -> np.
     thesis's convention; also "321", "313" or any scipy sequence)."""
     from scipy.spatial.transform import Rotation
 
-    return Rotation.from_euler(EULER_SEQUENCES.get(sequence, sequence), angles).as_quat()
+    seq = EULER_SEQUENCES.get(sequence, sequence) if isinstance(sequence, str) else None
+    if seq is None or len(seq) != 3 or not (set(seq) <= set("xyz") or set(seq) <= set("XYZ")) or seq[0] == seq[1] or seq[1] == seq[2]:
+        raise ValueError(f"invalid argument `sequence`: must be '123', '321', '313' or three axes (scipy's 'XYZ', 'zxz', ...), got {sequence!r}")
+    a = as_float_array(angles, "angles")
+    if a.shape[-1:] != (3,) or a.ndim > 2 or not np.all(np.isfinite(a)):
+        raise ValueError(f"invalid argument `angles`: must be 3 finite angles (rad) or an (n, 3) array of them, got {angles!r}")
+    return Rotation.from_euler(seq, a).as_quat()
 
 

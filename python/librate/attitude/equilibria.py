@@ -173,7 +173,7 @@ def equilibrium_stability(system: System | str, point, *, n: int = 401, k_range:
 
     sys_ = resolve_system(system)
     k = _point(point)
-    n = as_count(n, "n", 3)
+    n = as_count(n, "n", 3, maximum=4001)  # an n x n grid of samples: 16e6 at most
     try:
         lo, hi = (float(v) for v in k_range)
     except (TypeError, ValueError):

@@ -141,7 +141,10 @@ class Appendage:
         m = _positive("mass", mass)
         f = _positive("frequency_hz", frequency_hz)
         z = _positive("damping_ratio", damping_ratio, allow_zero=True)
-        k = m * (2 * math.pi * f) ** 2
+        k = m * (2 * math.pi * f) * (2 * math.pi * f)
+        if not 0 < k < math.inf or not math.isfinite(2 * z * math.sqrt(k * m)):
+            raise ValueError(f"invalid arguments `mass`, `frequency_hz`: the stiffness m (2 pi f)^2 = {k:g} must be finite and > 0, "
+                             f"got mass = {mass!r}, frequency_hz = {frequency_hz!r}")
         return cls(m, position, direction, k, 2 * z * math.sqrt(k * m), name)
 
     @property
@@ -317,6 +320,9 @@ class FlexibleBody:
         """The same body with every clamped frequency multiplied by ``frequency_factor`` (stiffness
         by its square, damping by it: the damping ratios are kept)."""
         f = _positive("frequency_factor", frequency_factor)
+        if not all(0 < a.stiffness * f * f < math.inf for a in self.appendages):
+            raise ValueError(f"invalid argument `frequency_factor`: the scaled stiffnesses (times {f:g}**2) must stay finite and > 0, "
+                             f"got {frequency_factor!r}")
         apps = [replace(a, stiffness=a.stiffness * f * f, damping=a.damping * f) for a in self.appendages]
         return FlexibleBody(self.hub, apps, name if name is not None else f"{self.name} x{f:g}")
 

@@ -17,6 +17,7 @@ import numpy as np
 from .. import _core
 from .._checks import as_float_array, as_real
 from ..constants import OMEGA_SUN, SOLAR_PRESSURE_1AU
+from ..orbits.system import resolve_system
 from .body import RigidBody
 
 __all__ = ["Sun", "Facet", "FacetBody", "FlatPlate"]
@@ -52,7 +53,7 @@ class Sun:
 
     def angle(self, t) -> np.ndarray:
         """The Sun's angle from the synodic X axis at times t (TU), unwrapped (rad)."""
-        t = np.asarray(t, dtype=float)
+        t = as_float_array(t, "t")
         return _core.sun_angle(float(self.theta0), np.ascontiguousarray(t.ravel())).reshape(t.shape)
 
     def direction(self, t) -> np.ndarray:
@@ -193,7 +194,7 @@ class FlatPlate:
         area_m2 = as_real(area_m2, "area_m2", positive=True)
         iz_kgm2 = as_real(iz_kgm2, "iz_kgm2", positive=True)
         offset_m = as_real(offset_m, "offset_m")
-        return cls(sun.pressure * area_m2 * offset_m * system.tu_s**2 / iz_kgm2, cs, cd, sun)
+        return cls(sun.pressure * area_m2 * offset_m * resolve_system(system).tu_s**2 / iz_kgm2, cs, cd, sun)
 
     def with_eps(self, eps: float) -> FlatPlate:
         return FlatPlate(float(eps), self.cs, self.cd, self.sun)
@@ -201,7 +202,7 @@ class FlatPlate:
     def wzdot(self, t, phi) -> np.ndarray:
         """The SRP angular acceleration (1/TU^2) at times t and attitudes phi (broadcast), by the
         core's plate law."""
-        t, phi = np.broadcast_arrays(np.asarray(t, dtype=float), np.asarray(phi, dtype=float))
+        t, phi = np.broadcast_arrays(as_float_array(t, "t"), as_float_array(phi, "phi"))
         out = _core.flat_plate_wzdot(float(self.eps), float(self.cs), float(self.cd), float(self.sun.theta0),
                                      np.ascontiguousarray(t.ravel()), np.ascontiguousarray(phi.ravel()))
         return out.reshape(t.shape)

@@ -22,7 +22,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .. import _core
-from .._checks import as_count, as_real
+from .._checks import as_between, as_count, as_float_array, as_real, as_tolerance
 from .._display import fmt, html_summary, short_repr
 from .._errors import ConvergenceError, LibrateError
 from .._progress import as_progress
@@ -244,7 +244,8 @@ class OrbitFamily:
     def _member(self, *, x0, z0, period, period_days, jacobi, which) -> PeriodicOrbit:
         given = {k: v for k, v in dict(x0=x0, z0=z0, period=period, period_days=period_days, jacobi=jacobi).items() if v is not None}
         if len(given) != 1:
-            raise ValueError("invalid argument: give exactly one of x0, z0, period, period_days, jacobi")
+            names = ", ".join(f"`{k}`" for k in ("x0", "z0", "period", "period_days", "jacobi"))
+            raise ValueError(f"invalid arguments {names}: give exactly one of them, got {', '.join(given) or 'none'}")
         (name, value), = given.items()
         user = name
         value = as_real(value, name)
@@ -331,11 +332,14 @@ class OrbitFamily:
     def resonant(self, k: int, kind: str = "synodic") -> PeriodicOrbit:
         """The 1:k resonant member: synodic T = 2 pi / k, or Sun-resonant T = Ts / k
         (Ts = 2 pi / (1 - n_sun), the apparent solar period in the synodic frame)."""
-        if not isinstance(k, (int, np.integer)) or k < 1:
-            raise ValueError(f"invalid argument `k`: must be an integer >= 1, got {k!r}")
+        k = as_count(k, "k", 1, maximum=10_000)
         if kind not in ("synodic", "sun"):
             raise ValueError(f"invalid argument `kind`: must be 'synodic' or 'sun', got {kind!r}")
         base = 2 * math.pi if kind == "synodic" else SUN_SYNODIC_PERIOD
+        lo, hi = float(np.min(self.period)), float(np.max(self.period))
+        if not lo <= base / k <= hi:
+            raise ValueError(f"invalid argument `k`: the 1:{k} {kind} resonant period {base / k:.6g} TU is outside the {self.kind} family's "
+                             f"range [{lo:.6g}, {hi:.6g}], got {k!r}")
         return self.member(period=base / k)
 
     # --- the JPL catalog format ---------------------------------------------------------------
@@ -674,9 +678,9 @@ def correct_dro(
     if ydot0 is not None:
         ydot0 = as_real(ydot0, "ydot0", positive=True)
     as_count(max_iter, "max_iter", 1)
-    as_real(tol, "tol", positive=True)
-    as_real(rtol, "rtol", positive=True)
-    as_real(atol, "atol", positive=True)
+    as_tolerance(tol, "tol")
+    as_tolerance(rtol, "rtol")
+    as_tolerance(atol, "atol")
     d = 1.0 - mu - x0
     if ydot0 is None and d > 0.2:
         start = _correct_dro_at(sys_, 0.95, None, tol, max_iter, rtol, atol)
@@ -731,7 +735,7 @@ def dro_family(system: System | str = "earth-moon", x0=None, *, check_geometry: 
     """
     sys_ = resolve_system(system)
     mu = sys_.mu
-    xs = DRO_DEFAULT_X0.copy() if x0 is None else np.atleast_1d(np.asarray(x0, dtype=float)).ravel()
+    xs = DRO_DEFAULT_X0.copy() if x0 is None else np.atleast_1d(as_float_array(x0, "x0")).ravel()
     if xs.size == 0 or not np.all(np.isfinite(xs)) or np.any(xs <= -mu) or np.any(xs >= 1 - mu):
         raise ValueError(f"invalid argument `x0`: DROs start between the primaries, -mu < x0 < 1 - mu = ({-mu}, {1 - mu}); got {x0!r}")
     progress = as_progress(progress, "dro family", "member")
@@ -791,7 +795,7 @@ def _default_dro_family(system: System) -> OrbitFamily:
 def _one_target(kw: dict) -> tuple[str, float]:
     given = {k: v for k, v in kw.items() if v is not None}
     if len(given) != 1:
-        raise ValueError(f"invalid argument: give exactly one of {', '.join(kw)}")
+        raise ValueError(f"invalid arguments {', '.join(f'`{k}`' for k in kw)}: give exactly one of them, got {', '.join(given) or 'none'}")
     return next(iter(given.items()))
 
 
@@ -842,6 +846,7 @@ def lyapunov_family(system: System | str = "earth-moon", point: int = 1, *, max_
     total)`` after each member (total: max_members until the end)."""
     sys_ = resolve_system(system)
     point = _check_point(point)
+    max_members, ds_max = as_count(max_members, "max_members", 2), as_between(ds_max, "ds_max", 1e-5, 0.5)
     first = _lyapunov_start(sys_, point, 2e-3)
     res = continue_arclength(
         sys_, first, spatial=False, orient=np.array([-1.0, 0.0, 0.0]), ds=2e-3, ds_max=ds_max, max_members=max_members,
@@ -890,6 +895,7 @@ def halo_family(system: System | str = "earth-moon", point: int = 2, branch: str
     sys_ = resolve_system(system)
     point = _check_point(point)
     sign = _check_branch(branch)
+    max_members, ds_max = as_count(max_members, "max_members", 2), as_between(ds_max, "ds_max", 1e-5, 0.5)
     lyap = _cached_lyapunov(sys_, point)
     cands = [b for b in lyap.bifurcations if b["index"] == "out-of-plane" and b["level"] == 1.0]
     if not cands:

@@ -22,7 +22,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .. import _core
-from .._checks import as_state
+from .._checks import as_count, as_size, as_state, as_tolerance
 from .._errors import ConvergenceError
 from .propagation import propagate
 from .system import System, resolve_system
@@ -144,12 +144,6 @@ def _least_squares(t: np.ndarray, positions: np.ndarray, period: float, n: int) 
     return coef[0], coef[1 : n + 1], coef[n + 1 :]
 
 
-def _positive_int(value, name: str, low: int) -> int:
-    if not isinstance(value, (int, np.integer)) or isinstance(value, bool) or value < low:
-        raise ValueError(f"invalid argument `{name}`: must be an integer >= {low}, got {value!r}")
-    return int(value)
-
-
 def fit_fourier(
     system: System | str,
     state0,
@@ -186,14 +180,13 @@ def fit_fourier(
         raise ValueError(f"invalid argument `period`: must be a finite number > 0 (TU), got {period!r}")
     period = float(period)
     if n_harmonics is not None:
-        n_max = _positive_int(n_harmonics, "n_harmonics", 1)
+        n_max = as_count(n_harmonics, "n_harmonics", 1)
     else:
-        n_max = _positive_int(max_harmonics, "max_harmonics", 1)
-        if not (isinstance(jacobi_tol, (int, float, np.floating)) and math.isfinite(jacobi_tol) and jacobi_tol > 0):
-            raise ValueError(f"invalid argument `jacobi_tol`: must be a finite number > 0, got {jacobi_tol!r}")
-    m = max(1024, 8 * n_max) if n_samples is None else _positive_int(n_samples, "n_samples", 4 * n_max + 1)
-    if not (math.isfinite(closure_tol) and closure_tol > 0):
-        raise ValueError(f"invalid argument `closure_tol`: must be a finite number > 0, got {closure_tol!r}")
+        n_max = as_count(max_harmonics, "max_harmonics", 1)
+        as_tolerance(jacobi_tol, "jacobi_tol")
+    # per sample: its time, state and check point (float64) and a row of the (2 N + 1) harmonics
+    m = max(1024, 8 * n_max) if n_samples is None else as_size(n_samples, "n_samples", 4 * n_max + 1, item_bytes=8 * (16 + 2 * n_max + 1))
+    as_tolerance(closure_tol, "closure_tol")
 
     # Samples (even indices) and check points (odd indices), then t = T for the closure.
     t_all = np.arange(2 * m + 1) * (period / (2 * m))

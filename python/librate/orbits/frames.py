@@ -24,7 +24,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._checks import as_state
+from .._checks import as_count, as_float_array, as_size, as_state
 from .propagation import propagate
 from .system import System, resolve_system
 
@@ -37,7 +37,7 @@ _PLANAR_SIN_I = 1e-10
 
 def _times_states(t, states, name: str = "states") -> tuple[np.ndarray, np.ndarray, bool]:
     """Broadcast t (scalar or (n,)) against states ((6,) or (n, 6)); the flag says 'single state'."""
-    arr = np.asarray(states, dtype=np.float64)
+    arr = as_float_array(states, name)
     single = arr.ndim == 1
     if single:
         arr = arr.reshape(1, -1)
@@ -45,7 +45,7 @@ def _times_states(t, states, name: str = "states") -> tuple[np.ndarray, np.ndarr
         raise ValueError(f"invalid argument `{name}`: must have shape (6,) or (n, 6), got shape {np.shape(states)}")
     if not np.all(np.isfinite(arr)):
         raise ValueError(f"invalid argument `{name}`: must be finite")
-    ta = np.asarray(t, dtype=np.float64)
+    ta = as_float_array(t, "t")
     if ta.ndim == 0:
         ta = np.full(arr.shape[0], float(ta))
     elif ta.ndim == 1 and ta.shape[0] == arr.shape[0]:
@@ -214,11 +214,9 @@ def mean_elements(
     s0 = as_state(orbit_state0, "orbit_state0")
     if not (isinstance(period, (int, float, np.floating)) and math.isfinite(period) and period > 0):
         raise ValueError(f"invalid argument `period`: must be a finite number > 0 (TU), got {period!r}")
-    if not isinstance(n_periods, (int, np.integer)) or isinstance(n_periods, bool) or n_periods < 1:
-        raise ValueError(f"invalid argument `n_periods`: must be an integer >= 1, got {n_periods!r}")
-    if not isinstance(samples_per_period, (int, np.integer)) or isinstance(samples_per_period, bool) or samples_per_period < 8:
-        raise ValueError(f"invalid argument `samples_per_period`: must be an integer >= 8, got {samples_per_period!r}")
-    m, k = int(samples_per_period), int(n_periods)
+    k = as_count(n_periods, "n_periods", 1)
+    # per sample: its time, state and seven elements (float64), and their unwrapped copies
+    m = as_size(samples_per_period, "samples_per_period", 8, item_bytes=8 * 24 * k)
     t = np.arange(m * k) * (float(period) / m)
     tr = propagate(sys_, s0, float(period) * k, t_eval=t, rtol=rtol, atol=atol, collision="point")
     el = osculating_elements(sys_, tr.t, tr.y, theta0=theta0)

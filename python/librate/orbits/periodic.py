@@ -9,7 +9,7 @@ from functools import cached_property
 import numpy as np
 
 from .. import _core
-from .._checks import as_count, as_number, as_real
+from .._checks import as_count, as_number, as_real, as_tolerance
 from .._display import html_summary, short_repr
 from .._errors import CollisionError
 from .system import System, resolve_system
@@ -128,7 +128,7 @@ class PeriodicOrbit:
         kwargs.setdefault("collision", "point")
         kwargs.setdefault("rtol", SHOOT_RTOL)
         kwargs.setdefault("atol", SHOOT_ATOL)
-        return propagate(self.system, self.state0, n_periods * self.period, **kwargs)
+        return propagate(self.system, self.state0, as_real(n_periods, "n_periods") * self.period, **kwargs)
 
 
 @dataclass(frozen=True)
@@ -274,10 +274,11 @@ def correct_symmetric(
     """
     sys_ = resolve_system(system)
     collision_mode(collision)
-    as_number(tol, "tol", positive=True)
+    as_tolerance(tol, "tol")
     as_count(max_iter, "max_iter", 1)
-    for name, v in (("t_max", t_max), ("rtol", rtol), ("atol", atol)):
-        as_real(v, name, positive=True)
+    as_real(t_max, "t_max", positive=True)
+    for name, v in (("rtol", rtol), ("atol", atol)):
+        as_tolerance(v, name)
     if period is not None:
         period = as_real(period, "period", positive=True)
     if jacobi is not None:
@@ -294,7 +295,7 @@ def correct_symmetric(
     if period is not None or jacobi is not None:
         given = [c for c in given if c[0] != "fix"]
     if len(given) != 1:
-        raise ValueError("invalid argument: give exactly one of `fix`, `period` or `jacobi`")
+        raise ValueError("invalid arguments `fix`, `period`, `jacobi`: give exactly one of them")
     kind, value = given[0]
     if kind == "fix":
         if value not in _VARS:
@@ -344,10 +345,10 @@ def correct_periodic(
     """
     sys_ = resolve_system(system)
     collision_mode(collision)
-    as_number(tol, "tol", positive=True)
+    as_tolerance(tol, "tol")
     as_count(max_iter, "max_iter", 1)
     for name, v in (("rtol", rtol), ("atol", atol)):
-        as_real(v, name, positive=True)
+        as_tolerance(v, name)
     if jacobi is not None:
         jacobi = as_real(jacobi, "jacobi")
     try:

@@ -10,7 +10,7 @@ from typing import Literal
 import numpy as np
 
 from .. import _core
-from .._checks import as_count, as_direction, as_float_array, as_real, as_state, as_states, as_time_span
+from .._checks import as_count, as_direction, as_float_array, as_real, as_state, as_states, as_threads, as_time_span, as_tolerance
 from .._errors import CollisionError
 from .system import System, resolve_system
 
@@ -40,17 +40,16 @@ class Event:
         index = _COORDS.get(coordinate, coordinate) if isinstance(coordinate, str) else coordinate
         if not isinstance(index, (int, np.integer)) or not 0 <= int(index) < 6:
             raise ValueError(f"invalid argument `coordinate`: must be one of x, y, z, xd, yd, zd or 0..5, got {coordinate!r}")
-        return cls("crossing", (float(index), float(value)), as_direction(direction), bool(terminal))
+        return cls("crossing", (float(index), as_real(value, "value")), as_direction(direction), bool(terminal))
 
     @classmethod
     def distance(cls, center: Sequence[float], radius: float, *, direction: int = 0, terminal: bool = False) -> Event:
         """``|r - center| == radius`` (nondimensional)."""
-        c = np.asarray(center, dtype=np.float64).ravel()
+        c = as_float_array(center, "center").ravel()
         if c.shape != (3,) or not np.all(np.isfinite(c)):
             raise ValueError(f"invalid argument `center`: must be 3 finite numbers, got {center!r}")
-        if not (math.isfinite(radius) and radius >= 0):
-            raise ValueError(f"invalid argument `radius`: must be finite and >= 0, got {radius!r}")
-        return cls("distance", (*map(float, c), float(radius)), as_direction(direction), bool(terminal))
+        radius = as_real(radius, "radius", nonnegative=True)
+        return cls("distance", (*map(float, c), radius), as_direction(direction), bool(terminal))
 
     @classmethod
     def surface(cls, primary: str | int = "moon", *, terminal: bool = True) -> Event:
@@ -176,8 +175,8 @@ def integration_options(rtol, atol, h0, h_min, h_max, max_steps, safety, fixed_s
             if value != default:
                 raise ValueError(f"invalid argument `{name}`: adaptive step options do not apply with fixed_step; got {name} = {value!r}")
     return dict(
-        rtol=as_real(rtol, "rtol", positive=True),
-        atol=as_real(atol, "atol", positive=True),
+        rtol=as_tolerance(rtol, "rtol"),
+        atol=as_tolerance(atol, "atol"),
         h0=None if h0 is None else as_real(h0, "h0", positive=True),
         h_min=as_real(h_min, "h_min", nonnegative=True),
         h_max=as_real(h_max, "h_max", positive=True, allow_inf=True),
@@ -341,11 +340,10 @@ def propagate_many(
         raise ValueError(f"invalid argument `t_final`: must be one time or one per state ({arr.shape[0]}), got {tf.size}")
     if on_error not in ("raise", "mask"):
         raise ValueError(f"invalid argument `on_error`: must be 'raise' or 'mask', got {on_error!r}")
-    if threads is not None and (isinstance(threads, (bool, np.bool_)) or not isinstance(threads, (int, np.integer)) or threads < 1):
-        raise ValueError(f"invalid argument `threads`: must be an integer >= 1 or None (all cores), got {threads!r}")
+    threads = as_threads(threads)
     radii = collision_radii(sys_, collision)
     r = _core.propagate_many(
-        sys_.mu, arr, float(t0), tf, stm=bool(stm), threads=None if threads is None else int(threads),
+        sys_.mu, arr, float(t0), tf, stm=bool(stm), threads=threads,
         options=integration_options(rtol, atol, h0, h_min, h_max, max_steps, safety, fixed_step), collision=radii,
     )
     errors = {i: (_collision(sys_, e, None) if isinstance(e, CollisionError) else e) for i, e in r.errors.items()}

@@ -7,10 +7,17 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import _core
-from .._checks import as_real, as_states
+from .._checks import as_float_array, as_real, as_states
 from .._display import html_summary, short_repr
 
 __all__ = ["System"]
+
+
+def _scaled(value, name: str, factor: float):
+    """``value`` (a number: a float; an array: an array) times ``factor``, a ValueError naming
+    ``name`` for what is not numbers."""
+    a = as_float_array(value, name)
+    return a * factor if a.ndim else float(a) * factor
 
 
 @dataclass(frozen=True)
@@ -78,7 +85,7 @@ class System:
 
     def jacobi(self, states) -> np.ndarray | float:
         """Jacobi constant C = 2U - |v|^2 of a (6,) state (a float) or of (n, 6) states."""
-        arr = np.asarray(states, dtype=np.float64)
+        arr = as_float_array(states, "states")
         c = _core.jacobi(self.mu, as_states(arr))
         return float(c[0]) if arr.ndim == 1 else c
 
@@ -95,27 +102,27 @@ class System:
 
     def distance_km(self, length):
         """Nondimensional length(s) to km."""
-        return np.asarray(length) * self.lu_km if np.ndim(length) else float(length) * self.lu_km
+        return _scaled(length, "length", self.lu_km)
 
     def speed_km_s(self, speed):
         """Nondimensional speed(s) to km/s."""
-        return np.asarray(speed) * self.vu_km_s if np.ndim(speed) else float(speed) * self.vu_km_s
+        return _scaled(speed, "speed", self.vu_km_s)
 
     def time_s(self, t):
         """Nondimensional time(s) to seconds."""
-        return np.asarray(t) * self.tu_s if np.ndim(t) else float(t) * self.tu_s
+        return _scaled(t, "t", self.tu_s)
 
     def period_days(self, t):
         """Nondimensional time(s) to days."""
-        return np.asarray(t) * self.tu_days if np.ndim(t) else float(t) * self.tu_days
+        return _scaled(t, "t", self.tu_days)
 
     def from_km(self, distance_km):
         """km to nondimensional length."""
-        return np.asarray(distance_km) / self.lu_km if np.ndim(distance_km) else float(distance_km) / self.lu_km
+        return _scaled(distance_km, "distance_km", 1.0 / self.lu_km)
 
     def from_days(self, days):
         """Days to nondimensional time."""
-        return np.asarray(days) / self.tu_days if np.ndim(days) else float(days) / self.tu_days
+        return _scaled(days, "days", 1.0 / self.tu_days)
 
     def to_dimensional(self, states) -> np.ndarray:
         """(…, 6) states to km and km/s."""

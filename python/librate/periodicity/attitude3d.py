@@ -39,7 +39,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .. import _core
-from .._checks import as_count, as_number
+from .._checks import as_count, as_tolerance
 from .._display import fmt, html_summary, short_repr
 from .._errors import ConvergenceError
 from .._progress import as_progress
@@ -236,7 +236,7 @@ def periodic_attitude_3d(orbit: PeriodicOrbit, body: RigidBody, *, guess, n_peri
     if not isinstance(body, RigidBody) or body.is_rod or type(body) is not RigidBody:
         raise ValueError(f"invalid argument `body`: must be a librate.RigidBody with every principal moment > 0, got {body!r}")
     n_periods = as_count(n_periods, "n_periods", 1)
-    tol = as_number(tol, "tol", positive=True)
+    tol = as_tolerance(tol, "tol")
     max_iter = as_count(max_iter, "max_iter", 1)
     q, w = _guess(guess, n_periods)
     if not isinstance(symmetric, (bool, np.bool_)):
@@ -498,7 +498,7 @@ def attitude_family_3d(orbits, body: RigidBody, *, guess, period_days, n_periods
     n_periods = as_count(n_periods, "n_periods", 1)
     max_points = as_count(max_points, "max_points", 2)
     first_orbit = orbits.member(period_days=float(targets[0]))
-    tol = as_number(tol, "tol", positive=True)
+    tol = as_tolerance(tol, "tol")
     s0 = periodic_attitude_3d(first_orbit, body, guess=guess, n_periods=n_periods, tol=tol)
     problem = OrbitFamilyBranch3D(orbits, body, n_periods, tol)
     from scipy.spatial.transform import Rotation
@@ -667,7 +667,7 @@ def attitude_family_3d_inertia(orbit: PeriodicOrbit, bodies, *, guess, steps: in
             raise ValueError(f"invalid argument `bodies`: must be two librate.RigidBody with every moment > 0, got {b!r}")
     steps = as_count(steps, "steps", 1)
     n_periods = as_count(n_periods, "n_periods", 1)
-    tol = as_number(tol, "tol", positive=True)
+    tol = as_tolerance(tol, "tol")
     problem = InertiaBranch3D(orbit, (b0, b1), n_periods, tol)
     from scipy.spatial.transform import Rotation
 

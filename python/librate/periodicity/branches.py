@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .._checks import as_count, as_number
+from .._checks import as_count, as_number, as_tolerance
 from .._errors import ConvergenceError
 from ..attitude.srp import FlatPlate, Sun
 from ..orbits.periodic import PeriodicOrbit
@@ -102,7 +102,7 @@ def periodic_attitude(
     n_periods = as_count(n_periods, "n_periods", 1)
     n_total = n_total_of(n, n_periods)
     phi0 = as_number(phi0, "phi0")
-    tol = as_number(tol, "tol", positive=True)
+    tol = as_tolerance(tol, "tol")
     max_iter = as_count(max_iter, "max_iter", 1)
     if wz0 is not None:
         wz0 = as_number(wz0, "wz0")

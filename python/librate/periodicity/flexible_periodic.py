@@ -12,6 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import _core
+from .._checks import as_float_array, as_size
 from ..attitude.flexible import FlexibleBody, flexible_run_inputs, quasi_static
 from ..attitude.propagate import propagate_attitude
 from ..orbits.propagation import integration_options
@@ -258,13 +259,19 @@ def frequency_scan(
     quasi-static ones (amplification) and the attitude departs from the rigid motion: the exchange
     between structural and attitude motion."""
     sys_, s, t0, tf, names = flexible_run_inputs(system, orbit_state, body, t_span, torques, orbit)
-    fs = np.asarray(factors, dtype=float).ravel()
+    fs = as_float_array(factors, "factors").ravel()
     if fs.size == 0 or not np.all(np.isfinite(fs)) or np.any(fs <= 0):
         raise ValueError(f"invalid argument `factors`: must be positive numbers, got {factors!r}")
-    te = np.linspace(t0, tf, int(samples))
+    # per sample and factor: the coupled and the rigid runs' times, states and deflections (float64)
+    te = np.linspace(t0, tf, as_size(samples, "samples", 2, item_bytes=8 * 64 * max(fs.size, 1)))
     rows = []
-    for f in fs:
-        b = body.scaled(float(f))
+    bodies = []
+    for f in fs:  # every factor checked before any work
+        try:
+            bodies.append(body.scaled(float(f)))
+        except ValueError as err:
+            raise ValueError(f"invalid argument `factors`: {float(f):g}: {err}") from None
+    for f, b in zip(fs, bodies):
         qs = quasi_static(sys_, s, attitude, b, (t0, tf), torques=names, orbit=orbit, t_eval=te, rtol=rtol, atol=atol, max_steps=max_steps)
         tr = propagate_attitude(sys_, s, attitude, b, (t0, tf), torques=names, orbit=orbit, t_eval=te, deflection=deflection,
                                 rtol=rtol, atol=atol, max_steps=max_steps)

@@ -26,7 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import _core
-from .._checks import as_count, as_float_array, as_number
+from .._checks import as_count, as_float_array, as_number, as_threads, as_tolerance, check_cells
 from .._core import __version__
 from .._display import fmt, html_summary, short_repr
 from .._progress import as_progress
@@ -85,7 +85,7 @@ class Map3DGrid:
 
     @property
     def n_cases(self) -> int:
-        return int(np.prod(self.full_shape))
+        return math.prod(self.full_shape)
 
     def cases(self, start: int = 0, stop: int | None = None) -> tuple[np.ndarray, np.ndarray]:
         """(inertia (m, 3), w0 (m, 3)) of the flat cases [start, stop)."""
@@ -94,6 +94,10 @@ class Map3DGrid:
         moments = np.array([b.moments for b in self.bodies], dtype=float)
         w0 = np.stack([self.rates[k][idx[k + 1]] for k in range(3)], axis=1)
         return np.ascontiguousarray(moments[idx[0]]), np.ascontiguousarray(w0)
+
+
+#: Bytes per case of a 3-D map: six residuals and their norm (float64) and the status (uint8).
+CELL_BYTES = 7 * 8 + 1
 
 
 def _bodies(body) -> tuple[tuple[RigidBody, ...], bool]:
@@ -129,6 +133,7 @@ def map3d_grid(body, *, wx0, wy0, wz0, q0=None) -> Map3DGrid:
     """The validated grid of :func:`attitude_map_3d` (a ValueError naming the argument)."""
     bodies, body_dim = _bodies(body)
     rates, dims = zip(*(_rate(v, n) for v, n in ((wx0, "wx0"), (wy0, "wy0"), (wz0, "wz0"))))
+    check_cells((len(bodies), *(r.size for r in rates)), "`body`, `wx0`, `wy0`, `wz0`", item_bytes=CELL_BYTES)
     return Map3DGrid(bodies, body_dim, tuple(rates), tuple(dims), _quaternion(q0))
 
 
@@ -151,9 +156,7 @@ def _check(orbit, n_periods, tol) -> tuple[int, float]:
     if not isinstance(orbit, PeriodicOrbit):
         raise ValueError(f"invalid argument `orbit`: must be a librate.PeriodicOrbit, got {type(orbit).__name__}")
     n_periods = as_count(n_periods, "n_periods", 1)
-    tol = as_number(tol, "tol", positive=True)
-    if not 1e-15 <= tol <= 1e-3:
-        raise ValueError(f"invalid argument `tol`: must be in [1e-15, 1e-3], got {tol!r}")
+    tol = as_tolerance(tol, "tol")
     return n_periods, tol
 
 
@@ -224,6 +227,7 @@ def attitude_map_3d(orbit: PeriodicOrbit, body, *, wx0, wy0, wz0, q0=None, n_per
     """
     progress = as_progress(progress, "3-D map", "case")
     n_periods, tol = _check(orbit, n_periods, tol)
+    threads = as_threads(threads)
     grid = map3d_grid(body, wx0=wx0, wy0=wy0, wz0=wz0, q0=q0)
     n = grid.n_cases
     residual = np.full((n, 6), np.nan)
@@ -275,7 +279,7 @@ def find_periodic_attitudes_3d(orbit: PeriodicOrbit, body: RigidBody, dataset, *
     max_seeds = as_count(max_seeds, "max_seeds", 1)
     max_iter = as_count(max_iter, "max_iter", 1)
     threshold = as_number(threshold, "threshold", positive=True)
-    tol = as_number(tol, "tol", positive=True)
+    tol = as_tolerance(tol, "tol")
     n_periods = int(dataset.attrs["n_periods"]) if n_periods is None else as_count(n_periods, "n_periods", 1)
     ds = dataset
     m = np.array(body.moments)

@@ -15,7 +15,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from .._checks import as_count, as_float_array, as_number
+from .._checks import as_count, as_float_array, as_number, as_threads, as_tolerance, check_cells
 from .._core import __version__
 from .._errors import LibrateError
 from .._progress import as_progress
@@ -24,6 +24,7 @@ from ..orbits.periodic import PeriodicOrbit
 from ..results.kinds import MAP_VARIABLES
 from .solutions import (
     MAP_ATOL,
+    MAP_CELL_BYTES,
     MAP_METHOD,
     MAP_RTOL,
     AttitudeSolution,
@@ -103,11 +104,11 @@ def periodicity_map(
         return _stack_srp(maps, plates)
     srp = check_srp(srp)
     kzs, wz = map_grid(kz, wz0, n_periods)
+    phi0 = as_number(phi0, "phi0")
+    check_cells((len(olist), kzs.size, wz.size), "`orbits`, `kz`, `wz0`", item_bytes=MAP_CELL_BYTES)
     chunk = as_count(chunk, "chunk", 1)
-    threads = None if threads is None else as_count(threads, "threads", 1)
-    for name, v in (("rtol", rtol), ("atol", atol)):
-        if not (as_number(v, name, positive=True) >= (1e-15 if name == "rtol" else 0)):
-            raise ValueError(f"invalid argument `rtol`: must be >= 1e-15 (below double precision), got {v!r}")
+    threads = as_threads(threads)
+    rtol, atol = as_tolerance(rtol, "rtol"), as_tolerance(atol, "atol")
     no, nk, nw = len(olist), kzs.size, wz.size
     dwz = np.full((no, nk, nw), np.nan)
     dphi = np.full((no, nk, nw), np.nan)

@@ -21,7 +21,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .. import _core
-from .._checks import as_count, as_number
+from .._checks import as_count, as_number, as_size, as_threads, as_tolerance
 from .._display import fmt, html_summary, short_repr
 from .._progress import as_progress
 from ..attitude.body import RigidBody
@@ -32,13 +32,16 @@ from ..orbits.periodic import PeriodicOrbit
 __all__ = ["AttitudeSolution", "find_periodic_attitudes", "orbit_forcing", "clear_forcing_cache", "sweep", "candidates",
            "check_orbit", "check_kz", "check_kinds", "KINDS", "check_srp", "is_symmetric", "MAP_RTOL", "MAP_ATOL", "correct", "verified", "refine", "refine_groups",
            "turns_of", "n_total_of", "per_period", "turns_array", "SOLVE_RTOL", "SOLVE_ATOL", "STEP_MAX_ITER", "MAP_METHOD",
-           "STEP_MAX_HALVINGS"]
+           "STEP_MAX_HALVINGS", "MAP_CELL_BYTES"]
 
 MAP_RTOL = 1e-12
 #: The lanes' method of the maps: RKF7(8); RKN8(6) is within 0.9-1.0x of its time at equal
 #: accuracy (bench/bench_lanes.py), not enough to change the defaults' results.
 MAP_METHOD = "rkf78"
 MAP_ATOL = 1e-12
+#: Bytes per (orbit, kz, wz0) cell of a map: dwz, dphi, phi_T (float64), status (uint8), and the
+#: case grids and engine outputs (float64) of one orbit's row.
+MAP_CELL_BYTES = 3 * 8 + 1 + 4 * 8
 #: A continuation step's corrector: a good prediction converges in a few Newton steps; one that
 #: does not is a step too long (the driver halves it), not worth forty iterations.
 STEP_MAX_ITER = 10
@@ -74,8 +77,8 @@ def sweep(forcing, t_final, phi0, wz0, kz, *, stm=False, rtol=MAP_RTOL, atol=MAP
     error estimate is of sixth order, so the same accuracy comes at a looser rtol: see
     bench/bench_lanes.py)."""
     chunk = as_count(chunk, "chunk", 1)
-    threads = None if threads is None else as_count(threads, "threads", 1)
-    rtol, atol = as_number(rtol, "rtol", positive=True), as_number(atol, "atol", positive=True)
+    threads = as_threads(threads)
+    rtol, atol = as_tolerance(rtol, "rtol"), as_tolerance(atol, "atol")
     n = np.broadcast(np.asarray(phi0), np.asarray(wz0), np.asarray(kz), np.asarray(0.0 if eps is None else eps)).shape
     flat = lambda a: np.ascontiguousarray(np.broadcast_to(np.asarray(a, dtype=np.float64), n)).ravel()  # noqa: E731
     p, w, k = flat(phi0), flat(wz0), flat(kz)
@@ -404,8 +407,8 @@ def find_periodic_attitudes(
         raise ValueError(f"invalid argument `wz0_range`: must be finite with lo < hi, got {wz0_range!r}")
     kinds = check_kinds(kinds)
     n_periods = as_count(n_periods, "n_periods", 1)
-    if n_grid is not None:
-        n_grid = as_count(n_grid, "n_grid", 2)
+    if n_grid is not None:  # the sweep's cases and outputs, float64: about 8 numbers per rate
+        n_grid = as_size(n_grid, "n_grid", 2, item_bytes=64)
     seeds = [as_number(v, "phi0") for v in (phi0 if isinstance(phi0, (list, tuple, np.ndarray)) else [phi0])]
     if not seeds:
         raise ValueError("invalid argument `phi0`: need at least one starting attitude")

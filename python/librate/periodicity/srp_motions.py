@@ -13,7 +13,7 @@ from concurrent.futures import ThreadPoolExecutor
 import numpy as np
 
 from .. import _core
-from .._checks import as_count, as_number
+from .._checks import as_count, as_float_array, as_number, check_cells
 from .._core import __version__
 from .._progress import as_progress
 from ..attitude.srp import FacetBody, FlatPlate, Sun, force_torque
@@ -22,6 +22,7 @@ from ..orbits.periodic import PeriodicOrbit
 from ..orbits.system import check_system
 from .branches import branch_fold, eps_branches
 from .solutions import (
+    MAP_CELL_BYTES,
     check_kinds,
     check_kz,
     check_orbit,
@@ -130,14 +131,15 @@ def srp_map(
                              f"(T = Ts/K, Ts = {SUN_SYNODIC_PERIOD * orbit.system.tu_days:.2f} d); give the revolutions K")
     n_periods = as_count(n_periods, "n_periods", 1)
     steps = as_count(steps, "steps", 1)
-    es = np.asarray(eps, dtype=np.float64).ravel()
+    es = as_float_array(eps, "eps").ravel()
     if es.size < 2 or not np.all(np.isfinite(es)) or np.any(np.diff(es) <= 0):
         raise ValueError(f"invalid argument `eps`: must be a finite, strictly increasing array of at least 2 values, got {eps!r}")
-    wz = np.asarray(wz0, dtype=np.float64).ravel()
+    wz = as_float_array(wz0, "wz0").ravel()
     if wz.size < 2 or not np.all(np.isfinite(wz)) or np.any(np.diff(wz) <= 0):
         raise ValueError("invalid argument `wz0`: must be a finite, strictly increasing array of at least 2 rates")
+    check_cells((es.size, wz.size), "`eps`, `wz0`", item_bytes=MAP_CELL_BYTES)
     phi0 = as_number(phi0, "phi0")
-    plate = FlatPlate(0.0, cs, cd, Sun(theta0=theta_sun0))
+    plate = FlatPlate(0.0, cs, cd, Sun(theta0=as_number(theta_sun0, "theta_sun0")))
     e_grid, w_grid = np.meshgrid(es, wz, indexing="ij")
     forcing = orbit_forcing(orbit)
     shape = (es.size, wz.size)
@@ -336,7 +338,7 @@ def sun_pointing_accelerations(system, body_or_plate, t, *, orbit: PeriodicOrbit
             raise ValueError(f"invalid argument `sun`: must be a librate.Sun, got {sun!r}")
     else:
         raise ValueError(f"invalid argument `body_or_plate`: must be a librate.FlatPlate or a librate.FacetBody, got {type(body_or_plate).__name__}")
-    t = np.asarray(t, dtype=float)
+    t = as_float_array(t, "t")
     if not np.all(np.isfinite(t)):
         raise ValueError("invalid argument `t`: times must be finite")
     phi = sun_angle(sun_.theta0, t) + offset
