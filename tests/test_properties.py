@@ -7,6 +7,8 @@ per-example deadline. Examples are few per property (CI time): the suite is abou
 
 import math
 import re
+import sys
+from pathlib import Path
 
 import librate
 import numpy as np
@@ -388,3 +390,65 @@ def test_flat_plate_from_geometry_invalid(name, data):
     kw = {"area_m2": 100.0, "offset_m": 2.0, "iz_kgm2": 1e8}
     kw[name] = data.draw(GEOMETRY_BAD[name], label=name)
     raises_naming(name, lambda: librate.FlatPlate.from_geometry(EM, **kw))
+
+
+# --- issue 24 #6 and #13: bounded inputs, every error naming the parameter ---------------------
+# tests/fuzz_api.py runs in a child process: under an address-space limit, so that an allocation
+# past it is a MemoryError or an abort (a failure here), not a swapped machine; and with a 60 s
+# watchdog per call that ends the child even inside the Rust core (a hang is a failure too).
+
+#: The child's address-space limit (RLIMIT_AS). Importing librate with numpy, scipy and xarray
+#: and running two worker threads reserves about 1.5 GiB of address space; the largest array
+#: the API lets one argument size is MAX_ARRAY_BYTES = 2 GiB (librate._checks), which the fuzz
+#: does not reach (it draws hostile values, not large valid ones).
+FUZZ_ADDRESS_SPACE = 4 * 1024**3
+FUZZ = Path(__file__).with_name("fuzz_api.py")
+
+
+def _child(*args, timeout: float):
+    import json
+    import os
+    import resource
+    import subprocess
+
+    def limit():
+        resource.setrlimit(resource.RLIMIT_AS, (FUZZ_ADDRESS_SPACE, FUZZ_ADDRESS_SPACE))
+
+    env = dict(os.environ, RAYON_NUM_THREADS="2")
+    p = subprocess.run([sys.executable, str(FUZZ), *args], capture_output=True, text=True, timeout=timeout, preexec_fn=limit, env=env)
+    rows = [json.loads(line) for line in p.stdout.splitlines() if line.startswith("[")]
+    assert p.returncode == 0, f"the child died (status {p.returncode}) after {rows[-1] if rows else 'no call'}: {p.stderr[-3000:]}"
+    return rows
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="resource limits (POSIX)")
+def test_issue24_reproductions_are_refused_naming_the_parameter():
+    """Each reproduction of issue 24 #6 and #13 (rtol = 1000 hung the map, threads = 2**31 hung
+    the thread pool, n_grid / n_samples = 2**31 allocated 16-32 GiB, 2**63 raised OverflowError,
+    strings raised numpy's messages) is a ValueError naming the parameter, at once (< 2 s each:
+    nothing was computed)."""
+    from fuzz_api import REGRESSIONS
+
+    rows = _child("regressions", timeout=300)
+    assert len(rows) == len(REGRESSIONS)
+    for case, param, kind, message, seconds, _, name in rows:
+        assert kind == "ValueError" and f"`{name}`" in message, (case, param, kind, message)
+        assert seconds < 2.0, (case, param, seconds)
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(sys.platform == "win32", reason="resource limits (POSIX)")
+def test_fuzz_the_public_api_in_a_limited_process():
+    """Hypothesis draws hostile values (2**31, 2**63, 1e300, NaN, strings, None, objects, ...)
+    for every parameter of 49 public calls, the other arguments valid (8 examples each, about
+    1900 calls): only ValueError, TypeError or a librate error escapes; every ValueError and
+    TypeError names a parameter (`name`); no call runs 60 s (the watchdog) and the process stays
+    within FUZZ_ADDRESS_SPACE."""
+    from fuzz_api import CASES
+
+    rows = _child("fuzz", "8", timeout=1500)
+    assert len(rows) >= 8 * sum(len(base) for _, base in CASES.values()) // 2  # hypothesis may stop early on small strategies
+    bad = [r for r in rows if r[2].startswith("BAD:")]
+    unnamed = [r for r in rows if r[2] in ("ValueError", "TypeError") and not re.search(r"`\w+`", r[3])]
+    assert not bad, bad[:10]
+    assert not unnamed, unnamed[:10]
