@@ -452,3 +452,17 @@ def test_fuzz_the_public_api_in_a_limited_process():
     unnamed = [r for r in rows if r[2] in ("ValueError", "TypeError") and not re.search(r"`\w+`", r[3])]
     assert not bad, bad[:10]
     assert not unnamed, unnamed[:10]
+
+
+def test_sizes_are_refused_with_their_memory_before_allocating():
+    """Issue 24 #6: n_grid = 2**31 tried to allocate 16 GiB (numpy MemoryError); a 1000**3 3-D
+    map grid 57 GB. Now a ValueError names the parameter, the range and the memory asked for
+    (the limit: librate._checks.MAX_ARRAY_BYTES = 2 GiB)."""
+    from librate._checks import MAX_ARRAY_BYTES
+
+    with pytest.raises(ValueError, match=r"invalid argument `n_grid`: must be an integer in \[2, [\d,]+\]: 2,147,483,648 would need about 137 GB"):
+        librate.find_periodic_attitudes(ORBIT, kz=0.8, wz0_range=(0.5, 1.0), n_grid=2**31)
+    w = np.linspace(0.0, 1.0, 1000)
+    with pytest.raises(ValueError, match=r"invalid arguments `body`, `wx0`, `wy0`, `wz0`: a grid of 1 x 1,000 x 1,000 x 1,000 .* 57 GB"):
+        librate.attitude_map_3d(ORBIT, librate.RigidBody(1.0, 2.0, 2.5), wx0=w, wy0=w, wz0=w)
+    assert MAX_ARRAY_BYTES == 2 * 1024**3
