@@ -38,7 +38,8 @@ print(f"map: {ds.sizes['orbit']} orbits x {ds.sizes['wz0']} rates, {ds.sizes['so
 
 # 4. figures, and the map saved with its units and reloaded
 lp.save_figure(lp.plot_family(fam), out / "family.png", close=True)
-lp.save_figure(lp.plot_residuals(dro, kz=0.8, wz0=np.linspace(-2.5, 2.5, 1001)), out / "residuals.png", close=True)
+one = librate.periodicity_map(dro, kz=0.8, wz0=np.linspace(-2.5, 2.5, 1001))  # the figures take data: the one orbit's map
+lp.save_figure(lp.plot_residuals(one), out / "residuals.png", close=True)
 lp.save_figure(lp.plot_map(ds), out / "map.png", close=True)
 path = save_dataset(ds, out / "map.zarr")
 again = librate.open_result(path)

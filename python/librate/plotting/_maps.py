@@ -10,8 +10,6 @@ from typing import TYPE_CHECKING
 import numpy as np
 from matplotlib.lines import Line2D
 
-from ..orbits.periodic import PeriodicOrbit
-from ..periodicity.maps import periodicity_map
 from ..periodicity.solutions import KINDS, check_kinds
 from ._style import (
     DPHI_COLOR,
@@ -35,13 +33,11 @@ if TYPE_CHECKING:
 
 
 def plot_residuals(
-    orbit_or_ds,
+    ds,
     ax=None,
     *,
     kz: float | None = None,
-    wz0=None,
     orbit_index: int | None = None,
-    phi0: float = 0.0,
     rate: str = "relative",
     solutions: bool = True,
     kinds: Sequence[str] = KINDS,
@@ -55,43 +51,30 @@ def plot_residuals(
     colour by N, circle periodic, diamond half-turn, filled when linearly stable), labelled
     "N = ..." when ``annotate``.
 
-    ``orbit_or_ds``: a Dataset from :func:`librate.periodicity_map` (``orbit_index`` picks the
-    orbit when it holds several, ``kz`` the Kz value when it holds several), or a planar
-    :class:`~librate.PeriodicOrbit` with ``kz`` (a number) and ``wz0`` (the grid of INERTIAL
-    initial rates, increasing): the map is then computed here (``phi0``: the initial angle).
-    ``rate``: the horizontal axis, ``"relative"`` (default: phidot(0) = wz(0) - 1, relative to
-    the synodic frame, what the thesis figures plot under the label wz(0)) or ``"inertial"``
-    (wz(0)); the axis label says which. Returns the Figure.
+    ``ds``: a Dataset from :func:`librate.periodicity_map` (``orbit_index`` picks the orbit when it
+    holds several, ``kz`` the Kz value when it holds several); for one orbit, compute its map
+    first, ``periodicity_map(orbit, kz=kz, wz0=wz0)``. ``rate``: the horizontal axis,
+    ``"relative"`` (default: phidot(0) = wz(0) - 1, relative to the synodic frame, what the thesis
+    figures plot under the label wz(0)) or ``"inertial"`` (wz(0)); the axis label says which.
+    Returns the Figure.
     """
     offset, xlabel = rate_axis(rate)
     kinds = check_kinds(kinds)
-    if isinstance(orbit_or_ds, PeriodicOrbit):
-        if kz is None:
-            raise ValueError("invalid argument `kz`: a number in [-1, 1] is needed with an orbit")
-        if wz0 is None:
-            raise ValueError("invalid argument `wz0`: the inertial initial rates to scan are needed with an orbit")
-        if orbit_index not in (None, 0):
-            raise ValueError(f"invalid argument `orbit_index`: one orbit was given, got {orbit_index!r}")
-        ds = periodicity_map(orbit_or_ds, kz=kz, wz0=wz0, phi0=phi0, solve=bool(solutions))
-        i = j = 0
+    ds = check_map(ds, "ds")
+    norb = ds.sizes["orbit"]
+    if orbit_index is None and norb != 1:
+        raise ValueError(f"invalid argument `orbit_index`: the Dataset holds {norb} orbits, pick one")
+    i = check_index(0 if orbit_index is None else orbit_index, norb, "orbit_index")
+    kzs = np.asarray(ds["kz"].values, dtype=float)
+    if kz is None:
+        if kzs.size != 1:
+            raise ValueError(f"invalid argument `kz`: the Dataset holds {kzs.size} Kz values {kzs.tolist()}, pick one")
+        j = 0
     else:
-        ds = check_map(orbit_or_ds, "orbit_or_ds")
-        if wz0 is not None:
-            raise ValueError("invalid argument `wz0`: rates are given only with an orbit (a Dataset has its own)")
-        norb = ds.sizes["orbit"]
-        if orbit_index is None and norb != 1:
-            raise ValueError(f"invalid argument `orbit_index`: the Dataset holds {norb} orbits, pick one")
-        i = check_index(0 if orbit_index is None else orbit_index, norb, "orbit_index")
-        kzs = np.asarray(ds["kz"].values, dtype=float)
-        if kz is None:
-            if kzs.size != 1:
-                raise ValueError(f"invalid argument `kz`: the Dataset holds {kzs.size} Kz values {kzs.tolist()}, pick one")
-            j = 0
-        else:
-            hit = np.flatnonzero(np.abs(kzs - float(kz)) <= 1e-12)
-            if not hit.size:
-                raise ValueError(f"invalid argument `kz`: {kz!r} is not in the Dataset's Kz values {kzs.tolist()}")
-            j = int(hit[0])
+        hit = np.flatnonzero(np.abs(kzs - float(kz)) <= 1e-12)
+        if not hit.size:
+            raise ValueError(f"invalid argument `kz`: {kz!r} is not in the Dataset's Kz values {kzs.tolist()}")
+        j = int(hit[0])
     kz_value = float(ds["kz"].values[j])
     x = np.asarray(ds["wz0"].values, dtype=float) - offset
     dwz = np.asarray(ds["dwz"].values[i, j], dtype=float)
