@@ -141,8 +141,13 @@ class Geometry:
 
 def geometry(orbit: PeriodicOrbit) -> Geometry:
     """Winding numbers (signed turns of the projected position about each primary over one
-    period) and closest approaches, from the integrated orbit."""
-    tr = orbit.propagate(rtol=1e-11, atol=1e-11)
+    period) and closest approaches, from the integrated orbit (at rtol = atol = 1e-11, point
+    masses; the orbit's fields were checked when it was made)."""
+    from .propagation import collision_radii, integrate, tolerance_options
+
+    sys_ = orbit.system
+    tr = integrate(sys_, np.ascontiguousarray(orbit.state0, dtype=float), 0.0, float(orbit.period), tolerance_options(1e-11, 1e-11),
+                   collision_radii(sys_, "point"))
     y = tr.y
     wind, dmin = [], []
     for c in orbit.system.primary_positions():

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -266,13 +267,33 @@ def propagate(
             raise ValueError(f"invalid argument `events`: must be librate.Event objects, got {e!r}")
     te = None if t_eval is None else as_float_array(t_eval, "t_eval").ravel()
     radii = collision_radii(sys_, collision)
+    return integrate(sys_, s, t0, tf, integration_options(rtol, atol, h0, h_min, h_max, max_steps, safety, fixed_step), radii,
+                     stm=bool(stm), t_eval=te, events=evs)
+
+
+@functools.lru_cache(maxsize=16)
+def _tolerance_options(rtol: float, atol: float) -> tuple:
+    return tuple(integration_options(rtol, atol, None, 0.0, math.inf, 1_000_000, 0.8, None).items())
+
+
+def tolerance_options(rtol: float, atol: float) -> dict:
+    """The integrator settings of :func:`propagate` with the tolerances ``rtol``, ``atol`` and the
+    default step control, checked once per pair (for internal callers with fixed settings)."""
+    return dict(_tolerance_options(float(rtol), float(atol)))
+
+
+def integrate(system: System, state: np.ndarray, t0: float, tf: float, options: dict, radii: tuple[float, float] | None, *,
+              stm: bool = False, t_eval: np.ndarray | None = None, events: Sequence[Event] = ()) -> Trajectory:
+    """The one call of the core's propagator behind :func:`propagate`, on arguments already
+    checked where they entered (a System, a (6,) float state, ``options`` from
+    :func:`integration_options` or :func:`tolerance_options`, ``radii`` from
+    :func:`collision_radii`): internal callers with known-good values call it directly."""
     r = _core.propagate(
-        sys_.mu, s, t0, tf, stm=bool(stm), t_eval=te, events=[e._spec(sys_) for e in evs],
-        options=integration_options(rtol, atol, h0, h_min, h_max, max_steps, safety, fixed_step), collision=radii,
+        system.mu, state, t0, tf, stm=stm, t_eval=t_eval, events=[e._spec(system) for e in events], options=options, collision=radii,
     )
     err = r.collision
     tr = Trajectory(
-        system=sys_,
+        system=system,
         t=r.t,
         y=r.y,
         t_final=r.t_final,
@@ -285,7 +306,7 @@ def propagate(
         collision_primary=None if err is None else int(err.primary),
     )
     if err is not None:
-        raise _collision(sys_, err, tr)
+        raise _collision(system, err, tr)
     return tr
 
 
