@@ -1,5 +1,5 @@
 """The rules between sections of a study (and what each command needs from it), on the section
-models that passed type validation; the rules within one section are its model's ``problems()``
+models that passed type validation; the rules within one section are its model's validator
 (:mod:`librate.app.schema`)."""
 
 from __future__ import annotations
@@ -30,21 +30,12 @@ def _check_increasing(key: str, g, problems: list[str]) -> None:
 def check_sections(s: dict[str, Table], given: dict, purpose: str | None) -> list[str]:
     """Consistency checks on the sections that passed type validation (``s``); ``given`` is the
     raw study as written (to tell a missing section from a defaulted one). The rules within one
-    section are its model's ``problems()``; the rules between sections are here."""
-    sysc = s.get("system")
-    problems, mu = sysc.problems() if sysc is not None else ([], None)
-
+    section are its model's validator; the rules between sections are here."""
+    problems: list[str] = []
     orb = s.get("orbits")
-    if orb is not None:
-        problems += orb.problems(mu)
-
     body = s.get("body")
-    if body is not None:
-        problems += body.problems()
-
     tq = s.get("torques")
     if tq is not None:
-        problems += tq.problems()
         srp = tq.srp  # one rule between [torques.srp] and [body]:
         if srp is not None and srp.eps is None and srp.area_m2 is not None and srp.offset_m is not None \
                 and body is not None and body.iz is None and body.kz is not None:

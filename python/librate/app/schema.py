@@ -1,6 +1,7 @@
 """The study schema: one pydantic model per TOML section, each key's type, range and description
-on its field, and each section's own rules in its ``problems()`` method; the error messages
-(every one names the dotted key, the value given and what is allowed)."""
+on its field, and each section's own rules as its model's validator (``_rules``, raising
+:class:`SectionProblems`); the error messages (every one names the dotted key, the value given and
+what is allowed)."""
 
 from __future__ import annotations
 
@@ -12,7 +13,7 @@ import warnings
 from typing import Annotated, Any, Literal
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Discriminator, Field, Tag, ValidationError, model_validator
+from pydantic import BaseModel, ConfigDict, Discriminator, Field, Tag, ValidationError, ValidationInfo, model_validator
 
 #: What a study can be checked for (the commands that run it).
 PURPOSES = ("family", "solve", "map")
@@ -36,6 +37,23 @@ class StudyError(ValueError):
 
 
 # --- schema ------------------------------------------------------------------------------------
+class SectionProblems(ValueError):
+    """What a section's rules (its model's validator) found, one line per problem naming its
+    key; :func:`pydantic_problems` lists them after the type problems. ``section``: the section
+    as validated (its types are right), for the rules between sections."""
+
+    def __init__(self, problems: list[str], section: BaseModel):
+        super().__init__("; ".join(problems))
+        self.problems = list(problems)
+        self.section = section
+
+
+def _rules_found(section: BaseModel, found: list[str]) -> BaseModel:
+    if found:
+        raise SectionProblems(found, section)
+    return section
+
+
 class Table(BaseModel):
     model_config = ConfigDict(extra="forbid", strict=True, frozen=True, allow_inf_nan=False)
 
@@ -95,18 +113,26 @@ class SystemSection(Table):
     radii_km: list[Annotated[float, Field(ge=0)]] | None = Field(None, min_length=2, max_length=2, description="two numbers >= 0, the primaries' radii in km")
     name: str | None = Field(None, description="a string")
 
-    def problems(self) -> tuple[list[str], float | None]:
-        """The rules between this section's keys (a preset, or a custom system); also the mass
-        ratio mu when it is known (for the orbits' checks)."""
+    def mass_ratio(self) -> float | None:
+        """The system's mass ratio mu when it is known (for the orbits' rules)."""
         from ..orbits.system import System
 
-        sysc, problems, mu = self, [], None
+        if self.preset is not None:
+            return System.preset(self.preset).mu if self.preset in System.presets() else None
+        if any(getattr(self, k) is not None for k in ("mu", "lu_km", "tu_s", "radii_km")):
+            return self.mu
+        return System.preset("earth-moon").mu
+
+    @model_validator(mode="after")
+    def _rules(self) -> SystemSection:
+        """The rules between this section's keys: a preset, or a custom system."""
+        from ..orbits.system import System
+
+        sysc, problems = self, []
         custom = [k for k in ("mu", "lu_km", "tu_s", "radii_km") if getattr(sysc, k) is not None]
         if sysc.preset is not None:
             if sysc.preset not in System.presets():
                 problems.append(problem("system.preset", sysc.preset, "unknown preset"))
-            else:
-                mu = System.preset(sysc.preset).mu
             for k in custom:
                 problems.append(problem(f"system.{k}", getattr(sysc, k), "cannot be combined with system.preset (a preset fixes the constants)",
                                          "either system.preset alone, or system.mu, system.lu_km and system.tu_s (and optionally system.radii_km)"))
@@ -114,11 +140,7 @@ class SystemSection(Table):
             for k in ("mu", "lu_km", "tu_s"):
                 if getattr(sysc, k) is None:
                     problems.append(missing(f"system.{k}", f"missing: a custom system (given {', '.join('system.' + c for c in custom)}) needs system.mu, system.lu_km and system.tu_s"))
-            if sysc.mu is not None:
-                mu = sysc.mu
-        else:
-            mu = System.preset("earth-moon").mu
-        return problems, mu
+        return _rules_found(self, problems)
 
 
 class OrbitsSection(Table):
@@ -135,9 +157,12 @@ class OrbitsSection(Table):
     members: int | None = Field(None, ge=1, le=10_000, description="an integer >= 1: that many members evenly spread along the family")
     max_members: int | None = Field(None, ge=2, le=5_000, description="an integer in [2, 5000], the continuation's length (lyapunov and halo)")
 
-    def problems(self, mu: float | None) -> list[str]:
+    @model_validator(mode="after")
+    def _rules(self, info: ValidationInfo) -> OrbitsSection:
         """The rules between this section's keys (what applies to which family, one way to
-        select the members, their ranges; ``mu``: the system's mass ratio, when known)."""
+        select the members, their ranges; the validation context's ``mu``: the system's mass
+        ratio, when known)."""
+        mu = (info.context or {}).get("mu")
         orb, problems = self, []
         if orb.kind == "dro":
             for k in ("point", "branch", "max_members"):
@@ -162,7 +187,7 @@ class OrbitsSection(Table):
                                          "values in (-mu, 1 - mu)"))
             if k == "period_days" and np.any(v <= 0):
                 problems.append(problem("orbits.period_days", grid_raw(orb.period_days), "periods must be > 0 days"))
-        return problems
+        return _rules_found(self, problems)
 
 
 FLEXIBLE_PRESETS = ("sample-station", "sample-station-low-frequency")
@@ -181,7 +206,8 @@ class BodySection(Table):
     mass_kg: float | None = Field(None, gt=0, description="a number > 0, the mass in kg")
     flexible: str | None = None
 
-    def problems(self) -> list[str]:
+    @model_validator(mode="after")
+    def _rules(self) -> BodySection:
         """The rules between this section's keys (Kz, the moments or a flexible body; the
         moments' triangle inequality; a Kz table within [-1, 1])."""
         body, problems = self, []
@@ -218,7 +244,7 @@ class BodySection(Table):
                 v = getattr(body.kz, k)
                 if not -1 <= v <= 1:
                     problems.append(problem(f"body.kz.{k}", v, "Kz must be in [-1, 1]", "a number in [-1, 1]"))
-        return problems
+        return _rules_found(self, problems)
 
 
 class SrpSection(Table):
@@ -244,7 +270,8 @@ class SrpSection(Table):
             data = {("theta_sun0" if k == "theta0" else k): v for k, v in data.items()}
         return data
 
-    def problems(self) -> list[str]:
+    @model_validator(mode="after")
+    def _rules(self) -> SrpSection:
         """The rules between this section's keys (eps or the geometry; cs + cd <= 1)."""
         srp, problems = self, []
         geo = [k for k in ("area_m2", "offset_m") if getattr(srp, k) is not None]
@@ -260,7 +287,7 @@ class SrpSection(Table):
             problems.append(problem("torques.srp.cd", srp.cd, f"cs + cd = {srp.cs + srp.cd:g} exceeds 1 (the absorbed fraction is 1 - cs - cd)"))
         if srp.pressure is not None and srp.eps is not None:
             problems.append(problem("torques.srp.pressure", srp.pressure, "only used with the geometry (area_m2, offset_m); eps already includes it"))
-        return problems
+        return _rules_found(self, problems)
 
 
 class TorquesSection(Table):
@@ -269,12 +296,13 @@ class TorquesSection(Table):
     gravity_gradient: list[Literal["earth", "moon"]] = Field(default_factory=lambda: ["earth", "moon"], description="a list of primaries among 'earth' and 'moon'")
     srp: SrpSection | None = None
 
-    def problems(self) -> list[str]:
-        """The rules between this section's keys (and those of [torques.srp])."""
+    @model_validator(mode="after")
+    def _rules(self) -> TorquesSection:
+        """The rules between this section's keys ([torques.srp] checks its own)."""
         problems: list[str] = []
         if len(set(self.gravity_gradient)) != len(self.gravity_gradient):
             problems.append(problem("torques.gravity_gradient", self.gravity_gradient, "a primary is listed twice"))
-        return problems + (self.srp.problems() if self.srp is not None else [])
+        return _rules_found(self, problems)
 
 
 class RatesSection(Table):
@@ -404,11 +432,17 @@ def unknown_key(key: str, value: Any) -> str:
     return text + (f" (did you mean `{(parent + '.') if parent else ''}{hint[0]}`?)" if hint else "")
 
 
-def pydantic_problems(prefix: str, err: ValidationError) -> list[str]:
-    out = []
+def pydantic_problems(prefix: str, err: ValidationError, rules: list[str] | None = None) -> list[str]:
+    """The problems of a section's validation, one line each naming the key: the type problems
+    (returned), and what its rules found (:class:`SectionProblems`; added to ``rules`` when
+    given, else returned after the type problems)."""
+    out: list[str] = []
+    found: list[str] = []
     for e in err.errors():
         key = _dotted(prefix, e["loc"])
-        if e["type"] == "extra_forbidden":
+        if isinstance((e.get("ctx") or {}).get("error"), SectionProblems):
+            found += e["ctx"]["error"].problems
+        elif e["type"] == "extra_forbidden":
             out.append(unknown_key(key, e["input"]))
         elif e["type"] == "missing":
             out.append(missing(key, "missing (required)"))
@@ -419,6 +453,9 @@ def pydantic_problems(prefix: str, err: ValidationError) -> list[str]:
             if e["type"] == "model_type":
                 msg = "must be a table"
             out.append(problem(key, e["input"], msg))
+    if rules is None:
+        return out + found
+    rules += found
     return out
 
 

@@ -52,6 +52,7 @@ from .schema import (
     OrbitsSection,
     OutputSection,
     RatesSection,
+    SectionProblems,
     SolverSection,
     StudyError,
     SystemSection,
@@ -105,22 +106,36 @@ class Study(Header):
             raise ValueError(f"invalid argument `purpose`: must be one of {', '.join(PURPOSES)} or None, got {purpose!r}")
         if not isinstance(data, dict):
             raise StudyError([f"the study must be a table of sections, got {type(data).__name__}"], source)
-        problems: list[str] = []
+        # Type problems are listed in the order of the file, then the sections' own rules (their
+        # validators) in the order of SECTIONS, then the rules between sections. [system] is
+        # validated first: the orbits' rules take its mass ratio.
+        typed: dict[str, list[str]] = {}
+        ruled: dict[str, list[str]] = {}
         sections: dict[str, Table] = {}
-        for key, value in data.items():
+        mu = SystemSection().mass_ratio() if "system" not in data else None
+        for key in sorted(data, key=lambda k: k != "system"):
+            value = data[key]
             if key in ("title", "description"):
                 if not isinstance(value, str):
-                    problems.append(problem(key, value, "must be a string"))
+                    typed[key] = [problem(key, value, "must be a string")]
             elif key in SECTIONS:
                 if not isinstance(value, dict):
-                    problems.append(problem(key, value, f"must be a table [{key}]", f"a table [{key}] with keys {', '.join(SECTIONS[key].model_fields)}"))
+                    typed[key] = [problem(key, value, f"must be a table [{key}]", f"a table [{key}] with keys {', '.join(SECTIONS[key].model_fields)}")]
                     continue
                 try:
-                    sections[key] = SECTIONS[key].model_validate(value)
+                    sections[key] = SECTIONS[key].model_validate(value, context={"mu": mu})
                 except ValidationError as err:
-                    problems += pydantic_problems(key, err)
+                    ruled[key] = []
+                    typed[key] = pydantic_problems(key, err, ruled[key])
+                    if not typed[key]:  # the types are right, its own rules failed: the rules between sections still see it
+                        found = [e["ctx"]["error"] for e in err.errors() if e["loc"] == () and isinstance((e.get("ctx") or {}).get("error"), SectionProblems)]
+                        if found:
+                            sections[key] = found[0].section
+                if key == "system" and key in sections:
+                    mu = sections[key].mass_ratio()
             else:
-                problems.append(unknown_key(key, value))
+                typed[key] = [unknown_key(key, value)]
+        problems = [p for key in data for p in typed.get(key, [])] + [p for key in SECTIONS for p in ruled.get(key, [])]
         # Sections left out take their defaults ([body] and [rates] have none); a section that
         # failed type validation is left out of the checks that involve it.
         valid: dict[str, Table] = {}
