@@ -13,7 +13,7 @@ import warnings
 from typing import Annotated, Any, Literal
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Discriminator, Field, Tag, ValidationError, ValidationInfo, model_validator
+from pydantic import BaseModel, ConfigDict, Discriminator, Field, Tag, TypeAdapter, ValidationError, ValidationInfo, model_validator
 
 #: What a study can be checked for (the commands that run it).
 PURPOSES = ("family", "solve", "map")
@@ -100,7 +100,7 @@ RateGrid = Annotated[
     Annotated[float, Tag("number")] | Annotated[list[float], Field(min_length=1, max_length=MAX_GRID), Tag("list")] | Annotated[Range, Tag("range")],
     Discriminator(_number_grid_tag, custom_error_type="grid", custom_error_message=_RATE_MSG),
 ]
-_TAGS = {"list", "range", "number"}
+_TAGS = {"list", "range", "number", "planar", "3d"}
 
 
 class SystemSection(Table):
@@ -325,6 +325,83 @@ class AttitudeSection(Table):
     w0: list[float] | None = Field(None, min_length=3, max_length=3, description="three numbers, the inertial rate in body axes (1/TU), with attitude.start = 'given'")
     tol: float | None = Field(None, ge=1e-14, le=1e-6, description="a number in [1e-14, 1e-6], the 3-D corrector's tolerance on the closure (default 1e-12; 1e-10 for NRHOs)")
 
+    @classmethod
+    def model_validate(cls, obj: Any, **kwargs: Any) -> AttitudeSection:
+        """[attitude] is a union discriminated by ``model``: :class:`PlanarAttitude` or
+        :class:`Attitude3D` (a third model, e.g. the ephemeris, is one more member)."""
+        if cls is AttitudeSection:
+            return _ATTITUDE.validate_python(obj, **kwargs)
+        return super().model_validate(obj, **kwargs)
+
+
+_3D_KEYS = ("start", "n", "q0", "w0", "tol")
+
+
+class PlanarAttitude(AttitudeSection):
+    """[attitude] model = "planar" (the default): the planar model, phi and wz."""
+
+    model: Literal["planar"] = "planar"
+
+    @model_validator(mode="after")
+    def _rules(self) -> PlanarAttitude:
+        """The 3-D keys do not apply to the planar model."""
+        return _rules_found(self, [problem(f"attitude.{k}", getattr(self, k), "applies only to attitude.model = \"3d\"",
+                                           "attitude.model = '3d' with it, or leave it out") for k in _3D_KEYS if getattr(self, k) is not None])
+
+
+class Attitude3D(AttitudeSection):
+    """[attitude] model = "3d": the 3-D rigid body (quaternion and three rates), and how a solve starts."""
+
+    model: Literal["3d"]
+
+    def start_on(self, orbits_kind: str | None) -> str:
+        """How a 3-D solve starts: ``start``, else "given" with ``w0``, else "spin" on a halo
+        family, else "planar"."""
+        if self.start is not None:
+            return self.start
+        if self.w0 is not None:
+            return "given"
+        return "spin" if orbits_kind == "halo" else "planar"
+
+    @model_validator(mode="after")
+    def _rules(self, info: ValidationInfo) -> Attitude3D:
+        """The rules between this section's keys: what each start takes (the validation
+        context's ``orbits_kind`` decides the default start), and a unit ``q0``."""
+        start = self.start_on((info.context or {}).get("orbits_kind"))
+        problems: list[str] = []
+        if start == "planar":
+            for k in ("q0", "w0"):
+                if getattr(self, k) is not None:
+                    problems.append(problem(f"attitude.{k}", getattr(self, k), "cannot be combined with attitude.start = \"planar\" (the start is the planar solution: "
+                                             "phi0 = solver.phi0 about Z, wz0 from the rates.wz0 scan)", "attitude.q0 and attitude.w0 with attitude.start = 'given'"))
+        elif start == "spin" and self.w0 is not None:
+            problems.append(problem("attitude.w0", self.w0, "cannot be combined with attitude.start = \"spin\" (the spin is w = (1 + 2 pi n / (K T)) e_Z)",
+                                     "attitude.w0 with attitude.start = 'given'"))
+        if start in ("planar", "spin") and self.n is None:
+            problems.append(missing("attitude.n", f"missing: attitude.start = \"{start}\" needs the net turns n per attitude period"))
+        if start == "given":
+            if self.w0 is None:
+                problems.append(missing("attitude.w0", "missing: attitude.start = \"given\" starts from attitude.w0 (and attitude.q0, default the identity)"))
+            if self.n is not None:
+                problems.append(problem("attitude.n", self.n, "does not apply to attitude.start = \"given\" (the start is attitude.q0, attitude.w0)",
+                                         "attitude.n with attitude.start = 'planar' or 'spin'"))
+        if self.q0 is not None and abs(math.hypot(*self.q0) - 1) > 1e-6:  # finite: the schema refuses inf and nan
+            problems.append(problem("attitude.q0", self.q0, f"must be a unit quaternion (|q0| = {math.hypot(*self.q0):.6g})"))
+        return _rules_found(self, problems)
+
+
+def _model_tag(v: Any) -> str | None:
+    if isinstance(v, dict):
+        m = v.get("model", "planar")
+        return m if m in ("planar", "3d") else None
+    return getattr(v, "model", None)
+
+
+_ATTITUDE = TypeAdapter(Annotated[Annotated[PlanarAttitude, Tag("planar")] | Annotated[Attitude3D, Tag("3d")],
+                                  Discriminator(_model_tag, custom_error_type="attitude_model", custom_error_message="must be 'planar' or '3d'")])
+
+
+
 
 class SolverSection(Table):
     """[solver]: tolerances, periods per solution, initial angle."""
@@ -442,6 +519,9 @@ def pydantic_problems(prefix: str, err: ValidationError, rules: list[str] | None
         key = _dotted(prefix, e["loc"])
         if isinstance((e.get("ctx") or {}).get("error"), SectionProblems):
             found += e["ctx"]["error"].problems
+        elif e["type"] == "attitude_model":  # the discriminator of [attitude]: its model
+            value = e["input"].get("model") if isinstance(e["input"], dict) else e["input"]
+            out.append(problem(f"{key}.model", value, e["msg"]))
         elif e["type"] == "extra_forbidden":
             out.append(unknown_key(key, e["input"]))
         elif e["type"] == "missing":

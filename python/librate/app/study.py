@@ -51,6 +51,7 @@ from .schema import (
     Header,
     OrbitsSection,
     OutputSection,
+    PlanarAttitude,
     RatesSection,
     SectionProblems,
     SolverSection,
@@ -86,7 +87,7 @@ class Study(Header):
     body: BodySection | None = None
     torques: TorquesSection = Field(default_factory=TorquesSection)
     rates: RatesSection | None = None
-    attitude: AttitudeSection = Field(default_factory=AttitudeSection)
+    attitude: AttitudeSection = Field(default_factory=PlanarAttitude)
     solver: SolverSection = Field(default_factory=SolverSection)
     output: OutputSection = Field(default_factory=OutputSection)
     base_dir: str = Field(".", exclude=True)
@@ -107,13 +108,15 @@ class Study(Header):
         if not isinstance(data, dict):
             raise StudyError([f"the study must be a table of sections, got {type(data).__name__}"], source)
         # Type problems are listed in the order of the file, then the sections' own rules (their
-        # validators) in the order of SECTIONS, then the rules between sections. [system] is
-        # validated first: the orbits' rules take its mass ratio.
+        # validators) in the order of SECTIONS, then the rules between sections. [system] and
+        # [orbits] are validated first: the orbits' rules take the mass ratio, and the default
+        # start of a 3-D [attitude] depends on the family.
         typed: dict[str, list[str]] = {}
         ruled: dict[str, list[str]] = {}
         sections: dict[str, Table] = {}
-        mu = SystemSection().mass_ratio() if "system" not in data else None
-        for key in sorted(data, key=lambda k: k != "system"):
+        context = {"mu": SystemSection().mass_ratio() if "system" not in data else None,
+                   "orbits_kind": OrbitsSection().kind if "orbits" not in data else None}
+        for key in sorted(data, key=lambda k: {"system": 0, "orbits": 1}.get(k, 2)):
             value = data[key]
             if key in ("title", "description"):
                 if not isinstance(value, str):
@@ -123,7 +126,7 @@ class Study(Header):
                     typed[key] = [problem(key, value, f"must be a table [{key}]", f"a table [{key}] with keys {', '.join(SECTIONS[key].model_fields)}")]
                     continue
                 try:
-                    sections[key] = SECTIONS[key].model_validate(value, context={"mu": mu})
+                    sections[key] = SECTIONS[key].model_validate(value, context=context)
                 except ValidationError as err:
                     ruled[key] = []
                     typed[key] = pydantic_problems(key, err, ruled[key])
@@ -132,7 +135,9 @@ class Study(Header):
                         if found:
                             sections[key] = found[0].section
                 if key == "system" and key in sections:
-                    mu = sections[key].mass_ratio()
+                    context["mu"] = sections[key].mass_ratio()
+                if key == "orbits" and key in sections:
+                    context["orbits_kind"] = sections[key].kind
             else:
                 typed[key] = [unknown_key(key, value)]
         problems = [p for key in data for p in typed.get(key, [])] + [p for key in SECTIONS for p in ruled.get(key, [])]
@@ -143,7 +148,7 @@ class Study(Header):
             if k in sections:
                 valid[k] = sections[k]
             elif k not in data and k not in ("body", "rates"):
-                valid[k] = model()
+                valid[k] = model.model_validate({}, context=context)
         problems += check_sections(valid, data, purpose)
         if problems:
             raise StudyError(problems, source)
