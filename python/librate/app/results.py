@@ -386,7 +386,9 @@ def solutions_3d_dataset(family_ds, orbits, period_days, start: dict, attrs: dic
 def multipliers_3d(ds) -> np.ndarray:
     """The complex Floquet multipliers (member, 6) of a saved 3-D solve (``multipliers_real``
     and ``multipliers_imag``)."""
-    return ds["multipliers_real"].values + 1j * ds["multipliers_imag"].values
+    from ..results.kinds import Solutions3DResult
+
+    return Solutions3DResult.multipliers(ds)
 
 
 def solution_3d(ds, member: int = 0):

@@ -168,13 +168,18 @@ class Solutions3DResult(ResultKind):
     kind = "solutions_3d"
     figure_names = ("multipliers", "body_axes")
 
+    @staticmethod
+    def multipliers(ds) -> np.ndarray:
+        """The complex Floquet multipliers (member, 6), stored as ``multipliers_real`` and ``multipliers_imag``."""
+        return ds["multipliers_real"].values + 1j * ds["multipliers_imag"].values
+
     @classmethod
     def figures(cls, result, names=None, skip=None, *, solution: Callable | None = None, **data) -> list[Figure]:
         """The Floquet multipliers along the family, and the body axes along the first member's
         orbit: ``solution()`` returns that member's AttitudeSolution3D (the computing layer
         corrects it again from the stored state; without it the figure is left out)."""
         lp = _plotting()
-        mult = result["multipliers_real"].values + 1j * result["multipliers_imag"].values
+        mult = cls.multipliers(result)
         table = {"multipliers": lambda: lp.plot_family_multipliers(result.assign(multipliers=(("member", "k"), mult)))}
         if solution is not None:
             table["body_axes"] = lambda: lp.plot_body_axes(solution())
