@@ -412,7 +412,7 @@ def family(study, kind, point, branch, x0, members, system_name, fmt, sets, out_
     for b in fam.bifurcations:
         _echo(quiet, f"  bifurcation: {b['index']} index, {b['type']}, near x0 = {b['x0']:.6g}")
     click.echo(f"written: {path}")
-    _figures(fam, path, st.figures(("family", "period", "stability")), quiet)
+    _figures(fam, path, _wanted(st, ("family", "period", "stability")), quiet)
 
 
 def _quote(v):
@@ -474,7 +474,7 @@ def solve(study, sets, out_dir, resume, quiet) -> None:
         if not quiet:
             _summary_3d(ds, el)
         click.echo(f"written: {path}")
-        _figures(ds, path, st.figures(("multipliers", "body_axes")), quiet)
+        _figures(ds, path, _wanted(st, ("multipliers", "body_axes")), quiet)
         return
     n = ds.sizes["solution"]
     _echo(quiet, f"{n} periodic solution(s) over {ds.sizes['orbit']} orbit(s) x {ds.sizes['kz']} Kz ({el:.2f} s)")
@@ -485,7 +485,7 @@ def solve(study, sets, out_dir, resume, quiet) -> None:
             click.echo(f"{r['orbit']:>5d} {r['x0']:>9.5f} {r['period_days']:>8.4f} {r['kz']:>6.3g} {r['n']:>4g} {r['kind']:>9} {r['wz0']:>13.8f} "
                        f"{r['phidot0']:>13.8f} {r['phi0']:>9.5f} {r['trace']:>10.4g} {'yes' if r['stable'] else 'no':>6} {r['residual']:>9.1e}")
     click.echo(f"written: {path}")
-    _figures(ds, path, st.figures(("solutions",)), quiet)
+    _figures(ds, path, _wanted(st, ("solutions",)), quiet)
 
 
 def _summary_3d(ds, elapsed: float) -> None:
@@ -564,7 +564,7 @@ def map_(study, out_dir, quiet, scheduler, resume, sets) -> None:
         if not quiet:
             _map_3d_summary(ds, el)
         click.echo(f"written: {path}")
-        _figures(ds, path, st.figures(("map",)), quiet)
+        _figures(ds, path, _wanted(st, ("map",)), quiet)
         return
     if not quiet:
         no, nk, nw = ds.sizes["orbit"], ds.sizes["kz"], ds.sizes["wz0"]
@@ -572,7 +572,7 @@ def map_(study, out_dir, quiet, scheduler, resume, sets) -> None:
                    + ("" if int(ds.attrs.get("complete", 1)) else "  [INCOMPLETE: interrupted; re-run to resume]"))
         _solution_summary(ds)
     click.echo(f"written: {path}")
-    _figures(ds, path, st.figures(("map", "residuals", "solutions")), quiet)
+    _figures(ds, path, _wanted(st, ("map", "residuals", "solutions")), quiet)
 
 
 def _map_3d_summary(ds, elapsed: float) -> None:
@@ -703,6 +703,16 @@ def verify(result_path) -> None:
 #: The file suffix of each figure: a result STEM.zarr gets STEM_<suffix>.png beside it.
 _FIGURE_FILES = {"family": "orbits", "period": "period", "stability": "stability", "map": "contours", "residuals": "residuals",
                  "solutions": "solutions", "multipliers": "multipliers", "body_axes": "body_axes"}
+
+
+def _wanted(st, available: tuple[str, ...]) -> list[str]:
+    """The study's figures among this command's ``available``; says so when its output.figures
+    names none of them (a command never leaves its figures out silently)."""
+    names = st.figures(available)
+    if not names:
+        click.echo(f"figures: none drawn: output.figures = {list(st.output.figures)} names none of this command's "
+                   f"({', '.join(available)})", err=True)
+    return names
 
 
 def _figures(result, path: Path, names, quiet: bool, extra: dict | None = None) -> list[Path]:

@@ -169,6 +169,12 @@ def map_coords(olist, kzs, wz) -> dict:
     }
 
 
+def _common_family(olist) -> str:
+    """The family name the orbits share (a study's members, which come without their family), else ""."""
+    names = {getattr(o, "family", "") for o in olist}
+    return names.pop() if len(names) == 1 and "symmetric" not in names else ""
+
+
 def map_dataset(olist, family, kzs, wz, grid, done, *, phi0, n_periods, rtol, atol, srp, complete, attrs=None, solutions=None):
     """The map's Dataset: residual grids over (orbit, kz, wz0), coordinates with units and the
     parameters as attributes (shared by periodicity_map and run_map); ``solutions``: (orbit
@@ -195,7 +201,7 @@ def map_dataset(olist, family, kzs, wz, grid, done, *, phi0, n_periods, rtol, at
             "lu_km": olist[0].system.lu_km,
             "tu_s": olist[0].system.tu_s,
             "system_name": olist[0].system.name,
-            "family": family.kind if family is not None else "",
+            "family": family.kind if family is not None else _common_family(olist),
             "librate_version": __version__,
             "srp_eps": float(srp.eps) if srp is not None else 0.0,
             "srp_cs": float(srp.cs) if srp is not None else 0.0,

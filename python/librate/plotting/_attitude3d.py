@@ -122,8 +122,9 @@ def plot_family_multipliers(ds, ax=None, *, against: str = "period") -> Figure:
     Figure."""
     import ast
 
+    from matplotlib import colormaps
     from matplotlib.patches import Circle
-
+    from matplotlib.ticker import MaxNLocator
 
     if "multipliers" not in getattr(ds, "data_vars", {}) or "period_days" not in getattr(ds, "data_vars", {}):
         raise ValueError("invalid argument `ds`: must be the Dataset of librate.attitude_family_3d")
@@ -146,15 +147,25 @@ def plot_family_multipliers(ds, ax=None, *, against: str = "period") -> Figure:
     a.set_xlabel({"period": "orbit period (days)", "x0": "$x_0$ (LU)", "z0": "$z_0$ (LU)"}[against])
     a.set_ylabel("|Floquet multiplier|")
     moments = ds.attrs.get("body_moments")
-    a.set_title(f"body {moments}" if moments is not None else "")
-    colors = np.broadcast_to(np.arange(m.shape[0])[:, None], m.shape)
-    sc = b.scatter(m.real.ravel(), m.imag.ravel(), c=colors.ravel(), cmap="viridis", s=8)
+    if isinstance(moments, str):
+        moments = ast.literal_eval(moments)
+    body = "" if moments is None else ", body $I_x, I_y, I_z$ = " + ", ".join(f"{float(v):.4g}" for v in np.ravel(moments)) + " kg m$^2$"
+    a.set_title(f"|multiplier| of the {m.shape[1]}", fontsize="medium")
+    if ax is None:
+        fig.suptitle(f"Floquet multipliers along the 3-D attitude family{body}", fontsize="medium")
+    # one colour per member: integer steps on the colour bar (a member index has no fractions)
+    n_members = m.shape[0]
+    colors = np.broadcast_to(np.arange(n_members)[:, None], m.shape)
+    sc = b.scatter(m.real.ravel(), m.imag.ravel(), c=colors.ravel(), cmap=colormaps["viridis"].resampled(max(n_members, 1)),
+                   vmin=-0.5, vmax=n_members - 0.5, s=8)
     sc.set_gid("multipliers")
     b.add_patch(Circle((0, 0), 1.0, fill=False, color="k", linewidth=0.6))
     b.set_aspect("equal", adjustable="datalim")
     b.set_xlabel("Re")
     b.set_ylabel("Im")
-    fig.colorbar(sc, ax=b, label="member (along the family)")
+    cb = fig.colorbar(sc, ax=b, label="member index (along the family)")
+    cb.ax.yaxis.set_major_locator(MaxNLocator(integer=True))
+    b.set_title("the multipliers in the complex plane (unit circle)", fontsize="medium")
     return fig
 
 
@@ -231,6 +242,11 @@ def plot_map_3d(ds, ax=None, *, orbits=None) -> Figure:
         title = "" if i is None else f"orbit {i}"
         if i is not None and "period_days" in ds.coords:
             title += f": T = {float(ds['period_days'].values[i]):.3f} d"
-        a.set_title(f"{title}  min {float(np.nanmin(r.values)):.2e}".strip())
-        fig.colorbar(mesh, ax=a, label="log10 max |residual|")
+        a.set_title(f"{title}  smallest {float(np.nanmin(r.values)):.2e} (red star)".strip(), fontsize="medium")
+        fig.colorbar(mesh, ax=a, label="log10 max |residual| (closure after K periods)")
+    fixed = [d for d in ("wx0", "wy0", "wz0") if d not in rate_dims and d in ds.variables and ds[d].size == 1]
+    held = ", ".join(f"{d} = {float(ds[d].values):g} 1/TU" for d in fixed)
+    if ax is None:
+        fig.suptitle("3-D attitude map: the six closure residuals' max-norm over the initial rates" + (f" ({held})" if held else ""),
+                     fontsize="medium")
     return fig

@@ -20,6 +20,7 @@ from ._style import (
     check_index,
     check_map,
     draw_solutions,
+    family_name,
     figure_axes,
     kz_mask,
     n_color,
@@ -231,8 +232,7 @@ def plot_map(
     if legend:
         a.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=7.5, borderaxespad=0.0)
     if created:
-        fam = ds.attrs.get("family", "") or "orbit"
-        a.set_title(f"attitude periodicity map, {fam.upper() if fam == 'dro' else fam} family, $K_z$ = {kz_value:g}")
+        a.set_title(f"attitude periodicity map, {family_name(ds.attrs.get('family', ''))} family, $K_z$ = {kz_value:g}")
     return fig
 
 

@@ -12,7 +12,7 @@ import numpy as np
 from matplotlib.cm import ScalarMappable
 from matplotlib.colors import Normalize
 from matplotlib.lines import Line2D
-from matplotlib.ticker import FuncFormatter
+from matplotlib.ticker import FuncFormatter, MaxNLocator
 from matplotlib.transforms import blended_transform_factory
 
 from ..attitude.propagate import AttitudeTrajectory
@@ -28,6 +28,7 @@ from ._style import (
     PROJECTIONS,
     check_family,
     family_axis,
+    family_name,
     figure_axes,
     length_scale,
     level_crossings,
@@ -150,6 +151,8 @@ def plot_family(
             a.set_ylabel(f"y ({unit})")
             a.set_zlabel(f"z ({unit})")
             a.set_box_aspect(np.maximum(np.ptp(allp, axis=0), 1e-3 * np.ptp(allp)))
+            for axis in (a.xaxis, a.yaxis, a.zaxis):  # a few ticks: a narrow 3-D axis would print its labels over each other
+                axis.set_major_locator(MaxNLocator(4))
         else:
             a.set_xlabel(f"{proj[0]} ({unit})")
             a.set_ylabel(f"{proj[1]} ({unit})")
@@ -160,7 +163,7 @@ def plot_family(
         sm.set_array(np.asarray(values))
         fig.colorbar(sm, ax=axs, label=clabel, shrink=0.9)
     if created:
-        axs[0].set_title(f"{fam.kind} family, synodic frame ({len(sel)} of {len(fam)} members)")
+        axs[0].set_title(f"{family_name(fam.kind)} family, synodic frame ({len(sel)} of {len(fam)} members)")
     return fig
 
 
@@ -199,7 +202,7 @@ def plot_period(
     created = ax is None
     fig, (a,) = figure_axes(ax, 1, figsize=(7.0, 5.0))
     period = fam.period * tscale
-    (line,) = a.plot(x, period, color="k", linewidth=1.6, label=f"{fam.kind} period")
+    (line,) = a.plot(x, period, color="k", linewidth=1.6, label=f"{family_name(fam.kind)} period")
     line.set_gid("period")
     groups = [(k, 2 * math.pi / k, "synodic", "tab:red", "--", f"1:{k}") for k in res]
     groups += [(k, SUN_SYNODIC_PERIOD / k, "sun", "tab:orange", ":", f"1:{k} Sun") for k in sres]
@@ -236,7 +239,7 @@ def plot_period(
     a.grid(True, linewidth=0.3, alpha=0.5)
     a.legend(loc="best", fontsize=7.5)
     if created:
-        a.set_title(f"{fam.kind} family: period and resonances")
+        a.set_title(f"{family_name(fam.kind)} family: period and resonances")
     return fig
 
 
@@ -341,7 +344,7 @@ def plot_stability(
     a.grid(True, linewidth=0.3, alpha=0.5)
     a.legend(loc="best", fontsize=8)
     if created:
-        a.set_title(f"{fam.kind} family: stability indices")
+        a.set_title(f"{family_name(fam.kind)} family: stability indices")
     return fig
 
 

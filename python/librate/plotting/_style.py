@@ -43,6 +43,12 @@ def check_family(family) -> OrbitFamily:
     return family
 
 
+def family_name(kind: str) -> str:
+    """A family's kind as figure titles show it: the acronym DRO in capitals, other kinds as
+    named (``lyapunov-L1``, ``halo-L2-south``); an unnamed one is "orbit"."""
+    return "DRO" if kind == "dro" else (kind or "orbit")
+
+
 def figure_axes(ax, n: int, *, three_d: Sequence[bool] | None = None, figsize=None) -> tuple[Figure, list[Axes]]:
     """The figure and a list of ``n`` Axes: new ones (up to three per row, constrained layout)
     when ``ax`` is None, else the given Axes (one, or a sequence of ``n``)."""

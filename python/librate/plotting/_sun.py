@@ -19,7 +19,7 @@ from ..orbits.families import OrbitFamily
 from ..orbits.periodic import PeriodicOrbit
 from ..orbits.system import check_system
 from ..periodicity.srp_motions import sun_angle, sun_pointing_accelerations, sun_resonance
-from ._style import EARTH, LABEL_OFFSETS, MOON, SRP_COLOR, SUN_COLOR, check_family, draw_primaries, figure_axes, length_scale, time_scale
+from ._style import EARTH, LABEL_OFFSETS, MOON, SRP_COLOR, SUN_COLOR, check_family, draw_primaries, family_name, figure_axes, length_scale, time_scale
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -175,7 +175,7 @@ def plot_sun_resonant(
             missing.append(int(k))
     if not found:
         raise ValueError(f"invalid argument `ks`: no Sun-resonant member 1:K (T = Ts/K) for K in {tuple(ks)} lies in the "
-                         f"{fam.kind} family's period range [{fam.period_days.min():.2f}, {fam.period_days.max():.2f}] d")
+                         f"{family_name(fam.kind)} family's period range [{fam.period_days.min():.2f}, {fam.period_days.max():.2f}] d")
     created = ax is None
     fig, (a,) = figure_axes(ax, 1, figsize=(7.2, 6.2))
     cm = matplotlib.colormaps["viridis"]
@@ -217,7 +217,7 @@ def plot_sun_resonant(
     a.grid(True, linewidth=0.3, alpha=0.5)
     a.legend(loc="upper left", fontsize=7.5)
     if created:
-        a.set_title(f"Sun-resonant {fam.kind.upper() if fam.kind == 'dro' else fam.kind} orbits ($T = T_s/K$, $T_s$ = {SUN_SYNODIC_PERIOD * sys_.tu_days:.2f} d), synodic frame")
+        a.set_title(f"Sun-resonant {family_name(fam.kind)} orbits ($T = T_s/K$, $T_s$ = {SUN_SYNODIC_PERIOD * sys_.tu_days:.2f} d), synodic frame")
     return fig
 
 
