@@ -19,7 +19,19 @@ from ..orbits.families import OrbitFamily
 from ..orbits.periodic import PeriodicOrbit
 from ..orbits.system import check_system
 from ..periodicity.srp_motions import sun_angle, sun_pointing_accelerations, sun_resonance
-from ._style import EARTH, LABEL_OFFSETS, MOON, SRP_COLOR, SUN_COLOR, check_family, draw_primaries, family_name, figure_axes, length_scale, time_scale
+from ._style import (
+    EARTH,
+    LABEL_OFFSETS,
+    MOON,
+    SRP_COLOR,
+    SUN_COLOR,
+    check_family,
+    draw_primaries,
+    family_name,
+    figure_axes,
+    length_scale,
+    time_scale,
+)
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
