@@ -243,8 +243,9 @@ def propagate(
         Events to locate.
     t_eval : array_like, optional
         Output times (monotonic, inside the span) instead of every accepted step.
-    h0, h_min, h_max, max_steps, safety : float
-        Step control; ``fixed_step`` switches to fixed steps.
+    h0, h_min, h_max, max_steps, safety, fixed_step : float
+        Step control: the first, smallest and largest step, the step limit and the step
+        controller's safety factor; ``fixed_step`` switches to fixed steps of that size.
     collision : {"radius", "point", None}
         Reaching a primary stops the integration with `librate.CollisionError`: ``"radius"``
         (default): within the system's radius of either primary (``r1_km``, ``r2_km``; a primary

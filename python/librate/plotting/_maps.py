@@ -63,6 +63,39 @@ def plot_residuals(
     ``rate``: the horizontal axis, ``"relative"`` (default: phidot(0) = wz(0) - 1, relative to
     the synodic frame, what the thesis figures plot under the label wz(0)) or ``"inertial"``
     (wz(0)); the axis label says which. Returns the Figure.
+
+    Parameters
+    ----------
+    orbit_or_ds : xarray.Dataset or PeriodicOrbit
+        A map of `librate.periodicity_map`, or a planar orbit (then ``kz`` and ``wz0`` are needed).
+    kz : float, optional
+        The Kz (of the map, or to compute).
+    wz0 : array_like, optional
+        With an orbit: the inertial initial rates, increasing.
+    orbit_index : int, optional
+        The orbit of a map holding several.
+    phi0 : float, default 0.0
+        With an orbit: the initial angle.
+    rate : {"relative", "inertial"}
+        The horizontal axis.
+    solutions : bool, default True
+        Mark the refined solutions.
+    kinds : sequence of {"periodic", "half-turn"}
+        The solutions marked.
+    annotate : bool, default True
+        Label them "N = ...".
+    ax : matplotlib Axes or sequence of Axes, optional
+        Draw into these (one per panel); default a new Figure.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure.
+
+    Raises
+    ------
+    ValueError
+        A bad argument, naming it and the allowed values.
     """
     offset, xlabel = rate_axis(rate)
     kinds = check_kinds(kinds)
@@ -197,6 +230,37 @@ def plot_map(
     markers are the refined solutions, exact whatever the grid. ``against``: the orbit axis, ``"period"`` (days, default)
     or ``"x0"``. ``rate``: the rate axis, ``"relative"`` (phidot(0) = wz(0) - 1, default, the
     thesis convention) or ``"inertial"`` (wz(0)). Returns the Figure.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A map of `librate.periodicity_map` with at least 2 orbits.
+    kz_index : int, default 0
+        The Kz drawn.
+    against : {"period", "x0"}
+        The orbit axis.
+    rate : {"relative", "inertial"}
+        The rate axis.
+    solutions : bool, default True
+        Mark the refined solutions.
+    kinds : sequence of {"periodic", "half-turn"}
+        The solutions marked.
+    half_turn_contours : bool, optional
+        Add the contours Dphi = pi (default: when half-turns are marked).
+    legend : bool, default True
+        Draw the legend.
+    ax : matplotlib Axes or sequence of Axes, optional
+        Draw into these (one per panel); default a new Figure.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure.
+
+    Raises
+    ------
+    ValueError
+        A bad argument, naming it and the allowed values.
     """
     ds = check_map(ds)
     j = check_index(kz_index, ds.sizes["kz"], "kz_index")
