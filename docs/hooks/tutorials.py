@@ -72,7 +72,8 @@ def execute(script: Path) -> nbformat.NotebookNode:
         work = Path(tmp)
         setup = nbformat.v4.new_code_cell(SETUP.format(script=script.name))
         nb.cells.insert(0, setup)
-        client = NotebookClient(nb, timeout=TIMEOUT_S, kernel_name="python3", resources={"metadata": {"path": str(work)}})
+        client = NotebookClient(nb, timeout=TIMEOUT_S, kernel_name="python3", resources={"metadata": {"path": str(work)}},
+                                extra_arguments=["--IPKernelApp.log_level=ERROR"])  # no kernel banner in the build log
         seen: set[Path] = set()
         with client.setup_kernel():
             for index, cell in enumerate(nb.cells):
