@@ -92,6 +92,7 @@ def execute(script: Path) -> nbformat.NotebookNode:
     for index, cell in enumerate(nb.cells):  # the notebook numbers its cells as if it had run alone
         if cell.cell_type == "code":
             cell.execution_count = index
+    nbformat.validate(nb)  # the downloadable notebook opens in Jupyter as it is
     return nb
 
 
