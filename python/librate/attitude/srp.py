@@ -40,7 +40,7 @@ class Sun:
 
     See Also
     --------
-    Sun.at_epoch : the Sun's phase at a calendar epoch.
+    - [`Sun.at_epoch`][librate.attitude.srp.Sun.at_epoch]: the Sun's phase at a calendar epoch.
     """
 
     theta0: float = 0.0
@@ -153,7 +153,8 @@ class FacetBody(RigidBody):
 
     See Also
     --------
-    FacetBody.flat_plate, FacetBody.two_sided_panel, FacetBody.box_with_arrays : ready-made surfaces.
+    - [`FacetBody.flat_plate`][librate.attitude.srp.FacetBody.flat_plate], [`FacetBody.two_sided_panel`][librate.attitude.srp.FacetBody.two_sided_panel],
+      [`FacetBody.box_with_arrays`][librate.attitude.srp.FacetBody.box_with_arrays]: ready-made surfaces.
     """
 
     facets: tuple = field(default=())
@@ -227,7 +228,7 @@ class FlatPlate:
 
     See Also
     --------
-    FlatPlate.from_geometry : eps from the plate's area, offset and the body's Iz.
+    - [`FlatPlate.from_geometry`][librate.attitude.srp.FlatPlate.from_geometry]: eps from the plate's area, offset and the body's Iz.
 
     Examples
     --------

@@ -105,7 +105,7 @@ def synodic_to_eci(system: System | str, t, states, theta0: float = 0.0) -> np.n
 
     See Also
     --------
-    eci_to_synodic : the inverse.
+    - [`eci_to_synodic`][librate.orbits.frames.eci_to_synodic]: the inverse.
     """
     sys_ = resolve_system(system)
     ta, s, single = _times_states(t, states)

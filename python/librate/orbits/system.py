@@ -41,7 +41,7 @@ class System:
 
     See Also
     --------
-    System.preset : the named systems (``System.presets()`` lists them).
+    - [`System.preset`][librate.orbits.system.System.preset]: the named systems (``System.presets()`` lists them).
 
     Examples
     --------
