@@ -153,7 +153,8 @@ class FacetBody(RigidBody):
 
     See Also
     --------
-    - [`FacetBody.flat_plate`][librate.attitude.srp.FacetBody.flat_plate], [`FacetBody.two_sided_panel`][librate.attitude.srp.FacetBody.two_sided_panel],
+    - [`FacetBody.flat_plate`][librate.attitude.srp.FacetBody.flat_plate],
+      [`FacetBody.two_sided_panel`][librate.attitude.srp.FacetBody.two_sided_panel],
       [`FacetBody.box_with_arrays`][librate.attitude.srp.FacetBody.box_with_arrays]: ready-made surfaces.
     """
 

@@ -134,7 +134,8 @@ def periodic_attitude(
     See Also
     --------
     - [`find_periodic_attitudes`][librate.periodicity.solutions.find_periodic_attitudes]: every solution in a window of rates.
-    - [`attitude_family`][librate.periodicity.attitude_families.attitude_family]: the solution followed along an orbit family, through folds.
+    - [`attitude_family`][librate.periodicity.attitude_families.attitude_family]: the solution followed along an
+      orbit family, through folds.
 
     Examples
     --------

@@ -251,7 +251,8 @@ def attitude_map_3d(orbit: PeriodicOrbit, body, *, wx0, wy0, wz0, q0=None, n_per
 
     See Also
     --------
-    - [`find_periodic_attitudes_3d`][librate.periodicity.map3d.find_periodic_attitudes_3d]: periodic motions seeded from the map's near-zeros.
+    - [`find_periodic_attitudes_3d`][librate.periodicity.map3d.find_periodic_attitudes_3d]: periodic motions
+      seeded from the map's near-zeros.
     """
     progress = as_progress(progress, "3-D map", "case")
     n_periods, tol = _check(orbit, n_periods, tol)

@@ -279,7 +279,8 @@ def plot_sun_resonant(
     a.grid(True, linewidth=0.3, alpha=0.5)
     a.legend(loc="upper left", fontsize=7.5)
     if created:
-        a.set_title(f"Sun-resonant {family_name(fam.kind)} orbits ($T = T_s/K$, $T_s$ = {SUN_SYNODIC_PERIOD * sys_.tu_days:.2f} d), synodic frame")
+        ts_days = SUN_SYNODIC_PERIOD * sys_.tu_days
+        a.set_title(f"Sun-resonant {family_name(fam.kind)} orbits ($T = T_s/K$, $T_s$ = {ts_days:.2f} d), synodic frame")
     return fig
 
 
