@@ -373,7 +373,7 @@ def family(study, kind, point, branch, x0, members, system_name, fmt, sets, out_
     for b in fam.bifurcations:
         _echo(quiet, f"  bifurcation: {b['index']} index, {b['type']}, near x0 = {b['x0']:.6g}")
     click.echo(f"written: {path}")
-    _figures(fam, path, st.figures(("family", "period", "stability")), quiet)
+    _figures(fam, path, _wanted(st, ("family", "period", "stability")), quiet)
 
 
 def _quote(v):
@@ -435,14 +435,14 @@ def solve(study, sets, out_dir, resume, quiet) -> None:
         if not quiet:
             _lines(solve_3d_summary(ds, el))
         click.echo(f"written: {path}")
-        _figures(ds, path, st.figures(("multipliers", "body_axes")), quiet)
+        _figures(ds, path, _wanted(st, ("multipliers", "body_axes")), quiet)
         return
     n = ds.sizes["solution"]
     _echo(quiet, f"{n} periodic solution(s) over {ds.sizes['orbit']} orbit(s) x {ds.sizes['kz']} Kz ({el:.2f} s)")
     if n and not quiet:
         _lines(solutions_table(ds))
     click.echo(f"written: {path}")
-    _figures(ds, path, st.figures(("solutions",)), quiet)
+    _figures(ds, path, _wanted(st, ("solutions",)), quiet)
 
 
 @main.command(name="map", context_settings=_CONTEXT, short_help="The attitude periodicity map of a study (thesis Fig. 24).")
@@ -491,7 +491,7 @@ def map_(study, out_dir, quiet, scheduler, resume, sets) -> None:
         if not quiet:
             _lines(map_3d_summary(ds, el))
         click.echo(f"written: {path}")
-        _figures(ds, path, st.figures(("map",)), quiet)
+        _figures(ds, path, _wanted(st, ("map",)), quiet)
         return
     if not quiet:
         no, nk, nw = ds.sizes["orbit"], ds.sizes["kz"], ds.sizes["wz0"]
@@ -499,7 +499,7 @@ def map_(study, out_dir, quiet, scheduler, resume, sets) -> None:
                    + ("" if int(ds.attrs.get("complete", 1)) else "  [INCOMPLETE: interrupted; re-run to resume]"))
         _lines(map_solutions_summary(ds))
     click.echo(f"written: {path}")
-    _figures(ds, path, st.figures(("map", "residuals", "solutions")), quiet)
+    _figures(ds, path, _wanted(st, ("map", "residuals", "solutions")), quiet)
 
 
 @main.command(context_settings=_CONTEXT, short_help="Re-draw the figures of any saved result, without recomputing.")
@@ -579,6 +579,24 @@ def verify(result_path) -> None:
         sys.exit(1)
 
 
+<<<<<<< HEAD
+=======
+#: The file suffix of each figure: a result STEM.zarr gets STEM_<suffix>.png beside it.
+_FIGURE_FILES = {"family": "orbits", "period": "period", "stability": "stability", "map": "contours", "residuals": "residuals",
+                 "solutions": "solutions", "multipliers": "multipliers", "body_axes": "body_axes"}
+
+
+def _wanted(st, available: tuple[str, ...]) -> list[str]:
+    """The study's figures among this command's ``available``; says so when its output.figures
+    names none of them (a command never leaves its figures out silently)."""
+    names = st.figures(available)
+    if not names:
+        click.echo(f"figures: none drawn: output.figures = {list(st.output.figures)} names none of this command's "
+                   f"({', '.join(available)})", err=True)
+    return names
+
+
+>>>>>>> docs
 def _figures(result, path: Path, names, quiet: bool, extra: dict | None = None) -> list[Path]:
     """Draw the figures of the result saved at ``path`` beside it (:func:`librate.app.commands.draw_figures`)."""
     from .commands import draw_figures

@@ -18,6 +18,7 @@ from ._style import (
     check_index,
     check_map,
     draw_solutions,
+    family_name,
     figure_axes,
     kz_mask,
     n_color,
@@ -57,6 +58,35 @@ def plot_residuals(
     ``"relative"`` (default: phidot(0) = wz(0) - 1, relative to the synodic frame, what the thesis
     figures plot under the label wz(0)) or ``"inertial"`` (wz(0)); the axis label says which.
     Returns the Figure.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A map of `librate.periodicity_map`.
+    ax : matplotlib Axes or sequence of Axes, optional
+        Draw into these (one per panel); default a new Figure.
+    kz : float, optional
+        The Kz value, when the map holds several.
+    orbit_index : int, optional
+        The orbit, when the map holds several.
+    rate : {"relative", "inertial"}
+        The horizontal axis.
+    solutions : bool, default True
+        Mark the refined solutions.
+    kinds : sequence of {"periodic", "half-turn"}
+        The solutions marked.
+    annotate : bool, default True
+        Label them "N = ...".
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure.
+
+    Raises
+    ------
+    ValueError
+        A bad argument, naming it and the allowed values.
     """
     offset, xlabel = rate_axis(rate)
     kinds = check_kinds(kinds)
@@ -179,6 +209,37 @@ def plot_map(
     markers are the refined solutions, exact whatever the grid. ``against``: the orbit axis, ``"period"`` (days, default)
     or ``"x0"``. ``rate``: the rate axis, ``"relative"`` (phidot(0) = wz(0) - 1, default, the
     thesis convention) or ``"inertial"`` (wz(0)). Returns the Figure.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A map of `librate.periodicity_map` with at least 2 orbits.
+    kz_index : int, default 0
+        The Kz drawn.
+    against : {"period", "x0"}
+        The orbit axis.
+    rate : {"relative", "inertial"}
+        The rate axis.
+    solutions : bool, default True
+        Mark the refined solutions.
+    kinds : sequence of {"periodic", "half-turn"}
+        The solutions marked.
+    half_turn_contours : bool, optional
+        Add the contours Dphi = pi (default: when half-turns are marked).
+    legend : bool, default True
+        Draw the legend.
+    ax : matplotlib Axes or sequence of Axes, optional
+        Draw into these (one per panel); default a new Figure.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure.
+
+    Raises
+    ------
+    ValueError
+        A bad argument, naming it and the allowed values.
     """
     ds = check_map(ds)
     j = check_index(kz_index, ds.sizes["kz"], "kz_index")
@@ -214,8 +275,7 @@ def plot_map(
     if legend:
         a.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=7.5, borderaxespad=0.0)
     if created:
-        fam = ds.attrs.get("family", "") or "orbit"
-        a.set_title(f"attitude periodicity map, {fam.upper() if fam == 'dro' else fam} family, $K_z$ = {kz_value:g}")
+        a.set_title(f"attitude periodicity map, {family_name(ds.attrs.get('family', ''))} family, $K_z$ = {kz_value:g}")
     return fig
 
 

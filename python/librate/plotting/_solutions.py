@@ -69,6 +69,37 @@ def plot_solution_families(
     single panel. ``against``: ``"period"`` (days) or ``"x0"``;
     ``rate``: ``"relative"`` (phidot(0) = wz(0) - 1, default) or ``"inertial"``. Returns the
     Figure.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A map of `librate.periodicity_map` with solutions.
+    n : int or iterable of int, optional
+        The N shown (default all).
+    kinds : sequence of {"periodic", "half-turn"}
+        The closures shown.
+    against : {"period", "x0"}
+        The horizontal axis.
+    rate : {"relative", "inertial"}
+        The vertical axis.
+    separate : bool, default True
+        One panel per (kind, N).
+    stability : bool, default True
+        Overdraw the linearly stable solutions, filled.
+    max_jump : float, optional
+        The largest rate step (1/TU) between consecutive orbits within a branch.
+    ax : matplotlib Axes or sequence of Axes, optional
+        Draw into these (one per panel); default a new Figure.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure.
+
+    Raises
+    ------
+    ValueError
+        A bad argument, naming it and the allowed values.
     """
     ds = check_map(ds)
     tab = solution_table(ds)
@@ -199,6 +230,31 @@ def plot_attitude_motion(
     synodic X axis (unwrapped, in degrees unless ``degrees=False``): a periodic motion reaches
     phi0 + 360 N deg after each period. ``rate``: ``"relative"`` (phidot = wz - 1, relative to
     the synodic frame, default) or ``"inertial"`` (wz). ``ax``: two Axes. Returns the Figure.
+
+    Parameters
+    ----------
+    solutions : AttitudeSolution or list of AttitudeSolution
+        The motions.
+    n_periods : float, default 1
+        Orbit periods drawn.
+    rate : {"relative", "inertial"}
+        phidot = wz - 1, or wz.
+    degrees : bool, default True
+        Angles in degrees.
+    samples : int, default 400
+        Points per period.
+    ax : matplotlib Axes or sequence of Axes, optional
+        Draw into these (one per panel); default a new Figure.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure.
+
+    Raises
+    ------
+    ValueError
+        A bad argument, naming it and the allowed values.
     """
     offset, ylabel = rate_axis(rate, initial=False)
     sols = [solutions] if isinstance(solutions, AttitudeSolution) else solutions
