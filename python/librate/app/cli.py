@@ -579,13 +579,6 @@ def verify(result_path) -> None:
         sys.exit(1)
 
 
-<<<<<<< HEAD
-=======
-#: The file suffix of each figure: a result STEM.zarr gets STEM_<suffix>.png beside it.
-_FIGURE_FILES = {"family": "orbits", "period": "period", "stability": "stability", "map": "contours", "residuals": "residuals",
-                 "solutions": "solutions", "multipliers": "multipliers", "body_axes": "body_axes"}
-
-
 def _wanted(st, available: tuple[str, ...]) -> list[str]:
     """The study's figures among this command's ``available``; says so when its output.figures
     names none of them (a command never leaves its figures out silently)."""
@@ -596,7 +589,6 @@ def _wanted(st, available: tuple[str, ...]) -> list[str]:
     return names
 
 
->>>>>>> docs
 def _figures(result, path: Path, names, quiet: bool, extra: dict | None = None) -> list[Path]:
     """Draw the figures of the result saved at ``path`` beside it (:func:`librate.app.commands.draw_figures`)."""
     from .commands import draw_figures
