@@ -426,6 +426,16 @@ def _fingerprint_3d(olist, grid, n_periods: int, tol: float) -> str:
     return h.hexdigest()
 
 
+def _orbit_map_3d(orbit, body, rates: dict, q0, n_periods: int, tol: float, names: tuple) -> dict:
+    """One orbit's part of a 3-D map (the unit of work, picklable for Dask): its arrays ``names``."""
+    from ..periodicity.map3d import attitude_map_3d
+
+    ds = attitude_map_3d(orbit, body, wx0=rates["wx0"], wy0=rates["wy0"], wz0=rates["wz0"], q0=q0, n_periods=n_periods, tol=tol)
+    if int(ds.attrs.get("complete", 0)) != 1:
+        raise KeyboardInterrupt(f"in the orbit of x0 = {orbit.state0[0]:.6g} LU")
+    return {k: np.asarray(ds[k].values) for k in names}
+
+
 def run_map_3d_to(orbits, store: str | Path, *, body, rates: dict, q0, n_periods: int = 1, tol: float = 1e-12, resume: bool = True,
                   scheduler=None, progress: bool | None = None, attrs: dict[str, Any] | None = None):
     """The 3-D attitude map of a ``[attitude] model = "3d"`` study, written to ``store`` (a
@@ -440,19 +450,22 @@ def run_map_3d_to(orbits, store: str | Path, *, body, rates: dict, q0, n_periods
     the orbit in flight, and the same call again reuses the finished orbits (a damaged one is
     named in a warning and recomputed). An existing ``store`` of the same study is reused; of
     another study it is refused unless ``resume`` is False: then the new map is computed
-    aside and replaces the old one only once complete. Returns ``(dataset, store_path)``."""
+    aside and replaces the old one only once complete. Returns ``(dataset, store_path)``.
+
+    ``scheduler``: None (this process, all cores), a Dask ``distributed.Client`` or its address:
+    each orbit is one task (:func:`librate.app.distribute.run_tasks`: checksummed on arrival,
+    written by the worker itself where it shares the store's filesystem, resubmitted when lost
+    with its worker); the map equals the local one bit for bit."""
     import warnings
 
-    from ..periodicity import map3d as m3
     from ..periodicity.map3d import COMPONENTS, map3d_dataset, map3d_grid
     from ..periodicity.maps import orbits_of
     from ..results.atomic import clean_orphans, remove_path, replace_path, temporary_sibling
     from ..results.kinds import map3d_schema
     from ..results.store import PartStore
+    from .distribute import ArrivalError, Region, Task, run_tasks
     from .progress import bar as progress_bar
 
-    if scheduler is not None:
-        raise ValueError("invalid argument `scheduler`: 3-D maps run in this process (all cores); a Dask scheduler is for planar maps")
     store = Path(store)
     attrs = dict(attrs or {})
     study = attrs.get("study")
@@ -484,16 +497,24 @@ def run_map_3d_to(orbits, store: str | Path, *, body, rates: dict, q0, n_periods
             warnings.warn(f"{parts}: {len(damaged)} damaged orbit(s) are recomputed: "
                           + "; ".join(f"orbit {i}: {why}" for i, why in sorted(damaged.items())), RuntimeWarning, stacklevel=2)
         done = pstore.done_flags(damaged)
+        todo = [Task(i, _orbit_map_3d, (orbit, body, rates, q0, n_periods, tol, tuple(schema.variables)))
+                for i, orbit in enumerate(olist) if not done[i]]
+
+        def commit(i, part):
+            pstore.write_part(i, part)
+            done[i] = True
+
+        def commit_written(i, sums):
+            if not pstore.commit_written(i, sums):
+                raise ArrivalError(f"orbit {i}: the region written by a worker does not match its digests")
+            done[i] = True
+
         with progress_bar(len(olist), "3-D attitude map", "orbit", progress, initial=int(done.sum())) as bar:
-            for i, orbit in enumerate(olist):
-                if done[i]:
-                    continue
-                ds_i = m3.attitude_map_3d(orbit, body, wx0=rates["wx0"], wy0=rates["wy0"], wz0=rates["wz0"], q0=q0, n_periods=n_periods, tol=tol)
-                if int(ds_i.attrs.get("complete", 0)) != 1:  # interrupted: the finished orbits are kept
-                    raise KeyboardInterrupt(f"3-D map interrupted in orbit {i}; {int(done.sum())} finished orbit(s) kept in {parts}")
-                pstore.write_part(i, {k: ds_i[k].values for k in schema.variables})
-                done[i] = True
-                bar.update(1)
+            try:
+                run_tasks(todo, commit, scheduler=scheduler, bar=bar, region=None if scheduler is None else Region.of(pstore, lock),
+                          commit_written=commit_written)
+            except KeyboardInterrupt as err:  # the finished orbits are kept
+                raise KeyboardInterrupt(f"3-D map interrupted ({err}); {int(done.sum())} finished orbit(s) kept in {parts}") from None
         shared = ("mu", "lu_km", "tu_s", "system_name", "n_periods", "tol", "q0", "simd_level", "librate_version")  # the same for every orbit
         final = {k: tpl.attrs[k] for k in shared if k in tpl.attrs}
         final.update({"librate_result": "map_3d", **attrs, "title": "librate 3-D attitude map"})
