@@ -135,6 +135,36 @@ def test_a_region_is_written_only_where_the_writers_record_is_seen(tmp_path):
     assert not Region(str(tmp_path / "map.zarr"), {}, str(tmp_path / "absent"), "pid 1 on here").visible()
 
 
+def _part(i):
+    return {"x": np.arange(4.0) + i}
+
+
+def test_a_written_region_that_does_not_check_out_is_computed_again_and_sent_whole(cluster, tmp_path):
+    """Workers that see the writer's record write their regions (reference: the values read back
+    from the store); a region the client refuses (ArrivalError) is computed again and arrives
+    as data instead, committed once."""
+    import zarr
+    from librate.app.distribute import ArrivalError
+
+    _, client = cluster
+    g = zarr.open_group(str(tmp_path / "s.zarr"), mode="w", zarr_format=2)
+    g.create_array("x", shape=(3, 4), chunks=(1, 4), dtype="f8", fill_value=np.nan)
+    owner = tmp_path / ".s.zarr.lock.owner"
+    owner.write_text("pid 1 on here")
+    region = Region(str(tmp_path / "s.zarr"), {"x": "f8"}, str(owner), "pid 1 on here")
+    refused, values = [], {}
+
+    def commit_written(k, sums):
+        refused.append(k)
+        raise ArrivalError(f"part {k} refused")
+
+    run_tasks([Task(i, _part, (i,)) for i in range(3)], values.__setitem__, scheduler=client, region=region, commit_written=commit_written)
+    assert sorted(refused) == [0, 1, 2] and sorted(values) == [0, 1, 2]
+    for i in range(3):
+        np.testing.assert_array_equal(values[i]["x"], np.arange(4.0) + i)
+        np.testing.assert_array_equal(g["x"][i], np.arange(4.0) + i)  # what the worker wrote
+
+
 # --- SIGKILL of a worker mid-run: planar map, 3-D map, solve ---------------------------------------
 def _count_written(monkeypatch) -> list:
     """Record the parts committed from a worker's own region write (client side)."""
