@@ -202,7 +202,11 @@ def test_planar_map_survives_a_killed_worker_bit_identically(cluster, fam, tmp_p
         assert written == []
 
 
-def test_3d_map_survives_a_killed_worker_bit_identically(cluster, fam, tmp_path, monkeypatch):
+@pytest.mark.parametrize("chunk_cases", ["auto", 16], ids=["task-per-orbit", "task-per-chunk"])
+def test_3d_map_survives_a_killed_worker_bit_identically(cluster, fam, tmp_path, monkeypatch, chunk_cases):
+    """Per orbit (8 orbits of 80 cases: "auto" keeps one task each, written by the workers) and
+    per chunk of 16 cases (5 tasks an orbit, gathered, each orbit committed whole): both equal
+    the local map, computed one orbit at a time, bit for bit."""
     from librate.app.results import run_map_3d_to
     from librate.results.store import verify_store
 
@@ -210,12 +214,26 @@ def test_3d_map_survives_a_killed_worker_bit_identically(cluster, fam, tmp_path,
     _wait_workers(client)
     written = _count_written(monkeypatch)
     kw = dict(body=BODY, rates=RATES_3D, q0=[0.0, 0.0, 0.0, 1.0], tol=1e-10, progress=False)
-    with Killer(client, len(X0)) as k:
-        ds, path = run_map_3d_to(fam, tmp_path / "d" / "map.zarr", scheduler=client, **kw)
+    with Killer(client, len(X0) * (1 if chunk_cases == "auto" else 5)) as k:
+        ds, path = run_map_3d_to(fam, tmp_path / "d" / "map.zarr", scheduler=client, chunk_cases=chunk_cases, **kw)
     assert k.killed is not None, "no worker was killed mid-run"
-    assert verify_store(path).ok and sorted(i for i, ok in written if ok) == list(range(len(X0)))
+    assert verify_store(path).ok
+    assert sorted(i for i, ok in written if ok) == (list(range(len(X0))) if chunk_cases == "auto" else [])
     ref, _ = run_map_3d_to(fam, tmp_path / "l" / "map.zarr", **kw)
     _same_map(ds, ref, ("residual", "residual_norm", "status"))
+
+
+def test_3d_map_chunks_locally_give_the_same_bits(fam, tmp_path):
+    """A count of cases per task applies locally too (rounded up to the 8 lanes: 20 -> 24);
+    reference: the map of one task per orbit (exact equality)."""
+    from librate.app.results import run_map_3d_to
+
+    kw = dict(body=BODY, rates=RATES_3D, q0=[0.0, 0.0, 0.0, 1.0], tol=1e-10, progress=False)
+    a, _ = run_map_3d_to(list(fam)[:2], tmp_path / "a.zarr", chunk_cases=20, **kw)
+    b, _ = run_map_3d_to(list(fam)[:2], tmp_path / "b.zarr", chunk_cases=None, **kw)
+    _same_map(a, b, ("residual", "residual_norm", "status"))
+    with pytest.raises(ValueError, match="`chunk_cases`"):
+        run_map_3d_to(list(fam)[:2], tmp_path / "c.zarr", chunk_cases=0, **kw)
 
 
 @pytest.fixture(scope="module")
