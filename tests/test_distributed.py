@@ -270,6 +270,7 @@ def test_solve_3d_refuses_a_scheduler(tmp_path):
 
 
 # --- every worker restarted, and a scheduler gone for good ------------------------------------------
+@pytest.mark.slow
 def test_a_restart_of_every_worker_loses_no_finished_part(cluster, fam, tmp_path):
     """client.restart() mid-run cancels every task in flight (lost tasks): they are submitted
     again, and the store equals the local map bit for bit."""
@@ -297,6 +298,7 @@ def test_a_restart_of_every_worker_loses_no_finished_part(cluster, fam, tmp_path
     _same_map(ds, run_map(fam, kz=KZ, wz0=WZ, progress=False), ("dwz", "dphi", "phi_T", "status"))
 
 
+@pytest.mark.slow
 def test_a_scheduler_gone_for_good_stops_the_run_and_the_same_call_resumes(fam, tmp_path):
     """The cluster (scheduler and workers) closed mid-run: the run stops with an error saying
     the finished rows are kept; the same call on a new cluster computes only the rest, and the
