@@ -8,7 +8,10 @@ Fails (exit 1, listing page and excerpt) when any HTML page
 - loads a script or stylesheet from another host (a CDN): the site must work without network;
 - shows a raw Sphinx role (``:func:``, ``:class:``, ``:meth:``...).
 It also requires that the pages with math (physics.md ...) hold MathML (``<math``), at least as
-many formulas as the Markdown sources mark, so a formula cannot vanish silently.
+many formulas as the Markdown sources mark, so a formula cannot vanish silently, and that every
+example ran into its tutorial page (docs/hooks/tutorials.py): the page exists, shows the examples'
+last printed line ("written: ...") and at least one figure whose PNG is in the site, and its
+executed notebook is there.
 """
 
 from __future__ import annotations
@@ -34,6 +37,26 @@ SOURCE_MATH = re.compile(r"\\\((.+?)\\\)|\\\[(.+?)\\\]|\$\$(.+?)\$\$", re.S)
 def strip_code(html: str) -> str:
     """The page without <pre>/<code> blocks (code may show TeX or roles on purpose)."""
     return re.sub(r"<(pre|code)\b.*?</\1>", "", html, flags=re.S)
+
+
+def check_tutorials(site: Path) -> list[str]:
+    """Every numbered example is an executed tutorial page with its output, figures and notebook."""
+    problems = []
+    for script in sorted((ROOT / "examples").glob("[0-9][0-9]_*.py")):
+        page = site / "tutorials" / script.stem / "index.html"
+        if not page.is_file():
+            problems.append(f"{page.relative_to(site)}: no tutorial page for examples/{script.name}")
+            continue
+        text = page.read_text(encoding="utf-8")
+        images = re.findall(r'<img[^>]+src="([^"]+\.png)"', text)
+        missing = [src for src in images if not (page.parent / src).resolve().is_file()]
+        if not images or missing:
+            problems.append(f"{page.relative_to(site)}: figures {images}, missing {missing}")
+        if "written: " not in text:
+            problems.append(f"{page.relative_to(site)}: no 'written: ...' line (every example prints it last): did it run?")
+        if not (site / "tutorials" / f"{script.stem}.ipynb").is_file():
+            problems.append(f"tutorials/{script.stem}.ipynb: missing")
+    return problems
 
 
 def main(site: Path) -> int:
@@ -62,6 +85,7 @@ def main(site: Path) -> int:
             problems.append(f"{html_path.relative_to(site)}: {found} MathML formulas, the source marks {expected}")
     if not n_math:
         problems.append("no MathML formula anywhere in the site")
+    problems += check_tutorials(site)
     for p in problems:
         print(p, file=sys.stderr)
     print(f"site check: {len(pages)} pages, {n_math} MathML formulas, {len(problems)} problem(s)")

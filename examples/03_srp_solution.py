@@ -9,6 +9,7 @@ the flat-plate amplitude eps up to 0.02 (cs = 0.4 specular), the initial angle p
 corrected together (the mirror symmetry is broken). The figure compares the two motions.
 """
 
+# %%
 import sys
 from pathlib import Path
 
@@ -21,6 +22,10 @@ em = librate.System.preset("earth-moon")
 orbit = librate.dro_family(em).resonant(2, "sun")
 print(f"1:2 Sun-resonant DRO: x0 = {orbit.x0:.6f} LU, T = {orbit.period_days:.3f} d")
 
+# %% [markdown]
+# ## The gravity-gradient solution, then continuation in the SRP amplitude
+
+# %%
 gravity = librate.periodic_attitude(orbit, kz=0.8, n=-1, n_periods=2)
 print(f"gravity gradient only: wz0 = {gravity.wz0:.8f} 1/TU, phi0 = {gravity.phi0:.3g} rad, residual {gravity.residual:.1e}")
 
@@ -31,6 +36,10 @@ print(f"continued to eps = {path.eps[-1]:g} in {len(path.eps) - 1} steps ({path.
 print(f"with SRP: wz0 = {srp.wz0:.8f} 1/TU, phi0 = {srp.phi0:.6f} rad, residual {srp.residual:.1e}, "
       f"{'stable' if srp.stable else 'unstable'} (trace {srp.trace:.4f})")
 
+# %% [markdown]
+# ## The two motions compared
+
+# %%
 # The legend tells the gravity-only motion (dashed) from the SRP one (red, with its eps).
 lp.save_figure(lp.plot_srp_comparison(gravity, srp), out / "srp_motion.png", close=True)
 print(f"written: {out}/srp_motion.png")

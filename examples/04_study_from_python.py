@@ -6,6 +6,7 @@ Equivalent to `librate map study.toml` then `librate plot OUTPUT/map.zarr`. An i
 raises librate.StudyError listing every problem (key, value, what is allowed) before any work.
 """
 
+# %%
 import sys
 from pathlib import Path
 
@@ -30,11 +31,19 @@ phidot0 = { start = -3.0, stop = 1.0, num = 120 }   # relative to the synodic fr
 folder = "."                    # next to this file
 ''')
 
+# %% [markdown]
+# ## An invalid study is refused before any work, with every problem listed
+
+# %%
 try:
     librate.Study.from_dict({"body": {"kz": 1.5}, "rates": {"wz0": [2.0, 1.0]}}, purpose="map")
 except librate.StudyError as err:
     print(err)  # body.kz = 1.5 ... rates.wz0 = [2.0, 1.0] ...
 
+# %% [markdown]
+# ## The study run, its result reloaded, and its figure
+
+# %%
 study = librate.Study.from_toml(toml, purpose="map")
 ds, path = run_map(study)
 print(f"map: {dict(ds.sizes)}, written to {path}")

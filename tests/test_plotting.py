@@ -393,11 +393,12 @@ def test_plot_residuals_fig23(dro1266, map_rates, tmp_path):
     """Thesis Fig. 23 on the 12.66-day DRO, Kz = 0.8, phidot0 in [-3.5, 1.5]: the curves carry
     the map's Dwz and Dphi against phidot0 = wz0 - 1 (the Dphi line broken by NaNs at the +-pi
     wrap: no segment jumps by more than pi); the solution markers sit at (phidot0, 0) of the
-    map's solutions, filled exactly for the stable ones, the N = -1 one at -2.4545."""
-    fig = lp.plot_residuals(dro1266, kz=0.8, wz0=map_rates)
+    map's solutions, filled exactly for the stable ones, the N = -1 one at -2.4545. The figure
+    takes the data: the map of the one orbit is computed first."""
+    ds = librate.periodicity_map(dro1266, kz=0.8, wz0=map_rates)
+    fig = lp.plot_residuals(ds)
     assert_png(fig, tmp_path / "fig23.png")
     ax = fig.axes[0]
-    ds = librate.periodicity_map(dro1266, kz=0.8, wz0=map_rates)
     (hw,) = gid(ax, "residual-dwz")
     np.testing.assert_array_equal(hw.get_xdata(), ds.phidot0.values)
     np.testing.assert_array_equal(hw.get_ydata(), ds.dwz.values[0, 0])
@@ -418,7 +419,7 @@ def test_plot_residuals_fig23(dro1266, map_rates, tmp_path):
     n_minus_1 = float(ds.sol_phidot0.values[(ds.sol_n.values == -1) & (ds.sol_kind.values == "periodic")][0])
     assert round(n_minus_1, 4) == -2.4545 and any(abs(p[0] - n_minus_1) < 1e-12 for p in pts)
     assert "relative to the synodic frame" in ax.get_xlabel()
-    # the same figure from the Dataset, and on the inertial axis
+    # the same figure on the inertial axis
     ax2 = lp.plot_residuals(ds, rate="inertial").axes[0]
     np.testing.assert_array_equal(gid(ax2, "residual-dwz")[0].get_xdata(), map_rates)
     np.testing.assert_allclose(sorted(p[0] for p in marker_points(ax2)), sorted(ds.sol_wz0.values), atol=1e-12)
@@ -583,14 +584,12 @@ def unsolved(small_map, map_rates, em):
 
 
 MAP_BAD = [
-    (lambda m, u, o: lp.plot_residuals(o, wz0=[0.0, 1.0]), "`kz`"),
-    (lambda m, u, o: lp.plot_residuals(o, kz=0.8), "`wz0`"),
-    (lambda m, u, o: lp.plot_residuals(o, kz=0.8, wz0=[0.0, 1.0], rate="synodic"), "`rate`"),
+    (lambda m, u, o: lp.plot_residuals(o), "`ds`"),  # an orbit is not data: its map is computed first
+    (lambda m, u, o: lp.plot_residuals(m, orbit_index=0, rate="synodic"), "`rate`"),
     (lambda m, u, o: lp.plot_residuals(m), "`orbit_index`"),
     (lambda m, u, o: lp.plot_residuals(m, orbit_index=0, kz=0.3), "`kz`"),
     (lambda m, u, o: lp.plot_residuals(m, orbit_index=9), "`orbit_index`"),
-    (lambda m, u, o: lp.plot_residuals(m, orbit_index=0, wz0=[0.0, 1.0]), "`wz0`"),
-    (lambda m, u, o: lp.plot_residuals("map"), "`orbit_or_ds`"),
+    (lambda m, u, o: lp.plot_residuals("map"), "`ds`"),
     (lambda m, u, o: lp.plot_map("map"), "`ds`"),
     (lambda m, u, o: lp.plot_map(m, kz_index=1), "`kz_index`"),
     (lambda m, u, o: lp.plot_map(m, against="jacobi"), "`against`"),
@@ -940,8 +939,8 @@ def test_map_sol_n_is_integer_and_keeps_its_attributes(small_map):
 def test_one_colour_per_n_in_families_and_solve_scatter(kz_map, small_map, tmp_path):
     """Issue 23 #7: the solution-family lines are coloured by N (``n_color``, exact RGBA), Kz
     told by line style; the CLI's ``solve`` scatter colours each N as the map figures do and
-    marks periodic (circle) and half-turn (diamond) motions apart, filled exactly when stable."""
-    from librate.app.cli import _solutions_scatter
+    marks periodic (circle) and half-turn (diamond) motions apart, filled exactly when stable
+    (``lp.plot_solution_scatter``, the figure the CLI draws)."""
     from matplotlib.colors import to_rgba
 
     fig = lp.plot_solution_families(kz_map, n=(1, 0, -1))
@@ -957,7 +956,7 @@ def test_one_colour_per_n_in_families_and_solve_scatter(kz_map, small_map, tmp_p
     ds = small_map
     sols = ds[[v for v in ds.data_vars if v.startswith("sol_")]].drop_vars("orbit", errors="ignore")
     sols["sol_x0"] = ("solution", ds.x0.values[ds.sol_orbit.values])
-    fig = _solutions_scatter(sols)
+    fig = lp.plot_solution_scatter(sols)
     assert_png(fig, tmp_path / "solve_solutions.png")
     ax = fig.axes[0]
     pts = np.column_stack([sols.sol_x0.values, sols.sol_phidot0.values])

@@ -475,6 +475,7 @@ def test_force_while_another_process_writes_removes_nothing(tmp_path, fam, good_
     finally:
         holder.kill()
         holder.wait()
+        holder.stdout.close()
 
 
 def test_force_is_all_or_nothing(tmp_path, fam, good_store, monkeypatch):

@@ -53,7 +53,7 @@ def fig07():
 def fig23():
     """Fig. 23: residual curves of the 12.66-day DRO at Kz = 0.8 (N = -1 at phidot0 = -2.4545)."""
     d = librate.dro(EM, period_days=12.66)
-    return lp.plot_residuals(d, kz=0.8, wz0=np.linspace(-2.5, 2.5, 2001))
+    return lp.plot_residuals(librate.periodicity_map(d, kz=0.8, wz0=np.linspace(-2.5, 2.5, 2001)))
 
 
 def _map():

@@ -76,19 +76,57 @@ __all__ = [
     "simd_set_active",
 ]
 
-class LibrateError(Exception): ...
+class LibrateError(Exception):
+    """The base class of librate's errors: ``except librate.LibrateError`` catches them all."""
 
 class IntegrationError(LibrateError):
+    """An integration stopped before its final time: step-size underflow, too many steps, a
+    non-finite state.
+
+    Attributes
+    ----------
+    t : float
+        The time reached (TU).
+    steps : int
+        The steps taken.
+    kind : str
+        What stopped it.
+    """
+
     t: float
     steps: int
     kind: str
 
 class CollisionError(IntegrationError):
+    """The trajectory reached a primary: its radius, or a tiny sphere (1e-8 LU) for point masses.
+
+    Attributes
+    ----------
+    primary : int
+        1 (the larger) or 2.
+    distance : float
+        The distance from the primary's centre where it stopped (LU).
+    radius : float
+        The collision radius (LU).
+    """
+
     primary: int
     distance: float
     radius: float
 
 class ConvergenceError(LibrateError):
+    """An iterative solver (a Newton corrector, a continuation) did not converge.
+
+    Attributes
+    ----------
+    iterations : int
+        The iterations done.
+    residual : float
+        The last residual.
+    tolerance : float
+        The tolerance asked.
+    """
+
     iterations: int
     residual: float
     tolerance: float

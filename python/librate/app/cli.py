@@ -13,11 +13,11 @@ import time
 from pathlib import Path
 
 import click
-import numpy as np
 
 from .._core import __version__
 from .._errors import LibrateError
 from ..orbits.system import System
+from .commands import demo_summary, map_3d_summary, map_solutions_summary, solutions_table, solve_3d_summary
 from .jobs import run_family, run_map, run_solve
 
 _CONTEXT = {"help_option_names": ["-h", "--help"], "max_content_width": 100}
@@ -108,13 +108,6 @@ _PRESET = click.Choice(System.presets())
 _DEMO_KEYS = {"system.preset": "--system", "body.kz": "--kz", "orbits.x0.num": "--orbits", "rates.wz0.num": "--rates"}
 
 
-def _demo_study(system_name: str, kz: float, n_orbits: int, n_rates: int) -> str:
-    import json
-
-    return json.dumps({"system": {"preset": system_name}, "orbits": {"kind": "dro", "x0": {"start": 0.95, "stop": 0.15, "num": n_orbits}},
-                       "body": {"kz": kz}, "rates": {"wz0": {"start": -3.0, "stop": 2.0, "num": n_rates}}}, sort_keys=True)
-
-
 def _in_cli_words(message: str, keys: dict[str, str]) -> str:
     for key, option in keys.items():
         message = message.replace(f"{key}: ", f"{option} ")
@@ -146,64 +139,30 @@ def demo(system_name: str, kz: float, n_orbits: int, n_rates: int, out_dir: str,
                      Fig. 24, Fig. 23 (first orbit), Figs. 27-29, Fig. 3
     `librate plot OUT/demo.nc` re-draws the first three from the file.
     """
-    from ..orbits.families import dro_family
-    from ..periodicity.maps import periodicity_map
+    from .commands import run_demo
     from .progress import reporter
-    from .results import ResultExists, check_output, open_result, save_dataset
+    from .results import ResultExists
 
     out = Path(out_dir)
     path = out / "demo.nc"
-    study = _demo_study(system_name, kz, n_orbits, n_rates)
+    _check_writable(out, "--out")
     try:
-        decision = check_output(path, "map", study, force=not resume, say=lambda text: _say(_in_cli_words(text, _DEMO_KEYS)))
+        ds, fam = run_demo(system_name, kz, n_orbits, n_rates, path, force=not resume, say=lambda text: _say(_in_cli_words(text, _DEMO_KEYS)),
+                           echo=lambda text: _echo(quiet, text),
+                           progress=reporter("periodicity map (and solutions)", "orbit", None if not quiet else False))
     except ResultExists as err:
         raise UserError(_in_cli_words(str(err), _DEMO_KEYS)) from None
     except FileExistsError as err:
         raise UserError(str(err)) from None
-    _check_writable(out, "--out")
-    if decision == "resume":
-        _say(f"reused: {path} already holds this map (same options; --force recomputes it)")
-        ds = open_result(path)
-        if not quiet:
-            _demo_summary(ds)
-        click.echo(f"written: {path} (earlier)")
-        return
-    system = System.preset(system_name)
-    t0 = time.perf_counter()
-    fam = dro_family(system, x0=np.linspace(0.95, 0.15, n_orbits))
-    t1 = time.perf_counter()
-    _echo(quiet, f"DRO family: {len(fam)} members, x0 {fam.x0[0]:.3f} -> {fam.x0[-1]:.3f}, period {fam.period_days.min():.2f} to {fam.period_days.max():.2f} d ({t1 - t0:.2f} s)")
-    wz0 = np.linspace(-3.0, 2.0, n_rates)
-    ds = periodicity_map(fam, kz=kz, wz0=wz0, progress=reporter("periodicity map (and solutions)", "orbit", None if not quiet else False))
-    t2 = time.perf_counter()
-    n_traj = ds.dwz.size
-    _echo(quiet, f"periodicity map: {len(fam)} orbits x {n_rates} rates at Kz = {kz}: {n_traj} attitude trajectories in {t2 - t1:.2f} s ({n_traj / (t2 - t1):,.0f} per s, with solving)")
-    if not quiet:
-        _demo_summary(ds)
-    from .._core import __version__
-
-    ds.attrs.update({"librate_result": "map", "librate_command": "demo", "study": study, "librate_version": __version__})
-    try:
-        save_dataset(ds, path)
     except OSError as err:
         raise UserError(f"--out {out}: cannot write {path.name} there ({err.strerror or err})") from None
+    if not quiet:
+        _lines(demo_summary(ds))
+    if fam is None:
+        click.echo(f"written: {path} (earlier)")
+        return
     click.echo(f"written: {path} (xarray Dataset: dwz, dphi, phi_T over (orbit, kz, wz0), solutions, units and parameters)")
-    _figures(ds, path, ("map", "residuals", "solutions"), quiet, extra={"family": lambda lp: lp.plot_family(fam)})
-
-
-def _demo_summary(ds, shown_n: int = 3) -> None:
-    n_, kind_ = ds.sol_n.values, ds.sol_kind.values.astype(str)
-    listed = np.abs(n_) <= shown_n
-    total = int(ds.sizes["solution"])
-    omitted = "" if listed.all() else f"; listed below: |N| <= {shown_n} ({int(listed.sum())}), {total - int(listed.sum())} with |N| > {shown_n} omitted"
-    click.echo(f"solutions (phi(T) = 2 pi N, wz(T) = wz0, refined by Newton, residual from an independent re-propagation): {total}{omitted}")
-    click.echo(f"{'N':>4} {'kind':>10} {'count':>6} {'stable':>7} {'phidot0 range [1/TU]':>24} {'max residual':>13}")
-    for (n, kind) in sorted(set(zip(n_.tolist(), kind_.tolist())), key=lambda x: (x[1], x[0])):
-        if abs(n) > shown_n:
-            continue
-        sel = (n_ == n) & (kind_ == kind)
-        pd = ds.sol_phidot0.values[sel]
-        click.echo(f"{n:>4g} {kind:>10} {int(sel.sum()):>6} {int(ds.sol_stable.values[sel].sum()):>7} {pd.min():>11.4f} .. {pd.max():<10.4f} {ds.sol_residual.values[sel].max():>13.1e}")
+    _figures(ds, path, ("map", "residuals", "solutions"), quiet, extra={"orbits": lambda lp: lp.plot_family(fam)})
 
 
 @main.command(name="dros", context_settings=_CONTEXT, short_help="Correct distant retrograde orbits and check that each closes.")
@@ -249,14 +208,11 @@ _FAILURES = (FileExistsError, RuntimeError, ValueError, LibrateError, OSError)
 
 def _check_writable(folder: Path, what: str) -> None:
     """Refuse, before any work, an output folder that cannot be created or written."""
-    import tempfile
+    from .commands import writable_problem
 
-    try:
-        folder.mkdir(parents=True, exist_ok=True)
-        with tempfile.TemporaryFile(dir=folder):
-            pass
-    except OSError as err:
-        raise UserError(f"{what} {folder}: cannot write there ({err.strerror or type(err).__name__})") from None
+    why = writable_problem(folder)
+    if why is not None:
+        raise UserError(f"{what} {folder}: cannot write there ({why})")
 
 
 def _failure(err: Exception) -> click.ClickException:
@@ -305,6 +261,11 @@ def _load_study(path: str | None, purpose: str, overrides: dict, force: bool = F
 def _show(quiet: bool) -> bool | None:
     """Progress bars: never with --quiet, else only in a terminal (None: decided on stderr)."""
     return False if quiet else None
+
+
+def _lines(lines: list[str]) -> None:
+    for line in lines:
+        click.echo(line)
 
 
 def _echo(quiet: bool, text: str) -> None:
@@ -412,7 +373,7 @@ def family(study, kind, point, branch, x0, members, system_name, fmt, sets, out_
     for b in fam.bifurcations:
         _echo(quiet, f"  bifurcation: {b['index']} index, {b['type']}, near x0 = {b['x0']:.6g}")
     click.echo(f"written: {path}")
-    _figures(fam, path, st.figures(("family", "period", "stability")), quiet)
+    _figures(fam, path, _wanted(st, ("family", "period", "stability")), quiet)
 
 
 def _quote(v):
@@ -473,50 +434,16 @@ def solve(study, sets, out_dir, resume, quiet, scheduler) -> None:
     el = time.perf_counter() - t0
     if three_d:
         if not quiet:
-            _summary_3d(ds, el)
+            _lines(solve_3d_summary(ds, el))
         click.echo(f"written: {path}")
-        _figures(ds, path, st.figures(("multipliers", "body_axes")), quiet)
+        _figures(ds, path, _wanted(st, ("multipliers", "body_axes")), quiet)
         return
     n = ds.sizes["solution"]
     _echo(quiet, f"{n} periodic solution(s) over {ds.sizes['orbit']} orbit(s) x {ds.sizes['kz']} Kz ({el:.2f} s)")
     if n and not quiet:
-        click.echo(f"{'orbit':>5} {'x0 [LU]':>9} {'T [d]':>8} {'Kz':>6} {'N':>4} {'kind':>9} {'wz0 [1/TU]':>13} {'phidot0':>13} {'phi0':>9} {'trace':>10} {'stable':>6} {'residual':>9}")
-        for j in range(n):
-            r = {k: ds[f"sol_{k}"].values[j] for k in ("orbit", "x0", "period_days", "kz", "n", "kind", "wz0", "phidot0", "phi0", "trace", "stable", "residual")}
-            click.echo(f"{r['orbit']:>5d} {r['x0']:>9.5f} {r['period_days']:>8.4f} {r['kz']:>6.3g} {r['n']:>4g} {r['kind']:>9} {r['wz0']:>13.8f} "
-                       f"{r['phidot0']:>13.8f} {r['phi0']:>9.5f} {r['trace']:>10.4g} {'yes' if r['stable'] else 'no':>6} {r['residual']:>9.1e}")
+        _lines(solutions_table(ds))
     click.echo(f"written: {path}")
-    _figures(ds, path, st.figures(("solutions",)), quiet)
-
-
-def _summary_3d(ds, elapsed: float) -> None:
-    """The table of a 3-D solve: one line per member, then how the continuation ended and the
-    located stability changes."""
-    import ast
-
-    from .results import multipliers_3d
-
-    m = multipliers_3d(ds)
-    n = ds.sizes["member"]
-    click.echo(f"periodic 3-D attitude motion along {n} of {ds.attrs.get('members_requested', n)} member(s) of the {ds.attrs.get('orbit_family')} family, "
-               f"body moments ({', '.join(f'{v:.6g}' for v in np.atleast_1d(ds.attrs['body_moments']))}) kg m^2, K = {ds.attrs['n_periods']} ({elapsed:.2f} s); start: {ds.attrs.get('start_description')}")
-    click.echo(f"{'member':>6} {'T [d]':>9} {'x0 [LU]':>9} {'z0 [LU]':>9} {'q0 (x, y, z, w)':>36} {'w0 [1/TU] (x, y, z)':>36} "
-               f"{'max|mult|':>10} {'stable':>6} {'turns':>6} {'residual':>9}")
-    for j in range(n):
-        q, w = ds["q0"].values[j], ds["w0"].values[j]
-        turns = ds["turns"].values[j]
-        click.echo(f"{j:>6d} {ds['period_days'].values[j]:>9.5f} {ds['x0'].values[j]:>9.5f} {ds['z0'].values[j]:>9.5f} "
-                   f"{' '.join(f'{v:8.5f}' for v in q):>36} {' '.join(f'{v:11.7f}' for v in w):>36} {np.abs(m[j]).max():>10.6g} "
-                   f"{'yes' if ds['stable'].values[j] else 'no':>6} {'-' if np.isnan(turns) else f'{round(turns, 3) + 0.0:.3f}':>6} {ds['residual'].values[j]:>9.1e}")
-    click.echo(f"continuation: {ds.attrs.get('end_reason')}")
-    for ch in ast.literal_eval(ds.attrs.get("stability_changes", "[]")):
-        where = f"at T = {ch['at']:.10g} d" + ("" if ch["located"] else " (interpolated)")
-        if ch["between"][1] is None:  # past the last member (the continuation stalled there)
-            click.echo(f"stability change ({ch['kind']}) {where}, after T = {ch['between'][0]:.6g} d, the last member "
-                       f"(multipliers on the unit circle there: {ch['on_unit_circle'][0]})")
-            continue
-        click.echo(f"stability change ({ch['kind']}) {where}, between T = {ch['between'][0]:.6g} and {ch['between'][1]:.6g} d "
-                   f"(multipliers on the unit circle: {ch['on_unit_circle'][0]} -> {ch['on_unit_circle'][1]})")
+    _figures(ds, path, _wanted(st, ("solutions",)), quiet)
 
 
 @main.command(name="map", context_settings=_CONTEXT, short_help="The attitude periodicity map of a study (thesis Fig. 24).")
@@ -563,43 +490,17 @@ def map_(study, out_dir, quiet, scheduler, resume, sets) -> None:
     el = time.perf_counter() - t0
     if ds.attrs.get("librate_result") == "map_3d":
         if not quiet:
-            _map_3d_summary(ds, el)
+            _lines(map_3d_summary(ds, el))
         click.echo(f"written: {path}")
-        _figures(ds, path, st.figures(("map",)), quiet)
+        _figures(ds, path, _wanted(st, ("map",)), quiet)
         return
     if not quiet:
         no, nk, nw = ds.sizes["orbit"], ds.sizes["kz"], ds.sizes["wz0"]
         click.echo(f"periodicity map: {no} orbits x {nk} Kz x {nw} rates = {no * nk * nw} attitude trajectories ({el:.2f} s)"
                    + ("" if int(ds.attrs.get("complete", 1)) else "  [INCOMPLETE: interrupted; re-run to resume]"))
-        _solution_summary(ds)
+        _lines(map_solutions_summary(ds))
     click.echo(f"written: {path}")
-    _figures(ds, path, st.figures(("map", "residuals", "solutions")), quiet)
-
-
-def _map_3d_summary(ds, elapsed: float) -> None:
-    """One line for the 3-D map and one per orbit: its smallest residual max-norm and where."""
-    grid = [d for d in ds["residual_norm"].dims if d != "orbit"]
-    n = int(np.prod([ds.sizes[d] for d in ds["residual_norm"].dims]))
-    click.echo(f"3-D attitude map: {ds.sizes['orbit']} orbits x {' x '.join(f'{ds.sizes[d]} {d}' for d in grid)} = {n} trajectories "
-               f"({elapsed:.2f} s); residual = (rotation vector of R(0)' R(KT), w(KT) - w0)")
-    for i in range(ds.sizes["orbit"]):
-        r = ds["residual_norm"].isel(orbit=i)
-        k = np.unravel_index(int(np.nanargmin(r.values)), r.shape)
-        at = ", ".join(f"{d} = {float(ds[d].values[j]):.4f}" for d, j in zip(grid, k))
-        click.echo(f"  orbit {i} (T = {float(ds['period_days'].values[i]):.4f} d): smallest max |residual| {float(r.values[k]):.2e} at {at}")
-
-
-def _solution_summary(ds) -> None:
-    if "solution" not in ds.sizes or ds.sizes["solution"] == 0:
-        click.echo("solutions: none in the rate window")
-        return
-    n_, kind_ = ds["sol_n"].values, ds["sol_kind"].values.astype(str)
-    stable, res, pd = ds["sol_stable"].values, ds["sol_residual"].values, ds["sol_phidot0"].values
-    click.echo(f"solutions (wz(T) = wz0, phi(T) = phi0 + 2 pi N, refined by Newton): {ds.sizes['solution']}")
-    click.echo(f"{'N':>4} {'kind':>10} {'count':>6} {'stable':>7} {'phidot0 range [1/TU]':>24} {'max residual':>13}")
-    for n, kind in sorted(set(zip(n_.tolist(), kind_.tolist())), key=lambda x: (x[1], -x[0])):
-        sel = (n_ == n) & (kind_ == kind)
-        click.echo(f"{n:>4g} {kind:>10} {int(sel.sum()):>6} {int(stable[sel].sum()):>7} {pd[sel].min():>11.4f} .. {pd[sel].max():<10.4f} {res[sel].max():>13.1e}")
+    _figures(ds, path, _wanted(st, ("map", "residuals", "solutions")), quiet)
 
 
 @main.command(context_settings=_CONTEXT, short_help="Re-draw the figures of any saved result, without recomputing.")
@@ -632,8 +533,10 @@ def plot(result_path, quiet) -> None:
         p = resolve_result_path(result_path)
     except (ValueError, FileNotFoundError) as err:
         raise UserError(str(err)) from None
+    from .commands import refuse_damaged
+
     try:
-        _refuse_damaged_store(p)
+        refuse_damaged(p)
     except ValueError as err:  # refused: exit status 2, nothing drawn
         raise UserError(str(err)) from None
     try:
@@ -641,36 +544,12 @@ def plot(result_path, quiet) -> None:
     except (ValueError, FileNotFoundError) as err:
         raise UserError(str(err)) from None
     _check_writable(p.parent, "the folder of RESULT_PATH,")
-    from ..orbits.families import OrbitFamily
+    from .commands import describe_for_plot
 
-    if isinstance(res, OrbitFamily):
-        _echo(quiet, f"{res.kind} family: {len(res)} members")
-        names = ("family", "period", "stability")
-    elif res.attrs.get("librate_result") == "solutions_3d":
-        _echo(quiet, f"3-D solutions: {', '.join(f'{k} {v}' for k, v in res.sizes.items() if k == 'member')}")
-        names = ("multipliers", "body_axes")
-    else:
-        kind = res.attrs.get("librate_result") or ("map" if "dwz" in res.variables else "solutions")
-        _echo(quiet, f"{kind}: {', '.join(f'{k} {v}' for k, v in res.sizes.items())}")
-        names = ("map", "residuals", "solutions") if "dwz" in res.variables or kind == "map_3d" else ("solutions",)
-    written = _figures(res, p, names, quiet)
+    _echo(quiet, describe_for_plot(res))
+    written = _figures(res, p, None, quiet)
     if not written:
         raise click.ClickException("no figure could be drawn (see the messages above)")
-
-
-def _refuse_damaged_store(p: Path) -> None:
-    """A damaged result (any kind) is refused by name; an incomplete map store is drawn."""
-    from ..results.store import store_kind, verify_store
-    from .results import verify_result
-
-    if p.is_dir() and store_kind(p) is not None:
-        rep = verify_store(p)
-        if rep.damaged or rep.problems:
-            raise ValueError(rep.describe())
-        return
-    ok, report = verify_result(p)
-    if not ok:
-        raise ValueError(report)
 
 
 @main.command(context_settings=_CONTEXT, short_help="Check a saved result for damage, without recomputing it.")
@@ -701,113 +580,18 @@ def verify(result_path) -> None:
         sys.exit(1)
 
 
-#: The file suffix of each figure: a result STEM.zarr gets STEM_<suffix>.png beside it.
-_FIGURE_FILES = {"family": "orbits", "period": "period", "stability": "stability", "map": "contours", "residuals": "residuals",
-                 "solutions": "solutions", "multipliers": "multipliers", "body_axes": "body_axes"}
+def _wanted(st, available: tuple[str, ...]) -> list[str]:
+    """The study's figures among this command's ``available``; says so when its output.figures
+    names none of them (a command never leaves its figures out silently)."""
+    names = st.figures(available)
+    if not names:
+        click.echo(f"figures: none drawn: output.figures = {list(st.output.figures)} names none of this command's "
+                   f"({', '.join(available)})", err=True)
+    return names
 
 
 def _figures(result, path: Path, names, quiet: bool, extra: dict | None = None) -> list[Path]:
-    """Draw the named figures of the result saved at ``path`` beside it, as
-    ``<stem>_<figure>.png``; ``extra``: more figures, ``{name: make(plotting_module)}``. A
-    figure that does not apply or fails is skipped with a note (the result is kept)."""
-    if not names and not extra:
-        return []
-    try:
-        import matplotlib
+    """Draw the figures of the result saved at ``path`` beside it (:func:`librate.app.commands.draw_figures`)."""
+    from .commands import draw_figures
 
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-
-        from .. import plotting as lp
-    except ImportError as err:
-        click.echo(f"figures skipped: matplotlib, a required dependency of librate, cannot be imported ({err}); reinstall librate", err=True)
-        return []
-    from ..orbits.families import OrbitFamily
-    from .progress import bar
-
-    folder, stem = path.parent, path.stem
-    fname = lambda name, tail="": f"{stem}_{_FIGURE_FILES.get(name, name)}{tail}.png"
-    jobs = []
-    if isinstance(result, OrbitFamily):
-        table = {"family": lambda: lp.plot_family(result, n_orbits=30), "period": lambda: lp.plot_period(result),
-                 "stability": lambda: lp.plot_stability(result)}
-        jobs = [(fname(n), table[n]) for n in names if n in table]
-    elif result.attrs.get("librate_result") == "map_3d":
-        jobs = [(fname("residual_norm"), lambda: lp.plot_map_3d(result)) for n in names if n == "map"]
-    elif result.attrs.get("librate_result") == "solutions_3d":
-        from .results import multipliers_3d, solution_3d
-
-        table = {"multipliers": lambda: lp.plot_family_multipliers(result.assign(multipliers=(("member", "k"), multipliers_3d(result)))),
-                 "body_axes": lambda: lp.plot_body_axes(solution_3d(result, 0))}
-        jobs = [(fname(n), table[n]) for n in names if n in table]
-    elif "dwz" in result.variables:
-        kzs = np.atleast_1d(result["kz"].values)
-        for name in names:
-            if name == "map":
-                if result.sizes["orbit"] < 2:
-                    click.echo(f"{fname('map')} skipped: a periodicity map figure needs at least 2 orbits", err=True)
-                    continue
-                for j, kz in enumerate(kzs):
-                    jobs.append((fname("map", "" if kzs.size == 1 else f"_kz{kz:g}"), lambda j=j: lp.plot_map(result, kz_index=j)))
-            elif name == "residuals":
-                # thesis Fig. 23 is drawn on the 12.66-day DRO: the orbit nearest that period
-                near = int(np.argmin(np.abs(np.asarray(result["period_days"].values, dtype=float) - 12.66)))
-                jobs.append((fname("residuals"), lambda near=near: lp.plot_residuals(result, orbit_index=near, kz=float(kzs[0]))))
-            elif name == "solutions" and "sol_wz0" in result.variables:
-                if result.sizes["orbit"] < 2 or result.sizes.get("solution", 0) == 0:
-                    continue
-                # the thesis families N = 1, 0, -1 (Figs. 27-29) as panels; a rate jump over 1/TU
-                # between consecutive orbits starts a new branch (never a line joining two solutions)
-                ns = [k for k in (1, 0, -1) if np.any(np.asarray(result["sol_n"].values) == k)] or None
-                jobs.append((fname("solutions"), lambda ns=ns: lp.plot_solution_families(result, n=ns, max_jump=1.0)))
-    elif "sol_wz0" in result.variables and "solutions" in names and result.sizes.get("solution", 0):
-        jobs.append((fname("solutions"), lambda: _solutions_scatter(result)))
-    for name, make in (extra or {}).items():
-        jobs.append((fname(name), lambda make=make: make(lp)))
-    written = []
-    with bar(len(jobs), "figures", "figure", _show(quiet)) as progress:
-        for name, make in jobs:
-            try:
-                fig = make()
-            except Exception as err:  # a figure must not lose the computed result
-                progress.write(f"{name} skipped: {type(err).__name__}: {err}", file=sys.stderr)
-                progress.update(1)
-                continue
-            written.append(lp.save_figure(fig, folder / name))
-            plt.close(fig)
-            progress.update(1)
-            progress.write(f"written: {folder / name}", file=sys.stdout)
-    return written
-
-
-def _solutions_scatter(ds):
-    import matplotlib.pyplot as plt
-    from matplotlib.lines import Line2D
-
-    from .. import plotting as lp
-
-    fig, ax = plt.subplots(figsize=(6.4, 4.8), layout="constrained")
-    n = ds["sol_n"].values
-    kind = ds["sol_kind"].values.astype(str) if "sol_kind" in ds.variables else np.full(n.shape, "periodic")
-    stable = ds["sol_stable"].values.astype(bool)
-    x, y = ds["sol_x0"].values, ds["sol_phidot0"].values
-    handles = []
-    for k in sorted(set(n.tolist()), reverse=True):  # the same N, the same colour as in the map figures
-        c = lp.n_color(k)
-        for kd, marker in lp.KIND_MARKERS.items():
-            for st in (True, False):
-                sel = (n == k) & (kind == kd) & (stable == st)
-                if sel.any():
-                    ax.scatter(x[sel], y[sel], s=22, marker=marker, edgecolors=c, facecolors=c if st else "none",
-                               linewidths=1.2, gid="solutions")
-        handles.append(Line2D([], [], linestyle="none", marker="s", color=c, label=f"N = {k:g}"))
-    gray = dict(linestyle="none", color="0.3", markeredgecolor="0.3")
-    for kd, marker in lp.KIND_MARKERS.items():
-        if np.any(kind == kd):
-            handles.append(Line2D([], [], marker=marker, markerfacecolor="0.8", label=kd, **gray))
-    handles.append(Line2D([], [], marker="o", markerfacecolor="none", label="hollow: unstable", **gray))
-    ax.set_xlabel("$x_0$ (LU)")
-    ax.set_ylabel(r"$\dot\phi(0)$ (1/TU)")
-    ax.set_title("periodic attitude solutions (filled: stable)")
-    ax.legend(handles=handles, fontsize="small")
-    return fig
+    return draw_figures(result, path, names, show=_show(quiet), extra=extra)

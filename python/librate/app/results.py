@@ -188,14 +188,40 @@ def read_attrs(path: str | Path) -> dict:
 
 
 def open_result(path: str | Path, *, verify: bool = False):
-    """Reload a saved result without recomputing: an :class:`~librate.OrbitFamily` for a family
-    (through :meth:`OrbitFamily.load`), an ``xarray.Dataset`` for a periodicity map or a table
-    of periodic solutions (its ``attrs["study"]`` is the study as JSON).
+    """Reload a saved result without recomputing.
 
-    ``path``: a ``.zarr`` folder or a ``.nc`` file, or an output folder holding exactly one of
-    map/family/solutions. ``verify``: first check the result as :func:`verify_result` does
-    (every chunk against its checksum, every map row computed) and raise ``ValueError`` naming
-    the damage. Raises ``FileNotFoundError`` or ``ValueError`` (not a librate result, or damaged).
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        A ``.zarr`` folder or a ``.nc`` file, or an output folder holding exactly one of map,
+        family or solutions.
+    verify : bool, default False
+        First check the result as `verify_result` does (every chunk against its checksum, every
+        map row computed).
+
+    Returns
+    -------
+    OrbitFamily or xarray.Dataset
+        An `OrbitFamily` for a family (through `OrbitFamily.load`); an ``xarray.Dataset`` for a
+        periodicity map or a table of periodic solutions, its ``attrs["study"]`` the study as
+        JSON when a study made it.
+
+    Raises
+    ------
+    FileNotFoundError
+        Nothing at ``path``.
+    ValueError
+        Not a librate result, or (with ``verify``) damaged: the message names the damage.
+
+    Examples
+    --------
+    >>> import librate, numpy as np, tempfile, pathlib
+    >>> fam = librate.dro_family(librate.System.preset("earth-moon"), x0=[0.9, 0.8])
+    >>> path = pathlib.Path(tempfile.mkdtemp()) / "dros.nc"
+    >>> fam.save(path)
+    >>> same = librate.open_result(path)
+    >>> bool(np.array_equal(same.state0, fam.state0))
+    True
     """
     from ..orbits.families import OrbitFamily
 
@@ -386,7 +412,9 @@ def solutions_3d_dataset(family_ds, orbits, period_days, start: dict, attrs: dic
 def multipliers_3d(ds) -> np.ndarray:
     """The complex Floquet multipliers (member, 6) of a saved 3-D solve (``multipliers_real``
     and ``multipliers_imag``)."""
-    return ds["multipliers_real"].values + 1j * ds["multipliers_imag"].values
+    from ..results.kinds import Solutions3DResult
+
+    return Solutions3DResult.multipliers(ds)
 
 
 def solution_3d(ds, member: int = 0):

@@ -1,10 +1,9 @@
 """The rules between sections of a study (and what each command needs from it), on the section
-models that passed type validation; the rules within one section are its model's ``problems()``
+models that passed type validation; the rules within one section are its model's validator
 (:mod:`librate.app.schema`)."""
 
 from __future__ import annotations
 
-import math
 from typing import Any
 
 import numpy as np
@@ -30,21 +29,12 @@ def _check_increasing(key: str, g, problems: list[str]) -> None:
 def check_sections(s: dict[str, Table], given: dict, purpose: str | None) -> list[str]:
     """Consistency checks on the sections that passed type validation (``s``); ``given`` is the
     raw study as written (to tell a missing section from a defaulted one). The rules within one
-    section are its model's ``problems()``; the rules between sections are here."""
-    sysc = s.get("system")
-    problems, mu = sysc.problems() if sysc is not None else ([], None)
-
+    section are its model's validator; the rules between sections are here."""
+    problems: list[str] = []
     orb = s.get("orbits")
-    if orb is not None:
-        problems += orb.problems(mu)
-
     body = s.get("body")
-    if body is not None:
-        problems += body.problems()
-
     tq = s.get("torques")
     if tq is not None:
-        problems += tq.problems()
         srp = tq.srp  # one rule between [torques.srp] and [body]:
         if srp is not None and srp.eps is None and srp.area_m2 is not None and srp.offset_m is not None \
                 and body is not None and body.iz is None and body.kz is not None:
@@ -74,10 +64,6 @@ def check_sections(s: dict[str, Table], given: dict, purpose: str | None) -> lis
             if g is not None and not (three_d and isinstance(g, (int, float))) and (k in ("wz0", "phidot0") or three_d):
                 _check_increasing(f"rates.{k}", g, problems)
 
-    if att is not None and not three_d:
-        for k in ("start", "n", "q0", "w0", "tol"):
-            if getattr(att, k) is not None:
-                problems.append(problem(f"attitude.{k}", getattr(att, k), "applies only to attitude.model = \"3d\"", "attitude.model = '3d' with it, or leave it out"))
     if three_d:
         problems += _check_3d(att, start, s, given)
 
@@ -116,44 +102,22 @@ def check_sections(s: dict[str, Table], given: dict, purpose: str | None) -> lis
     return problems
 
 
-def start_of(att, orb) -> str:
-    """How a 3-D solve starts: ``attitude.start``, else "given" with attitude.w0, else "spin"
-    on a halo family, else "planar"."""
-    if att.start is not None:
-        return att.start
-    if att.w0 is not None:
-        return "given"
-    return "spin" if orb is not None and orb.kind == "halo" else "planar"
-
-
 _NOT_3D = "not modelled in 3-D yet (the 3-D model has the gravity gradient of both primaries on a rigid body)"
 
 
+def start_of(att, orb) -> str:
+    """How a 3-D solve starts (:meth:`librate.app.schema.Attitude3D.start_on` for the orbits' family)."""
+    return att.start_on(orb.kind if orb is not None else None)
+
+
 def _check_3d(att, start: str, s: dict, given: dict) -> list[str]:
-    """The checks of ``[attitude] model = "3d"`` on the sections that passed type validation."""
+    """The rules between ``[attitude] model = "3d"`` and the other sections that passed type
+    validation (the rules within [attitude] are its model's validator)."""
     problems: list[str] = []
     orb, body, tq, sol = s.get("orbits"), s.get("body"), s.get("torques"), s.get("solver")
-    if start == "planar":
-        if orb is not None and orb.kind == "halo":
-            problems.append(problem("attitude.start", start, "the planar start takes a planar solution, which needs a planar family (orbits.kind = 'dro' or 'lyapunov')",
-                                     "'spin' or 'given' on a halo family"))
-        for k in ("q0", "w0"):
-            if getattr(att, k) is not None:
-                problems.append(problem(f"attitude.{k}", getattr(att, k), "cannot be combined with attitude.start = \"planar\" (the start is the planar solution: "
-                                         "phi0 = solver.phi0 about Z, wz0 from the rates.wz0 scan)", "attitude.q0 and attitude.w0 with attitude.start = 'given'"))
-    elif start == "spin" and att.w0 is not None:
-        problems.append(problem("attitude.w0", att.w0, "cannot be combined with attitude.start = \"spin\" (the spin is w = (1 + 2 pi n / (K T)) e_Z)",
-                                 "attitude.w0 with attitude.start = 'given'"))
-    if start in ("planar", "spin") and att.n is None:
-        problems.append(missing("attitude.n", f"missing: attitude.start = \"{start}\" needs the net turns n per attitude period"))
-    if start == "given":
-        if att.w0 is None:
-            problems.append(missing("attitude.w0", "missing: attitude.start = \"given\" starts from attitude.w0 (and attitude.q0, default the identity)"))
-        if att.n is not None:
-            problems.append(problem("attitude.n", att.n, "does not apply to attitude.start = \"given\" (the start is attitude.q0, attitude.w0)",
-                                     "attitude.n with attitude.start = 'planar' or 'spin'"))
-    if att.q0 is not None and abs(math.hypot(*att.q0) - 1) > 1e-6:  # finite: the schema refuses inf and nan
-        problems.append(problem("attitude.q0", att.q0, f"must be a unit quaternion (|q0| = {math.hypot(*att.q0):.6g})"))
+    if start == "planar" and orb is not None and orb.kind == "halo":
+        problems.append(problem("attitude.start", start, "the planar start takes a planar solution, which needs a planar family (orbits.kind = 'dro' or 'lyapunov')",
+                                 "'spin' or 'given' on a halo family"))
     if att.q0 is not None and sol is not None and "phi0" in (given.get("solver") or {}):
         problems.append(problem("solver.phi0", sol.phi0, "cannot be combined with attitude.q0 (q0 is the whole initial attitude)",
                                  "solver.phi0 (a rotation about Z) or attitude.q0, not both"))

@@ -77,16 +77,61 @@ def run_map(
     atol: float = MAP_ATOL,
     replace: bool = False,
 ):
-    """Compute a periodicity map (as :func:`librate.periodicity_map`) row by row into a Zarr
-    store at ``out`` (resumable; see the module docs), and return it as an xarray Dataset.
+    """Compute a periodicity map (as `librate.periodicity_map`) row by row into a Zarr store,
+    resumable, and return it.
 
-    ``scheduler``: None (local, all cores), a Dask ``distributed.Client``, or its address
-    ("tcp://host:port"): each orbit row becomes a task. ``progress``: progress bars (the rows,
-    then the solutions) with rate and ETA on stderr (default: only when stderr is a terminal). ``attrs``: extra attributes
-    (e.g. the study as JSON). Without ``out`` nothing is written (and nothing can be resumed).
-    ``replace``: an existing librate result at ``out`` is replaced all or nothing: the new map is
-    computed into a temporary sibling under ``out``'s writer lock, and takes the name only once
-    complete (the old one stays until then, and a second writer is refused meanwhile).
+    Each orbit row is written with its checksum as it completes; a run interrupted (or killed)
+    resumes from the rows already in the store, and the result is the same as an uninterrupted
+    run.
+
+    Parameters
+    ----------
+    orbits : OrbitFamily, list of PeriodicOrbit or PeriodicOrbit
+        Planar periodic orbits.
+    kz : float or array_like
+        Inertia ratio(s) Kz in [-1, 1].
+    wz0 : array_like
+        Inertial initial rates (1/TU), strictly increasing.
+    phi0 : float, default 0.0
+        Initial angle (rad).
+    n_periods : int, default 1
+        K, the orbit periods per attitude period.
+    srp : FlatPlate, optional
+        Solar radiation pressure.
+    out : str or pathlib.Path, optional
+        The Zarr store; without it nothing is written (and nothing can be resumed).
+    resume : bool, default True
+        Resume a store of the same inputs.
+    scheduler : None, distributed.Client or str
+        None: local, all cores; a Dask client or its address ("tcp://host:port"): each orbit row
+        becomes a task.
+    progress : bool, optional
+        Progress bars (the rows, then the solutions) with rate and ETA on stderr (default: only
+        when stderr is a terminal).
+    solve : bool, default True
+        Refine the periodic solutions.
+    attrs : dict, optional
+        Extra attributes (e.g. the study as JSON).
+    rtol, atol : float
+        Integration tolerances.
+    replace : bool, default False
+        An existing librate result at ``out`` is replaced all or nothing: the new map is computed
+        into a temporary sibling under ``out``'s writer lock and takes the name only once
+        complete.
+
+    Returns
+    -------
+    xarray.Dataset
+        The map, as `periodicity_map` returns it.
+
+    Raises
+    ------
+    ValueError
+        A bad argument, naming it.
+    ResultExists
+        ``out`` holds a map of other inputs (the message names what changed), unless ``replace``.
+    StoreBusyError
+        Another process is writing the same store (it holds its writer lock).
     """
     olist, family = orbits_of(orbits)
     for o in olist:

@@ -1,6 +1,7 @@
 """The study schema: one pydantic model per TOML section, each key's type, range and description
-on its field, and each section's own rules in its ``problems()`` method; the error messages
-(every one names the dotted key, the value given and what is allowed)."""
+on its field, and each section's own rules as its model's validator (``_rules``, raising
+:class:`SectionProblems`); the error messages (every one names the dotted key, the value given and
+what is allowed)."""
 
 from __future__ import annotations
 
@@ -12,7 +13,7 @@ import warnings
 from typing import Annotated, Any, Literal
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Discriminator, Field, Tag, ValidationError, model_validator
+from pydantic import BaseModel, ConfigDict, Discriminator, Field, Tag, TypeAdapter, ValidationError, ValidationInfo, model_validator
 
 #: What a study can be checked for (the commands that run it).
 PURPOSES = ("family", "solve", "map")
@@ -36,6 +37,23 @@ class StudyError(ValueError):
 
 
 # --- schema ------------------------------------------------------------------------------------
+class SectionProblems(ValueError):
+    """What a section's rules (its model's validator) found, one line per problem naming its
+    key; :func:`pydantic_problems` lists them after the type problems. ``section``: the section
+    as validated (its types are right), for the rules between sections."""
+
+    def __init__(self, problems: list[str], section: BaseModel):
+        super().__init__("; ".join(problems))
+        self.problems = list(problems)
+        self.section = section
+
+
+def _rules_found(section: BaseModel, found: list[str]) -> BaseModel:
+    if found:
+        raise SectionProblems(found, section)
+    return section
+
+
 class Table(BaseModel):
     model_config = ConfigDict(extra="forbid", strict=True, frozen=True, allow_inf_nan=False)
 
@@ -82,7 +100,7 @@ RateGrid = Annotated[
     Annotated[float, Tag("number")] | Annotated[list[float], Field(min_length=1, max_length=MAX_GRID), Tag("list")] | Annotated[Range, Tag("range")],
     Discriminator(_number_grid_tag, custom_error_type="grid", custom_error_message=_RATE_MSG),
 ]
-_TAGS = {"list", "range", "number"}
+_TAGS = {"list", "range", "number", "planar", "3d"}
 
 
 class SystemSection(Table):
@@ -95,18 +113,26 @@ class SystemSection(Table):
     radii_km: list[Annotated[float, Field(ge=0)]] | None = Field(None, min_length=2, max_length=2, description="two numbers >= 0, the primaries' radii in km")
     name: str | None = Field(None, description="a string")
 
-    def problems(self) -> tuple[list[str], float | None]:
-        """The rules between this section's keys (a preset, or a custom system); also the mass
-        ratio mu when it is known (for the orbits' checks)."""
+    def mass_ratio(self) -> float | None:
+        """The system's mass ratio mu when it is known (for the orbits' rules)."""
         from ..orbits.system import System
 
-        sysc, problems, mu = self, [], None
+        if self.preset is not None:
+            return System.preset(self.preset).mu if self.preset in System.presets() else None
+        if any(getattr(self, k) is not None for k in ("mu", "lu_km", "tu_s", "radii_km")):
+            return self.mu
+        return System.preset("earth-moon").mu
+
+    @model_validator(mode="after")
+    def _rules(self) -> SystemSection:
+        """The rules between this section's keys: a preset, or a custom system."""
+        from ..orbits.system import System
+
+        sysc, problems = self, []
         custom = [k for k in ("mu", "lu_km", "tu_s", "radii_km") if getattr(sysc, k) is not None]
         if sysc.preset is not None:
             if sysc.preset not in System.presets():
                 problems.append(problem("system.preset", sysc.preset, "unknown preset"))
-            else:
-                mu = System.preset(sysc.preset).mu
             for k in custom:
                 problems.append(problem(f"system.{k}", getattr(sysc, k), "cannot be combined with system.preset (a preset fixes the constants)",
                                          "either system.preset alone, or system.mu, system.lu_km and system.tu_s (and optionally system.radii_km)"))
@@ -114,11 +140,7 @@ class SystemSection(Table):
             for k in ("mu", "lu_km", "tu_s"):
                 if getattr(sysc, k) is None:
                     problems.append(missing(f"system.{k}", f"missing: a custom system (given {', '.join('system.' + c for c in custom)}) needs system.mu, system.lu_km and system.tu_s"))
-            if sysc.mu is not None:
-                mu = sysc.mu
-        else:
-            mu = System.preset("earth-moon").mu
-        return problems, mu
+        return _rules_found(self, problems)
 
 
 class OrbitsSection(Table):
@@ -135,9 +157,12 @@ class OrbitsSection(Table):
     members: int | None = Field(None, ge=1, le=10_000, description="an integer >= 1: that many members evenly spread along the family")
     max_members: int | None = Field(None, ge=2, le=5_000, description="an integer in [2, 5000], the continuation's length (lyapunov and halo)")
 
-    def problems(self, mu: float | None) -> list[str]:
+    @model_validator(mode="after")
+    def _rules(self, info: ValidationInfo) -> OrbitsSection:
         """The rules between this section's keys (what applies to which family, one way to
-        select the members, their ranges; ``mu``: the system's mass ratio, when known)."""
+        select the members, their ranges; the validation context's ``mu``: the system's mass
+        ratio, when known)."""
+        mu = (info.context or {}).get("mu")
         orb, problems = self, []
         if orb.kind == "dro":
             for k in ("point", "branch", "max_members"):
@@ -162,7 +187,7 @@ class OrbitsSection(Table):
                                          "values in (-mu, 1 - mu)"))
             if k == "period_days" and np.any(v <= 0):
                 problems.append(problem("orbits.period_days", grid_raw(orb.period_days), "periods must be > 0 days"))
-        return problems
+        return _rules_found(self, problems)
 
 
 FLEXIBLE_PRESETS = ("sample-station", "sample-station-low-frequency")
@@ -181,7 +206,8 @@ class BodySection(Table):
     mass_kg: float | None = Field(None, gt=0, description="a number > 0, the mass in kg")
     flexible: str | None = None
 
-    def problems(self) -> list[str]:
+    @model_validator(mode="after")
+    def _rules(self) -> BodySection:
         """The rules between this section's keys (Kz, the moments or a flexible body; the
         moments' triangle inequality; a Kz table within [-1, 1])."""
         body, problems = self, []
@@ -218,7 +244,7 @@ class BodySection(Table):
                 v = getattr(body.kz, k)
                 if not -1 <= v <= 1:
                     problems.append(problem(f"body.kz.{k}", v, "Kz must be in [-1, 1]", "a number in [-1, 1]"))
-        return problems
+        return _rules_found(self, problems)
 
 
 class SrpSection(Table):
@@ -244,7 +270,8 @@ class SrpSection(Table):
             data = {("theta_sun0" if k == "theta0" else k): v for k, v in data.items()}
         return data
 
-    def problems(self) -> list[str]:
+    @model_validator(mode="after")
+    def _rules(self) -> SrpSection:
         """The rules between this section's keys (eps or the geometry; cs + cd <= 1)."""
         srp, problems = self, []
         geo = [k for k in ("area_m2", "offset_m") if getattr(srp, k) is not None]
@@ -260,7 +287,7 @@ class SrpSection(Table):
             problems.append(problem("torques.srp.cd", srp.cd, f"cs + cd = {srp.cs + srp.cd:g} exceeds 1 (the absorbed fraction is 1 - cs - cd)"))
         if srp.pressure is not None and srp.eps is not None:
             problems.append(problem("torques.srp.pressure", srp.pressure, "only used with the geometry (area_m2, offset_m); eps already includes it"))
-        return problems
+        return _rules_found(self, problems)
 
 
 class TorquesSection(Table):
@@ -269,12 +296,13 @@ class TorquesSection(Table):
     gravity_gradient: list[Literal["earth", "moon"]] = Field(default_factory=lambda: ["earth", "moon"], description="a list of primaries among 'earth' and 'moon'")
     srp: SrpSection | None = None
 
-    def problems(self) -> list[str]:
-        """The rules between this section's keys (and those of [torques.srp])."""
+    @model_validator(mode="after")
+    def _rules(self) -> TorquesSection:
+        """The rules between this section's keys ([torques.srp] checks its own)."""
         problems: list[str] = []
         if len(set(self.gravity_gradient)) != len(self.gravity_gradient):
             problems.append(problem("torques.gravity_gradient", self.gravity_gradient, "a primary is listed twice"))
-        return problems + (self.srp.problems() if self.srp is not None else [])
+        return _rules_found(self, problems)
 
 
 class RatesSection(Table):
@@ -296,6 +324,83 @@ class AttitudeSection(Table):
     q0: list[float] | None = Field(None, min_length=4, max_length=4, description="four numbers, a unit quaternion (scalar last): the body relative to the synodic frame at t = 0, with attitude.start = 'given' or 'spin'")
     w0: list[float] | None = Field(None, min_length=3, max_length=3, description="three numbers, the inertial rate in body axes (1/TU), with attitude.start = 'given'")
     tol: float | None = Field(None, ge=1e-14, le=1e-6, description="a number in [1e-14, 1e-6], the 3-D corrector's tolerance on the closure (default 1e-12; 1e-10 for NRHOs)")
+
+    @classmethod
+    def model_validate(cls, obj: Any, **kwargs: Any) -> AttitudeSection:
+        """[attitude] is a union discriminated by ``model``: :class:`PlanarAttitude` or
+        :class:`Attitude3D` (a third model, e.g. the ephemeris, is one more member)."""
+        if cls is AttitudeSection:
+            return _ATTITUDE.validate_python(obj, **kwargs)
+        return super().model_validate(obj, **kwargs)
+
+
+_3D_KEYS = ("start", "n", "q0", "w0", "tol")
+
+
+class PlanarAttitude(AttitudeSection):
+    """[attitude] model = "planar" (the default): the planar model, phi and wz."""
+
+    model: Literal["planar"] = "planar"
+
+    @model_validator(mode="after")
+    def _rules(self) -> PlanarAttitude:
+        """The 3-D keys do not apply to the planar model."""
+        return _rules_found(self, [problem(f"attitude.{k}", getattr(self, k), "applies only to attitude.model = \"3d\"",
+                                           "attitude.model = '3d' with it, or leave it out") for k in _3D_KEYS if getattr(self, k) is not None])
+
+
+class Attitude3D(AttitudeSection):
+    """[attitude] model = "3d": the 3-D rigid body (quaternion and three rates), and how a solve starts."""
+
+    model: Literal["3d"]
+
+    def start_on(self, orbits_kind: str | None) -> str:
+        """How a 3-D solve starts: ``start``, else "given" with ``w0``, else "spin" on a halo
+        family, else "planar"."""
+        if self.start is not None:
+            return self.start
+        if self.w0 is not None:
+            return "given"
+        return "spin" if orbits_kind == "halo" else "planar"
+
+    @model_validator(mode="after")
+    def _rules(self, info: ValidationInfo) -> Attitude3D:
+        """The rules between this section's keys: what each start takes (the validation
+        context's ``orbits_kind`` decides the default start), and a unit ``q0``."""
+        start = self.start_on((info.context or {}).get("orbits_kind"))
+        problems: list[str] = []
+        if start == "planar":
+            for k in ("q0", "w0"):
+                if getattr(self, k) is not None:
+                    problems.append(problem(f"attitude.{k}", getattr(self, k), "cannot be combined with attitude.start = \"planar\" (the start is the planar solution: "
+                                             "phi0 = solver.phi0 about Z, wz0 from the rates.wz0 scan)", "attitude.q0 and attitude.w0 with attitude.start = 'given'"))
+        elif start == "spin" and self.w0 is not None:
+            problems.append(problem("attitude.w0", self.w0, "cannot be combined with attitude.start = \"spin\" (the spin is w = (1 + 2 pi n / (K T)) e_Z)",
+                                     "attitude.w0 with attitude.start = 'given'"))
+        if start in ("planar", "spin") and self.n is None:
+            problems.append(missing("attitude.n", f"missing: attitude.start = \"{start}\" needs the net turns n per attitude period"))
+        if start == "given":
+            if self.w0 is None:
+                problems.append(missing("attitude.w0", "missing: attitude.start = \"given\" starts from attitude.w0 (and attitude.q0, default the identity)"))
+            if self.n is not None:
+                problems.append(problem("attitude.n", self.n, "does not apply to attitude.start = \"given\" (the start is attitude.q0, attitude.w0)",
+                                         "attitude.n with attitude.start = 'planar' or 'spin'"))
+        if self.q0 is not None and abs(math.hypot(*self.q0) - 1) > 1e-6:  # finite: the schema refuses inf and nan
+            problems.append(problem("attitude.q0", self.q0, f"must be a unit quaternion (|q0| = {math.hypot(*self.q0):.6g})"))
+        return _rules_found(self, problems)
+
+
+def _model_tag(v: Any) -> str | None:
+    if isinstance(v, dict):
+        m = v.get("model", "planar")
+        return m if m in ("planar", "3d") else None
+    return getattr(v, "model", None)
+
+
+_ATTITUDE = TypeAdapter(Annotated[Annotated[PlanarAttitude, Tag("planar")] | Annotated[Attitude3D, Tag("3d")],
+                                  Discriminator(_model_tag, custom_error_type="attitude_model", custom_error_message="must be 'planar' or '3d'")])
+
+
 
 
 class SolverSection(Table):
@@ -404,11 +509,20 @@ def unknown_key(key: str, value: Any) -> str:
     return text + (f" (did you mean `{(parent + '.') if parent else ''}{hint[0]}`?)" if hint else "")
 
 
-def pydantic_problems(prefix: str, err: ValidationError) -> list[str]:
-    out = []
+def pydantic_problems(prefix: str, err: ValidationError, rules: list[str] | None = None) -> list[str]:
+    """The problems of a section's validation, one line each naming the key: the type problems
+    (returned), and what its rules found (:class:`SectionProblems`; added to ``rules`` when
+    given, else returned after the type problems)."""
+    out: list[str] = []
+    found: list[str] = []
     for e in err.errors():
         key = _dotted(prefix, e["loc"])
-        if e["type"] == "extra_forbidden":
+        if isinstance((e.get("ctx") or {}).get("error"), SectionProblems):
+            found += e["ctx"]["error"].problems
+        elif e["type"] == "attitude_model":  # the discriminator of [attitude]: its model
+            value = e["input"].get("model") if isinstance(e["input"], dict) else e["input"]
+            out.append(problem(f"{key}.model", value, e["msg"]))
+        elif e["type"] == "extra_forbidden":
             out.append(unknown_key(key, e["input"]))
         elif e["type"] == "missing":
             out.append(missing(key, "missing (required)"))
@@ -419,6 +533,9 @@ def pydantic_problems(prefix: str, err: ValidationError) -> list[str]:
             if e["type"] == "model_type":
                 msg = "must be a table"
             out.append(problem(key, e["input"], msg))
+    if rules is None:
+        return out + found
+    rules += found
     return out
 
 

@@ -51,7 +51,9 @@ from .schema import (
     Header,
     OrbitsSection,
     OutputSection,
+    PlanarAttitude,
     RatesSection,
+    SectionProblems,
     SolverSection,
     StudyError,
     SystemSection,
@@ -85,7 +87,7 @@ class Study(Header):
     body: BodySection | None = None
     torques: TorquesSection = Field(default_factory=TorquesSection)
     rates: RatesSection | None = None
-    attitude: AttitudeSection = Field(default_factory=AttitudeSection)
+    attitude: AttitudeSection = Field(default_factory=PlanarAttitude)
     solver: SolverSection = Field(default_factory=SolverSection)
     output: OutputSection = Field(default_factory=OutputSection)
     base_dir: str = Field(".", exclude=True)
@@ -105,22 +107,40 @@ class Study(Header):
             raise ValueError(f"invalid argument `purpose`: must be one of {', '.join(PURPOSES)} or None, got {purpose!r}")
         if not isinstance(data, dict):
             raise StudyError([f"the study must be a table of sections, got {type(data).__name__}"], source)
-        problems: list[str] = []
+        # Type problems are listed in the order of the file, then the sections' own rules (their
+        # validators) in the order of SECTIONS, then the rules between sections. [system] and
+        # [orbits] are validated first: the orbits' rules take the mass ratio, and the default
+        # start of a 3-D [attitude] depends on the family.
+        typed: dict[str, list[str]] = {}
+        ruled: dict[str, list[str]] = {}
         sections: dict[str, Table] = {}
-        for key, value in data.items():
+        context = {"mu": SystemSection().mass_ratio() if "system" not in data else None,
+                   "orbits_kind": OrbitsSection().kind if "orbits" not in data else None}
+        for key in sorted(data, key=lambda k: {"system": 0, "orbits": 1}.get(k, 2)):
+            value = data[key]
             if key in ("title", "description"):
                 if not isinstance(value, str):
-                    problems.append(problem(key, value, "must be a string"))
+                    typed[key] = [problem(key, value, "must be a string")]
             elif key in SECTIONS:
                 if not isinstance(value, dict):
-                    problems.append(problem(key, value, f"must be a table [{key}]", f"a table [{key}] with keys {', '.join(SECTIONS[key].model_fields)}"))
+                    typed[key] = [problem(key, value, f"must be a table [{key}]", f"a table [{key}] with keys {', '.join(SECTIONS[key].model_fields)}")]
                     continue
                 try:
-                    sections[key] = SECTIONS[key].model_validate(value)
+                    sections[key] = SECTIONS[key].model_validate(value, context=context)
                 except ValidationError as err:
-                    problems += pydantic_problems(key, err)
+                    ruled[key] = []
+                    typed[key] = pydantic_problems(key, err, ruled[key])
+                    if not typed[key]:  # the types are right, its own rules failed: the rules between sections still see it
+                        found = [e["ctx"]["error"] for e in err.errors() if e["loc"] == () and isinstance((e.get("ctx") or {}).get("error"), SectionProblems)]
+                        if found:
+                            sections[key] = found[0].section
+                if key == "system" and key in sections:
+                    context["mu"] = sections[key].mass_ratio()
+                if key == "orbits" and key in sections:
+                    context["orbits_kind"] = sections[key].kind
             else:
-                problems.append(unknown_key(key, value))
+                typed[key] = [unknown_key(key, value)]
+        problems = [p for key in data for p in typed.get(key, [])] + [p for key in SECTIONS for p in ruled.get(key, [])]
         # Sections left out take their defaults ([body] and [rates] have none); a section that
         # failed type validation is left out of the checks that involve it.
         valid: dict[str, Table] = {}
@@ -128,7 +148,7 @@ class Study(Header):
             if k in sections:
                 valid[k] = sections[k]
             elif k not in data and k not in ("body", "rates"):
-                valid[k] = model()
+                valid[k] = model.model_validate({}, context=context)
         problems += check_sections(valid, data, purpose)
         if problems:
             raise StudyError(problems, source)

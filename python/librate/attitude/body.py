@@ -40,12 +40,43 @@ def torque_names(torques) -> tuple[str, ...]:
 
 @dataclass(frozen=True)
 class RigidBody:
-    """Principal moments of inertia about the body axes x, y, z (kg m^2, or normalised: only
-    ratios matter for gravity-gradient dynamics). ``mass_kg`` is needed only for the orbital
-    coupling term (thesis eq. 37). Validated: finite numbers >= 0 with Iz > 0, triangle
-    inequality. One zero moment is a thin rod along that axis (Ix = 0 and Iy = Iz: Kz = 1;
-    Iy = 0 and Ix = Iz: Kz = -1), valid for the planar model, which depends only on Kz; the 3-D
-    models need every moment > 0."""
+    """A rigid body by its principal moments of inertia about the body axes x, y, z.
+
+    Only the ratios matter for gravity-gradient dynamics, so normalised moments are accepted; the
+    planar model depends only on Kz. One zero moment is a thin rod along that axis (Ix = 0 and
+    Iy = Iz: Kz = 1; Iy = 0 and Ix = Iz: Kz = -1), valid for the planar model; the 3-D models need
+    every moment > 0.
+
+    Parameters
+    ----------
+    ix, iy, iz : float
+        Principal moments (kg m^2, or normalised): finite, >= 0, Iz > 0, obeying the triangle
+        inequality.
+    mass_kg : float, optional
+        The mass, needed only for the orbital coupling term (thesis eq. 37, ``orbit="coupled"``).
+
+    Attributes
+    ----------
+    kz : float
+        Kz = (Iy - Ix) / Iz, in [-1, 1].
+    moments : (float, float, float)
+        (ix, iy, iz).
+    is_rod : bool
+        One moment is zero.
+
+    Raises
+    ------
+    ValueError
+        A negative, non-finite or zero Iz moment, or moments breaking the triangle inequality.
+
+    Examples
+    --------
+    >>> import librate
+    >>> librate.RigidBody(12.12e6, 89.68e6, 96.95e6).kz
+    0.8
+    >>> librate.RigidBody.from_kz(0.5).kz
+    0.5
+    """
 
     ix: float
     iy: float
@@ -98,9 +129,27 @@ class RigidBody:
 
 
 def quaternion_from_euler(angles: Sequence[float], sequence: str = "123") -> np.ndarray:
-    """Scalar-last quaternion of the body relative to the synodic frame from Euler angles
-    (rad) in a named sequence ("123" = rotations about x, then the new y, then the new z, the
-    thesis's convention; also "321", "313" or any scipy sequence)."""
+    """The scalar-last quaternion of the body relative to the synodic frame from Euler angles.
+
+    Parameters
+    ----------
+    angles : sequence of 3 float
+        The angles (rad).
+    sequence : str, default "123"
+        "123" = rotations about x, then the new y, then the new z (the thesis's convention); also
+        "321", "313" or any scipy rotation sequence.
+
+    Returns
+    -------
+    numpy.ndarray, shape (4,)
+        (qx, qy, qz, qw).
+
+    Examples
+    --------
+    >>> import librate, numpy as np
+    >>> np.round(librate.quaternion_from_euler([0.0, 0.0, np.pi / 2]), 6)
+    array([0.      , 0.      , 0.707107, 0.707107])
+    """
     from scipy.spatial.transform import Rotation
 
     return Rotation.from_euler(EULER_SEQUENCES.get(sequence, sequence), angles).as_quat()

@@ -127,10 +127,38 @@ class AttitudeEquilibrium:
 
 
 def attitude_equilibrium(system: System | str, point, body: RigidBody, q0=None) -> AttitudeEquilibrium:
-    """The linearised 3-D attitude of ``body`` held at the collinear point ``point`` (1, 2, 3)
-    with its principal axes on the synodic axes (``q0``, scalar last; default the identity: body
-    x, y, z on synodic X, Y, Z; any signed permutation of the axes is accepted), gravity gradient
-    of both primaries. See :class:`AttitudeEquilibrium`."""
+    """The linearised 3-D attitude of a body held at a collinear Lagrange point, its principal axes
+    on the synodic axes, under the gravity gradient of both primaries.
+
+    Parameters
+    ----------
+    system : System or str
+        The system.
+    point : {1, 2, 3}
+        The collinear point.
+    body : RigidBody
+        The body (every moment > 0).
+    q0 : array_like, shape (4,), optional
+        The equilibrium attitude, scalar last, body relative to synodic (default the identity:
+        body x, y, z on synodic X, Y, Z); any signed permutation of the axes is accepted.
+
+    Returns
+    -------
+    AttitudeEquilibrium
+        The 6x6 matrix, its eigenvalues, ``stable`` and the moments about the synodic axes.
+
+    Raises
+    ------
+    ValueError
+        A bad point, body or q0 (not a signed axis permutation).
+
+    Examples
+    --------
+    >>> import librate
+    >>> eq = librate.attitude_equilibrium("earth-moon", 1, librate.RigidBody(1.0, 2.0, 2.5))
+    >>> eq.eigenvalues.shape
+    (6,)
+    """
     sys_ = resolve_system(system)
     k = _point(point)
     if not isinstance(body, RigidBody) or body.is_rod:
@@ -162,13 +190,31 @@ def moments_from_ratios(k_x, k_y):
 
 
 def equilibrium_stability(system: System | str, point, *, n: int = 401, k_range: tuple[float, float] = (-1.0, 1.0)):
-    """The linear stability of the equilibrium attitude at ``point`` over the plane of Robinson's
-    inertia ratios k_x = (Iy - Iz)/Ix and k_y = (Iz - Ix)/Iy (thesis Fig. 19), ``n`` x ``n``
-    samples of the open square ``k_range`` (ends excluded: |k| = 1 are thin rods), from the
-    closed-form polynomial. An xarray Dataset over (k_y, k_x) with ``stable`` (bool),
-    ``pitch_stable`` (K3 > 0, the decoupled rotation about Z), ``roll_yaw`` (a code of
-    :data:`ROLL_YAW_REGIONS`), ``max_real`` (the largest real part of the six eigenvalues,
-    1/TU), the polynomial's ``b`` and ``c`` (s^4 + b s^2 + c); attributes: the point, sigma, h."""
+    """The linear stability of the equilibrium attitude at a collinear point over the plane of
+    Robinson's inertia ratios (thesis Fig. 19).
+
+    k_x = (Iy - Iz) / Ix and k_y = (Iz - Ix) / Iy are sampled on an ``n`` x ``n`` grid of the
+    open square ``k_range`` (ends excluded: |k| = 1 are thin rods), from the closed-form
+    characteristic polynomial s^4 + b s^2 + c of the roll-yaw motion and the pitch term.
+
+    Parameters
+    ----------
+    system : System or str
+        The system.
+    point : {1, 2, 3}
+        The collinear point.
+    n : int, default 401
+        Samples per axis.
+    k_range : (float, float), default (-1, 1)
+        The square's range.
+
+    Returns
+    -------
+    xarray.Dataset
+        Over (k_y, k_x): ``stable`` (bool), ``pitch_stable`` (K3 > 0, the decoupled rotation about
+        Z), ``roll_yaw`` (a code of ``ROLL_YAW_REGIONS``), ``max_real`` (the largest real part of
+        the six eigenvalues, 1/TU), ``b`` and ``c``; attributes: the point, sigma, h.
+    """
     import xarray as xr
 
     sys_ = resolve_system(system)

@@ -97,13 +97,28 @@ def _vector2(name: str, value) -> tuple[float, float]:
 
 @dataclass(frozen=True)
 class Appendage:
-    """An appendage mass on a spring: ``mass`` (kg) at ``position`` (m, body axes (x, y), from the
-    undeformed system's centre of mass), deflecting along ``direction`` (normal to the position;
-    normalised) against ``stiffness`` (N/m) and ``damping`` (N s/m, >= 0). ``name`` labels it in
-    figures and files.
+    """An appendage mass on a spring, in the planar flexible model.
 
-    Raises ValueError for a non-positive mass or stiffness, negative damping, a mass at the centre
-    of mass (zero position), a zero direction or one not normal to the arm.
+    Parameters
+    ----------
+    mass : float
+        Mass (kg, > 0).
+    position : (float, float)
+        Position (m) in body axes (x, y), from the undeformed system's centre of mass (not zero).
+    direction : (float, float)
+        The deflection direction, normal to the position (normalised).
+    stiffness : float
+        Spring stiffness (N/m, > 0).
+    damping : float, default 0.0
+        Damping (N s/m, >= 0).
+    name : str, default ""
+        A label in figures and files.
+
+    Raises
+    ------
+    ValueError
+        A non-positive mass or stiffness, negative damping, a mass at the centre of mass, a zero
+        direction or one not normal to the arm.
     """
 
     mass: float
@@ -201,13 +216,33 @@ def _hub(hub) -> RigidBody:
 
 @dataclass(frozen=True)
 class FlexibleBody:
-    """A planar flexible spacecraft: a rigid ``hub`` (a :class:`RigidBody` with ``mass_kg``: its
-    principal moments about its own centre, kg m^2, axes along the body axes; or a pair
-    ``(mass_kg, J0)`` for a hub with inertia J0 about z only) and ``appendages`` (a sequence of
-    :class:`Appendage`, positions from the undeformed system's centre of mass).
+    """A planar flexible spacecraft: a rigid hub with spring-mass appendages.
 
-    Derived: ``total_mass``, ``hub_position`` (the hub centre), ``inertia`` (composite moment about
-    z, kg m^2), ``kz`` and ``principal_angle`` of the rigid composite body (:meth:`rigid_body`).
+    Parameters
+    ----------
+    hub : RigidBody or (float, float)
+        A `RigidBody` with ``mass_kg`` (its principal moments about its own centre, kg m^2, axes
+        along the body axes), or a pair ``(mass_kg, J0)`` for a hub with inertia J0 about z only.
+    appendages : sequence of Appendage
+        Positions from the undeformed system's centre of mass.
+    name : str, default "custom"
+        A label.
+
+    Attributes
+    ----------
+    total_mass : float
+        kg.
+    hub_position : numpy.ndarray
+        The hub centre (m).
+    inertia : float
+        The composite moment about z (kg m^2).
+    kz, principal_angle : float
+        Of the rigid composite body (`FlexibleBody.rigid_body`).
+
+    Raises
+    ------
+    ValueError
+        A bad hub or appendage.
     """
 
     hub: RigidBody
@@ -583,19 +618,44 @@ def quasi_static(
     atol: float = 1e-12,
     max_steps: int = 1_000_000,
 ) -> QuasiStaticResponse:
-    """High structural frequencies: the quasi-static closed form along the rigid solution.
+    """The quasi-static response of a stiff flexible body along its rigid solution (high structural
+    frequencies).
 
     The rigid composite body (the flexible body frozen undeformed) is propagated from
-    ``attitude = (phi0, wz0)`` (phi of the body x axis, wz inertial). Along it, the transverse load
-    on m_j is L_j = m_j [t_j . T_B b_j - wzdot (b_j x t_j)] (tidal + Euler; the centrifugal part
-    vanishes because t_j is normal to b_j), and the deflection is q_j = L_j / k_j
-    = L_j / (m_j Omega_j^2), less the damper's lag c_j L_j' / k_j^2 (a relative
-    2 zeta_j rate / Omega_j), with its derivatives in closed form from the orbit's velocity and
-    acceleration. Fed back into the attitude equation, it gives the torque perturbation
-    dtau = sum_j [dtau/dq_j q_j - m_j (b_j x t_j) qddot_j] and the attitude perturbation
-    (dphi, dwz) from the rigid variational equation forced by dtau / I0 (Duhamel's integral along
-    the rigid solution). Valid when Omega_j >> the orbital and attitude rates: the full model
-    differs from q by a relative O((rate / Omega)^2).
+    ``attitude``. Along it the transverse load on m_j is L_j = m_j [t_j . T_B b_j - wzdot (b_j x
+    t_j)] (tidal + Euler) and the deflection q_j = L_j / k_j, less the damper's lag, with its
+    derivatives in closed form. Fed back into the attitude equation, it gives the torque
+    perturbation and the attitude perturbation (dphi, dwz) from the rigid variational equation
+    (Duhamel's integral). Valid when every Omega_j is much larger than the orbital and attitude
+    rates: the full model differs by a relative O((rate / Omega)^2).
+
+    Parameters
+    ----------
+    system : System or str
+        The system.
+    orbit_state : array_like, shape (6,)
+        The initial orbit state.
+    attitude : (float, float)
+        (phi0, wz0): the angle of the body x axis (rad) and the inertial rate (1/TU).
+    body : FlexibleBody
+        The body.
+    t_span : float or (float, float)
+        Final time, or (t0, tf), in TU.
+    torques : sequence of str, default ("gravity_gradient",)
+        Torque names.
+    orbit : {"integrate", "held"}
+        As in `propagate_attitude`.
+    t_eval : array_like, optional
+        Output times.
+    rtol, atol : float, default 1e-12
+        Tolerances.
+    max_steps : int
+        Step limit.
+
+    Returns
+    -------
+    QuasiStaticResponse
+        The deflections, their rates and the attitude perturbation along the rigid solution.
     """
     sys_, s, t0, tf, names = flexible_run_inputs(system, orbit_state, body, t_span, torques, orbit)
     phi0, wz0 = flexible_attitude(attitude)

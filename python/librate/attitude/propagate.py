@@ -28,11 +28,37 @@ __all__ = ["AttitudeTrajectory", "propagate_attitude"]
 
 @dataclass(frozen=True)
 class AttitudeTrajectory:
-    """Result of :func:`propagate_attitude`: ``t`` (n,), ``orbit`` (n, 6), ``q`` (n, 4, scalar
-    last), ``w`` (n, 3, inertial rate in body axes); planar runs also ``phi`` and ``wz`` (n,).
-    ``stm``: 13x13 (3-D) or 2x2 (planar, d(phi, wz)) at the final time, when asked.
-    ``flex``: for a :class:`~librate.FlexibleBody`, the deflections ``flex.q`` (n, appendages; m)
-    and their rates ``flex.qdot`` (m/TU) (:class:`~librate.attitude.FlexibleResponse`); else None."""
+    """The result of `propagate_attitude`.
+
+    Attributes
+    ----------
+    system : System
+        The system.
+    body : RigidBody
+        The body.
+    torque_models : tuple of str
+        The torques integrated.
+    planar : bool
+        The reduced planar model was integrated.
+    t : numpy.ndarray, shape (n,)
+        Times (TU).
+    orbit : numpy.ndarray, shape (n, 6)
+        The orbit states.
+    q : numpy.ndarray, shape (n, 4)
+        Scalar-last quaternions of the body relative to the synodic frame.
+    w : numpy.ndarray, shape (n, 3)
+        Inertial angular velocity in body axes (1/TU).
+    phi, wz : numpy.ndarray, shape (n,) or None
+        Planar runs: the angle of the body x axis from the synodic X axis (rad) and the inertial
+        rate (1/TU).
+    stm : numpy.ndarray or None
+        When asked: 13x13 (3-D) or 2x2 (planar, d(phi, wz)) at the final time.
+    stats : Stats
+        Step statistics.
+    flex : FlexibleResponse or None
+        For a `FlexibleBody`: the deflections ``flex.q`` (n, appendages; m) and their rates
+        ``flex.qdot`` (m/TU).
+    """
 
     system: System
     body: RigidBody
@@ -119,23 +145,72 @@ def propagate_attitude(
 ) -> AttitudeTrajectory:
     """Propagate the attitude of a rigid body along its CR3BP orbit.
 
-    ``attitude`` is ``(q, w)`` in 3-D (q scalar-last unit quaternion of the body relative to the
-    synodic frame, w the inertial angular velocity in body axes) or ``(phi0, wz0)`` when
-    ``planar`` (the reduced model; wz inertial, phidot = wz - 1). ``torques``: names from
-    :data:`TORQUES` ("gravity_gradient_earth" alone is the two-body limit). ``orbit``:
-    "integrate" (point-mass CR3BP), "held" (the body kept at its initial position, as at the
-    Lagrange points) or "coupled" (with the second-order extended-body acceleration, thesis
-    eq. 37, which needs ``body.mass_kg``; inertia in kg m^2 and the system's LU).
+    Parameters
+    ----------
+    system : System or str
+        The system, or a preset name.
+    orbit_state : array_like, shape (6,)
+        The initial orbit state (nondimensional).
+    attitude : (q, w) or (phi0, wz0)
+        3-D: q the scalar-last unit quaternion of the body relative to the synodic frame and w
+        the inertial angular velocity in body axes (1/TU); ``planar`` (or a `FlexibleBody`): the
+        angle phi0 (rad) and the inertial rate wz0 (1/TU; phidot = wz - 1).
+    body : RigidBody, FacetBody or FlexibleBody
+        The body; a `FlexibleBody` runs the planar flexible model.
+    t_span : float or (float, float)
+        Final time tf, or (t0, tf), in TU.
+    torques : sequence of str, default ("gravity_gradient",)
+        Torque names (``librate.attitude.TORQUES``); "gravity_gradient_earth" alone is the
+        two-body limit; "srp" with a `FacetBody` (3-D).
+    planar : bool, default False
+        The reduced planar model.
+    orbit : {"integrate", "held", "coupled"}
+        "integrate": the point-mass CR3BP; "held": the body kept at its initial position (as at
+        the Lagrange points); "coupled": with the second-order extended-body acceleration (thesis
+        eq. 37; needs ``body.mass_kg``, inertia in kg m^2).
+    srp : FlatPlate, optional
+        Planar runs: the simplified SRP plate.
+    sun : Sun, optional
+        3-D SRP: the Sun (default phase 0).
+    srp_force : bool, default False
+        3-D SRP: also apply the SRP force to the orbit (needs ``body.mass_kg``).
+    stm : bool, default False
+        Also integrate the variational equations (13x13 in 3-D, 2x2 planar).
+    t_eval : array_like, optional
+        Output times instead of every accepted step.
+    rtol, atol : float, default 1e-12
+        Error tolerances.
+    h0, h_min, h_max, max_steps, safety, fixed_step
+        Step control, as in `propagate`.
+    deflection : None, "quasi-static" or (q0, qdot0)
+        A `FlexibleBody`'s initial deflections: undeformed at rest, the closed-form quasi-static
+        ones, or given (m, m/TU).
 
-    Solar radiation pressure: planar runs take ``srp=FlatPlate(...)`` (the simplified plate);
-    3-D runs take a :class:`librate.FacetBody` with "srp" among ``torques`` (inertia in kg m^2),
-    the Sun from ``sun`` (a :class:`librate.Sun`, default phase 0), and ``srp_force=True``
-    adds the SRP force to the orbit (needs ``body.mass_kg``; off by default). Both SRP models
-    are integrated piecewise between the faces' Sun-terminator crossings (the plate law is C1).
+    Returns
+    -------
+    AttitudeTrajectory
+        Times, orbit, quaternions, rates (and phi, wz when planar; the STM when asked).
 
-    A :class:`~librate.FlexibleBody` runs the planar flexible model (whatever ``planar``):
-    ``attitude = (phi0, wz0)``, ``deflection`` None (undeformed, at rest), "quasi-static" (on the
-    closed-form deflection) or (q0 in m, qdot0 in m/TU); the deflections are in ``traj.flex``.
+    Raises
+    ------
+    ValueError
+        A bad argument, naming it and the allowed values.
+    IntegrationError
+        The integration cannot reach tf.
+
+    Notes
+    -----
+    Both SRP models are integrated piecewise between the faces' Sun-terminator crossings (the
+    plate law is only C1 there).
+
+    Examples
+    --------
+    >>> import librate
+    >>> dro = librate.dro(period_days=12.66)
+    >>> body = librate.RigidBody.from_kz(0.8)
+    >>> tr = librate.propagate_attitude("earth-moon", dro.state0, (0.0, 1.0), body, dro.period, planar=True)
+    >>> tr.phi.shape == tr.t.shape
+    True
     """
     sys_ = resolve_system(system)
     s = as_state(orbit_state, "orbit_state")

@@ -24,8 +24,24 @@ __all__ = ["Sun", "Facet", "FacetBody", "FlatPlate"]
 
 @dataclass(frozen=True)
 class Sun:
-    """The apparent Sun: phase ``theta0`` (rad, from the synodic X axis at t = 0) and pressure
-    (N/m^2, 4.56e-6 at 1 AU)."""
+    """The apparent Sun, seen from the Earth-Moon synodic frame.
+
+    Parameters
+    ----------
+    theta0 : float, default 0.0
+        The Sun's phase: its angle from the synodic X axis at t = 0 (rad).
+    pressure : float, default 4.56e-6
+        Solar radiation pressure (N/m^2; 4.56e-6 at 1 AU).
+
+    Raises
+    ------
+    ValueError
+        A non-finite phase, or a negative pressure.
+
+    See Also
+    --------
+    - [`Sun.at_epoch`][librate.attitude.srp.Sun.at_epoch]: the Sun's phase at a calendar epoch.
+    """
 
     theta0: float = 0.0
     pressure: float = SOLAR_PRESSURE_1AU
@@ -63,9 +79,25 @@ class Sun:
 
 @dataclass(frozen=True)
 class Facet:
-    """A flat surface element: ``area`` (m^2), outward ``normal`` and centre of pressure
-    ``center`` (m, from the centre of mass) in body axes, and the fractions of light absorbed
-    (``ca``), reflected specularly (``cs``) and diffusely (``cd``), summing to one."""
+    """A flat surface element of a spacecraft, for solar radiation pressure.
+
+    Parameters
+    ----------
+    area : float
+        Area (m^2, > 0).
+    normal : (float, float, float)
+        Outward normal in body axes (normalised).
+    center : (float, float, float), default (0, 0, 0)
+        Centre of pressure (m, from the centre of mass, body axes).
+    ca, cs, cd : float
+        Fractions of the light absorbed, reflected specularly and reflected diffusely: each in
+        [0, 1], summing to one.
+
+    Raises
+    ------
+    ValueError
+        A bad area, a zero normal, or fractions outside [0, 1] or not summing to one.
+    """
 
     area: float
     normal: tuple[float, float, float]
@@ -108,8 +140,23 @@ def force_torque(facets, sun_body) -> tuple[np.ndarray, np.ndarray]:
 
 @dataclass(frozen=True)
 class FacetBody(RigidBody):
-    """A rigid body (principal moments ix, iy, iz in kg m^2, ``mass_kg``) with a surface made of
-    :class:`Facet` elements for solar radiation pressure."""
+    """A rigid body with a surface of `Facet` elements, for the 3-D SRP torque and force.
+
+    Parameters
+    ----------
+    ix, iy, iz : float
+        Principal moments of inertia (kg m^2).
+    mass_kg : float, optional
+        The mass, needed for the SRP force on the orbit (``srp_force=True``).
+    facets : tuple of Facet
+        The surface.
+
+    See Also
+    --------
+    - [`FacetBody.flat_plate`][librate.attitude.srp.FacetBody.flat_plate],
+      [`FacetBody.two_sided_panel`][librate.attitude.srp.FacetBody.two_sided_panel],
+      [`FacetBody.box_with_arrays`][librate.attitude.srp.FacetBody.box_with_arrays]: ready-made surfaces.
+    """
 
     facets: tuple = field(default=())
 
@@ -156,12 +203,41 @@ class FacetBody(RigidBody):
 
 @dataclass(frozen=True)
 class FlatPlate:
-    """The simplified planar SRP model (docs/physics.md, solar radiation pressure): one two-sided flat plate with normal
-    x_B and centre of pressure offset d along y_B; with alpha the Sun's angle in body axes,
-    wzdot_srp = eps [(1 + Cs) cos(alpha)|cos(alpha)| + (2/3) Cd cos(alpha)],
-    eps = P A d TU^2 / Iz (nondimensional; eps = P (A/m) TU^2 d / k^2 = 1.03e4 d/k^2 with d and k
-    in metres for A/m = 0.016 m^2/kg and the default TU: the often quoted "about 10 d/k^2
-    per metre" holds with d and k in km)."""
+    """The simplified planar SRP model (docs/physics.md, solar radiation pressure).
+
+    One two-sided flat plate with normal x_B and centre of pressure offset d along y_B; with
+    alpha the Sun's angle in body axes,
+    wzdot_srp = eps [(1 + Cs) cos(alpha) |cos(alpha)| + (2/3) Cd cos(alpha)],
+    eps = P A d TU^2 / Iz (nondimensional; eps = P (A/m) TU^2 d / k^2 = 1.03e4 d / k^2 with d and
+    k in metres for A/m = 0.016 m^2/kg and the default TU: the often quoted "about 10 d / k^2 per
+    metre" holds with d and k in km).
+
+    Parameters
+    ----------
+    eps : float
+        The plate amplitude (nondimensional, any sign).
+    cs, cd : float, default 0.0
+        Specular and diffuse reflection fractions, each in [0, 1], cs + cd <= 1 (absorbed: ca =
+        1 - cs - cd).
+    sun : Sun, default Sun()
+        The Sun (phase and pressure).
+
+    Raises
+    ------
+    ValueError
+        A non-finite eps, or fractions out of range.
+
+    See Also
+    --------
+    - [`FlatPlate.from_geometry`][librate.attitude.srp.FlatPlate.from_geometry]: eps from the plate's area, offset and the body's Iz.
+
+    Examples
+    --------
+    >>> import librate
+    >>> plate = librate.FlatPlate(0.02, cs=0.4)
+    >>> round(plate.ca, 6)
+    0.6
+    """
 
     eps: float
     cs: float = 0.0

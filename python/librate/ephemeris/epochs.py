@@ -1,13 +1,16 @@
 """Epochs: ISO strings with a time scale (TDB, TT, UTC) or TDB seconds past J2000.
 
 UTC goes to TT through pyerfa (the IAU SOFA library: its leap-second table), TT to TDB by
-``erfa.dtdb`` (Fairhead & Bretagnon series, geocentre).
+``erfa.dtdb`` (Fairhead & Bretagnon series, geocentre). A UTC epoch past the table's reach
+(leap seconds are announced six months ahead) takes the table's last offset TAI - UTC: the
+only value there is, so pyerfa's "dubious year" warning for such epochs is not passed on.
 """
 
 from __future__ import annotations
 
 import math
 import re
+import warnings
 
 __all__ = ["tdb_seconds", "iso_tdb"]
 
@@ -42,14 +45,17 @@ def tdb_seconds(epoch: str | float) -> float:
 
     y, mo, d, h, mi = (int(m.group(i)) for i in range(1, 6))
     sec, scale = float(m.group(6)), m.group(7)
-    try:
-        d1, d2 = erfa.dtf2d("UTC" if scale == "UTC" else scale, y, mo, d, h, mi, sec)
-    except Exception as exc:  # erfa raises on an impossible date or time of day
-        raise ValueError(f"epoch: {epoch!r} is not a valid date and time: {exc}") from exc
-    d1, d2 = float(d1), float(d2)
-    if scale == "UTC":
-        d1, d2 = (float(x) for x in erfa.utctai(d1, d2))
-        d1, d2 = (float(x) for x in erfa.taitt(d1, d2))
+    with warnings.catch_warnings():
+        # a UTC epoch beyond the leap-second table: the last offset applies (module docstring)
+        warnings.filterwarnings("ignore", message=r".*dubious year", category=erfa.ErfaWarning)
+        try:
+            d1, d2 = erfa.dtf2d("UTC" if scale == "UTC" else scale, y, mo, d, h, mi, sec)
+        except Exception as exc:  # erfa raises on an impossible date or time of day
+            raise ValueError(f"epoch: {epoch!r} is not a valid date and time: {exc}") from exc
+        d1, d2 = float(d1), float(d2)
+        if scale == "UTC":
+            d1, d2 = (float(x) for x in erfa.utctai(d1, d2))
+            d1, d2 = (float(x) for x in erfa.taitt(d1, d2))
     if scale in ("UTC", "TT"):
         # TDB = TT + dtdb; the TT Julian date serves as the argument (the difference is < 2 ms)
         return ((d1 - _J2000_JD) + d2) * _S_PER_DAY + _tt_to_tdb(d1, d2)

@@ -45,15 +45,24 @@ def _coefficients(value, name: str) -> np.ndarray:
 class FourierOrbit:
     """A periodic orbit as a truncated Fourier series (nondimensional units).
 
-    ``a0`` is the mean position (3,), ``cos[n - 1]`` and ``sin[n - 1]`` the (x, y, z)
-    coefficients of cos(2 pi n t / T) and sin(2 pi n t / T), n = 1..N.
-
-    The remaining fields describe how a series from :func:`fit_fourier` was obtained (``None``
-    for a series built by hand): ``jacobi_error`` is the maximum over the check times of the
-    relative Jacobi-constant error |C_series(t) - C0| / |C0|, with C = 2U - |v|^2 evaluated
-    from the series' positions and velocities; ``jacobi_history[k]`` is that error with k + 1
-    harmonics; ``position_error`` and ``velocity_error`` are the maximum distances from the
-    integrated orbit at the check times (midway between the fit samples).
+    Parameters
+    ----------
+    period : float
+        The period T (TU).
+    a0 : numpy.ndarray, shape (3,)
+        The mean position.
+    cos, sin : numpy.ndarray, shape (N, 3)
+        ``cos[n - 1]`` and ``sin[n - 1]``: the (x, y, z) coefficients of cos(2 pi n t / T) and
+        sin(2 pi n t / T), n = 1..N.
+    system : System, optional
+        The system (for the Jacobi constant).
+    jacobi0, jacobi_error, jacobi_history, position_error, velocity_error : optional
+        How a series from `fit_fourier` was obtained (None for a series built by hand):
+        ``jacobi_error`` is the largest relative Jacobi-constant error |C_series(t) - C0| / |C0|
+        over the check times, with C = 2U - |v|^2 from the series' positions and velocities;
+        ``jacobi_history[k]`` that error with k + 1 harmonics; ``position_error`` and
+        ``velocity_error`` the largest distances from the integrated orbit at the check times
+        (midway between the fit samples).
     """
 
     period: float
@@ -163,22 +172,54 @@ def fit_fourier(
     rtol: float = 1e-13,
     atol: float = 1e-13,
 ) -> FourierOrbit:
-    """Fourier series of the periodic orbit through ``state0`` with period ``period`` (TU).
+    """The Fourier series of a periodic orbit (thesis Fig. 22).
 
-    The orbit is integrated over one period (``librate.propagate`` at ``rtol``, ``atol``) and
-    sampled at ``n_samples`` uniform times t_k = k T / n_samples; the coefficients of each
-    coordinate are the least-squares fit of the series with N harmonics to these samples. The
-    fit is checked at the midpoints between samples, which it has not seen.
+    The orbit is integrated over one period and sampled at ``n_samples`` uniform times t_k = k T
+    / n_samples; the coefficients of each coordinate are the least-squares fit of the series with
+    N harmonics. The fit is checked at the midpoints between samples, which it has not seen.
+    Without ``n_harmonics``, N = 1, 2, ... up to ``max_harmonics`` is tried and the smallest N
+    whose largest relative Jacobi-constant error is below ``jacobi_tol`` is returned.
 
-    With ``n_harmonics`` given, that N is used. Otherwise N = 1, 2, ... up to ``max_harmonics``
-    is tried and the smallest N whose maximum relative Jacobi-constant error from the series,
-    |C(t) - C0| / |C0| with C = 2U - |v|^2 from the series' positions and velocities, is below
-    ``jacobi_tol`` is returned (thesis Fig. 22); the errors of every N tried are in
-    ``jacobi_history``. ``n_samples`` defaults to max(1024, 8 N_max) and must exceed 4 N_max.
+    Parameters
+    ----------
+    system : System or str
+        The system.
+    state0 : array_like, shape (6,)
+        A state on the periodic orbit.
+    period : float
+        Its period (TU).
+    n_harmonics : int, optional
+        Use this N.
+    jacobi_tol : float, default 1e-6
+        The relative Jacobi-constant error to reach.
+    max_harmonics : int, default 60
+        The largest N tried.
+    n_samples : int, optional
+        Default max(1024, 8 N_max); must exceed 4 N_max.
+    closure_tol : float, default 1e-7
+        How closely ``state0`` must return to itself after ``period`` (relative to the orbit's size).
+    rtol, atol : float, default 1e-13
+        Integration tolerances.
 
-    Raises ``ValueError`` for bad arguments, including a ``state0`` that does not return to
-    itself after ``period`` within ``closure_tol`` (relative to the orbit's size), and
-    :class:`librate.ConvergenceError` when no N <= ``max_harmonics`` meets ``jacobi_tol``.
+    Returns
+    -------
+    FourierOrbit
+        The series, with its errors (``jacobi_history``: every N tried).
+
+    Raises
+    ------
+    ValueError
+        A bad argument, or a ``state0`` that does not close after ``period``.
+    ConvergenceError
+        No N <= ``max_harmonics`` meets ``jacobi_tol``.
+
+    Examples
+    --------
+    >>> import librate
+    >>> dro = librate.dro(period_days=12.66)
+    >>> series = librate.fit_fourier(dro.system, dro.state0, dro.period)
+    >>> series.jacobi_error < 1e-6
+    True
     """
     sys_ = resolve_system(system)
     s0 = as_state(state0, "state0")

@@ -85,9 +85,28 @@ def _eci_nondim(mu: float, t: np.ndarray, s: np.ndarray, theta0: float) -> tuple
 
 
 def synodic_to_eci(system: System | str, t, states, theta0: float = 0.0) -> np.ndarray:
-    """Synodic states (nondimensional, (6,) or (n, 6)) at time(s) t to Earth-centred inertial
-    states in km and km/s (same shape). ``theta0`` is the angle of the synodic x axis from the ECI
-    X axis at t = 0 (rad)."""
+    """Synodic states to Earth-centred inertial states in km and km/s.
+
+    Parameters
+    ----------
+    system : System or str
+        The system.
+    t : float or array_like
+        Time(s) (TU).
+    states : array_like, shape (6,) or (n, 6)
+        Synodic nondimensional states.
+    theta0 : float, default 0.0
+        The angle of the synodic x axis from the ECI X axis at t = 0 (rad).
+
+    Returns
+    -------
+    numpy.ndarray
+        ECI states (km, km/s), the shape of ``states``.
+
+    See Also
+    --------
+    - [`eci_to_synodic`][librate.orbits.frames.eci_to_synodic]: the inverse.
+    """
     sys_ = resolve_system(system)
     ta, s, single = _times_states(t, states)
     r, v = _eci_nondim(sys_.mu, ta, s, _check_angle(theta0))
@@ -96,8 +115,25 @@ def synodic_to_eci(system: System | str, t, states, theta0: float = 0.0) -> np.n
 
 
 def eci_to_synodic(system: System | str, t, states_km, theta0: float = 0.0) -> np.ndarray:
-    """Inverse of :func:`synodic_to_eci`: Earth-centred inertial states (km, km/s) at time(s) t to
-    synodic nondimensional states."""
+    """Earth-centred inertial states (km, km/s) to synodic nondimensional states: the inverse of
+    `synodic_to_eci`.
+
+    Parameters
+    ----------
+    system : System or str
+        The system.
+    t : float or array_like
+        Time(s) (TU).
+    states_km : array_like, shape (6,) or (n, 6)
+        ECI states (km, km/s).
+    theta0 : float, default 0.0
+        The angle of the synodic x axis from the ECI X axis at t = 0 (rad).
+
+    Returns
+    -------
+    numpy.ndarray
+        Synodic states, the shape of ``states_km``.
+    """
     sys_ = resolve_system(system)
     ta, s, single = _times_states(t, states_km, "states_km")
     theta = _check_angle(theta0) + ta
@@ -152,9 +188,27 @@ def _elements(gm: float, r: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, ...]
 
 
 def osculating_elements(system: System | str, t, states, theta0: float = 0.0) -> OsculatingElements:
-    """Osculating Keplerian elements about the Earth of synodic states (nondimensional, (6,)
-    or (n, 6)) at time(s) t, after :func:`synodic_to_eci` with ``theta0``; GM = 1 - mu in
-    nondimensional units. Returns :class:`OsculatingElements` with arrays of length n."""
+    """Osculating Keplerian elements about the Earth of synodic states.
+
+    The states go to the ECI frame (`synodic_to_eci` with ``theta0``); GM = 1 - mu in
+    nondimensional units.
+
+    Parameters
+    ----------
+    system : System or str
+        The system.
+    t : float or array_like
+        Time(s) (TU).
+    states : array_like, shape (6,) or (n, 6)
+        Synodic nondimensional states.
+    theta0 : float, default 0.0
+        The synodic x axis's ECI angle at t = 0 (rad).
+
+    Returns
+    -------
+    OsculatingElements
+        Arrays of length n (a, e, i, the node, the argument of perigee, the anomaly).
+    """
     sys_ = resolve_system(system)
     ta, s, _ = _times_states(t, states)
     r, v = _eci_nondim(sys_.mu, ta, s, _check_angle(theta0))
@@ -201,14 +255,36 @@ def mean_elements(
     rtol: float = 1e-13,
     atol: float = 1e-13,
 ) -> MeanElements:
-    """Mean osculating elements about the Earth along a periodic orbit and its apsidal drift.
+    """Mean osculating elements about the Earth along a periodic orbit, and its apsidal drift
+    (thesis Table 1).
 
-    The synodic orbit through ``orbit_state0`` is propagated over ``n_periods`` periods and
-    sampled at ``samples_per_period`` uniform times per period (t_k = k T / samples, the end of a
-    period belonging to the next); the osculating a, e and argument of perigee are averaged over
-    each period. See :class:`MeanElements`. A synodic orbit of period T returns rotated by T in
-    the ECI frame, so its drift per period is T - 2 pi modulo 2 pi; the 1:1 resonant DRO
-    (T = 2 pi) has none (thesis Table 1).
+    The synodic orbit is propagated over ``n_periods`` periods and sampled at
+    ``samples_per_period`` uniform times per period; the osculating a, e and argument of perigee
+    are averaged over each period. A synodic orbit of period T returns rotated by T in the ECI
+    frame, so its drift per period is T - 2 pi modulo 2 pi; the 1:1 resonant DRO (T = 2 pi) has
+    none.
+
+    Parameters
+    ----------
+    system : System or str
+        The system.
+    orbit_state0 : array_like, shape (6,)
+        The orbit's initial state.
+    period : float
+        Its period (TU).
+    n_periods : int, default 3
+        Periods averaged.
+    samples_per_period : int, default 2000
+        Samples per period.
+    theta0 : float, default 0.0
+        The synodic x axis's ECI angle at t = 0 (rad).
+    rtol, atol : float, default 1e-13
+        Integration tolerances.
+
+    Returns
+    -------
+    MeanElements
+        The per-period means and the apsidal drift.
     """
     sys_ = resolve_system(system)
     s0 = as_state(orbit_state0, "orbit_state0")

@@ -40,11 +40,51 @@ def real_if_real(nu) -> np.ndarray:
 class PeriodicOrbit:
     """A corrected periodic orbit.
 
-    ``state0`` (6,) starts on the x-z plane, perpendicular to it; ``period`` is in TU
-    (``period_days`` in days); ``jacobi`` the Jacobi constant. ``monodromy``,
-    ``eigenvalues`` and ``stability_indices`` are computed on first use (one propagation
-    over the period with the STM). Stability indices are nu = (lambda + 1/lambda)/2 of the
-    non-trivial pairs: [in-plane, out-of-plane] for planar orbits; stable when |nu| <= 1.
+    Made by the correctors (`correct_symmetric`, `correct_periodic`, `dro`, `halo`, ...) and the
+    families. ``monodromy``, ``eigenvalues`` and ``stability_indices`` are computed on first use
+    (one propagation over the period with the STM).
+
+    Parameters
+    ----------
+    system : System
+        The system.
+    state0 : numpy.ndarray, shape (6,)
+        The initial state; symmetric orbits start on the x-z plane, perpendicular to it.
+    period : float
+        The period (TU).
+    jacobi : float
+        The Jacobi constant.
+    family : str, default "symmetric"
+        The family's name ("dro", "lyapunov-L1", "halo-L2-south", ...).
+    iterations : int
+        The corrector's Newton iterations.
+    residual : float
+        The corrector's final residual.
+
+    Attributes
+    ----------
+    x0, z0, vy0 : float
+        Components of ``state0``.
+    planar : bool
+        z0 = 0 and no out-of-plane velocity.
+    period_days : float
+        The period in days.
+    monodromy : numpy.ndarray, shape (6, 6)
+        The state transition matrix over one period.
+    eigenvalues : numpy.ndarray
+        The monodromy's eigenvalues.
+    stability_indices : numpy.ndarray
+        nu = (lambda + 1/lambda) / 2 of the non-trivial pairs: [in-plane, out-of-plane] for
+        planar orbits; stable when |nu| <= 1.
+    is_stable : bool
+        Every |nu| <= 1.
+
+    Examples
+    --------
+    >>> import librate
+    >>> dro = librate.dro(period_days=12.66)
+    >>> round(dro.period_days, 2), bool(dro.planar)
+    (12.66, True)
     """
 
     system: System
@@ -141,8 +181,13 @@ class Geometry:
 
 def geometry(orbit: PeriodicOrbit) -> Geometry:
     """Winding numbers (signed turns of the projected position about each primary over one
-    period) and closest approaches, from the integrated orbit."""
-    tr = orbit.propagate(rtol=1e-11, atol=1e-11)
+    period) and closest approaches, from the integrated orbit (at rtol = atol = 1e-11, point
+    masses; the orbit's fields were checked when it was made)."""
+    from .propagation import collision_radii, integrate, tolerance_options
+
+    sys_ = orbit.system
+    tr = integrate(sys_, np.ascontiguousarray(orbit.state0, dtype=float), 0.0, float(orbit.period), tolerance_options(1e-11, 1e-11),
+                   collision_radii(sys_, "point"))
     y = tr.y
     wind, dmin = [], []
     for c in orbit.system.primary_positions():
@@ -261,16 +306,59 @@ def correct_symmetric(
 ) -> PeriodicOrbit:
     """Correct an orbit symmetric about the x-z plane by half-period single shooting.
 
-    ``guess`` is (x0, z0, vy0) (or a full (6,) state on the plane). The unknowns are (x0, vy0)
-    for planar orbits and (x0, z0, vy0) in 3-D; one extra condition closes the Newton system:
-    ``fix`` one unknown ("x0", "z0" or "vy0") at its guessed value, or a target ``period`` (TU),
-    or a target ``jacobi`` constant. Raises :class:`librate.ConvergenceError` on failure.
+    The unknowns are (x0, vy0) for planar orbits and (x0, z0, vy0) in 3-D; one extra condition
+    closes the Newton system: ``fix`` one unknown at its guessed value, or a target ``period``,
+    or a target ``jacobi`` constant.
 
-    ``collision`` ("radius" by default, as :func:`librate.propagate`): a corrected orbit that
-    passes within a primary's radius over its period raises :class:`librate.CollisionError`
-    naming the primary, the closest approach (km) and the radius
-    (:func:`check_outside_primaries`); ``"point"``: only the singular points count; ``None``:
-    no check (the bare point-mass solution).
+    Parameters
+    ----------
+    system : System or str
+        The system.
+    guess : array_like
+        (x0, z0, vy0), or a full (6,) state on the plane.
+    spatial : bool, default False
+        Correct in 3-D (z0 free).
+    fix : {"x0", "z0", "vy0", None}
+        The unknown held at its guess (None with ``period`` or ``jacobi``).
+    period : float, optional
+        A target period (TU).
+    jacobi : float, optional
+        A target Jacobi constant.
+    family : str, default "symmetric"
+        The name stored on the orbit.
+    tol : float, default 1e-11
+        Newton tolerance on the half-period crossing residuals.
+    max_iter : int, default 40
+        Newton iterations.
+    t_max : float, default 50.0
+        The longest half period searched for the x-z plane crossing (TU).
+    rtol, atol : float, default 1e-13
+        Integration tolerances.
+    collision : {"radius", "point", None}
+        As in `propagate`: a corrected orbit that passes within a primary's radius over its
+        period raises `CollisionError` naming the primary, the closest approach (km) and the
+        radius; ``"point"``: only the singular points count; ``None``: no check.
+
+    Returns
+    -------
+    PeriodicOrbit
+        The corrected orbit.
+
+    Raises
+    ------
+    ConvergenceError
+        Newton did not converge (with ``iterations``, ``residual``, ``tolerance``).
+    CollisionError
+        The orbit passes within a primary's radius.
+    ValueError
+        A bad argument, naming it.
+
+    Examples
+    --------
+    >>> import librate
+    >>> orbit = librate.correct_symmetric("earth-moon", (0.8, 0.0, 0.5), fix="x0")
+    >>> round(orbit.x0, 6), orbit.family
+    (0.8, 'symmetric')
     """
     sys_ = resolve_system(system)
     collision_mode(collision)
@@ -331,16 +419,50 @@ def correct_periodic(
     atol: float = SHOOT_ATOL,
     collision: str | None = "radius",
 ) -> PeriodicOrbit:
-    """Correct a periodic orbit with no symmetry assumed, by single (one state) or multiple
-    shooting (patch states equally spaced in time over the period guess).
+    """Correct a periodic orbit with no symmetry assumed, by single or multiple shooting.
 
-    The period is free and a Poincare phase condition pins the first patch near its guess.
-    The member of the family is selected by its Jacobi constant (``jacobi``; default: the
-    first patch's) or, with ``fixed_period=True``, by the period. Multiple shooting is the
-    remedy for long or strongly unstable orbits: each segment's sensitivity stays moderate.
-    The least-squares Newton step absorbs the conserved Jacobi constant's redundant equation.
-    ``collision`` as in :func:`correct_symmetric` (default "radius": an orbit through a
-    primary's radius raises :class:`librate.CollisionError`).
+    The period is free and a Poincare phase condition pins the first patch near its guess; the
+    member of the family is selected by its Jacobi constant or, with ``fixed_period=True``, by
+    the period. Multiple shooting is the remedy for long or strongly unstable orbits: each
+    segment's sensitivity stays moderate. The least-squares Newton step absorbs the conserved
+    Jacobi constant's redundant equation.
+
+    Parameters
+    ----------
+    system : System or str
+        The system.
+    states : array_like, shape (6,) or (m, 6)
+        One state (single shooting) or m patch states equally spaced in time over the period guess.
+    period : float
+        The period guess (TU).
+    jacobi : float, optional
+        The target Jacobi constant (default: the first patch's).
+    fixed_period : bool, default False
+        Hold the period instead of the Jacobi constant.
+    family : str, default "periodic"
+        The name stored on the orbit.
+    tol : float, default 1e-10
+        Newton tolerance.
+    max_iter : int, default 25
+        Newton iterations.
+    rtol, atol : float, default 1e-13
+        Integration tolerances.
+    collision : {"radius", "point", None}
+        As in `correct_symmetric`.
+
+    Returns
+    -------
+    PeriodicOrbit
+        The corrected orbit.
+
+    Raises
+    ------
+    ConvergenceError
+        Newton did not converge.
+    CollisionError
+        The orbit passes within a primary's radius.
+    ValueError
+        A bad argument, naming it.
     """
     sys_ = resolve_system(system)
     collision_mode(collision)

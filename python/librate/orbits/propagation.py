@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -22,11 +23,30 @@ _PRIMARIES = {"earth": 0, "moon": 1, "primary1": 0, "primary2": 1, 1: 0, 2: 1}
 
 @dataclass(frozen=True)
 class Event:
-    """An event located to about 1e-12 in time during :func:`propagate`.
+    """An event located to about 1e-12 in time during `propagate`.
 
-    Build one with :meth:`crossing`, :meth:`distance` or :meth:`surface`. ``direction`` is +1
-    (g increasing), -1 (decreasing) or 0 (both); a ``terminal`` event stops the integration at
-    its first occurrence. A start exactly on the surface (g = 0) is not an occurrence.
+    Build one with `Event.crossing` (a coordinate through a value), `Event.distance` (a distance
+    from a point) or `Event.surface` (a primary's surface). A start exactly on the surface
+    (g = 0) is not an occurrence.
+
+    Parameters
+    ----------
+    kind : {"crossing", "distance", "surface"}
+        The event function.
+    params : tuple of float
+        Its parameters (set by the constructors).
+    direction : {0, 1, -1}
+        +1: g increasing, -1: decreasing, 0: both.
+    terminal : bool, default False
+        Stop the integration at the first occurrence.
+
+    Examples
+    --------
+    >>> import librate
+    >>> ev = librate.Event.crossing("y", 0.0, direction=1, terminal=True)
+    >>> tr = librate.propagate("earth-moon", [0.85, 0, 0, 0, 0.49, 0], 10.0, events=[ev])
+    >>> tr.status
+    'event'
     """
 
     kind: Literal["crossing", "distance", "surface"]
@@ -224,8 +244,9 @@ def propagate(
         Events to locate.
     t_eval : array_like, optional
         Output times (monotonic, inside the span) instead of every accepted step.
-    h0, h_min, h_max, max_steps, safety : float
-        Step control; ``fixed_step`` switches to fixed steps.
+    h0, h_min, h_max, max_steps, safety, fixed_step : float
+        Step control: the first, smallest and largest step, the step limit and the step
+        controller's safety factor; ``fixed_step`` switches to fixed steps of that size.
     collision : {"radius", "point", None}
         Reaching a primary stops the integration with `librate.CollisionError`: ``"radius"``
         (default): within the system's radius of either primary (``r1_km``, ``r2_km``; a primary
@@ -266,13 +287,33 @@ def propagate(
             raise ValueError(f"invalid argument `events`: must be librate.Event objects, got {e!r}")
     te = None if t_eval is None else as_float_array(t_eval, "t_eval").ravel()
     radii = collision_radii(sys_, collision)
+    return integrate(sys_, s, t0, tf, integration_options(rtol, atol, h0, h_min, h_max, max_steps, safety, fixed_step), radii,
+                     stm=bool(stm), t_eval=te, events=evs)
+
+
+@functools.lru_cache(maxsize=16)
+def _tolerance_options(rtol: float, atol: float) -> tuple:
+    return tuple(integration_options(rtol, atol, None, 0.0, math.inf, 1_000_000, 0.8, None).items())
+
+
+def tolerance_options(rtol: float, atol: float) -> dict:
+    """The integrator settings of :func:`propagate` with the tolerances ``rtol``, ``atol`` and the
+    default step control, checked once per pair (for internal callers with fixed settings)."""
+    return dict(_tolerance_options(float(rtol), float(atol)))
+
+
+def integrate(system: System, state: np.ndarray, t0: float, tf: float, options: dict, radii: tuple[float, float] | None, *,
+              stm: bool = False, t_eval: np.ndarray | None = None, events: Sequence[Event] = ()) -> Trajectory:
+    """The one call of the core's propagator behind :func:`propagate`, on arguments already
+    checked where they entered (a System, a (6,) float state, ``options`` from
+    :func:`integration_options` or :func:`tolerance_options`, ``radii`` from
+    :func:`collision_radii`): internal callers with known-good values call it directly."""
     r = _core.propagate(
-        sys_.mu, s, t0, tf, stm=bool(stm), t_eval=te, events=[e._spec(sys_) for e in evs],
-        options=integration_options(rtol, atol, h0, h_min, h_max, max_steps, safety, fixed_step), collision=radii,
+        system.mu, state, t0, tf, stm=stm, t_eval=t_eval, events=[e._spec(system) for e in events], options=options, collision=radii,
     )
     err = r.collision
     tr = Trajectory(
-        system=sys_,
+        system=system,
         t=r.t,
         y=r.y,
         t_final=r.t_final,
@@ -285,7 +326,7 @@ def propagate(
         collision_primary=None if err is None else int(err.primary),
     )
     if err is not None:
-        raise _collision(sys_, err, tr)
+        raise _collision(system, err, tr)
     return tr
 
 
@@ -318,15 +359,56 @@ def propagate_many(
     on_error: Literal["raise", "mask"] = "raise",
     collision: str | None = "radius",
 ) -> BatchResult:
-    """Propagate (n, 6) states from ``t0`` to ``t_final`` (one time, or one per state) on all
-    cores, with the GIL released. Each member is integrated exactly as :func:`propagate` would,
-    so results are bit-identical to one-at-a-time calls whatever ``threads`` is.
+    """Propagate many CR3BP states on all cores, with the GIL released.
 
-    ``on_error="raise"`` raises the first member's error (its ``batch_result`` attribute keeps
-    every finished member); ``"mask"`` returns NaN rows flagged by ``ok`` and listed in ``errors``.
-    ``collision`` as in :func:`propagate`: a member reaching a primary has ``ok = False``,
-    ``status`` "collision_primary1" or "collision_primary2" and a
-    :class:`librate.CollisionError` in ``errors``.
+    Each member is integrated exactly as `propagate` would, so results are bit-identical to
+    one-at-a-time calls whatever ``threads`` is.
+
+    Parameters
+    ----------
+    system : System or str
+        The system.
+    states : array_like, shape (n, 6)
+        The initial states.
+    t_final : float or array_like, shape (n,)
+        One final time, or one per state (TU).
+    t0 : float, default 0.0
+        The initial time.
+    stm : bool, default False
+        Also integrate each 6x6 state transition matrix.
+    rtol, atol : float, default 1e-12
+        Tolerances.
+    h0, h_min, h_max, max_steps, safety, fixed_step
+        Step control, as in `propagate`.
+    threads : int, optional
+        Worker threads (default: all cores).
+    on_error : {"raise", "mask"}
+        "raise": raise the first member's error (its ``batch_result`` attribute keeps every
+        finished member); "mask": NaN rows flagged by ``ok`` and listed in ``errors``.
+    collision : {"radius", "point", None}
+        As in `propagate`: a member reaching a primary has ``ok = False``, ``status``
+        "collision_primary1" or "collision_primary2" and a `CollisionError` in ``errors``.
+
+    Returns
+    -------
+    BatchResult
+        Final states ``y`` (n, 6), the STMs ``stm`` when asked, ``ok``, ``status``, ``errors`` and
+    the step statistics ``stats``.
+
+    Raises
+    ------
+    ValueError
+        A bad argument, naming it.
+    IntegrationError
+        With ``on_error="raise"``, the first member that failed.
+
+    Examples
+    --------
+    >>> import librate, numpy as np
+    >>> states = np.tile([0.85, 0, 0, 0, 0.49, 0], (4, 1))
+    >>> res = librate.propagate_many("earth-moon", states, 1.0)
+    >>> res.y.shape, bool(res.ok.all())
+    ((4, 6), True)
     """
     sys_ = resolve_system(system)
     arr = as_states(states)

@@ -21,9 +21,36 @@ class System:
     (1 / mean motion), so G = 1 and the synodic frame turns at rate 1. The larger primary sits at
     (-mu, 0, 0), the smaller at (1 - mu, 0, 0).
 
-    >>> em = System.preset("earth-moon")
+    Parameters
+    ----------
+    mu : float
+        The mass ratio m2 / (m1 + m2), in (0, 0.5].
+    lu_km : float
+        The length unit (km): the distance between the primaries.
+    tu_s : float
+        The time unit (s): 1 / mean motion.
+    r1_km, r2_km : float, default 0.0
+        The primaries' radii (km), for collision checks (0: point masses).
+    name : str, default "custom"
+        A label (the presets' names).
+
+    Raises
+    ------
+    ValueError
+        A constant out of range, naming it.
+
+    See Also
+    --------
+    - [`System.preset`][librate.orbits.system.System.preset]: the named systems (``System.presets()`` lists them).
+
+    Examples
+    --------
+    >>> import librate
+    >>> em = librate.System.preset("earth-moon")
     >>> round(em.period_days(2 * 3.141592653589793), 3)   # one synodic revolution
-    27.284
+    27.285
+    >>> round(em.distance_km(1.0))
+    384400
     """
 
     mu: float

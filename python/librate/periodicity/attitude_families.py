@@ -97,20 +97,54 @@ def attitude_family(
     direction: int = -1,
     progress=None,
 ) -> AttitudeFamily:
-    """Continue the symmetric periodic attitude motion with ``n`` turns (``kind``) through folds.
+    """Continue a symmetric periodic attitude motion with ``n`` turns along a parameter, through folds
+    (thesis Figs. 27-29).
 
-    ``orbits``: an :class:`OrbitFamily` (the parameter is the orbit's x0: the orbit through any
-    x0 in the family's range is corrected and tabulated on demand, in Rust) or one
-    :class:`PeriodicOrbit` (the parameter is Kz, from ``kz``). The curve G(p, wz0) =
-    phi(T/2) - pi turns = 0 (phi0 = 0) is followed by the shared pseudo-arclength driver
-    (:mod:`librate.solving.continuation`: step rules ``ds``, ``ds_min``, ``ds_max``, jump guards),
-    every point corrected by the Rust corrector with p freed. ``start`` (x0, or Kz) and ``wz0``
-    pick the first solution: by default the family's first member (or ``kz``) and, there, the
-    solution continued in Kz from Kz = 0 (as :func:`periodic_attitude`); ``direction`` the
-    initial sense in p. Folds (p turning back) are located to 1e-8 and the curve is followed
-    past them; ``bifurcations`` lists where the monodromy trace crosses +-2. ``progress``: True
-    for a bar on stderr, or ``progress(done, total)`` after each point (total: ``max_points``, the
-    points found at the end).
+    The curve G(p, wz0) = phi(T/2) - pi n = 0 (phi0 = 0) is followed by the shared pseudo-arclength
+    driver (`librate.solving.continuation`), every point corrected by the Rust corrector with p
+    freed. Folds (p turning back) are located to 1e-8 and the curve is followed past them.
+
+    Parameters
+    ----------
+    orbits : OrbitFamily or PeriodicOrbit
+        An `OrbitFamily`: the parameter is the orbit's x0 (the orbit through any x0 in the
+        family's range is corrected and tabulated on demand, in Rust). One `PeriodicOrbit`: the
+        parameter is Kz.
+    kz : float
+        The inertia ratio (the fixed Kz along an orbit family; the first Kz on one orbit).
+    n : int
+        Net turns per orbit period.
+    kind : {"periodic", "half-turn"}
+        The closure.
+    start : float, optional
+        The first parameter value (x0, or Kz); default the family's first member (or ``kz``).
+    wz0 : float, optional
+        The first solution's rate; default the one continued in Kz from Kz = 0 (as
+        `periodic_attitude`).
+    parameter_range : (float, float), optional
+        Stop outside this range of the parameter.
+    ds, ds_min, ds_max : float
+        Step rules of the continuation (first, smallest and largest arclength step).
+    max_points : int, default 400
+        The most points computed.
+    direction : {-1, 1}
+        The initial sense in the parameter.
+    progress : bool or callable, optional
+        True for a bar on stderr, or ``progress(done, total)`` after each point (total:
+        ``max_points``, then the points found at the end).
+
+    Returns
+    -------
+    AttitudeFamily
+        ``parameter``, ``wz0``, ``phidot0``, ``trace``, ``stable`` over the members; ``folds``,
+        ``bifurcations`` (where the monodromy trace crosses +-2) and ``end_reason``.
+
+    Raises
+    ------
+    ConvergenceError
+        The first solution cannot be found.
+    ValueError
+        A bad argument, naming it.
     """
     progress = as_progress(progress, f"attitude family N = {n}", "point")
     if kind not in KINDS:

@@ -71,27 +71,79 @@ def periodic_attitude(
     tol: float = 1e-12,
     max_iter: int = 40,
 ) -> AttitudeSolution:
-    """The periodic attitude motion with ``n`` net turns per orbit period (``kind="half-turn"``:
-    a half turn more over the K = ``n_periods`` periods) along ``orbit``, for the body with ``kz``.
+    """The periodic planar attitude motion with ``n`` net turns per orbit period along ``orbit``.
 
-    Which solution (no ``wz0``): the member of the N family continued in Kz from Kz = 0, where
-    the motion is torque-free and wz0 = 1 + 2 pi N / T is the unique solution; the branch is
-    followed by pseudo-arclength continuation (:mod:`librate.solving.continuation`) to ``kz``. If
-    the branch folds before ``kz``, :class:`librate.ConvergenceError` names the Kz of the fold
-    (located to 1e-8); :func:`find_periodic_attitudes` lists every solution in a rate window. This
-    needs the half-period (symmetric) formulation: an x-symmetric orbit started on the x axis and
-    ``phi0`` a multiple of pi/2; otherwise the torque-free rate is the starting guess of a direct
-    correction. With ``srp`` (docs/physics.md, solar radiation pressure) the gravity-only solution is then continued in
-    the plate amplitude eps from 0 to ``srp.eps`` (``free="phi0"``: phi0 corrected with wz0; a
-    fold before the target raises, naming its eps), or, with ``free="theta_sun0"``, corrected
-    directly in (Sun phase, wz0) with phi0 kept from the gravity-only solution (the returned
-    solution's ``srp.sun.theta0`` is the phase found).
+    Which solution, without a guess ``wz0``: the member of the N family continued in Kz from
+    Kz = 0, where the motion is torque-free and wz0 = 1 + 2 pi N / T is the unique solution; the
+    branch is followed by pseudo-arclength continuation (`librate.solving.continuation`) up to
+    ``kz``. This needs the half-period (symmetric) formulation: an x-symmetric orbit started on the
+    x axis and ``phi0`` a multiple of pi/2; otherwise the torque-free rate is the starting guess of
+    a direct correction. `find_periodic_attitudes` lists every solution in a rate window instead.
 
-    With a guess ``wz0``: the solution nearest to it, corrected directly. ``method``: "half"
-    (phi(KT/2) = phi0 + pi turns, wz0 unknown), "newton" (the full-period step [Phi(KT) - I] d =
-    -F with phi0 free; the correct form of thesis eq. 53, docs/physics.md), "auto": "half" when it
-    applies. The corrector is the Rust one (:func:`librate._core.attitude_correct`: globalised
-    Newton, one call); the solution is re-propagated independently. Raises ConvergenceError.
+    With ``srp`` (docs/physics.md, solar radiation pressure) the gravity-only solution is then
+    continued in the plate amplitude eps from 0 to ``srp.eps``. The corrector is the Rust one
+    (globalised Newton, one call); the returned solution is re-propagated independently.
+
+    Parameters
+    ----------
+    orbit : PeriodicOrbit
+        A planar periodic orbit (e.g. a member of `dro_family`).
+    kz : float
+        The body's inertia ratio Kz = (Iy - Ix) / Iz, in [-1, 1].
+    n : int or float
+        Net turns relative to the synodic frame per orbit period; ``n * n_periods`` must be a
+        whole number.
+    phi0 : float, default 0.0
+        Initial angle of the body x axis from the synodic X axis (rad).
+    wz0 : float, optional
+        A guess of the inertial initial rate (1/TU): the solution nearest to it is corrected
+        directly, with no continuation in Kz.
+    kind : {"periodic", "half-turn"}
+        ``"half-turn"``: phi(KT) = phi0 + 2 pi n K + pi (a half turn more over the K periods).
+    method : {"auto", "half", "newton"}
+        ``"half"``: phi(KT/2) = phi0 + pi turns with wz0 unknown (needs the symmetry);
+        ``"newton"``: the full-period step [Phi(KT) - I] d = -F with phi0 free (the correct form
+        of thesis eq. 53, see docs/physics.md); ``"auto"``: ``"half"`` when it applies.
+    n_periods : int, default 1
+        K, the orbit periods per attitude period (K = 2 on a 1:2 Sun-resonant orbit with SRP).
+    srp : FlatPlate, optional
+        Solar radiation pressure on a flat plate.
+    free : {"phi0", "theta_sun0"}
+        With ``srp``: ``"phi0"`` continues in eps with phi0 corrected together with wz0;
+        ``"theta_sun0"`` corrects (Sun phase, wz0) directly, phi0 kept from the gravity-only
+        solution (the returned ``srp.sun.theta0`` is the phase found).
+    tol : float, default 1e-12
+        Corrector tolerance on the closure residuals.
+    max_iter : int, default 40
+        Newton iterations per correction.
+
+    Returns
+    -------
+    AttitudeSolution
+        The solution: ``wz0``, ``phidot0``, ``phi0``, the monodromy and stability, the residual
+        of its independent re-propagation.
+
+    Raises
+    ------
+    ConvergenceError
+        The corrector failed, or the Kz (or eps) branch folds before the target: the message
+        names the Kz (or eps) of the fold, located to 1e-8.
+    ValueError
+        A bad argument, naming it and the allowed range.
+
+    See Also
+    --------
+    - [`find_periodic_attitudes`][librate.periodicity.solutions.find_periodic_attitudes]: every solution in a window of rates.
+    - [`attitude_family`][librate.periodicity.attitude_families.attitude_family]: the solution followed along an
+      orbit family, through folds.
+
+    Examples
+    --------
+    >>> import librate
+    >>> dro = librate.dro(period_days=12.66)  # the 12.66-day DRO of the Earth-Moon system
+    >>> sol = librate.periodic_attitude(dro, kz=0.8, n=-1)
+    >>> round(sol.phidot0, 3), sol.stable
+    (-2.455, False)
     """
     orbit = check_orbit(orbit)
     kz = check_kz(kz)
@@ -362,13 +414,47 @@ def branch_fold(br) -> dict | None:
 
 
 def continue_srp(solution: AttitudeSolution, srp, *, steps: int = 10, min_step: float = 1e-7, marks=()) -> SrpContinuation:
-    """Continue ``solution`` (gravity-only, or with SRP) to the plate ``srp`` (its eps is the
-    target; cs, cd and the Sun phase are kept along the way) by pseudo-arclength continuation in
-    (eps, phi0, wz0) (:mod:`librate.solving.continuation`, first step |target - eps0| / ``steps``,
-    smallest ``min_step``), every point corrected by the Rust corrector with eps freed and
-    re-propagated independently. A fold before the target (the branch turning back in eps; the
-    monodromy trace passes 2 there) is located to 1e-8 in eps and ends the continuation, on
-    the fold. ``marks``: eps values at which the branch is also corrected exactly (``marked``)."""
+    """Continue a periodic attitude motion in the flat-plate SRP amplitude eps up to a target plate.
+
+    Pseudo-arclength continuation in (eps, phi0, wz0) (`librate.solving.continuation`), every
+    point corrected by the Rust corrector with eps freed and re-propagated independently; the
+    plate's Cs, Cd and Sun phase are kept along the way. A fold before the target (the branch
+    turning back in eps; the monodromy trace passes 2 there) is located to 1e-8 in eps and ends
+    the continuation, on the fold.
+
+    Parameters
+    ----------
+    solution : AttitudeSolution
+        The start: gravity-only (eps = 0), or already with SRP.
+    srp : FlatPlate
+        The target plate; its ``eps`` is the target amplitude.
+    steps : int, default 10
+        The first step is |target - eps0| / ``steps``.
+    min_step : float, default 1e-7
+        The smallest step in eps before the continuation gives up.
+    marks : sequence of float, optional
+        eps values at which the branch is also corrected exactly (``marked`` of the result).
+
+    Returns
+    -------
+    SrpContinuation
+        ``solutions`` and ``eps`` along the branch, ``reached``, the ``fold`` if any,
+        ``end_reason``, ``marked`` and ``bifurcations``.
+
+    Raises
+    ------
+    ValueError
+        A bad argument, naming it.
+
+    Examples
+    --------
+    >>> import librate
+    >>> orbit = librate.dro_family(librate.System.preset("earth-moon")).resonant(2, "sun")
+    >>> gravity = librate.periodic_attitude(orbit, kz=0.8, n=-1, n_periods=2)
+    >>> path = librate.continue_srp(gravity, librate.FlatPlate(0.02, cs=0.4))
+    >>> path.reached, float(path.eps[-1])
+    (True, 0.02)
+    """
     br = eps_branch(solution, srp, steps=steps, min_step=min_step, marks=marks)
     e0 = 0.0 if solution.srp is None else float(solution.srp.eps)
     if br is None:

@@ -91,14 +91,42 @@ def flexible_periodic(
     atol: float = 1e-12,
     max_steps: int = 2_000_000,
 ) -> FlexiblePeriodic:
-    """The effect of flexibility on a rigid periodic orbit-attitude solution (an
-    :class:`~librate.AttitudeSolution` of :func:`~librate.periodic_attitude` computed with
-    ``kz=body.kz``, one orbit period).
+    """What flexibility does to a rigid periodic orbit-attitude solution.
 
-    ``method``: "quasi-static" (first order in (rate / Omega)^2, closed form: cheap at any
-    stiffness), "full" (the coupled model re-propagated and, with ``resolve``, the periodic
-    solution re-solved), or "auto": "full" when the stiffest mode makes fewer than 2e4 radians per
-    orbit period (the re-propagation is then cheap), else "quasi-static".
+    Parameters
+    ----------
+    solution : AttitudeSolution
+        A rigid solution of `periodic_attitude` computed with ``kz=body.kz``, over one orbit
+        period.
+    body : FlexibleBody
+        The flexible spacecraft.
+    method : {"auto", "quasi-static", "full"}
+        "quasi-static": first order in (rate / Omega)^2, closed form, cheap at any stiffness;
+        "full": the coupled model re-propagated (and re-solved, with ``resolve``); "auto": "full"
+        when the stiffest mode makes fewer than 2e4 radians per orbit period, else
+        "quasi-static".
+    resolve : bool, default True
+        With "full": re-solve the periodic solution of the coupled model (Rust corrector on all
+        2 + 2n initial values).
+    tol : float, default 1e-10
+        The corrector's tolerance.
+    max_iter : int, default 20
+        Its iterations.
+    rtol, atol : float, default 1e-12
+        Integration tolerances.
+    max_steps : int
+        Step limit.
+
+    Returns
+    -------
+    FlexiblePeriodic
+        The first-order drift and shift of the solution; with "full" the coupled model's drift
+        and, when re-solved, its periodic solution, residual and multipliers.
+
+    Raises
+    ------
+    ValueError
+        A bad argument (e.g. a solution computed with another Kz), naming it.
     """
     if not isinstance(solution, AttitudeSolution):
         raise ValueError(f"invalid argument `solution`: must be a librate.AttitudeSolution, got {type(solution).__name__}")
@@ -251,12 +279,50 @@ def frequency_scan(
     atol: float = 1e-11,
     max_steps: int = 2_000_000,
 ) -> FrequencyScan:
-    """The coupled response of ``body.scaled(f)`` for each frequency factor ``f`` in ``factors``:
-    the coupled model and the rigid composite model from the same ``attitude`` (and the
-    ``deflection`` start, default the quasi-static one), compared on ``samples`` times. Where a
-    structural frequency meets the orbital and attitude forcing, the deflections exceed the
-    quasi-static ones (amplification) and the attitude departs from the rigid motion: the exchange
-    between structural and attitude motion."""
+    """The coupled response of a flexible body over a range of structural frequencies (thesis
+    Fig. 46).
+
+    For each factor f, ``body.scaled(f)`` (every clamped frequency times f, the damping ratios
+    kept) is
+    propagated in the coupled model and as the rigid composite body from the same ``attitude``
+    (and ``deflection`` start), compared at ``samples`` times. Where a structural frequency meets
+    the orbital and attitude forcing, the deflections exceed the quasi-static ones
+    (amplification) and the attitude departs from the rigid motion.
+
+    Parameters
+    ----------
+    system : System or str
+        The system.
+    orbit_state : array_like, shape (6,)
+        The initial orbit state.
+    attitude : (float, float)
+        (phi0, wz0).
+    body : FlexibleBody
+        The body at factor 1.
+    t_span : float or (float, float)
+        The time span (TU).
+    factors : array_like
+        Frequency factors.
+    torques : sequence of str, default ("gravity_gradient",)
+        Torque names.
+    orbit : {"integrate", "held"}
+        As in `propagate_attitude`.
+    deflection : {"quasi-static"} or (q0, qdot0)
+        The initial deflections.
+    samples : int, default 1001
+        Comparison times.
+    rtol, atol : float, default 1e-11
+        Tolerances.
+    max_steps : int
+        Step limit.
+
+    Returns
+    -------
+    FrequencyScan
+        Per factor: the frequencies, the largest deflections of the coupled model and of the
+        closed form, their ratio ``amplification``, the attitude's largest departure from the rigid
+        motion and the largest structural energy.
+    """
     sys_, s, t0, tf, names = flexible_run_inputs(system, orbit_state, body, t_span, torques, orbit)
     fs = np.asarray(factors, dtype=float).ravel()
     if fs.size == 0 or not np.all(np.isfinite(fs)) or np.any(fs <= 0):

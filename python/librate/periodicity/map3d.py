@@ -209,18 +209,50 @@ def map3d_dataset(orbit: PeriodicOrbit, grid: Map3DGrid, residual: np.ndarray, s
 
 def attitude_map_3d(orbit: PeriodicOrbit, body, *, wx0, wy0, wz0, q0=None, n_periods: int = 1, tol: float = 1e-10,
                     progress: Callable[[int, int], None] | bool | None = None, threads: int | None = None):
-    """The 3-D attitude map of ``body`` along ``orbit`` (planar or spatial).
+    """The 3-D attitude map of a body along an orbit: the six closure residuals over a grid of
+    initial rates.
 
-    ``wx0``, ``wy0``, ``wz0``: each a number or a strictly increasing 1-D array of initial inertial
-    rates in body axes (rad/TU); ``body``: a :class:`~librate.RigidBody` or a list of them (a
-    ``body`` dimension with coordinates ix_iz, iy_iz, kz); ``q0``: the initial attitude of every
-    trajectory (scalar last, body relative to the synodic frame; default identity); ``tol``: the
-    integration tolerance (rtol = atol). Returns an xarray Dataset over (body?, wx0?, wy0?, wz0?)
-    (the array-valued ones, in that order) with ``residual`` (..., component: rx, ry, rz, dwx,
-    dwy, dwz), ``residual_norm`` (its max-norm) and ``status`` (0 ok, 1 max steps, 2 failed, 255
-    not computed), the orbit, n_periods, tol, q0 and the SIMD level as attributes. Work is done in
-    chunks (``progress(done, total)`` after each); on KeyboardInterrupt the finished chunks are
-    kept, with ``attrs["complete"] = 0``. Results are bit-identical for any ``threads``.
+    Work is done in chunks; on KeyboardInterrupt the finished chunks are kept, with
+    ``attrs["complete"] = 0``. Results are bit-identical for any ``threads``.
+
+    Parameters
+    ----------
+    orbit : PeriodicOrbit
+        The orbit (planar or spatial).
+    body : RigidBody or list of RigidBody
+        The body; a list adds a ``body`` dimension with coordinates ix_iz, iy_iz, kz.
+    wx0, wy0, wz0 : float or array_like
+        Initial inertial rates in body axes (1/TU): each a number or a strictly increasing 1-D
+        array.
+    q0 : array_like, shape (4,), optional
+        The initial attitude of every trajectory (scalar last, body relative to the synodic
+        frame; default identity).
+    n_periods : int, default 1
+        K, the orbit periods per attitude period.
+    tol : float, default 1e-10
+        The integration tolerance (rtol = atol).
+    progress : bool or callable, optional
+        True for a bar on stderr, or ``progress(done, total)`` after each chunk.
+    threads : int, optional
+        Worker threads.
+
+    Returns
+    -------
+    xarray.Dataset
+        Over (body?, wx0?, wy0?, wz0?) (the array-valued ones, in that order): ``residual``
+        (..., component: rx, ry, rz, dwx, dwy, dwz; the rotation vector of R(0)' R(KT) and
+        w(KT) - w0), ``residual_norm`` (its max-norm) and ``status`` (0 ok, 1 max steps, 2 failed,
+        255 not computed); the orbit, n_periods, tol, q0 and the SIMD level as attributes.
+
+    Raises
+    ------
+    ValueError
+        A bad argument, naming it.
+
+    See Also
+    --------
+    - [`find_periodic_attitudes_3d`][librate.periodicity.map3d.find_periodic_attitudes_3d]: periodic motions
+      seeded from the map's near-zeros.
     """
     progress = as_progress(progress, "3-D map", "case")
     n_periods, tol = _check(orbit, n_periods, tol)
@@ -250,16 +282,42 @@ def _same(a: AttitudeSolution3D, b: AttitudeSolution3D, tol: float) -> bool:
 
 def find_periodic_attitudes_3d(orbit: PeriodicOrbit, body: RigidBody, dataset, *, max_seeds: int = 16, threshold: float = 0.5,
                                tol: float = 1e-12, n_periods: int | None = None, max_iter: int = 40) -> list[AttitudeSolution3D]:
-    """Periodic 3-D motions of ``body`` along ``orbit`` seeded from the near-zeros of a 3-D map
-    (:func:`attitude_map_3d` of that orbit, with ``body`` one of its bodies).
+    """Periodic 3-D attitude motions seeded from the near-zeros of a 3-D map.
 
     Six residuals over a grid of one to three rates generally have no exact zeros, so the seeds
-    are the grid's local minima of ``residual_norm`` (over the neighbouring grid points along
-    every rate dimension) below ``threshold``, the ``max_seeds`` smallest. Each seed (the map's
-    q0, the grid rates) is corrected with all six unknowns free, all in one batched call of the
-    3-D corrector (:func:`~librate.periodic_attitude_3d`'s), to ``tol``; converged motions that
-    coincide (attitude and rates to 1e-8) are merged, and each is re-propagated independently
-    (:attr:`AttitudeSolution3D.residual`). Sorted by w0.
+    are the grid's local minima of ``residual_norm`` below ``threshold``, the ``max_seeds``
+    smallest. Each seed is corrected with all six unknowns free, in one batched call of the 3-D
+    corrector, to ``tol``; converged motions that coincide (attitude and rates to 1e-8) are
+    merged, and each is re-propagated independently.
+
+    Parameters
+    ----------
+    orbit : PeriodicOrbit
+        The orbit of the map.
+    body : RigidBody
+        One of the map's bodies.
+    dataset : xarray.Dataset
+        The map (`attitude_map_3d` of that orbit).
+    max_seeds : int, default 16
+        The most seeds corrected.
+    threshold : float, default 0.5
+        The largest ``residual_norm`` of a seed.
+    tol : float, default 1e-12
+        The corrector's tolerance.
+    n_periods : int, optional
+        K (default the map's).
+    max_iter : int, default 40
+        Newton iterations per seed.
+
+    Returns
+    -------
+    list of AttitudeSolution3D
+        Sorted by w0.
+
+    Raises
+    ------
+    ValueError
+        A bad argument (e.g. a body not in the map), naming it.
     """
     from scipy.ndimage import minimum_filter
 

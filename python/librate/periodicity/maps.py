@@ -71,22 +71,67 @@ def periodicity_map(
     srp=None,
     method: str = MAP_METHOD,
 ):
-    """Residual grids over (orbit, Kz, wz0) and the periodic solutions they contain.
+    """The attitude periodicity map: residual grids over (orbit, Kz, wz0) and the periodic solutions
+    they contain (thesis Fig. 24).
 
-    ``orbits``: an :class:`OrbitFamily`, a list of planar :class:`PeriodicOrbit` or one orbit;
-    ``kz``: one value or an array; ``wz0``: array of inertial initial rates. Returns an xarray
-    Dataset with ``dwz`` = wz(T) - wz0, ``dphi`` = phi(T) - phi0 wrapped to (-pi, pi] and the
-    unwrapped ``phi_T`` over dims (orbit, kz, wz0), coordinates with units (x0, period,
-    period_days per orbit; phidot0 = wz0 - 1), and, with ``solve``, the refined solutions along a
-    ``solution`` dimension. Work is done one orbit at a time (``progress(done, total)`` after
-    each); on KeyboardInterrupt the finished orbits are kept and returned, with
-    ``attrs["complete"] = 0``. Results are bit-identical for any ``chunk`` and ``threads``.
-    ``srp``: a :class:`librate.FlatPlate` (with ``n_periods`` = K for Sun-resonant orbits,
-    T = Ts / K); its parameters are stored as attributes. A list of plates (e.g. several eps or
-    Cs) adds an ``srp`` dimension (orbit, srp, kz, wz0) with their parameters as coordinates. With SRP the mirror symmetry is broken
-    and solutions are refined in (phi0, wz0) together (docs/physics.md, solar radiation pressure).
-    ``method``: the lanes' integrator ("rkf78", "dp87" or "rkn86": see :func:`sweep`), stored as
-    ``attrs["integrator"]``.
+    Every grid point is one attitude trajectory over K orbit periods (the SIMD engine); the zero
+    crossings of the residuals along wz0 are refined by Newton into periodic solutions (with
+    ``solve``). Work is done one orbit at a time; on KeyboardInterrupt the finished orbits are
+    kept and returned, with ``attrs["complete"] = 0``. Results are bit-identical for any ``chunk``
+    and ``threads``.
+
+    Parameters
+    ----------
+    orbits : OrbitFamily, list of PeriodicOrbit or PeriodicOrbit
+        Planar periodic orbits.
+    kz : float or array_like
+        Inertia ratio(s) Kz = (Iy - Ix) / Iz in [-1, 1].
+    wz0 : array_like
+        Inertial initial rates (1/TU), strictly increasing; phidot0 = wz0 - 1 relative to the
+        synodic frame.
+    phi0 : float, default 0.0
+        Initial angle (rad).
+    n_periods : int, default 1
+        K, the orbit periods per attitude period.
+    solve : bool, default True
+        Refine every crossing into a periodic solution (the ``sol_*`` variables).
+    progress : bool or callable, optional
+        True for a bar on stderr, or ``progress(done, total)`` called after each orbit.
+    rtol, atol : float, default 1e-12
+        Integration tolerances.
+    chunk : int, default 64
+        Trajectories per work unit.
+    threads : int, optional
+        Worker threads (default: all cores).
+    srp : FlatPlate or list of FlatPlate, optional
+        Solar radiation pressure (with ``n_periods`` = K for Sun-resonant orbits, T = Ts / K). A
+        list adds an ``srp`` dimension; solutions are then refined in (phi0, wz0) together (the
+        mirror symmetry is broken).
+    method : {"rkf78", "dp87", "rkn86"}
+        The engine's integrator, stored as ``attrs["integrator"]``.
+
+    Returns
+    -------
+    xarray.Dataset
+        ``dwz`` = wz(T) - wz0, ``dphi`` = phi(T) - phi0 wrapped to (-pi, pi] and the unwrapped
+        ``phi_T`` over (orbit, kz, wz0) with units; coordinates x0, period, period_days per orbit
+        and phidot0; with ``solve`` the solutions along ``solution`` (``sol_orbit``, ``sol_kz``,
+        ``sol_wz0``, ``sol_n``, ``sol_kind``, ``sol_stable``, ...).
+
+    Raises
+    ------
+    ValueError
+        A bad argument, naming it and the allowed range.
+    IntegrationError
+        A trajectory could not be integrated.
+
+    Examples
+    --------
+    >>> import librate, numpy as np
+    >>> fam = librate.dro_family(librate.System.preset("earth-moon"), x0=np.linspace(0.9, 0.7, 3))
+    >>> ds = librate.periodicity_map(fam, kz=0.8, wz0=np.linspace(-3.0, 2.0, 50))
+    >>> dict(ds["dwz"].sizes)
+    {'orbit': 3, 'kz': 1, 'wz0': 50}
     """
 
 
@@ -169,6 +214,12 @@ def map_coords(olist, kzs, wz) -> dict:
     }
 
 
+def _common_family(olist) -> str:
+    """The family name the orbits share (a study's members, which come without their family), else ""."""
+    names = {getattr(o, "family", "") for o in olist}
+    return names.pop() if len(names) == 1 and "symmetric" not in names else ""
+
+
 def map_dataset(olist, family, kzs, wz, grid, done, *, phi0, n_periods, rtol, atol, srp, complete, attrs=None, solutions=None):
     """The map's Dataset: residual grids over (orbit, kz, wz0), coordinates with units and the
     parameters as attributes (shared by periodicity_map and run_map); ``solutions``: (orbit
@@ -195,7 +246,7 @@ def map_dataset(olist, family, kzs, wz, grid, done, *, phi0, n_periods, rtol, at
             "lu_km": olist[0].system.lu_km,
             "tu_s": olist[0].system.tu_s,
             "system_name": olist[0].system.name,
-            "family": family.kind if family is not None else "",
+            "family": family.kind if family is not None else _common_family(olist),
             "librate_version": __version__,
             "srp_eps": float(srp.eps) if srp is not None else 0.0,
             "srp_cs": float(srp.cs) if srp is not None else 0.0,
@@ -286,8 +337,27 @@ def map_solutions_dataset(sols):
 
 
 def zero_contours(ds, var: str = "dwz", kz_index: int = 0) -> np.ndarray:
-    """Points (orbit x0, wz0) where ``var`` crosses zero along wz0, for each orbit row (linear
-    interpolation; for ``dphi`` the wrap jumps at +-pi are not crossings). (m, 2) array."""
+    """The points where a residual of a periodicity map crosses zero along wz0, orbit by orbit.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A map of `periodicity_map`.
+    var : {"dwz", "dphi"}
+        The residual; for ``"dphi"`` the wrap jumps at +-pi are not crossings.
+    kz_index : int, default 0
+        The Kz of the map.
+
+    Returns
+    -------
+    numpy.ndarray, shape (m, 2)
+        (orbit x0, wz0) of each crossing, by linear interpolation between grid points.
+
+    Raises
+    ------
+    ValueError
+        ``var`` is neither "dwz" nor "dphi".
+    """
     if var not in ("dwz", "dphi"):
         raise ValueError(f"invalid argument `var`: must be 'dwz' or 'dphi', got {var!r}")
     a = ds[var].values[:, kz_index, :]

@@ -143,16 +143,53 @@ def turns_array(values) -> np.ndarray:
 
 @dataclass(frozen=True)
 class AttitudeSolution:
-    """A periodic (or half-turn) planar attitude motion along an orbit, over K = ``n_periods``
-    orbit periods.
+    """A periodic (or half-turn) planar attitude motion along an orbit, over K = ``n_periods`` orbit
+    periods.
 
-    ``n_total``: net body turns relative to the synodic frame over the K periods, so that
-    phi(KT) = phi0 + 2 pi n_total (+ pi for "half-turn" solutions); ``n`` = n_total / K: turns
-    per orbit period (a whole number when K divides n_total). ``residual``: max(|Dphi|, |Dwz|)
-    after the K periods from an independent re-propagation (scalar model, orbit integrated
-    alongside, rtol = atol = 1e-14). ``monodromy``: the 2x2 d(phi, wz)(KT)/d(phi0, wz0); the
-    motion is linearly stable when |trace| < 2 (multipliers on the unit circle).
-    ``iterations``: the corrector's accepted Newton steps.
+    Made by `periodic_attitude`, `find_periodic_attitudes` and the maps; the fields are the
+    solution, the properties derived from it.
+
+    Parameters
+    ----------
+    orbit : PeriodicOrbit
+        The orbit.
+    kz : float
+        The body's inertia ratio Kz = (Iy - Ix) / Iz.
+    n_total : int
+        Net body turns relative to the synodic frame over the K periods: phi(KT) = phi0 +
+        2 pi n_total (+ pi for "half-turn" solutions).
+    kind : {"periodic", "half-turn"}
+        The closure.
+    phi0 : float
+        Initial angle (rad).
+    wz0 : float
+        Inertial initial rate (1/TU).
+    residual_dphi, residual_dwz : float
+        The closure residuals after the K periods, from an independent re-propagation (scalar
+        model, orbit integrated alongside, rtol = atol = 1e-14).
+    monodromy : numpy.ndarray, shape (2, 2)
+        d(phi, wz)(KT) / d(phi0, wz0).
+    iterations : int
+        The corrector's accepted Newton steps.
+    srp : FlatPlate, optional
+        The SRP plate, if any.
+    n_periods : int, default 1
+        K.
+
+    Attributes
+    ----------
+    n : int or float
+        Turns per orbit period, n_total / K (a whole number when K divides n_total).
+    phidot0 : float
+        Initial rate relative to the synodic frame, wz0 - 1 (1/TU).
+    residual : float
+        max(|residual_dphi|, |residual_dwz|).
+    trace : float
+        The monodromy's trace.
+    multipliers : numpy.ndarray
+        The monodromy's eigenvalues.
+    stable : bool
+        Linearly stable: |trace| < 2 (multipliers on the unit circle).
     """
 
     orbit: PeriodicOrbit
@@ -376,22 +413,54 @@ def find_periodic_attitudes(
     srp=None,
     progress=None,
 ) -> list[AttitudeSolution]:
-    """Every periodic (and half-turn) attitude motion with inertial wz0 in ``wz0_range``.
+    """Every periodic (and half-turn) attitude motion with inertial wz0 in a window of rates.
 
     A grid scan by the engine brackets the candidates (crossings of phi(T/2) - phi0 through
     multiples of pi/2 for symmetric cases, of phi(T) - phi0 through multiples of pi otherwise);
-    all are refined together by one call of the Rust corrector and kept when they converge
-    inside the window (each re-propagated independently). Sorted by wz0.
+    all are refined together by one call of the Rust corrector and kept when they converge inside
+    the window, each re-propagated independently.
 
-    ``phi0`` may be a sequence of starting attitudes: where the corrector frees phi0 (the full
-    closure, e.g. with SRP), scans from several attitudes find motions a single scan misses.
-    The scans then share one engine sweep and one corrector call per closure; duplicates are
-    merged within each scan, not across them (a motion found from two starts is listed twice,
-    possibly with different phi0 in the symmetric case), and the list is sorted by wz0, scans
-    in the given order where wz0 ties.
+    Parameters
+    ----------
+    orbit : PeriodicOrbit
+        A planar periodic orbit.
+    kz : float
+        Inertia ratio Kz = (Iy - Ix) / Iz in [-1, 1].
+    wz0_range : (float, float)
+        The window of inertial initial rates (1/TU).
+    phi0 : float or sequence of float, default 0.0
+        Initial angle(s) (rad). Several starting attitudes share one engine sweep and one
+        corrector call per closure, and find motions a single scan misses where the corrector
+        frees phi0 (e.g. with SRP); duplicates are merged within each scan, not across them.
+    kinds : sequence of {"periodic", "half-turn"}
+        The closures to look for.
+    n_grid : int, optional
+        Scan points (default: from the window's width).
+    n_periods : int, default 1
+        K, the orbit periods per attitude period.
+    srp : FlatPlate, optional
+        Solar radiation pressure.
+    progress : bool or callable, optional
+        True for a bar on stderr, or ``progress(done, total)`` after the scan and after each
+        closure's refinement.
 
-    ``progress``: True for a bar on stderr, or ``progress(done, total)`` after the scan and after
-    the refinement of each closure (symmetric, full).
+    Returns
+    -------
+    list of AttitudeSolution
+        Sorted by wz0 (scans in the given order where wz0 ties).
+
+    Raises
+    ------
+    ValueError
+        A bad argument, naming it and the allowed range.
+
+    Examples
+    --------
+    >>> import librate
+    >>> dro = librate.dro(period_days=12.66)
+    >>> sols = librate.find_periodic_attitudes(dro, kz=0.8, wz0_range=(-3.0, 2.0))
+    >>> sorted({s.n for s in sols if s.kind == "periodic"})
+    [-1, 0]
     """
     progress = as_progress(progress, "periodic attitudes", "step")
     orbit = check_orbit(orbit)

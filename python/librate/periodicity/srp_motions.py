@@ -67,45 +67,59 @@ def srp_map(
     steps: int = 4,
     progress: Callable[[int, int], None] | None = None,
 ):
-    """A flat-plate SRP periodicity map of one orbit over (eps, initial rate), for
-    :func:`librate.plotting.plot_srp_map` (thesis Figs. 35-36, 40-41).
+    """A flat-plate SRP periodicity map of one orbit over (eps, initial rate), with the solution
+    branches (thesis Figs. 35-36, 40-41; drawn by `librate.plotting.plot_srp_map`).
 
-    ``orbit``: a planar orbit, normally Sun-resonant (T = Ts / K, from
-    ``family.resonant(K, "sun")``); ``n_periods`` (default: that K, required for other orbits):
-    the revolutions after which periodicity is checked. ``eps``: increasing plate amplitudes (any
-    sign), ``wz0``: increasing INERTIAL initial rates; the plate has ``cs``, ``cd`` (ca = 1 - cs -
-    cd) and the Sun phase ``theta_sun0`` (``Sun.theta0``; :class:`librate.FlatPlate`, :class:`librate.Sun`);
-    the body has ``kz``; every motion starts at ``phi0``. The grid runs in one engine sweep:
-    ``dwz`` = wz(KT) - wz0, ``dphi`` = phi(KT) - phi0 wrapped to (-pi, pi], ``phi_T`` (unwrapped)
-    and ``status`` over dims (eps, wz0).
+    The grid runs in one engine sweep. With ``solve``: SRP breaks the mirror symmetry, so with
+    phi0 fixed there is no curve of solutions in the plane; the solutions shown are branches with
+    phi0 free (docs/physics.md, solar radiation pressure), continued by `continue_srp` through the
+    grid's eps values (``steps`` per interval) until the grid ends or the branch folds: from eps =
+    0, the gravity-only solutions of the listed ``kinds`` in the window (``branch_origin =
+    "gravity"``); and from each far end of the grid, the solutions found there that no branch from
+    eps = 0 reached, back towards 0 (``"end"``: e.g. the SRP-dominated motions of large eps).
 
-    With ``solve``, the solutions: SRP breaks the mirror symmetry, so with phi0 fixed there is no
-    curve of solutions in the plane (the two zero contours cross only at isolated points); the
-    solutions shown are BRANCHES with phi0 free (docs/physics.md, solar radiation pressure), continued by
-    :func:`librate.continue_srp` through the grid's eps values (``steps`` per interval) until
-    the grid ends or the branch folds: from eps = 0, the gravity-only solutions of the listed
-    ``kinds`` with wz0 in the window (:func:`librate.find_periodic_attitudes`), away from 0 on
-    each side (``branch_origin="gravity"``); and from each far end of the grid (the largest
-    eps, and the most negative), the solutions found there (:func:`librate.find_periodic_attitudes`
-    with that plate, scanned from phi0 and phi0 + pi/2, pi, -pi/2) that no branch from eps = 0
-    reached, back towards 0 (``"end"``: e.g. the
-    SRP-dominated motions of large eps, which the gravity-only branches do not reach before
-    they fold; such a branch may end at eps = 0 on a gravity-only solution with another phi0).
-    Variables: ``sol_*`` along ``solution`` (the solutions AT the grid's eps values:
-    ``sol_eps``, ``sol_wz0``, ``sol_phidot0``, ``sol_phi0`` wrapped to [-pi, pi], ``sol_n``,
-    ``sol_kind``, ``sol_branch``, ``sol_trace``, ``sol_stable``, ``sol_residual``), ``path_*``
-    along ``path`` (every continuation point, sorted by eps within a branch: ``path_branch``,
-    ``path_eps``, ``path_wz0``, ``path_phi0``, ``path_trace``) and ``branch_*`` along ``branch``
-    (``branch_n``, ``branch_kind``, ``branch_origin``, ``branch_start_eps``,
-    ``branch_end_eps`` / ``branch_end_wz0`` where it stopped short of the grid's
-    end, NaN otherwise, ``branch_fold`` True when that end is a fold: the monodromy trace within
-    0.05 of 2 there, where Phi - I is singular; otherwise the continuation failed, e.g. at once
-    for a strongly unstable start, trace ~1e5; and ``branch_end_reason`` from
-    :func:`librate.continue_srp`). Returns an xarray Dataset.
+    Parameters
+    ----------
+    orbit : PeriodicOrbit
+        A planar orbit, normally Sun-resonant (T = Ts / K, from ``family.resonant(K, "sun")``).
+    kz : float
+        Inertia ratio Kz.
+    wz0 : array_like
+        Increasing inertial initial rates (1/TU).
+    eps : array_like
+        Increasing plate amplitudes (any sign).
+    cs, cd : float, default 0.0
+        The plate's reflection fractions (ca = 1 - cs - cd).
+    theta_sun0 : float, default 0.0
+        The Sun phase (`Sun` ``theta0``, rad).
+    phi0 : float, default 0.0
+        Every motion's initial angle (rad).
+    n_periods : int, optional
+        The revolutions after which periodicity is checked: default the orbit's Sun resonance K
+        (required for other orbits).
+    solve : bool, default True
+        Trace the solution branches.
+    kinds : sequence of str, default ("periodic",)
+        The closures of the gravity-only starts.
+    steps : int, default 4
+        Continuation steps per eps interval of the grid.
+    progress : callable, optional
+        ``progress(done, total)`` after each branch and after the grid's sweep; ``total`` grows
+        as the branches to trace are found.
 
-    ``progress``: called as ``progress(done, total)`` after each branch and after the grid's
-    sweep (which runs beside the branches), from the calling thread; ``total`` grows as the
-    branches to trace are found, and ``done == total`` at the end.
+    Returns
+    -------
+    xarray.Dataset
+        ``dwz`` = wz(KT) - wz0, ``dphi`` (wrapped), ``phi_T`` and ``status`` over (eps, wz0); with
+        ``solve`` the solutions at the grid's eps values (``sol_*`` along ``solution``), every
+        continuation point (``path_*`` along ``path``) and the branches (``branch_*`` along
+        ``branch``: ``branch_n``, ``branch_kind``, ``branch_origin``, where and why each stopped,
+        ``branch_fold`` when it ends on a fold).
+
+    Raises
+    ------
+    ValueError
+        A bad argument, naming it.
     """
     import xarray as xr
 
@@ -304,14 +318,41 @@ def srp_map(
 
 def sun_pointing_accelerations(system, body_or_plate, t, *, orbit: PeriodicOrbit, offset: float = 0.0, kz: float | None = None,
                                sun=None) -> tuple[np.ndarray, np.ndarray]:
-    """The angular accelerations (1/TU^2) on a body held pointing at the Sun, phi(t) = theta_s(t)
-    + ``offset``, along ``orbit`` at times ``t`` (TU): (gravity gradient, SRP). Gravity gradient:
-    1.5 Kz [S cos 2 phi - C sin 2 phi] with S, C of the orbit's forcing
-    (:func:`librate.periodicity.orbit_forcing`); SRP: ``plate.wzdot(t, phi)`` for a
-    :class:`librate.FlatPlate` (then ``kz`` is required and the Sun is the plate's), or the z
-    torque of a :class:`librate.FacetBody`'s facets over Iz, times TU^2 (``kz`` from its inertia,
-    the Sun from ``sun``, default :class:`librate.Sun`; planar: body z along synodic Z, the
-    Sun at the angle -offset in body axes)."""
+    """The angular accelerations on a body held pointing at the Sun along an orbit (thesis Fig. 39):
+    the gravity-gradient and the SRP parts, for phi(t) = theta_s(t) + ``offset``.
+
+    Gravity gradient: 1.5 Kz [S cos 2 phi - C sin 2 phi] with S, C of the orbit's forcing; SRP:
+    ``plate.wzdot(t, phi)`` for a `FlatPlate`, or the z torque of a `FacetBody`'s facets over Iz.
+
+    Parameters
+    ----------
+    system : System or str
+        The system.
+    body_or_plate : FlatPlate or FacetBody
+        A plate (then ``kz`` is required and the Sun is the plate's), or a faceted body (``kz``
+        from its inertia; planar: body z along synodic Z, the Sun at the angle -offset in body
+        axes).
+    t : array_like
+        Times (TU).
+    orbit : PeriodicOrbit
+        The orbit.
+    offset : float, default 0.0
+        The body x axis's angle from the Sun direction (rad).
+    kz : float, optional
+        Inertia ratio (with a plate).
+    sun : Sun, optional
+        With a `FacetBody`: the Sun (default `Sun()`).
+
+    Returns
+    -------
+    (numpy.ndarray, numpy.ndarray)
+        (gravity gradient, SRP) angular accelerations at ``t`` (1/TU^2).
+
+    Raises
+    ------
+    ValueError
+        A bad argument, naming it.
+    """
     sys_ = check_system(system)
     if not isinstance(orbit, PeriodicOrbit):
         raise ValueError(f"invalid argument `orbit`: must be a librate.PeriodicOrbit, got {type(orbit).__name__}")

@@ -26,6 +26,7 @@ label it wz(0)); ``rate="inertial"`` plots wz, and the axis label says which. Ar
 - :func:`plot_residuals`: Dwz and Dphi after one period against the initial rate (Fig. 23)
 - :func:`plot_map`: the periodicity map, zero contours and solutions over (orbit, rate) (Fig. 24)
 - :func:`plot_solution_families`: solutions of each N across the orbit family, per Kz (Figs. 27-29)
+- :func:`plot_solution_scatter`: the solutions of ``librate solve``, phidot0 against x0 by N
 - :func:`plot_attitude_motion`: phi(t) and the rate of periodic motions (Figs. 30-31)
 - :func:`plot_sun_motion`: the apparent Sun motion in the synodic frame (Fig. 33)
 - :func:`plot_sun_resonant`: the Sun-resonant members T = Ts / K of a family (Fig. 34)
@@ -60,7 +61,7 @@ from ._attitude3d import plot_body_axes, plot_equilibrium_stability, plot_family
 from ._flexible import plot_flexible_body, plot_flexible_coordinate, plot_flexible_response, plot_frequency_scan
 from ._maps import plot_map, plot_residuals
 from ._orbits import plot_attitude, plot_eci, plot_family, plot_period, plot_stability
-from ._solutions import plot_attitude_motion, plot_solution_families
+from ._solutions import plot_attitude_motion, plot_solution_families, plot_solution_scatter
 from ._srp import plot_srp_comparison, plot_srp_map, plot_srp_maps
 from ._style import KIND_MARKERS, N_COLORS, figure_axes, n_color, save_figure
 from ._sun import plot_sun_motion, plot_sun_pointing, plot_sun_resonant
@@ -74,6 +75,7 @@ __all__ = [
     "plot_residuals",
     "plot_map",
     "plot_solution_families",
+    "plot_solution_scatter",
     "plot_attitude_motion",
     "plot_sun_motion",
     "plot_sun_resonant",

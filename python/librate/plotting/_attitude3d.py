@@ -23,7 +23,27 @@ def plot_equilibrium_stability(ds, ax=None, *, boundaries: bool = True) -> Figur
     ratios k_x = (Iy - Iz)/Ix (horizontal) and k_y = (Iz - Ix)/Iy (vertical): the stable regions
     filled (gid "stable"), the rest shaded by why it is unstable (pitch, roll-yaw divergence or
     flutter; gid "unstable"), and with ``boundaries`` the curves K1 K2 = 0, K3 = 0 and the
-    flutter boundary b^2 = 4c (gids "boundary-*"). Returns the Figure."""
+    flutter boundary b^2 = 4c (gids "boundary-*"). Returns the Figure.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        From `librate.equilibrium_stability`.
+    boundaries : bool, default True
+        Draw the stability boundaries.
+    ax : matplotlib Axes or sequence of Axes, optional
+        Draw into these (one per panel); default a new Figure.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure.
+
+    Raises
+    ------
+    ValueError
+        A bad argument, naming it and the allowed values.
+    """
     from matplotlib.colors import ListedColormap
     from matplotlib.patches import Patch
 
@@ -74,7 +94,27 @@ def plot_out_of_plane_stability(datasets, ax=None, *, against: str = "period") -
     (days) or x0 (``against``). Each member's marker shows whether it is stable in the plane and
     out of it (gids ``"class-<in>-<out>"``, e.g. ``"class-1-0"``: stable in the plane, unstable
     out of it). The bottom row shows the largest |roll/yaw multiplier| on a log scale (gid
-    ``"out-of-plane-modulus"``). Returns the Figure."""
+    ``"out-of-plane-modulus"``). Returns the Figure.
+
+    Parameters
+    ----------
+    datasets : sequence of xarray.Dataset
+        From `librate.periodicity.out_of_plane_family`, one column each.
+    against : {"period", "x0"}
+        The horizontal axis.
+    ax : matplotlib Axes or sequence of Axes, optional
+        Draw into these (one per panel); default a new Figure.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure.
+
+    Raises
+    ------
+    ValueError
+        A bad argument, naming it and the allowed values.
+    """
 
     dss = [datasets] if hasattr(datasets, "data_vars") else list(datasets)
     if not dss or not all("out_of_plane_modulus" in getattr(d, "data_vars", {}) for d in dss):
@@ -119,11 +159,32 @@ def plot_family_multipliers(ds, ax=None, *, against: str = "period") -> Figure:
     on a log scale (gid ``"modulus"``), with the unit circle as a line. The right panel shows the
     multipliers in the complex plane, coloured along the family (gid ``"multipliers"``). The
     stability changes listed in the Dataset are shaded (gid ``"stability-change"``). Returns the
-    Figure."""
+    Figure.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        From `librate.attitude_family_3d` (or a ``librate solve`` result of a 3-D study).
+    against : {"period", "x0", "z0"}
+        The horizontal axis.
+    ax : matplotlib Axes or sequence of Axes, optional
+        Draw into these (one per panel); default a new Figure.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure.
+
+    Raises
+    ------
+    ValueError
+        A bad argument, naming it and the allowed values.
+    """
     import ast
 
+    from matplotlib import colormaps
     from matplotlib.patches import Circle
-
+    from matplotlib.ticker import MaxNLocator
 
     if "multipliers" not in getattr(ds, "data_vars", {}) or "period_days" not in getattr(ds, "data_vars", {}):
         raise ValueError("invalid argument `ds`: must be the Dataset of librate.attitude_family_3d")
@@ -146,15 +207,25 @@ def plot_family_multipliers(ds, ax=None, *, against: str = "period") -> Figure:
     a.set_xlabel({"period": "orbit period (days)", "x0": "$x_0$ (LU)", "z0": "$z_0$ (LU)"}[against])
     a.set_ylabel("|Floquet multiplier|")
     moments = ds.attrs.get("body_moments")
-    a.set_title(f"body {moments}" if moments is not None else "")
-    colors = np.broadcast_to(np.arange(m.shape[0])[:, None], m.shape)
-    sc = b.scatter(m.real.ravel(), m.imag.ravel(), c=colors.ravel(), cmap="viridis", s=8)
+    if isinstance(moments, str):
+        moments = ast.literal_eval(moments)
+    body = "" if moments is None else ", body $I_x, I_y, I_z$ = " + ", ".join(f"{float(v):.4g}" for v in np.ravel(moments)) + " kg m$^2$"
+    a.set_title(f"|multiplier| of the {m.shape[1]}", fontsize="medium")
+    if ax is None:
+        fig.suptitle(f"Floquet multipliers along the 3-D attitude family{body}", fontsize="medium")
+    # one colour per member: integer steps on the colour bar (a member index has no fractions)
+    n_members = m.shape[0]
+    colors = np.broadcast_to(np.arange(n_members)[:, None], m.shape)
+    sc = b.scatter(m.real.ravel(), m.imag.ravel(), c=colors.ravel(), cmap=colormaps["viridis"].resampled(max(n_members, 1)),
+                   vmin=-0.5, vmax=n_members - 0.5, s=8)
     sc.set_gid("multipliers")
     b.add_patch(Circle((0, 0), 1.0, fill=False, color="k", linewidth=0.6))
     b.set_aspect("equal", adjustable="datalim")
     b.set_xlabel("Re")
     b.set_ylabel("Im")
-    fig.colorbar(sc, ax=b, label="member (along the family)")
+    cb = fig.colorbar(sc, ax=b, label="member index (along the family)")
+    cb.ax.yaxis.set_major_locator(MaxNLocator(integer=True))
+    b.set_title("the multipliers in the complex plane (unit circle)", fontsize="medium")
     return fig
 
 
@@ -164,7 +235,29 @@ def plot_body_axes(solution, ax=None, *, samples: int = 16, planes=("xy", "xz"))
     "xz" or "yz"), the orbit over the solution's K periods (gid ``"orbit"``) and, at ``samples``
     evenly spaced times, the projections of the body x, y and z axes as arrows (gids
     ``"axis-x"``, ``"axis-y"``, ``"axis-z"``; red, green, blue), scaled to 6 % of the orbit's
-    extent. Returns the Figure."""
+    extent. Returns the Figure.
+
+    Parameters
+    ----------
+    solution : AttitudeSolution3D
+        The motion.
+    samples : int, default 16
+        Arrow positions along the orbit.
+    planes : sequence of {"xy", "xz", "yz"}
+        One panel each.
+    ax : matplotlib Axes or sequence of Axes, optional
+        Draw into these (one per panel); default a new Figure.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure.
+
+    Raises
+    ------
+    ValueError
+        A bad argument, naming it and the allowed values.
+    """
 
     if not all(hasattr(solution, a) for a in ("q0", "w0", "orbit", "propagate", "n_periods")):
         raise ValueError(f"invalid argument `solution`: must be a librate.AttitudeSolution3D, got {type(solution).__name__}")
@@ -204,7 +297,27 @@ def plot_map_3d(ds, ax=None, *, orbits=None) -> Figure:
     3-D study with its ``orbit`` dimension): log10 of the residual max-norm over its two rate
     grids, one panel per orbit (``orbits``: the indices to draw, default the first three), the
     smallest residual marked (gid ``"minimum"``; where the 3-D corrector's seeds come from).
-    Returns the Figure."""
+    Returns the Figure.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        From `librate.attitude_map_3d`, or a ``librate map`` result of a 3-D study.
+    orbits : sequence of int, optional
+        The orbits drawn (default the first three).
+    ax : matplotlib Axes or sequence of Axes, optional
+        Draw into these (one per panel); default a new Figure.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure.
+
+    Raises
+    ------
+    ValueError
+        A bad argument, naming it and the allowed values.
+    """
 
     if "residual_norm" not in getattr(ds, "data_vars", {}):
         raise ValueError("invalid argument `ds`: must be a 3-D attitude map (librate.attitude_map_3d)")
@@ -231,6 +344,11 @@ def plot_map_3d(ds, ax=None, *, orbits=None) -> Figure:
         title = "" if i is None else f"orbit {i}"
         if i is not None and "period_days" in ds.coords:
             title += f": T = {float(ds['period_days'].values[i]):.3f} d"
-        a.set_title(f"{title}  min {float(np.nanmin(r.values)):.2e}".strip())
-        fig.colorbar(mesh, ax=a, label="log10 max |residual|")
+        a.set_title(f"{title}  smallest {float(np.nanmin(r.values)):.2e} (red star)".strip(), fontsize="medium")
+        fig.colorbar(mesh, ax=a, label="log10 max |residual| (closure after K periods)")
+    fixed = [d for d in ("wx0", "wy0", "wz0") if d not in rate_dims and d in ds.variables and ds[d].size == 1]
+    held = ", ".join(f"{d} = {float(ds[d].values):g} 1/TU" for d in fixed)
+    if ax is None:
+        fig.suptitle("3-D attitude map: the six closure residuals' max-norm over the initial rates" + (f" ({held})" if held else ""),
+                     fontsize="medium")
     return fig

@@ -10,8 +10,6 @@ from typing import TYPE_CHECKING
 import numpy as np
 from matplotlib.lines import Line2D
 
-from ..orbits.periodic import PeriodicOrbit
-from ..periodicity.maps import periodicity_map
 from ..periodicity.solutions import KINDS, check_kinds
 from ._style import (
     DPHI_COLOR,
@@ -20,6 +18,7 @@ from ._style import (
     check_index,
     check_map,
     draw_solutions,
+    family_name,
     figure_axes,
     kz_mask,
     n_color,
@@ -35,13 +34,11 @@ if TYPE_CHECKING:
 
 
 def plot_residuals(
-    orbit_or_ds,
+    ds,
     ax=None,
     *,
     kz: float | None = None,
-    wz0=None,
     orbit_index: int | None = None,
-    phi0: float = 0.0,
     rate: str = "relative",
     solutions: bool = True,
     kinds: Sequence[str] = KINDS,
@@ -55,43 +52,59 @@ def plot_residuals(
     colour by N, circle periodic, diamond half-turn, filled when linearly stable), labelled
     "N = ..." when ``annotate``.
 
-    ``orbit_or_ds``: a Dataset from :func:`librate.periodicity_map` (``orbit_index`` picks the
-    orbit when it holds several, ``kz`` the Kz value when it holds several), or a planar
-    :class:`~librate.PeriodicOrbit` with ``kz`` (a number) and ``wz0`` (the grid of INERTIAL
-    initial rates, increasing): the map is then computed here (``phi0``: the initial angle).
-    ``rate``: the horizontal axis, ``"relative"`` (default: phidot(0) = wz(0) - 1, relative to
-    the synodic frame, what the thesis figures plot under the label wz(0)) or ``"inertial"``
-    (wz(0)); the axis label says which. Returns the Figure.
+    ``ds``: a Dataset from :func:`librate.periodicity_map` (``orbit_index`` picks the orbit when it
+    holds several, ``kz`` the Kz value when it holds several); for one orbit, compute its map
+    first, ``periodicity_map(orbit, kz=kz, wz0=wz0)``. ``rate``: the horizontal axis,
+    ``"relative"`` (default: phidot(0) = wz(0) - 1, relative to the synodic frame, what the thesis
+    figures plot under the label wz(0)) or ``"inertial"`` (wz(0)); the axis label says which.
+    Returns the Figure.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A map of `librate.periodicity_map`.
+    ax : matplotlib Axes or sequence of Axes, optional
+        Draw into these (one per panel); default a new Figure.
+    kz : float, optional
+        The Kz value, when the map holds several.
+    orbit_index : int, optional
+        The orbit, when the map holds several.
+    rate : {"relative", "inertial"}
+        The horizontal axis.
+    solutions : bool, default True
+        Mark the refined solutions.
+    kinds : sequence of {"periodic", "half-turn"}
+        The solutions marked.
+    annotate : bool, default True
+        Label them "N = ...".
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure.
+
+    Raises
+    ------
+    ValueError
+        A bad argument, naming it and the allowed values.
     """
     offset, xlabel = rate_axis(rate)
     kinds = check_kinds(kinds)
-    if isinstance(orbit_or_ds, PeriodicOrbit):
-        if kz is None:
-            raise ValueError("invalid argument `kz`: a number in [-1, 1] is needed with an orbit")
-        if wz0 is None:
-            raise ValueError("invalid argument `wz0`: the inertial initial rates to scan are needed with an orbit")
-        if orbit_index not in (None, 0):
-            raise ValueError(f"invalid argument `orbit_index`: one orbit was given, got {orbit_index!r}")
-        ds = periodicity_map(orbit_or_ds, kz=kz, wz0=wz0, phi0=phi0, solve=bool(solutions))
-        i = j = 0
+    ds = check_map(ds, "ds")
+    norb = ds.sizes["orbit"]
+    if orbit_index is None and norb != 1:
+        raise ValueError(f"invalid argument `orbit_index`: the Dataset holds {norb} orbits, pick one")
+    i = check_index(0 if orbit_index is None else orbit_index, norb, "orbit_index")
+    kzs = np.asarray(ds["kz"].values, dtype=float)
+    if kz is None:
+        if kzs.size != 1:
+            raise ValueError(f"invalid argument `kz`: the Dataset holds {kzs.size} Kz values {kzs.tolist()}, pick one")
+        j = 0
     else:
-        ds = check_map(orbit_or_ds, "orbit_or_ds")
-        if wz0 is not None:
-            raise ValueError("invalid argument `wz0`: rates are given only with an orbit (a Dataset has its own)")
-        norb = ds.sizes["orbit"]
-        if orbit_index is None and norb != 1:
-            raise ValueError(f"invalid argument `orbit_index`: the Dataset holds {norb} orbits, pick one")
-        i = check_index(0 if orbit_index is None else orbit_index, norb, "orbit_index")
-        kzs = np.asarray(ds["kz"].values, dtype=float)
-        if kz is None:
-            if kzs.size != 1:
-                raise ValueError(f"invalid argument `kz`: the Dataset holds {kzs.size} Kz values {kzs.tolist()}, pick one")
-            j = 0
-        else:
-            hit = np.flatnonzero(np.abs(kzs - float(kz)) <= 1e-12)
-            if not hit.size:
-                raise ValueError(f"invalid argument `kz`: {kz!r} is not in the Dataset's Kz values {kzs.tolist()}")
-            j = int(hit[0])
+        hit = np.flatnonzero(np.abs(kzs - float(kz)) <= 1e-12)
+        if not hit.size:
+            raise ValueError(f"invalid argument `kz`: {kz!r} is not in the Dataset's Kz values {kzs.tolist()}")
+        j = int(hit[0])
     kz_value = float(ds["kz"].values[j])
     x = np.asarray(ds["wz0"].values, dtype=float) - offset
     dwz = np.asarray(ds["dwz"].values[i, j], dtype=float)
@@ -196,6 +209,37 @@ def plot_map(
     markers are the refined solutions, exact whatever the grid. ``against``: the orbit axis, ``"period"`` (days, default)
     or ``"x0"``. ``rate``: the rate axis, ``"relative"`` (phidot(0) = wz(0) - 1, default, the
     thesis convention) or ``"inertial"`` (wz(0)). Returns the Figure.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A map of `librate.periodicity_map` with at least 2 orbits.
+    kz_index : int, default 0
+        The Kz drawn.
+    against : {"period", "x0"}
+        The orbit axis.
+    rate : {"relative", "inertial"}
+        The rate axis.
+    solutions : bool, default True
+        Mark the refined solutions.
+    kinds : sequence of {"periodic", "half-turn"}
+        The solutions marked.
+    half_turn_contours : bool, optional
+        Add the contours Dphi = pi (default: when half-turns are marked).
+    legend : bool, default True
+        Draw the legend.
+    ax : matplotlib Axes or sequence of Axes, optional
+        Draw into these (one per panel); default a new Figure.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure.
+
+    Raises
+    ------
+    ValueError
+        A bad argument, naming it and the allowed values.
     """
     ds = check_map(ds)
     j = check_index(kz_index, ds.sizes["kz"], "kz_index")
@@ -231,8 +275,7 @@ def plot_map(
     if legend:
         a.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=7.5, borderaxespad=0.0)
     if created:
-        fam = ds.attrs.get("family", "") or "orbit"
-        a.set_title(f"attitude periodicity map, {fam.upper() if fam == 'dro' else fam} family, $K_z$ = {kz_value:g}")
+        a.set_title(f"attitude periodicity map, {family_name(ds.attrs.get('family', ''))} family, $K_z$ = {kz_value:g}")
     return fig
 
 

@@ -12,7 +12,7 @@ import numpy as np
 from matplotlib.cm import ScalarMappable
 from matplotlib.colors import Normalize
 from matplotlib.lines import Line2D
-from matplotlib.ticker import FuncFormatter
+from matplotlib.ticker import FuncFormatter, MaxNLocator
 from matplotlib.transforms import blended_transform_factory
 
 from ..attitude.propagate import AttitudeTrajectory
@@ -28,6 +28,7 @@ from ._style import (
     PROJECTIONS,
     check_family,
     family_axis,
+    family_name,
     figure_axes,
     length_scale,
     level_crossings,
@@ -69,6 +70,46 @@ def plot_family(
     ``projection="3d"`` Axes). ``units``: ``"LU"`` or ``"km"``. ``primaries`` marks the Earth
     and the Moon, ``lagrange_points`` the listed L-points (``()`` for none); a marker far from
     the orbits does not widen the view. Returns the Figure.
+
+    Parameters
+    ----------
+    family : OrbitFamily
+        The family.
+    n_orbits : int or None, default 30
+        Members drawn, evenly spread (None: all).
+    color_by : {"jacobi", "period", "x0", None}
+        The colour scale (None: one colour).
+    projection : str or sequence of str, optional
+        "xy", "xz", "yz" or "3d", or several (one panel each); default "xy" for planar families,
+        ("xy", "xz") for spatial ones.
+    units : {"LU", "km"}
+        Length unit.
+    samples : int, default 600
+        Points per orbit.
+    primaries : bool, default True
+        Mark the Earth and the Moon.
+    lagrange_points : iterable of int, default (1, 2)
+        The L-points marked.
+    cmap : str, default "turbo"
+        Colour map.
+    clim : (float, float), optional
+        The colour range (default the family's).
+    colorbar : bool, default True
+        Draw the colour bar.
+    linewidth : float, default 0.8
+        Line width.
+    ax : matplotlib Axes or sequence of Axes, optional
+        Draw into these (one per panel); default a new Figure.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure.
+
+    Raises
+    ------
+    ValueError
+        A bad argument, naming it and the allowed values.
     """
     fam = check_family(family)
     sys_ = fam.system
@@ -150,6 +191,8 @@ def plot_family(
             a.set_ylabel(f"y ({unit})")
             a.set_zlabel(f"z ({unit})")
             a.set_box_aspect(np.maximum(np.ptp(allp, axis=0), 1e-3 * np.ptp(allp)))
+            for axis in (a.xaxis, a.yaxis, a.zaxis):  # a few ticks: a narrow 3-D axis would print its labels over each other
+                axis.set_major_locator(MaxNLocator(4))
         else:
             a.set_xlabel(f"{proj[0]} ({unit})")
             a.set_ylabel(f"{proj[1]} ({unit})")
@@ -160,7 +203,7 @@ def plot_family(
         sm.set_array(np.asarray(values))
         fig.colorbar(sm, ax=axs, label=clabel, shrink=0.9)
     if created:
-        axs[0].set_title(f"{fam.kind} family, synodic frame ({len(sel)} of {len(fam)} members)")
+        axs[0].set_title(f"{family_name(fam.kind)} family, synodic frame ({len(sel)} of {len(fam)} members)")
     return fig
 
 
@@ -187,6 +230,35 @@ def plot_period(
     ``"z0"`` or ``"jacobi"``; for x0, ``primaries`` draws vertical lines at the Earth (-mu) and
     the Moon (1 - mu). The view is the data's range (widened to take in a line within 35 % of
     that range beyond it); lines out of the view are left out of the legend. Returns the Figure.
+
+    Parameters
+    ----------
+    family : OrbitFamily
+        The family.
+    resonances : iterable of int, default (1, 2, 3, 4)
+        The synodic 1:K resonances drawn.
+    sun_resonances : iterable of int, default (2, 4)
+        The Sun 1:K resonances drawn.
+    units : {"days", "TU"}
+        Period unit.
+    against : {"x0", "z0", "jacobi"}
+        The horizontal axis.
+    primaries : bool, default True
+        With x0: vertical lines at the primaries.
+    markers : bool, default True
+        Mark the family's crossings of the resonance lines.
+    ax : matplotlib Axes or sequence of Axes, optional
+        Draw into these (one per panel); default a new Figure.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure.
+
+    Raises
+    ------
+    ValueError
+        A bad argument, naming it and the allowed values.
     """
     fam = check_family(family)
     sys_ = fam.system
@@ -199,7 +271,7 @@ def plot_period(
     created = ax is None
     fig, (a,) = figure_axes(ax, 1, figsize=(7.0, 5.0))
     period = fam.period * tscale
-    (line,) = a.plot(x, period, color="k", linewidth=1.6, label=f"{fam.kind} period")
+    (line,) = a.plot(x, period, color="k", linewidth=1.6, label=f"{family_name(fam.kind)} period")
     line.set_gid("period")
     groups = [(k, 2 * math.pi / k, "synodic", "tab:red", "--", f"1:{k}") for k in res]
     groups += [(k, SUN_SYNODIC_PERIOD / k, "sun", "tab:orange", ":", f"1:{k} Sun") for k in sres]
@@ -236,7 +308,7 @@ def plot_period(
     a.grid(True, linewidth=0.3, alpha=0.5)
     a.legend(loc="best", fontsize=7.5)
     if created:
-        a.set_title(f"{fam.kind} family: period and resonances")
+        a.set_title(f"{family_name(fam.kind)} family: period and resonances")
     return fig
 
 
@@ -290,6 +362,33 @@ def plot_stability(
     ``family.bifurcations``. ``imag`` adds the imaginary parts dashed (``"stability-imag-j"``).
     ``yscale``: ``"linear"``, ``"symlog"`` or None (symlog when some |nu| exceeds 10).
     Returns the Figure.
+
+    Parameters
+    ----------
+    family : OrbitFamily
+        The family.
+    against : {"x0", "z0", "jacobi", "period"}
+        The horizontal axis.
+    imag : bool, default False
+        Add the imaginary parts, dashed.
+    band : bool, default True
+        Shade the stable band |nu| <= 1.
+    bifurcations : bool, default True
+        Mark the crossings of +1 and -1.
+    yscale : {"linear", "symlog", None}
+        None: symlog when some |nu| exceeds 10.
+    ax : matplotlib Axes or sequence of Axes, optional
+        Draw into these (one per panel); default a new Figure.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure.
+
+    Raises
+    ------
+    ValueError
+        A bad argument, naming it and the allowed values.
     """
     fam = check_family(family)
     x, xlabel = family_axis(fam, against)
@@ -341,7 +440,7 @@ def plot_stability(
     a.grid(True, linewidth=0.3, alpha=0.5)
     a.legend(loc="best", fontsize=8)
     if created:
-        a.set_title(f"{fam.kind} family: stability indices")
+        a.set_title(f"{family_name(fam.kind)} family: stability indices")
     return fig
 
 
@@ -371,6 +470,37 @@ def plot_eci(
     all in one (``ax`` a sequence of that many Axes). ``labels``: one per orbit; default "1:K"
     for resonant orbits, else x0 and the period. ``units``: ``"km"`` or ``"LU"``. Returns the
     Figure.
+
+    Parameters
+    ----------
+    orbits : PeriodicOrbit or iterable of PeriodicOrbit
+        The orbits.
+    n_periods : float, optional
+        Periods drawn; default ceil(2 pi / T).
+    samples_per_period : int, default 2000
+        Points per period.
+    theta0 : float, default 0.0
+        The synodic x axis's angle from the ECI X axis at t = 0 (rad).
+    units : {"km", "LU"}
+        Length unit.
+    separate : bool, default False
+        One panel per orbit.
+    labels : sequence of str, optional
+        One per orbit.
+    moon_path : bool, default True
+        Draw the Moon's circle.
+    ax : matplotlib Axes or sequence of Axes, optional
+        Draw into these (one per panel); default a new Figure.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure.
+
+    Raises
+    ------
+    ValueError
+        A bad argument, naming it and the allowed values.
     """
     if isinstance(orbits, PeriodicOrbit):
         orbits = [orbits]
@@ -435,6 +565,29 @@ def plot_attitude(traj, ax=None, *, period: float | None = None, relative_to: st
     ``relative_to``: "earth" or "moon" to show the angles relative to that primary's local
     vertical (the two-body convention of Fig. 16-18), else relative to the synodic frame.
     Rates are the inertial angular velocity components in body axes (1/TU).
+
+    Parameters
+    ----------
+    traj : AttitudeTrajectory
+        A 3-D run of `librate.propagate_attitude`.
+    period : float, optional
+        One revolution (TU) for the horizontal axis; default time in TU.
+    relative_to : {"earth", "moon", None}
+        Angles relative to that primary's local vertical, else to the synodic frame.
+    degrees : bool, default True
+        Angles in degrees.
+    ax : matplotlib Axes or sequence of Axes, optional
+        Draw into these (one per panel); default a new Figure.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure.
+
+    Raises
+    ------
+    ValueError
+        A bad argument, naming it and the allowed values.
     """
     if not isinstance(traj, AttitudeTrajectory):
         raise ValueError(f"invalid argument `traj`: must be a librate.AttitudeTrajectory, got {type(traj).__name__}")

@@ -13,7 +13,7 @@ from matplotlib.lines import Line2D
 from matplotlib.ticker import MultipleLocator
 
 from ..periodicity.solutions import AttitudeSolution, check_kinds
-from ._style import KZ_STYLES, check_map, figure_axes, kz_mask, n_color, orbit_axis, rate_axis, solution_table
+from ._style import KIND_MARKERS, KZ_STYLES, check_map, figure_axes, kz_mask, n_color, orbit_axis, rate_axis, solution_table
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -69,6 +69,37 @@ def plot_solution_families(
     single panel. ``against``: ``"period"`` (days) or ``"x0"``;
     ``rate``: ``"relative"`` (phidot(0) = wz(0) - 1, default) or ``"inertial"``. Returns the
     Figure.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A map of `librate.periodicity_map` with solutions.
+    n : int or iterable of int, optional
+        The N shown (default all).
+    kinds : sequence of {"periodic", "half-turn"}
+        The closures shown.
+    against : {"period", "x0"}
+        The horizontal axis.
+    rate : {"relative", "inertial"}
+        The vertical axis.
+    separate : bool, default True
+        One panel per (kind, N).
+    stability : bool, default True
+        Overdraw the linearly stable solutions, filled.
+    max_jump : float, optional
+        The largest rate step (1/TU) between consecutive orbits within a branch.
+    ax : matplotlib Axes or sequence of Axes, optional
+        Draw into these (one per panel); default a new Figure.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure.
+
+    Raises
+    ------
+    ValueError
+        A bad argument, naming it and the allowed values.
     """
     ds = check_map(ds)
     tab = solution_table(ds)
@@ -146,6 +177,40 @@ def plot_solution_families(
     return fig
 
 
+def plot_solution_scatter(ds, ax=None) -> Figure:
+    """The periodic attitude solutions of ``librate solve`` (the ``sol_*`` variables of a
+    Dataset, with or without a map): initial rate phidot0 against the orbit's x0, coloured by N
+    (the colours of the map figures), marker by kind, filled when linearly stable
+    (``gid="solutions"``). Returns the Figure."""
+    if not hasattr(ds, "data_vars") or not all(v in ds.variables for v in ("sol_n", "sol_stable", "sol_x0", "sol_phidot0")):
+        raise ValueError(f"invalid argument `ds`: must be an xarray Dataset with the sol_* variables of librate solve, got {type(ds).__name__}")
+    fig, (a,) = figure_axes(ax, 1, figsize=(6.4, 4.8))
+    n = ds["sol_n"].values
+    kind = ds["sol_kind"].values.astype(str) if "sol_kind" in ds.variables else np.full(n.shape, "periodic")
+    stable = ds["sol_stable"].values.astype(bool)
+    x, y = ds["sol_x0"].values, ds["sol_phidot0"].values
+    handles = []
+    for k in sorted(set(n.tolist()), reverse=True):  # the same N, the same colour as in the map figures
+        c = n_color(k)
+        for kd, marker in KIND_MARKERS.items():
+            for st in (True, False):
+                sel = (n == k) & (kind == kd) & (stable == st)
+                if sel.any():
+                    a.scatter(x[sel], y[sel], s=22, marker=marker, edgecolors=c, facecolors=c if st else "none",
+                              linewidths=1.2, gid="solutions")
+        handles.append(Line2D([], [], linestyle="none", marker="s", color=c, label=f"N = {k:g}"))
+    gray = dict(linestyle="none", color="0.3", markeredgecolor="0.3")
+    for kd, marker in KIND_MARKERS.items():
+        if np.any(kind == kd):
+            handles.append(Line2D([], [], marker=marker, markerfacecolor="0.8", label=kd, **gray))
+    handles.append(Line2D([], [], marker="o", markerfacecolor="none", label="hollow: unstable", **gray))
+    a.set_xlabel("$x_0$ (LU)")
+    a.set_ylabel(r"$\dot\phi(0)$ (1/TU)")
+    a.set_title("periodic attitude solutions (filled: stable)")
+    a.legend(handles=handles, fontsize="small")
+    return fig
+
+
 def plot_attitude_motion(
     solutions,
     ax=None,
@@ -165,6 +230,31 @@ def plot_attitude_motion(
     synodic X axis (unwrapped, in degrees unless ``degrees=False``): a periodic motion reaches
     phi0 + 360 N deg after each period. ``rate``: ``"relative"`` (phidot = wz - 1, relative to
     the synodic frame, default) or ``"inertial"`` (wz). ``ax``: two Axes. Returns the Figure.
+
+    Parameters
+    ----------
+    solutions : AttitudeSolution or list of AttitudeSolution
+        The motions.
+    n_periods : float, default 1
+        Orbit periods drawn.
+    rate : {"relative", "inertial"}
+        phidot = wz - 1, or wz.
+    degrees : bool, default True
+        Angles in degrees.
+    samples : int, default 400
+        Points per period.
+    ax : matplotlib Axes or sequence of Axes, optional
+        Draw into these (one per panel); default a new Figure.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure.
+
+    Raises
+    ------
+    ValueError
+        A bad argument, naming it and the allowed values.
     """
     offset, ylabel = rate_axis(rate, initial=False)
     sols = [solutions] if isinstance(solutions, AttitudeSolution) else solutions

@@ -65,6 +65,39 @@ def plot_srp_map(
     an eps (or (eps, label)) marked by a vertical line (``gid="eps-reference"``; only named in the
     legend when outside the map's range), e.g. the plate of a given A/m. ``rate``: ``"relative"`` (phidot(0) = wz(0) - 1, default) or ``"inertial"``.
     ``kinds``: the solutions shown. Returns the Figure.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A map of `librate.srp_map`.
+    rate : {"relative", "inertial"}
+        The rate axis.
+    solutions : bool, default True
+        Mark the solutions at the grid's eps values.
+    branches : bool, default True
+        Draw the branches and where they stopped.
+    kinds : sequence of {"periodic", "half-turn"}
+        The solutions shown.
+    half_turn_contours : bool, default False
+        Add the contours Dphi = pi.
+    reference : float or (float, str), optional
+        An eps (with a label) marked by a vertical line.
+    legend : bool, default True
+        Draw the legend.
+    markersize : float, default 3.5
+        Marker size.
+    ax : matplotlib Axes or sequence of Axes, optional
+        Draw into these (one per panel); default a new Figure.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure.
+
+    Raises
+    ------
+    ValueError
+        A bad argument, naming it and the allowed values.
     """
     ds = _check_srp_map(ds)
     offset, ylabel = rate_axis(rate)
@@ -166,6 +199,27 @@ def plot_srp_maps(maps, ax=None, *, titles: Sequence[str] | None = None, **kwarg
     among Kz, Cs, Cd, the Sun phase and eps), or ``titles`` (one per map); the legend is drawn
     beside the last panel only; with ``ax=None`` the suptitle names the common values. ``ax``: one
     Axes per map. Returns the Figure.
+
+    Parameters
+    ----------
+    maps : sequence of xarray.Dataset
+        Maps of `librate.srp_map` or `librate.periodicity_map`.
+    titles : sequence of str, optional
+        One per map (default: the parameter values that differ).
+    **kwargs
+        Passed on to `plot_srp_map` or `plot_map`.
+    ax : matplotlib Axes or sequence of Axes, optional
+        Draw into these (one per panel); default a new Figure.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure.
+
+    Raises
+    ------
+    ValueError
+        A bad argument, naming it and the allowed values.
     """
     try:
         maps = list(maps)
@@ -235,6 +289,33 @@ def plot_srp_comparison(
     from :func:`librate.continue_srp` of ``gravity_solution``). phi unwrapped from the synodic X
     axis, in degrees unless ``degrees=False``; ``rate``: ``"relative"`` (phidot = wz - 1, default)
     or ``"inertial"`` (wz). ``ax``: two Axes. Returns the Figure.
+
+    Parameters
+    ----------
+    gravity_solution : AttitudeSolution
+        The gravity-only motion.
+    srp_solution : AttitudeSolution
+        Its SRP counterpart on the same orbit.
+    n_periods : float, optional
+        Revolutions drawn (default the SRP solution's K).
+    rate : {"relative", "inertial"}
+        The rate axis.
+    degrees : bool, default True
+        Angles in degrees.
+    samples : int, default 400
+        Points per revolution.
+    ax : matplotlib Axes or sequence of Axes, optional
+        Draw into these (one per panel); default a new Figure.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure.
+
+    Raises
+    ------
+    ValueError
+        A bad argument, naming it and the allowed values.
     """
     for name, s in (("gravity_solution", gravity_solution), ("srp_solution", srp_solution)):
         if not isinstance(s, AttitudeSolution):

@@ -43,6 +43,12 @@ def check_family(family) -> OrbitFamily:
     return family
 
 
+def family_name(kind: str) -> str:
+    """A family's kind as figure titles show it: the acronym DRO in capitals, other kinds as
+    named (``lyapunov-L1``, ``halo-L2-south``); an unnamed one is "orbit"."""
+    return "DRO" if kind == "dro" else (kind or "orbit")
+
+
 def figure_axes(ax, n: int, *, three_d: Sequence[bool] | None = None, figsize=None) -> tuple[Figure, list[Axes]]:
     """The figure and a list of ``n`` Axes: new ones (up to three per row, constrained layout)
     when ``ax`` is None, else the given Axes (one, or a sequence of ``n``)."""
@@ -264,7 +270,36 @@ def save_figure(fig, path, *, dpi: int = 150, close: bool = False, **kwargs) -> 
     """Write ``fig`` (a Figure, or an Axes: its figure) to ``path`` (format from the suffix:
     .png, .pdf, .svg, ...), creating missing directories; ``bbox_inches="tight"`` unless given
     in ``kwargs`` (passed to ``Figure.savefig``). ``close`` closes it in pyplot afterwards.
-    Returns the path."""
+    Returns the path.
+
+    Parameters
+    ----------
+    fig : matplotlib Figure or Axes
+        The figure (or an Axes of it).
+    path : str or pathlib.Path
+        The file; the format from its suffix.
+    dpi : int, default 150
+        Resolution.
+    close : bool, default False
+        Close the figure in pyplot afterwards.
+    **kwargs
+        Passed to ``Figure.savefig``.
+
+    Returns
+    -------
+    pathlib.Path
+        The path written.
+
+    Examples
+    --------
+    >>> import matplotlib
+    >>> matplotlib.use("Agg")
+    >>> import librate, librate.plotting as lp, tempfile, pathlib
+    >>> fam = librate.dro_family(librate.System.preset("earth-moon"), x0=[0.9, 0.8, 0.7])
+    >>> path = lp.save_figure(lp.plot_family(fam), pathlib.Path(tempfile.mkdtemp()) / "dros.png", close=True)
+    >>> path.suffix
+    '.png'
+    """
     if isinstance(fig, Axes):
         fig = fig.figure
     if not hasattr(fig, "savefig"):

@@ -19,7 +19,19 @@ from ..orbits.families import OrbitFamily
 from ..orbits.periodic import PeriodicOrbit
 from ..orbits.system import check_system
 from ..periodicity.srp_motions import sun_angle, sun_pointing_accelerations, sun_resonance
-from ._style import EARTH, LABEL_OFFSETS, MOON, SRP_COLOR, SUN_COLOR, check_family, draw_primaries, figure_axes, length_scale, time_scale
+from ._style import (
+    EARTH,
+    LABEL_OFFSETS,
+    MOON,
+    SRP_COLOR,
+    SUN_COLOR,
+    check_family,
+    draw_primaries,
+    family_name,
+    figure_axes,
+    length_scale,
+    time_scale,
+)
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -53,6 +65,31 @@ def plot_sun_motion(
     ``gid="sun-behind-earth"``). ``theta_sun0``: the Sun's phase at t = 0 (rad, the
     ``theta0`` of a :class:`librate.Sun`); ``units``: ``"days"`` or ``"TU"``; ``ax``: two Axes. Returns the
     Figure.
+
+    Parameters
+    ----------
+    system : System or str
+        The system.
+    theta_sun0 : float, default 0.0
+        The Sun's phase at t = 0 (rad).
+    n_periods : float, default 1
+        Apparent solar periods drawn.
+    n_directions : int, default 8
+        Sun directions drawn.
+    units : {"days", "TU"}
+        Time unit.
+    ax : matplotlib Axes or sequence of Axes, optional
+        Draw into these (one per panel); default a new Figure.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure.
+
+    Raises
+    ------
+    ValueError
+        A bad argument, naming it and the allowed values.
     """
     sys_ = check_system(system)
     theta_sun0 = as_number(theta_sun0, "theta_sun0")
@@ -156,6 +193,31 @@ def plot_sun_resonant(
     member (T = Ts = 29.49 d) is longer than the family's longest period (27.39 d, where the DROs
     reach the Earth). ``units``: ``"LU"`` or ``"km"``; ``primaries`` marks the Earth and the Moon.
     Raises ValueError (naming ``ks``) when no K is in range. Returns the Figure.
+
+    Parameters
+    ----------
+    family : OrbitFamily
+        A planar family.
+    ks : iterable of int, default (1, 2, 3, 4)
+        The Sun resonances 1:K drawn.
+    units : {"LU", "km"}
+        Length unit.
+    samples : int, default 600
+        Points per orbit.
+    primaries : bool, default True
+        Mark the Earth and the Moon.
+    ax : matplotlib Axes or sequence of Axes, optional
+        Draw into these (one per panel); default a new Figure.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure.
+
+    Raises
+    ------
+    ValueError
+        A bad argument, naming it and the allowed values.
     """
     fam = check_family(family)
     try:
@@ -175,7 +237,7 @@ def plot_sun_resonant(
             missing.append(int(k))
     if not found:
         raise ValueError(f"invalid argument `ks`: no Sun-resonant member 1:K (T = Ts/K) for K in {tuple(ks)} lies in the "
-                         f"{fam.kind} family's period range [{fam.period_days.min():.2f}, {fam.period_days.max():.2f}] d")
+                         f"{family_name(fam.kind)} family's period range [{fam.period_days.min():.2f}, {fam.period_days.max():.2f}] d")
     created = ax is None
     fig, (a,) = figure_axes(ax, 1, figsize=(7.2, 6.2))
     cm = matplotlib.colormaps["viridis"]
@@ -217,7 +279,8 @@ def plot_sun_resonant(
     a.grid(True, linewidth=0.3, alpha=0.5)
     a.legend(loc="upper left", fontsize=7.5)
     if created:
-        a.set_title(f"Sun-resonant {fam.kind.upper() if fam.kind == 'dro' else fam.kind} orbits ($T = T_s/K$, $T_s$ = {SUN_SYNODIC_PERIOD * sys_.tu_days:.2f} d), synodic frame")
+        ts_days = SUN_SYNODIC_PERIOD * sys_.tu_days
+        a.set_title(f"Sun-resonant {family_name(fam.kind)} orbits ($T = T_s/K$, $T_s$ = {ts_days:.2f} d), synodic frame")
     return fig
 
 
@@ -247,6 +310,39 @@ def plot_sun_pointing(
     covering one apparent solar period, ceil(Ts / T), after which a Sun-resonant orbit's pattern
     repeats), ``samples`` points per period; ``units``: ``"days"`` or ``"TU"``. Accelerations in
     1/TU^2 (nondimensional torque per Iz). Returns the Figure.
+
+    Parameters
+    ----------
+    system : System or str
+        The system.
+    body_or_plate : FlatPlate or FacetBody
+        The spacecraft (a plate needs ``kz``).
+    orbit : PeriodicOrbit
+        The orbit.
+    offset : float, default 0.0
+        The body x axis's angle from the Sun (rad).
+    kz : float, optional
+        Inertia ratio (with a plate).
+    sun : Sun, optional
+        With a `FacetBody`: the Sun.
+    n_periods : float, optional
+        Orbit periods drawn (default ceil(Ts / T)).
+    samples : int, default 1500
+        Points per period.
+    units : {"days", "TU"}
+        Time unit.
+    ax : matplotlib Axes or sequence of Axes, optional
+        Draw into these (one per panel); default a new Figure.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure.
+
+    Raises
+    ------
+    ValueError
+        A bad argument, naming it and the allowed values.
     """
     sys_ = check_system(system)
     if not isinstance(orbit, PeriodicOrbit):

@@ -7,11 +7,13 @@ too, with the units and long names of their variables (the one place they are wr
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 
 from .store import StoreSchema, Var
 
-__all__ = ["FamilyResult", "KINDS", "Map3DResult", "MAP_3D_VARIABLES", "MAP_VARIABLES", "MapResult", "ResultKind", "Solutions3DResult",
+__all__ = ["FIGURE_FILES", "FamilyResult", "KINDS", "Map3DResult", "MAP_3D_VARIABLES", "MAP_VARIABLES", "MapResult", "ResultKind", "Solutions3DResult",
            "SolutionsResult", "kind_of", "map3d_schema", "map_schema"]
 
 #: The per-orbit variables of a planar map: units and long names (periodicity_map, run_map and
@@ -48,17 +50,33 @@ def map3d_schema(no: int, shape: tuple[int, ...], dims: tuple[str, ...], coords:
     return StoreSchema("map_3d", "orbit", no, v, coords)
 
 
+#: The file suffix of each figure: a result STEM.zarr gets STEM_<suffix>.png beside it.
+FIGURE_FILES = {"family": "orbits", "period": "period", "stability": "stability", "map": "contours", "residuals": "residuals",
+                "solutions": "solutions", "multipliers": "multipliers", "body_axes": "body_axes"}
+
+#: A figure to draw: (its file suffix, a function that draws it and returns the Figure).
+Figure = tuple[str, Callable]
+
+
+def _plotting():
+    """librate.plotting, imported when a figure is drawn (matplotlib stays out of the results)."""
+    from .. import plotting
+
+    return plotting
+
+
 _STUDY = ("system", "orbits", "body", "torques", "rates", "attitude", "solver")
 
 
 class ResultKind:
     """One kind of result. ``kind``: the ``librate_result`` attribute; ``inputs``: the study
-    sections it depends on (a change elsewhere leaves it valid); ``figures``: the figure names
-    ``librate plot`` draws for it; ``dtypes``: fixed dtypes of its variables."""
+    sections it depends on (a change elsewhere leaves it valid); ``figure_names``: the figures
+    ``librate plot`` draws for it (:meth:`figures` draws them); ``dtypes``: fixed dtypes of its
+    variables."""
 
     kind = ""
     inputs: tuple[str, ...] = _STUDY
-    figures: tuple[str, ...] = ()
+    figure_names: tuple[str, ...] = ()
     dtypes: dict[str, str] = {}
     dims = ("member",)
 
@@ -84,6 +102,15 @@ class ResultKind:
         ds.attrs["librate_result"] = self.kind
         return ds
 
+    @classmethod
+    def figures(cls, result, names=None, skip: Callable[[str, str], None] | None = None, **data) -> list[Figure]:
+        """The figures of ``result`` (what :func:`librate.open_result` returns for this kind)
+        among ``names`` (default: :attr:`figure_names`), as (file suffix, draw) pairs; ``draw()``
+        returns the matplotlib Figure (:mod:`librate.plotting`, imported only then). A figure
+        that does not apply to this result is left out, ``skip(suffix, reason)`` told why. ``data``:
+        what a figure needs beyond the result, supplied by the computing layer."""
+        return []
+
     def summary(self) -> str:
         ds = self.dataset
         sizes = ", ".join(f"{k} {v}" for k, v in ds.sizes.items() if k in ("member", "orbit", "kz", "wz0", "solution", "wx0", "wy0"))
@@ -98,7 +125,15 @@ class FamilyResult(ResultKind):
 
     kind = "family"
     inputs = ("system", "orbits")
-    figures = ("family", "period", "stability")
+    figure_names = ("family", "period", "stability")
+
+    @classmethod
+    def figures(cls, result, names=None, skip=None, **data) -> list[Figure]:
+        """The family's orbits (30 of them), its period against x0 and its stability indices."""
+        lp = _plotting()
+        table = {"family": lambda: lp.plot_family(result, n_orbits=30), "period": lambda: lp.plot_period(result),
+                 "stability": lambda: lp.plot_stability(result)}
+        return [(FIGURE_FILES[n], table[n]) for n in (cls.figure_names if names is None else names) if n in table]
 
     @classmethod
     def recognise(cls, ds) -> bool:
@@ -109,7 +144,16 @@ class SolutionsResult(ResultKind):
     """The planar periodic attitude solutions of ``librate solve``."""
 
     kind = "solutions"
-    figures = ("solutions",)
+    figure_names = ("solutions",)
+
+    @classmethod
+    def figures(cls, result, names=None, skip=None, **data) -> list[Figure]:
+        """The solutions' initial rates against x0."""
+        lp = _plotting()
+        want = cls.figure_names if names is None else names
+        if "solutions" in want and "sol_wz0" in result.variables and result.sizes.get("solution", 0):
+            return [(FIGURE_FILES["solutions"], lambda: lp.plot_solution_scatter(result))]
+        return []
     dtypes = {"sol_orbit": "int64", "sol_n_periods": "int64"}
 
     @classmethod
@@ -122,15 +166,60 @@ class Solutions3DResult(ResultKind):
     """The periodic 3-D attitude motions along an orbit family (``librate solve``, 3-D)."""
 
     kind = "solutions_3d"
-    figures = ("multipliers", "body_axes")
+    figure_names = ("multipliers", "body_axes")
+
+    @staticmethod
+    def multipliers(ds) -> np.ndarray:
+        """The complex Floquet multipliers (member, 6), stored as ``multipliers_real`` and ``multipliers_imag``."""
+        return ds["multipliers_real"].values + 1j * ds["multipliers_imag"].values
+
+    @classmethod
+    def figures(cls, result, names=None, skip=None, *, solution: Callable | None = None, **data) -> list[Figure]:
+        """The Floquet multipliers along the family, and the body axes along the first member's
+        orbit: ``solution()`` returns that member's AttitudeSolution3D (the computing layer
+        corrects it again from the stored state; without it the figure is left out)."""
+        lp = _plotting()
+        mult = cls.multipliers(result)
+        table = {"multipliers": lambda: lp.plot_family_multipliers(result.assign(multipliers=(("member", "k"), mult)))}
+        if solution is not None:
+            table["body_axes"] = lambda: lp.plot_body_axes(solution())
+        return [(FIGURE_FILES[n], table[n]) for n in (cls.figure_names if names is None else names) if n in table]
 
 
 class MapResult(ResultKind):
     """A planar periodicity map (a part store ``map.zarr``, or an exported ``.nc``)."""
 
     kind = "map"
-    figures = ("map", "residuals", "solutions")
+    figure_names = ("map", "residuals", "solutions")
     dtypes = {"status": "uint8"}
+
+    @classmethod
+    def figures(cls, result, names=None, skip=None, **data) -> list[Figure]:
+        """The map's zero contours (one figure per Kz), the residuals of the orbit nearest the
+        12.66-day DRO (thesis Fig. 23) and the solution families across the orbits (Figs. 27-29)."""
+        lp = _plotting()
+        kzs = np.atleast_1d(result["kz"].values)
+        out: list[Figure] = []
+        for name in cls.figure_names if names is None else names:
+            if name == "map":
+                if result.sizes["orbit"] < 2:
+                    if skip is not None:
+                        skip(FIGURE_FILES["map"], "a periodicity map figure needs at least 2 orbits")
+                    continue
+                for j, kz in enumerate(kzs):
+                    out.append((FIGURE_FILES["map"] + ("" if kzs.size == 1 else f"_kz{kz:g}"), lambda j=j: lp.plot_map(result, kz_index=j)))
+            elif name == "residuals":
+                # thesis Fig. 23 is drawn on the 12.66-day DRO: the orbit nearest that period
+                near = int(np.argmin(np.abs(np.asarray(result["period_days"].values, dtype=float) - 12.66)))
+                out.append((FIGURE_FILES["residuals"], lambda near=near: lp.plot_residuals(result, orbit_index=near, kz=float(kzs[0]))))
+            elif name == "solutions" and "sol_wz0" in result.variables:
+                if result.sizes["orbit"] < 2 or result.sizes.get("solution", 0) == 0:
+                    continue
+                # the thesis families N = 1, 0, -1 (Figs. 27-29) as panels; a rate jump over 1/TU
+                # between consecutive orbits starts a new branch (never a line joining two solutions)
+                ns = [k for k in (1, 0, -1) if np.any(np.asarray(result["sol_n"].values) == k)] or None
+                out.append((FIGURE_FILES["solutions"], lambda ns=ns: lp.plot_solution_families(result, n=ns, max_jump=1.0)))
+        return out
 
     @classmethod
     def recognise(cls, ds) -> bool:
@@ -141,8 +230,15 @@ class Map3DResult(ResultKind):
     """A 3-D attitude map (a part store, or a file written whole by older versions)."""
 
     kind = "map_3d"
-    figures = ("map", "residuals", "solutions")
+    figure_names = ("map",)
     dtypes = {"status": "uint8"}
+
+    @classmethod
+    def figures(cls, result, names=None, skip=None, **data) -> list[Figure]:
+        """log10 of the residual max-norm over the two rate grids."""
+        lp = _plotting()
+        want = cls.figure_names if names is None else names
+        return [("residual_norm", lambda: lp.plot_map_3d(result))] if "map" in want else []
 
     @classmethod
     def recognise(cls, ds) -> bool:

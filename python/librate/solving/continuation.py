@@ -30,6 +30,11 @@ correct them one by one; :func:`run_lockstep` advances many branches together an
 round's requests in one call per group of compatible problems (``batch_key``/``correct_many``:
 for example every branch of an SRP map in one Rust call, the SIMD lanes full). A branch takes
 the same path either way.
+
+The driver's data (points, conditions, branches, step rules) is in
+:mod:`librate.solving.continuation_data`, the runners in :mod:`librate.solving.lockstep`, the
+location of folds and bifurcations in :mod:`librate.solving.locate`; every name is importable
+from here.
 """
 
 from __future__ import annotations
@@ -37,12 +42,13 @@ from __future__ import annotations
 import dataclasses
 import math
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
-from typing import Any, Protocol
 
 import numpy as np
 
 from .._errors import LibrateError
+from .continuation_data import Bifurcation, Branch, Constraint, ContinuationProblem, CorrectionFailed, Fold, Point, StepRules
+from .locate import locate_fold, locate_natural, locate_sign, scaled_norm, sign_changes, test_values, unit_tangent
+from .lockstep import Marks, correct_marks, correct_together, correction, run_alone, run_lockstep
 
 __all__ = [
     "Point",
@@ -64,309 +70,6 @@ __all__ = [
 ]
 
 
-class CorrectionFailed(LibrateError):
-    """A problem's corrector did not converge for the requested condition."""
-
-
-@dataclass(frozen=True)
-class Point:
-    """One corrected point: the vector ``x`` (unknowns and parameter), the problem's payload
-    (e.g. a PeriodicOrbit or an AttitudeSolution) and the corrector's iteration count."""
-
-    x: np.ndarray
-    data: Any = None
-    iterations: int = 0
-
-
-@dataclass(frozen=True)
-class Constraint:
-    """The linear condition a . x = b that closes the problem's equations."""
-
-    a: np.ndarray
-    b: float
-
-    @staticmethod
-    def fix(n: int, index: int, value: float) -> Constraint:
-        a = np.zeros(n)
-        a[index] = 1.0
-        return Constraint(a, float(value))
-
-    @property
-    def fixed_index(self) -> int | None:
-        """The component the condition fixes, when it fixes one (natural continuation)."""
-        nz = np.flatnonzero(self.a)
-        return int(nz[0]) if nz.size == 1 and self.a[nz[0]] == 1.0 else None
-
-
-@dataclass(frozen=True)
-class Fold:
-    """A turning point in the parameter: ``parameter`` located to ``tolerance`` (``located``
-    False when the search could not be carried out and the value is interpolated)."""
-
-    parameter: float
-    point: Point
-    located: bool
-    tolerance: float
-
-
-@dataclass(frozen=True)
-class Bifurcation:
-    """Where the problem's test function ``name`` changes sign: ``parameter`` (located to the
-    run's tolerance, or ``located`` False: interpolated linearly in the test function), the
-    ``point`` there (or the nearest corrected one) and ``after``, the index of the branch's
-    point before it."""
-
-    name: str
-    parameter: float
-    point: Point
-    located: bool
-    after: int = -1
-
-
-@dataclass
-class Branch:
-    """A continued branch: its points in order, the folds and bifurcations met on the way, why
-    it ended, and how many steps were rejected as jumps."""
-
-    points: list[Point]
-    folds: list[Fold] = field(default_factory=list)
-    bifurcations: list[Bifurcation] = field(default_factory=list)
-    end_reason: str = ""
-    rejected_jumps: int = 0
-    reached: bool = False
-    #: points corrected exactly at requested parameter values met on the way (``marks``), in order
-    marked: list[Point] = field(default_factory=list)
-
-    def parameter(self, index: int) -> np.ndarray:
-        return np.array([p.x[index] for p in self.points])
-
-
-class ContinuationProblem(Protocol):
-    """What the driver needs from a problem.
-
-    ``parameter_index``: the parameter's component in x. ``scale``: per-component scales that
-    make distances in x comparable (steps, jump guard). ``correct(guess, constraint)``: solve
-    the problem's equations together with ``constraint`` from ``guess``; raise
-    CorrectionFailed (or any LibrateError) on failure. ``tangent(point)``: the (unnormalised)
-    null vector of the equations' Jacobian at the point (None: the driver uses secants).
-    Optional: ``guard(points, new, ratio)`` returns a reason to reject ``new`` (a jump) or None;
-    ``tests(point)`` returns named bifurcation test functions; ``correct_batch(guesses,
-    constraints)`` corrects many independent points at once (a list of Point or None), used for
-    the marks of :func:`arclength`; ``batch_key`` (hashable) with ``correct_many(requests)``:
-    problems of one type with equal keys correct the requests [(problem, guess, constraint)] of
-    several branches in one call (:func:`run_lockstep`), and their ``correct_batch`` takes
-    ``problems=`` (the owner of each guess) to correct the marks of several branches at once.
-    """
-
-    parameter_index: int
-    scale: np.ndarray
-
-    def correct(self, guess: np.ndarray, constraint: Constraint) -> Point: ...
-
-    def tangent(self, point: Point) -> np.ndarray | None: ...
-
-
-@dataclass(frozen=True)
-class StepRules:
-    """The one set of step-size rules and jump guards.
-
-    ``ds``, ``ds_min``, ``ds_max``: initial, smallest and largest step (scaled units).
-    ``growth``: factor after an easy step (at most ``easy_iterations`` corrector iterations).
-    ``jump``: largest accepted distance of the corrected point from the prediction, as a
-    fraction of the step. ``max_turn``: largest angle (rad) between consecutive tangents.
-    ``predictor`` (pseudo-arclength): "linear" (along the tangent) or "quadratic" (the curve's
-    second derivative from the point before added: an O(ds^3) guess, fewer corrector iterations
-    and so longer steps; the points are the same, their spacing is not).
-    """
-
-    ds: float = 1e-2
-    ds_min: float = 1e-7
-    ds_max: float = 5e-2
-    growth: float = 1.5
-    easy_iterations: int = 3
-    jump: float = 0.5
-    max_turn: float = 0.5
-    predictor: str = "linear"
-
-    def __post_init__(self):
-        if self.predictor not in ("linear", "quadratic"):
-            raise ValueError(f"invalid argument `predictor`: must be 'linear' or 'quadratic', got {self.predictor!r}")
-        for name in ("ds", "ds_min", "ds_max", "growth", "jump", "max_turn"):
-            v = getattr(self, name)
-            if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
-                raise ValueError(f"invalid argument `{name}`: must be a finite number > 0, got {v!r}")
-        if not self.ds_min <= self.ds_max:
-            raise ValueError(f"invalid argument `ds_min`: must not exceed ds_max ({self.ds_max}), got {self.ds_min}")
-        if self.growth < 1:
-            raise ValueError(f"invalid argument `growth`: must be >= 1, got {self.growth}")
-
-
-def _try(problem, guess, constraint):
-    """Ask the runner to correct ``guess`` under ``constraint`` (a generator step: the driver's
-    algorithms yield their corrections, so that one runner can correct the requests of many
-    branches together); the corrected Point, or None when the correction failed."""
-    pt = yield (np.asarray(guess, dtype=float), constraint)
-    return pt
-
-
-class _Marks(list):
-    """A request for many independent corrections at once (a branch's marks): [(guess,
-    constraint)], answered with a list of Point or None."""
-
-
-def _correct(problem, guess, constraint) -> Point | None:
-    """The one place a problem's corrector is called for a single point."""
-    try:
-        pt = problem.correct(guess, constraint)
-    except LibrateError:
-        return None
-    return _finite(pt)
-
-
-def _finite(pt: Point | None) -> Point | None:
-    return pt if pt is not None and np.all(np.isfinite(pt.x)) else None
-
-
-def _run(problem, steps):
-    """Drive one branch's generator, correcting each request alone."""
-    try:
-        request = next(steps)
-        while True:
-            answer = correct_marks([(problem, *r) for r in request]) if isinstance(request, _Marks) else _correct(problem, *request)
-            request = steps.send(answer)
-    except StopIteration as done:
-        return done.value
-
-
-def _groups(problems, method: str) -> dict:
-    """Indices of the problems that one call of ``method`` can serve together (same type and
-    ``batch_key``); a problem without either stands alone."""
-    groups: dict = {}
-    for i, problem in enumerate(problems):
-        key = getattr(problem, "batch_key", None)
-        groups.setdefault((type(problem), key) if key is not None and hasattr(problem, method) else ("alone", id(problem)), []).append(i)
-    return groups
-
-
-def correct_marks(requests: list) -> list[Point | None]:
-    """Independent corrections at fixed parameter values [(problem, guess, constraint)] (the
-    marks of one or many branches): one ``correct_batch(guesses, constraints, problems)`` call
-    per group of compatible problems (``batch_key``), else the problem's own ``correct_batch``,
-    else one by one."""
-    out: list[Point | None] = [None] * len(requests)
-    for key, idx in _groups([r[0] for r in requests], "correct_batch").items():
-        problem = requests[idx[0]][0]
-        batch = getattr(problem, "correct_batch", None)
-        if batch is None:
-            for i in idx:
-                out[i] = _correct(*requests[i])
-            continue
-        extra = {} if key[0] == "alone" else {"problems": [requests[i][0] for i in idx]}
-        try:
-            got = batch([requests[i][1] for i in idx], [requests[i][2] for i in idx], **extra)
-        except LibrateError:
-            got = [None] * len(idx)
-        for i, pt in zip(idx, got):
-            out[i] = _finite(pt)
-    return out
-
-
-def correct_together(requests: list) -> list[Point | None]:
-    """Correct one round of requests [(problem, guess, constraint)] of lock-step branches:
-    problems that share a ``batch_key`` are corrected in one call of their ``correct_many``
-    (e.g. one Rust call integrating every branch's trajectories in the SIMD lanes), the others
-    one by one. Results in request order."""
-    out: list[Point | None] = [None] * len(requests)
-    for key, idx in _groups([r[0] for r in requests], "correct_many").items():
-        if key[0] == "alone":
-            for i in idx:
-                out[i] = _correct(*requests[i])
-            continue
-        problem = requests[idx[0]][0]
-        try:
-            got = problem.correct_many([requests[i] for i in idx])
-        except LibrateError:
-            got = [None] * len(idx)
-        for i, pt in zip(idx, got):
-            out[i] = _finite(pt)
-    return out
-
-
-def run_lockstep(branches: Sequence[tuple[Any, Any]], done: Callable[[int], None] | None = None) -> list:
-    """Run several continuations in lock step: ``branches`` are (problem, steps) pairs, steps a
-    generator from :func:`arclength_steps` (or :func:`natural_steps`); each round, every live
-    branch's pending correction is gathered and corrected together (:func:`correct_together`).
-    Returns each generator's result (a Branch), in order. Each branch takes exactly the path it
-    takes alone: only the grouping of the corrector calls changes. ``done(i)`` is called as
-    branch i ends (e.g. for progress)."""
-    results: list = [None] * len(branches)
-    pending: dict[int, tuple] = {}
-    for i, (problem, steps) in enumerate(branches):
-        try:
-            pending[i] = next(steps)
-        except StopIteration as end:
-            results[i] = end.value
-            if done is not None:
-                done(i)
-    while pending:
-        order = sorted(pending)
-        single = [i for i in order if not isinstance(pending[i], _Marks)]
-        answers = dict(zip(single, correct_together([(branches[i][0], *pending[i]) for i in single])))
-        flat = [(i, r) for i in order if isinstance(pending[i], _Marks) for r in pending[i]]
-        got = iter(correct_marks([(branches[i][0], *r) for i, r in flat]))
-        for i in order:
-            if isinstance(pending[i], _Marks):
-                answers[i] = [next(got) for _ in pending[i]]
-        for i in order:
-            try:
-                pending[i] = branches[i][1].send(answers[i])
-            except StopIteration as end:
-                results[i] = end.value
-                del pending[i]
-                if done is not None:
-                    done(i)
-    return results
-
-
-def _norm(problem, v) -> float:
-    return float(np.linalg.norm(np.asarray(v) / problem.scale))
-
-
-def _unit_tangent(problem, point: Point, reference: np.ndarray | None, fallback: np.ndarray | None) -> np.ndarray | None:
-    """Unit tangent in scaled coordinates, oriented along ``reference``."""
-    t = problem.tangent(point)
-    if t is None or not np.all(np.isfinite(t)) or not np.any(t):
-        t = fallback
-    if t is None:
-        return None
-    t = np.asarray(t, dtype=float) / problem.scale
-    n = np.linalg.norm(t)
-    if n == 0 or not math.isfinite(n):
-        return None
-    t = t / n
-    if reference is not None and float(np.dot(t, reference)) < 0:
-        t = -t
-    return t
-
-
-def _tests(problem, point) -> dict[str, float]:
-    f = getattr(problem, "tests", None)
-    return dict(f(point)) if f is not None else {}
-
-
-def sign_changes(before: dict[str, float], after: dict[str, float]) -> list[tuple[str, float, float, float]]:
-    """The test functions that change sign between two consecutive points: (name, value
-    before, value after, w) with w in (0, 1) the zero of their linear interpolation. The one
-    detection rule of the driver, also applied to members known without a corrector (e.g. a
-    family read from a catalog)."""
-    out = []
-    for name, v in after.items():
-        u = before.get(name)
-        if u is not None and math.isfinite(u) and math.isfinite(v) and u * v < 0:
-            out.append((name, u, v, u / (u - v)))
-    return out
-
-
 def _guard(problem, points, new, ratio) -> str | None:
     f = getattr(problem, "guard", None)
     return f(points, new, ratio) if f is not None else None
@@ -374,7 +77,7 @@ def _guard(problem, points, new, ratio) -> str | None:
 
 def natural(problem: ContinuationProblem, first: Point, targets: Sequence[float], **options) -> Branch:
     """Natural-parameter continuation (:func:`natural_steps`), each correction alone."""
-    return _run(problem, natural_steps(problem, first, targets, **options))
+    return run_alone(problem, natural_steps(problem, first, targets, **options))
 
 
 def natural_steps(
@@ -403,7 +106,7 @@ def natural_steps(
     k = problem.parameter_index
     n = first.x.size
     history = [first]
-    tests_prev = _tests(problem, first)
+    tests_prev = test_values(problem, first)
     out: list[Point] = []
     branch = Branch(out)
     for target in (float(v) for v in np.atleast_1d(np.asarray(targets, dtype=float))):
@@ -424,25 +127,26 @@ def natural_steps(
                 guess = last.x.copy()
                 prev_step = abs(trial - last.x[k])
             guess[k] = trial
-            pt = yield from _try(problem, guess, Constraint.fix(n, k, trial))
+            pt = yield from correction(problem, guess, Constraint.fix(n, k, trial))
             status = "fail"
             if pt is not None:
                 ratio = abs(trial - last.x[k]) / max(prev_step, 1e-300)
-                moved = _norm(problem, pt.x - guess)
+                moved = scaled_norm(problem, pt.x - guess)
                 # the secant predictor's error is a fraction of the larger of this step and the
                 # last one; a corrected point farther off is another branch
-                reach = max(_norm(problem, guess - last.x), _norm(problem, last.x - history[-2].x)) if len(history) >= 2 else 0.0
-                if len(history) >= 2 and moved > rules.jump * reach + 1e-9 * (1 + _norm(problem, last.x)):
+                reach = (max(scaled_norm(problem, guess - last.x), scaled_norm(problem, last.x - history[-2].x))
+                         if len(history) >= 2 else 0.0)
+                if len(history) >= 2 and moved > rules.jump * reach + 1e-9 * (1 + scaled_norm(problem, last.x)):
                     status = "jump"
                 elif _guard(problem, history, pt, ratio):
                     status = "jump"
                 else:
                     status = "ok"
             if status == "ok":
-                tests_new = _tests(problem, pt)
+                tests_new = test_values(problem, pt)
                 for test, u, v, w in sign_changes(tests_prev, tests_new):
                     if locate_bifurcations:
-                        b = yield from _locate_natural(problem, test, last, pt, u, v, tol)
+                        b = yield from locate_natural(problem, test, last, pt, u, v, tol)
                     else:
                         b = Bifurcation(test, float(last.x[k] + w * (pt.x[k] - last.x[k])), pt, False)
                     # "after": the index of the last returned point (at a target) before it
@@ -471,7 +175,7 @@ def natural_steps(
 
 def arclength(problem: ContinuationProblem, first: Point, **options) -> Branch:
     """Pseudo-arclength continuation (:func:`arclength_steps`), each correction alone."""
-    return _run(problem, arclength_steps(problem, first, **options))
+    return run_alone(problem, arclength_steps(problem, first, **options))
 
 
 def _bend(points: list, t: np.ndarray, sx: np.ndarray, h: float, ds: float) -> np.ndarray | None:
@@ -568,7 +272,7 @@ def arclength_steps(
         ref[k] = float(direction)
     else:
         ref = np.asarray(direction, dtype=float) / problem.scale
-    t = _unit_tangent(problem, first, ref, None)
+    t = unit_tangent(problem, first, ref, None)
     if t is None:
         raise LibrateError("continuation: the tangent at the first point is undefined (singular Jacobian)")
     if t[k] * ref[k] < 0 or (ref[k] == 0 and float(np.dot(t, ref)) < 0):
@@ -583,13 +287,13 @@ def arclength_steps(
         todo = [i for i, pm in enumerate(pending_marks) if pm[3] is None]
         got: dict[int, Point | None] = {}
         if todo:
-            got = dict(zip(todo, (yield _Marks((pending_marks[i][0], pending_marks[i][1]) for i in todo))))
+            got = dict(zip(todo, (yield Marks((pending_marks[i][0], pending_marks[i][1]) for i in todo))))
         for i, (guess, _, step, on) in enumerate(pending_marks):
             pm = on if on is not None else got.get(i)
-            if pm is not None and _norm(problem, pm.x - guess) <= rules.jump * step + 1e-12:
+            if pm is not None and scaled_norm(problem, pm.x - guess) <= rules.jump * step + 1e-12:
                 branch.marked.append(pm)
         return branch
-    tests_prev = _tests(problem, first)
+    tests_prev = test_values(problem, first)
     ds = rules.ds
     last_ds = 0.0
     sx = problem.scale
@@ -606,7 +310,7 @@ def arclength_steps(
         guess = base.x + s * tb * sx
         if bend is not None:
             guess = guess + 0.5 * s * s * bend
-        return (yield from _try(problem, guess, constraint(base, tb, s)))
+        return (yield from correction(problem, guess, constraint(base, tb, s)))
 
     def land(value: float):
         """The point exactly at parameter ``value``, from the last point along the tangent."""
@@ -614,8 +318,9 @@ def arclength_steps(
         dp = t[k] * sx[k]
         guess = last.x + (value - last.x[k]) / dp * t * sx if dp != 0 else last.x.copy()
         guess[k] = value
-        pt = yield from _try(problem, guess, Constraint.fix(n, k, value))
-        if pt is not None and _norm(problem, pt.x - guess) <= rules.jump * max(_norm(problem, guess - last.x), rules.ds_min) + 1e-9:
+        pt = yield from correction(problem, guess, Constraint.fix(n, k, value))
+        reach = max(scaled_norm(problem, guess - last.x), rules.ds_min)
+        if pt is not None and scaled_norm(problem, pt.x - guess) <= rules.jump * reach + 1e-9:
             return pt
         return None
 
@@ -645,13 +350,13 @@ def arclength_steps(
             status = "fail"
             t_new = None
             if new is not None:
-                moved = _norm(problem, new.x - pred)
+                moved = scaled_norm(problem, new.x - pred)
                 if moved > rules.jump * ds + 1e-12:
                     status = "jump"
                 elif _guard(problem, points, new, 1.0):
                     status = "jump"
                 else:
-                    t_new = _unit_tangent(problem, new, t, (new.x - base.x))
+                    t_new = unit_tangent(problem, new, t, (new.x - base.x))
                     if t_new is None:
                         status = "fail"
                     elif math.acos(max(-1.0, min(1.0, float(np.dot(t_new, t))))) > rules.max_turn:
@@ -675,17 +380,17 @@ def arclength_steps(
 
         # a fold: the parameter component of the tangent changes sign
         if t[k] * t_new[k] < 0:
-            fold = (yield from _locate_fold(problem, base, t, ds, new, t_new, within, fold_tol)) if locate else Fold(float(new.x[k]), new, False, abs(new.x[k] - base.x[k]))
+            fold = (yield from locate_fold(problem, base, t, ds, new, t_new, within, fold_tol)) if locate else Fold(float(new.x[k]), new, False, abs(new.x[k] - base.x[k]))
             branch.folds.append(fold)
             if stop_at_fold:
                 if fold.located:
                     points.append(fold.point)  # the branch ends on its turning point
                 branch.end_reason = f"fold at {name} = {fold.parameter:.12g}" + ("" if fold.located else f" (not located: within {fold.tolerance:.2g})")
                 return (yield from finish())
-        tests_new = _tests(problem, new)
+        tests_new = test_values(problem, new)
         for test, u, v, w in sign_changes(tests_prev, tests_new):
             if locate and locate_bifurcations:
-                b = yield from _locate_sign(problem, test, base, t, ds, u, v, new, within, fold_tol)
+                b = yield from locate_sign(problem, test, base, t, ds, u, v, new, within, fold_tol)
             else:  # the linear interpolation of the test function between the two points
                 b = Bifurcation(test, float(base.x[k] + w * (new.x[k] - base.x[k])), new, False)
             branch.bifurcations.append(dataclasses.replace(b, after=len(points) - 1))
@@ -706,145 +411,3 @@ def arclength_steps(
     branch.end_reason = f"completed: max_points = {max_points} reached"
     return (yield from finish())
 
-
-def _illinois(f, a: float, fa: float, b: float, fb: float, done: Callable[[float, float], bool], max_iter: int = 60):
-    """Regula falsi (Illinois) on [a, b] with f(a) f(b) < 0; ``f`` (a generator of corrections,
-    as this one) returns (value, payload) or None where it cannot be evaluated (then the interval
-    is bisected)."""
-    side = 0
-    best = None
-    for _ in range(max_iter):
-        if done(a, b):
-            break
-        c = b - fb * (b - a) / (fb - fa) if fb != fa else 0.5 * (a + b)
-        if not (min(a, b) < c < max(a, b)):
-            c = 0.5 * (a + b)
-        r = yield from f(c)
-        if r is None:
-            c = 0.5 * (a + b)
-            r = yield from f(c)
-            if r is None:
-                return best, False
-        fc, payload = r
-        best = (c, payload)
-        if fc == 0:
-            return best, True
-        if (fc > 0) == (fb > 0):
-            b, fb = c, fc
-            if side == 1:
-                fa *= 0.5
-            side = 1
-        else:
-            a, fa = c, fc
-            if side == -1:
-                fb *= 0.5
-            side = -1
-    return best, True
-
-
-def _locate_fold(problem, base, t, ds, new, t_new, at, tol) -> Fold:
-    """The turning point between ``base`` and ``new``, searched on the hyperplanes
-    t . (y - y_base) = s, s in (0, ds): Illinois iterations on g(s) = dp/ds, the parameter's rate
-    along them (from the unit tangent at each point). Around the fold p(s) is a parabola, so p*
-    is estimated from each end of the bracket, p(a) + g(a) (s* - a) / 2 with s* the zero of g
-    interpolated linearly; located when the two estimates agree to ``tol``."""
-    k = problem.parameter_index
-    sk = float(problem.scale[k])
-
-    def rate(tt):
-        return float(tt[k]) * sk / max(float(np.dot(tt, t)), 1e-300)
-
-    a, pa, ga = 0.0, base, rate(t)
-    b, pb, gb = ds, new, rate(t_new)
-    wa, wb = ga, gb  # the Illinois weights (the rates themselves are kept for the estimates)
-    g0 = max(abs(ga), abs(gb))
-    side = 0
-    est, err = float(new.x[k]), math.inf
-    for _ in range(80):
-        lin = a - ga * (b - a) / (gb - ga) if gb != ga else 0.5 * (a + b)
-        ea = pa.x[k] + 0.5 * ga * (lin - a)
-        eb = pb.x[k] + 0.5 * gb * (lin - b)
-        est, err = 0.5 * (ea + eb), abs(ea - eb)
-        # located: the parameter to tol, and a bracket end on the fold itself (its rate 1e-4 of
-        # the step's: quantities that vanish at the fold, det(J), vanish there to that order)
-        if err <= tol and min(abs(ga), abs(gb)) <= 1e-4 * g0:
-            return Fold(float(est), pa if abs(ga) < abs(gb) else pb, True, float(err))
-        c = a - wa * (b - a) / (wb - wa) if wb != wa else 0.5 * (a + b)
-        if not a < c < b:
-            c = 0.5 * (a + b)
-        pc = yield from at(base, t, c)
-        tc = None if pc is None else _unit_tangent(problem, pc, t, pc.x - base.x)
-        if tc is None:
-            c = 0.5 * (a + b)
-            pc = yield from at(base, t, c)
-            tc = None if pc is None else _unit_tangent(problem, pc, t, pc.x - base.x)
-            if tc is None:
-                break
-        gc = rate(tc)
-        if (gc > 0) == (gb > 0):
-            b, pb, gb, wb = c, pc, gc, gc
-            if side == 1:
-                wa *= 0.5
-            side = 1
-        else:
-            a, pa, ga, wa = c, pc, gc, gc
-            if side == -1:
-                wb *= 0.5
-            side = -1
-        if b - a <= 1e-15 * ds:
-            break
-    return Fold(float(est), pa if abs(ga) < abs(gb) else pb, False, float(err))
-
-
-def _locate_natural(problem, name, a: Point, b: Point, u: float, v: float, tol: float):
-    """A sign change of the test ``name`` between the accepted points ``a`` and ``b`` of a
-    natural-parameter run, located to ``tol`` in the parameter: Illinois iterations on the test
-    function of points corrected at fixed parameter values (guesses interpolated linearly)."""
-    k = problem.parameter_index
-    n = a.x.size
-
-    def f(p):
-        w = (p - a.x[k]) / (b.x[k] - a.x[k])
-        guess = a.x + w * (b.x - a.x)
-        guess[k] = p
-        pt = yield from _try(problem, guess, Constraint.fix(n, k, p))
-        val = None if pt is None else _tests(problem, pt).get(name)
-        return None if val is None or not math.isfinite(val) else (val, pt)
-
-    best, ok = yield from _illinois(f, float(a.x[k]), u, float(b.x[k]), v, lambda lo, hi: abs(hi - lo) <= tol)
-    if best is None or not ok:
-        w = u / (u - v)
-        return Bifurcation(name, float(a.x[k] + w * (b.x[k] - a.x[k])), b if best is None else best[1], False)
-    return Bifurcation(name, float(best[0]), best[1], True)
-
-
-def _locate_sign(problem, name, base, t, ds, u, v, new, at, tol) -> Bifurcation:
-    k = problem.parameter_index
-
-    def f(s):
-        pt = yield from at(base, t, s)
-        if pt is None:
-            return None
-        val = _tests(problem, pt).get(name)
-        if val is None or not math.isfinite(val):
-            return None
-        return val, pt
-
-    state = {"last": None}
-
-    def g(s):
-        r = yield from f(s)
-        if r is not None:
-            state["last"] = r[1]
-        return r
-
-    def done(a, b):
-        return abs(b - a) * max(abs(t[k]), 1e-16) * problem.scale[k] <= tol
-
-    best, ok = yield from _illinois(g, 0.0, u, ds, v, done)
-    if best is None or not ok:
-        # not located (the corrector cannot converge next to it, as at a branch point, where the
-        # extended Jacobian is singular): the linear interpolation of the test function
-        w = u / (u - v)
-        return Bifurcation(name, float(base.x[k] + w * (new.x[k] - base.x[k])), new if best is None else best[1], False)
-    return Bifurcation(name, float(best[1].x[k]), best[1], ok)
