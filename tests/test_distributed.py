@@ -88,9 +88,20 @@ class Killer(threading.Thread):
         self.join(10)
 
 
-def _wait_workers(client, n=2):
-    """Both workers back (a killed one is restarted by its nanny; slow on a loaded machine)."""
-    client.wait_for_workers(n, timeout=240)
+def _wait_workers(cluster, n=2):
+    """Both workers back: a killed one is restarted by its nanny; a nanny that gave up (its
+    restart timed out on a loaded machine) is replaced by the cluster."""
+    c, client = cluster
+    try:
+        client.wait_for_workers(n, timeout=60)
+    except (TimeoutError, distributed.exceptions.WorkerStartTimeoutError):
+        from distributed.core import Status
+
+        for name, nanny in list(c.workers.items()):
+            if nanny.status in (Status.closed, Status.closing, Status.failed):
+                del c.workers[name]  # the cluster starts a new one for its spec
+        c.scale(n)
+        client.wait_for_workers(n, timeout=240)
 
 
 def _same_map(a, b, names):
@@ -187,7 +198,7 @@ def test_planar_map_survives_a_killed_worker_bit_identically(cluster, fam, tmp_p
     from librate.results.store import verify_store
 
     _, client = cluster
-    _wait_workers(client)
+    _wait_workers(cluster)
     out = tmp_path / "map.zarr" if store else None
     written = _count_written(monkeypatch)
     with Killer(client, len(X0)) as k:
@@ -211,7 +222,7 @@ def test_3d_map_survives_a_killed_worker_bit_identically(cluster, fam, tmp_path,
     from librate.results.store import verify_store
 
     _, client = cluster
-    _wait_workers(client)
+    _wait_workers(cluster)
     written = _count_written(monkeypatch)
     kw = dict(body=BODY, rates=RATES_3D, q0=[0.0, 0.0, 0.0, 1.0], tol=1e-10, progress=False)
     with Killer(client, len(X0) * (1 if chunk_cases == "auto" else 5)) as k:
@@ -248,7 +259,7 @@ def test_solve_survives_a_killed_worker_bit_identically(cluster, solve_study, tm
     from librate.app.jobs import run_solve
 
     _, client = cluster
-    _wait_workers(client)
+    _wait_workers(cluster)
     with Killer(client, len(X0) * 3) as k:
         ds, _ = run_solve(solve_study, tmp_path / "d", scheduler=client)
     assert k.killed is not None, "no worker was killed mid-run"
@@ -277,7 +288,7 @@ def test_a_restart_of_every_worker_loses_no_finished_part(cluster, fam, tmp_path
     from librate.app.runner import run_map
 
     _, client = cluster
-    _wait_workers(client)
+    _wait_workers(cluster)
 
     restarted = []
 
