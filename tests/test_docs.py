@@ -63,3 +63,25 @@ def test_every_readme_python_block_runs_as_pasted(tmp_path):
         res = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, capture_output=True, text=True, timeout=600,
                              env={**os.environ, "MPLBACKEND": "Agg"})
         assert res.returncode == 0, f"README block {i + 1} failed:\n{res.stderr[-2000:]}"
+
+
+@pytest.mark.slow
+def test_the_cluster_recipe_runs_on_a_local_cluster_with_worker_processes(tmp_path):
+    """Issue 22 #3: docs/cluster.md's recipe. Its SLURM block is valid Python naming SLURMCluster
+    (dask-jobqueue needs a batch system); its work block runs as pasted on the page's
+    LocalCluster of two worker processes, in a fresh interpreter, and writes complete stores."""
+    import ast
+
+    blocks = re.findall(r"```python\n(.*?)```", (DOCS / "cluster.md").read_text(), re.S)
+    assert len(blocks) == 3, "the page holds the SLURM cluster, the work and the local cluster"
+    slurm, work, local = blocks
+    ast.parse(slurm)
+    assert "SLURMCluster(" in slurm and "LocalCluster(" in local and "Client(cluster)" in work
+    code = local + "\n" + work + "\ncluster.close()\n"
+    res = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, capture_output=True, text=True, timeout=600)
+    assert res.returncode == 0, res.stderr[-3000:]
+    assert "complete = 1" in res.stdout and "3-D map: 6 orbits" in res.stdout, res.stdout
+    from librate.results.store import verify_store
+
+    for store in ("runs/map.zarr", "runs/map3d.zarr"):
+        assert verify_store(tmp_path / store).ok, store

@@ -389,7 +389,8 @@ def _quote(v):
 @click.option("--out", "out_dir", type=click.Path(file_okay=False), help="Output folder (default: output.folder of the study).")
 @click.option("--resume/--force", default=True, help=_FORCE_HELP)
 @click.option("--quiet", "-q", is_flag=True, help="No progress and no table; print only the written path.")
-def solve(study, sets, out_dir, resume, quiet) -> None:
+@click.option("--scheduler", metavar="tcp://HOST:PORT", help="Solve each orbit and Kz as a task on this Dask scheduler (planar studies; needs dask.distributed).")
+def solve(study, sets, out_dir, resume, quiet, scheduler) -> None:
     """Find the periodic attitude motions of each orbit and Kz of STUDY in its rate window.
 
     For every selected orbit (period T) and every Kz of [body], scans the study's grid of
@@ -427,7 +428,7 @@ def solve(study, sets, out_dir, resume, quiet) -> None:
     t0 = time.perf_counter()
     try:
         ds, path = run_solve(st, out_dir, progress=reporter("3-D solutions" if three_d else "solutions", "member" if three_d else "orbit-Kz",
-                                                           _show(quiet)), force=not resume, say=_say)
+                                                           _show(quiet)), force=not resume, say=_say, scheduler=scheduler)
     except _FAILURES as err:
         raise _failure(err) from None
     el = time.perf_counter() - t0
@@ -449,7 +450,7 @@ def solve(study, sets, out_dir, resume, quiet) -> None:
 @click.argument("study", type=click.Path(exists=True, dir_okay=False))
 @click.option("--out", "out_dir", type=click.Path(file_okay=False), help="Output folder (default: output.folder of the study); the map goes to OUT/map.zarr.")
 @click.option("--quiet", "-q", is_flag=True, help="No progress bar and no summary; print only the written paths.")
-@click.option("--scheduler", metavar="tcp://HOST:PORT", help="Run the map's chunks on this Dask scheduler (needs librate.app.runner and dask.distributed).")
+@click.option("--scheduler", metavar="tcp://HOST:PORT", help="Run the map's orbits (planar or 3-D) as tasks on this Dask scheduler (needs dask.distributed).")
 @click.option("--resume/--force", default=True, help=_FORCE_HELP)
 @click.option("--set", "sets", multiple=True, metavar="KEY=VALUE", help=_SET_HELP)
 def map_(study, out_dir, quiet, scheduler, resume, sets) -> None:

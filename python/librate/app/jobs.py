@@ -7,6 +7,7 @@ computes, and saves the result with the study and the package version as attribu
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Callable
 from pathlib import Path
@@ -60,7 +61,7 @@ def run_family(study: Study, out: str | Path | None = None, *, force: bool = Fal
     return sel, path
 
 def run_solve(study: Study, out: str | Path | None = None, progress: Callable[[int, int], None] | None = None, *, force: bool = False,
-              say: Callable[[str], None] | None = None):
+              say: Callable[[str], None] | None = None, scheduler=None):
     """The periodic attitude solutions of every selected orbit and Kz with wz0 in the rate
     window (:func:`librate.find_periodic_attitudes`, scanning on the study's rate grid),
     saved as ``solve.zarr`` (or ``.nc``). Returns ``(dataset, path)``; the Dataset has a
@@ -68,10 +69,18 @@ def run_solve(study: Study, out: str | Path | None = None, progress: Callable[[i
     stability, residual). An existing table of the same inputs is reused, one of other
     inputs refused unless ``force``, as in :func:`run_family`.
 
-    With ``[attitude] model = "3d"`` see the 3-D branch below instead."""
+    ``scheduler``: None (this process), a Dask ``distributed.Client`` or its address: each
+    (orbit, Kz) is one task (:func:`librate.app.distribute.run_tasks`, checksummed on arrival,
+    resubmitted when lost with its worker); the table equals the local one bit for bit.
+
+    With ``[attitude] model = "3d"`` see the 3-D branch below instead (one continuation: it
+    runs in this process, and a ``scheduler`` is refused)."""
     if study.attitude.model == "3d":
+        if scheduler is not None:
+            raise ValueError("invalid argument `scheduler`: a 3-D solve is one continuation along the members (sequential); "
+                             "it runs in this process (use scheduler=None)")
         return _run_solve_3d(study, out, progress, force=force, say=say)
-    from ..periodicity.solutions import find_periodic_attitudes
+    from .distribute import Task, run_tasks
     from .results import save_dataset, solutions_dataset
 
     path = _result_path(study, out, "solve")
@@ -81,17 +90,21 @@ def run_solve(study: Study, out: str | Path | None = None, progress: Callable[[i
     olist = list(orbits)
     wz = study.wz0_values()
     srp = study.build_srp(olist[0].system if olist else None)
-    rows = []
-    total = len(olist) * len(study.kz_values())
-    done = 0
-    for i, o in enumerate(olist):
-        for kz in study.kz_values():
-            sols = find_periodic_attitudes(o, kz=float(kz), wz0_range=(float(wz[0]), float(wz[-1])), phi0=study.solver.phi0,
-                                           n_grid=int(wz.size), n_periods=study.n_periods(), srp=srp)
-            rows += [(i, s) for s in sols]
-            done += 1
+    kzs = [float(kz) for kz in study.kz_values()]
+    found: dict[tuple[int, int], list] = {}
+    tasks = [Task((i, j), _solve_one, (o, kz, (float(wz[0]), float(wz[-1])), study.solver.phi0, int(wz.size), study.n_periods(), srp))
+             for i, o in enumerate(olist) for j, kz in enumerate(kzs)]
+
+    class _Count:  # progress(done, total) after each (orbit, Kz)
+        n = 0
+
+        def update(self, k: int) -> None:
+            self.n += k
             if progress is not None:
-                progress(done, total)
+                progress(self.n, len(tasks))
+
+    run_tasks(tasks, lambda key, sols: found.__setitem__(key, sols), scheduler=scheduler, bar=_Count())
+    rows = [(i, _solution_of(olist[i], srp, d)) for i in range(len(olist)) for j in range(len(kzs)) for d in found[(i, j)]]
     ds = solutions_dataset(rows, olist, study.kz_values(), study.result_attrs("solutions", "solve"))
     flex = study.build_flexible()
     if flex is not None and rows:
@@ -104,6 +117,22 @@ def run_solve(study: Study, out: str | Path | None = None, progress: Callable[[i
         ds["flex_max_dphi"] = ("solution", np.array([r.max_dphi for r in res]), {"units": "rad", "long_name": "largest attitude departure over a period"})
     path = save_dataset(ds, path)
     return ds, path
+
+def _solve_one(orbit, kz: float, window: tuple[float, float], phi0: float, n_grid: int, n_periods: int, srp) -> list[dict]:
+    """The solutions of one orbit and Kz (a task, picklable for Dask), as plain data (every field
+    of each AttitudeSolution but its orbit and plate, which the caller holds)."""
+    from ..periodicity.solutions import find_periodic_attitudes
+
+    sols = find_periodic_attitudes(orbit, kz=kz, wz0_range=window, phi0=phi0, n_grid=n_grid, n_periods=n_periods, srp=srp)
+    return [{f.name: getattr(s_, f.name) for f in dataclasses.fields(s_) if f.name not in ("orbit", "srp")} for s_ in sols]
+
+
+def _solution_of(orbit, srp, fields: dict):
+    """The AttitudeSolution of :func:`_solve_one`'s plain data on the caller's orbit and plate."""
+    from ..periodicity.solutions import AttitudeSolution
+
+    return AttitudeSolution(orbit=orbit, srp=srp, **fields)
+
 
 def _run_solve_3d(study: Study, out: str | Path | None = None, progress: Callable[[int, int], None] | None = None, *, force: bool = False,
                  say: Callable[[str], None] | None = None):

@@ -8,6 +8,8 @@ call on the same folder skips the finished rows; a folder that is not a librate 
 one written for different inputs (a fingerprint of every input is stored), is refused, never
 overwritten. Rows are computed by the deterministic engine (independent of threads and
 chunking), so a resumed or distributed run equals an uninterrupted local one bit for bit.
+The rows run through :func:`librate.app.distribute.run_tasks` (locally, or on Dask: each row
+checksummed on arrival, written by the worker itself on a shared filesystem).
 """
 
 from __future__ import annotations
@@ -26,6 +28,7 @@ from ..results.atomic import clean_orphans, remove_path, replace_path, temporary
 from ..results.kinds import map_schema
 from ..results.lock import writer_lock
 from ..results.store import PartStore
+from .distribute import ArrivalError, Region, Task, run_tasks
 from .progress import bar as progress_bar
 
 __all__ = ["run_map"]
@@ -189,23 +192,10 @@ def _run(olist, family, kzs, wz, coords, fp, args, out, resume, scheduler, progr
 
     todo = [i for i in range(no) if not done[i]]
     bar = progress_bar(no, "periodicity map", "orbit", progress, initial=no - len(todo))
+    region = None if store is None or lock is None or scheduler is None else Region.of(store, lock)
     try:
-        if scheduler is None:
-            for i in todo:
-                write(i, _row(olist[i], *args))
-                bar.update(1)
-        else:
-            from distributed import Client, as_completed
-
-            client = scheduler if isinstance(scheduler, Client) else Client(scheduler)
-            try:
-                futures = {client.submit(_row, olist[i], *args, pure=False): i for i in todo}
-                for fut in as_completed(futures):
-                    write(futures[fut], fut.result())
-                    bar.update(1)
-            finally:
-                if client is not scheduler:
-                    client.close()
+        run_tasks([Task(i, _row, (olist[i], *args)) for i in todo], write, scheduler=scheduler, bar=bar,
+                  region=region, commit_written=lambda i, sums: _commit_written(store, done, i, sums))
     finally:
         bar.close()
 
@@ -224,6 +214,13 @@ def _run(olist, family, kzs, wz, coords, fp, args, out, resume, scheduler, progr
         sol = {v: (("solution",), np.ascontiguousarray(ds[v].values), dict(ds[v].attrs)) for v in ds.data_vars if v.startswith("sol_")}
         store.finalise(sol, dict(ds.attrs), complete=bool(ds.attrs.get("complete", 0)))
     return ds
+
+
+def _commit_written(store, done, i, sums) -> None:
+    """Commit a part a worker wrote into the store itself, or say it did not check out."""
+    if not store.commit_written(i, sums):
+        raise ArrivalError(f"part {i}: the region written by a worker does not match its digests")
+    done[i] = True
 
 
 def _check_replaceable(out: Path) -> None:

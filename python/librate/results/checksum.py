@@ -11,7 +11,7 @@ import json
 import numpy as np
 
 __all__ = ["CHECKSUM_ATTR", "META_ATTR", "array_digest", "attrs_digest", "check_dataset", "dataset_checksums", "dataset_meta", "meta_digest",
-           "plain"]
+           "plain", "value_digest"]
 
 #: The attribute of a saved Dataset holding the digests of its variables' values (JSON).
 CHECKSUM_ATTR = "librate_checksums"
@@ -32,6 +32,38 @@ def array_digest(values) -> str:
     else:
         h.update("\0".join(x.decode() if isinstance(x, bytes) else str(x) for x in a.ravel().tolist()).encode())
     return h.hexdigest()
+
+
+def value_digest(value) -> str:
+    """An exact hex digest of a task's result (the bytes, dtype and shape of every array, every
+    number's bits, text; nested in dicts, lists and tuples), to check it on arrival from another
+    process. TypeError for anything else (a result must be plain data to be checked)."""
+    h = hashlib.blake2b(digest_size=16)
+    _feed(h, value)
+    return h.hexdigest()
+
+
+def _feed(h, v) -> None:
+    if isinstance(v, dict):
+        h.update(b"{%d" % len(v))
+        for k in sorted(v, key=str):
+            _feed(h, str(k))
+            _feed(h, v[k])
+    elif isinstance(v, (list, tuple)):
+        h.update(b"[%d" % len(v))
+        for x in v:
+            _feed(h, x)
+    elif isinstance(v, (np.ndarray, np.generic)):
+        a = np.ascontiguousarray(v)
+        if a.dtype.hasobject:
+            raise TypeError("value_digest: an object array cannot be checksummed")
+        h.update(f"a{a.dtype.str}{a.shape}".encode())
+        h.update(a.tobytes())
+    elif v is None or isinstance(v, (bool, int, float, complex, str, bytes)):
+        h.update(f"{type(v).__name__}:".encode())
+        h.update(v if isinstance(v, bytes) else np.float64(v).tobytes() if isinstance(v, float) else repr(v).encode())
+    else:
+        raise TypeError(f"value_digest: cannot checksum a {type(v).__name__} (return arrays, numbers, text, dicts or lists)")
 
 
 def plain(v):

@@ -34,7 +34,7 @@ from .atomic import clean_orphans, fsync_tree, remove_path, temporary_sibling
 from .checksum import array_digest, attrs_digest, meta_digest
 from .zarrcheck import blosc_problem, quiet_zarr, short
 
-__all__ = ["STORE_ATTRS", "PartStore", "StoreReport", "StoreSchema", "Var", "open_group", "part_digest", "verify_store"]
+__all__ = ["STORE_ATTRS", "PartStore", "StoreReport", "StoreSchema", "Var", "open_group", "part_digest", "verify_store", "write_region"]
 
 _SKIP_ATTRS = ("attrs_checksum",)
 #: The root attributes a part store keeps for itself (not part of an exported result).
@@ -72,6 +72,23 @@ def part_digest(values, dtype) -> int:
     """The 64-bit digest of one part of one variable, as stored (in the schema's dtype)."""
     a = np.ascontiguousarray(np.asarray(values, dtype=dtype))
     return int.from_bytes(hashlib.blake2b(a.tobytes(), digest_size=8).digest(), "little")
+
+
+def write_region(path: Path, dtypes: dict, i: int, part: dict) -> list[int]:
+    """Write the data of part ``i`` into the store at ``path`` from another process of the writer
+    (a worker on the same filesystem; variables ``dtypes`` by name), and return its digests in
+    column order. Neither digests nor the done flag are written: the writer checks the region
+    against these digests and commits it (:meth:`PartStore.commit_written`)."""
+    import zarr
+
+    sums = []
+    with zarr.config.set({"array.write_empty_chunks": True}), quiet_zarr():
+        g = zarr.open_group(str(path), mode="r+", use_consolidated=False)
+        for k, dtype in dtypes.items():
+            values = np.asarray(part[k]).astype(dtype, copy=False)
+            g[k][i] = values
+            sums.append(part_digest(values, dtype))
+    return sums
 
 
 def open_group(path: Path, kind: str, mode: str = "r"):
@@ -239,6 +256,26 @@ class PartStore:
             sums.append(part_digest(values, v.dtype))
         self.g["row_checksum"][i] = np.array(sums, dtype=np.uint64)  # after the data, before the flag
         self.g["done"][i] = True
+
+    def commit_written(self, i: int, digests) -> bool:
+        """Commit part ``i`` whose data another process wrote (:func:`write_region`): its region
+        is read back and checked against ``digests``, then the digests and the done flag are
+        written. Returns False, committing nothing, when the region does not match."""
+        if self.lock is not None:
+            self.lock.check()
+        if len(digests) != len(self.schema.variables):
+            return False
+        with quiet_zarr():
+            for (k, v), want in zip(self.schema.variables.items(), digests):
+                try:
+                    got = part_digest(np.asarray(self.g[k][i]), v.dtype)
+                except Exception:  # noqa: BLE001 - an unreadable chunk: not committed
+                    return False
+                if got != int(want):
+                    return False
+        self.g["row_checksum"][i] = np.array([int(d) for d in digests], dtype=np.uint64)
+        self.g["done"][i] = True
+        return True
 
     def read(self, name: str):
         """The whole array ``name``, or ValueError naming it when it is unreadable."""
