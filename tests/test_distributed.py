@@ -26,6 +26,10 @@ distributed = pytest.importorskip("distributed")
 from librate.app.distribute import Region, Task, run_tasks  # noqa: E402
 from librate.results.checksum import value_digest  # noqa: E402
 
+# The scheduler's HTTP server (its routes run even with the dashboard off) on a free port: its
+# default, 8787, may still be held by another test's cluster, and the warning that it moved is an
+# error under filterwarnings = error.
+FREE_HTTP_PORT = {"dashboard_address": ":0"}
 X0 = [0.9, 0.87, 0.84, 0.81, 0.78, 0.75, 0.72, 0.69]
 KZ = [0.4, 0.8]
 WZ = np.linspace(-3, 2, 20000)  # ~0.3 s a row: the kill lands mid-run
@@ -42,7 +46,7 @@ def fam(em):
 def cluster():
     from distributed import Client, LocalCluster
 
-    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as c, Client(c) as client:
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None, scheduler_kwargs=FREE_HTTP_PORT) as c, Client(c) as client:
         yield c, client
 
 
@@ -319,7 +323,7 @@ def test_a_scheduler_gone_for_good_stops_the_run_and_the_same_call_resumes(fam, 
     from librate.app.runner import run_map
 
     out = tmp_path / "map.zarr"
-    c = LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None)
+    c = LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None, scheduler_kwargs=FREE_HTTP_PORT)
     client = Client(c, timeout=3)
 
     def close():
@@ -344,7 +348,7 @@ def test_a_scheduler_gone_for_good_stops_the_run_and_the_same_call_resumes(fam, 
         c.close()
     kept = int(np.sum(zarr.open_group(str(out), mode="r")["done"][:]))
     assert 0 < kept < len(X0)
-    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as c2, Client(c2) as client2:
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None, scheduler_kwargs=FREE_HTTP_PORT) as c2, Client(c2) as client2:
         ds = run_map(fam, kz=KZ, wz0=WZ, scheduler=client2, progress=False, out=out, solve=False)
     assert ds.attrs["complete"] == 1
     _same_map(ds, run_map(fam, kz=KZ, wz0=WZ, progress=False, solve=False), ("dwz", "dphi", "phi_T", "status"))

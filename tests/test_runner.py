@@ -16,6 +16,11 @@ WZ = np.linspace(-3, 2, 1500)
 KZ = [0.4, 0.8]
 X0 = [0.95, 0.92, 0.9, 0.88, 0.85, 0.82, 0.8, 0.78, 0.75, 0.72]
 
+# The scheduler's HTTP server (its routes run even with the dashboard off) on a free port: its
+# default, 8787, may still be held by another test's cluster, and the warning that it moved is an
+# error under filterwarnings = error.
+FREE_HTTP_PORT = {"dashboard_address": ":0"}
+
 
 @pytest.fixture(scope="module")
 def fam(em):
@@ -125,5 +130,5 @@ def test_dask_local_cluster_gives_identical_results(fam, reference):
     """The same map on a Dask LocalCluster of two workers equals the local run bit for bit."""
     from distributed import Client, LocalCluster
 
-    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster, Client(cluster) as client:
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None, scheduler_kwargs=FREE_HTTP_PORT) as cluster, Client(cluster) as client:
         _same(run_map(fam, kz=KZ, wz0=WZ, scheduler=client, progress=False), reference)
