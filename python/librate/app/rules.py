@@ -68,7 +68,9 @@ def check_sections(s: dict[str, Table], given: dict, purpose: str | None) -> lis
         problems += _check_3d(att, start, s, given)
 
     # what the command needs
-    if purpose in ("solve", "map") and three_d:
+    if purpose == "transition":
+        problems += _needs_transition(s, given)
+    elif purpose in ("solve", "map") and three_d:
         problems += _needs_3d(purpose, start, s, given)
     elif purpose in ("solve", "map"):
         what, need = ("periodic solutions", "need") if purpose == "solve" else ("a periodicity map", "needs")
@@ -185,4 +187,21 @@ def _needs_3d(purpose: str, start: str, s: dict, given: dict) -> list[str]:
         problems.append(problem(f"rates.{name}", grid_raw(getattr(rates, name)), f"a 3-D map has grids over two rate components and one fixed number; "
                                  f"given {len(fixed)} fixed ({', '.join('rates.' + f for f in fixed) or 'none'})",
                                  "exactly one of rates.wx0, rates.wy0, rates.wz0 (or rates.phidot0) a number, the other two grids"))
+    return problems
+
+
+def _needs_transition(s: dict, given: dict) -> list[str]:
+    """What ``librate transition`` needs: [ephemeris], and one orbit selected by [orbits]."""
+    problems: list[str] = []
+    if "ephemeris" not in given:
+        problems.append(missing("ephemeris", "missing section [ephemeris]: a transition needs the epoch(s) (ephemeris.epoch)"))
+    orb = s.get("orbits")
+    if orb is not None:
+        sel = member_count(orb)
+        if sel is None:
+            problems.append(missing("orbits.x0", "missing: a transition carries one orbit into the ephemeris model: select it "
+                                                 "(e.g. orbits.x0 = [0.8], orbits.period_days = [6.56], orbits.members = 1)"))
+        elif sel[2] != 1:
+            problems.append(problem(f"orbits.{sel[0]}", sel[1], f"selects {sel[2]} orbits; a transition carries one orbit into the ephemeris model "
+                                    "(its epochs are ephemeris.epoch)", "exactly one value"))
     return problems

@@ -16,9 +16,9 @@ import numpy as np
 from pydantic import BaseModel, ConfigDict, Discriminator, Field, Tag, TypeAdapter, ValidationError, ValidationInfo, model_validator
 
 #: What a study can be checked for (the commands that run it).
-PURPOSES = ("family", "solve", "map")
+PURPOSES = ("family", "solve", "map", "transition")
 #: Figure names accepted in ``output.figures`` ("multipliers" and "body_axes": 3-D solves).
-FIGURES = ("family", "period", "stability", "map", "residuals", "solutions", "multipliers", "body_axes")
+FIGURES = ("family", "period", "stability", "map", "residuals", "solutions", "multipliers", "body_axes", "transition", "defects", "sweep")
 #: What output.figures accepts (its field's description).
 FIGURES_TEXT = "a list of figure names among " + ", ".join(repr(f) for f in FIGURES)
 
@@ -403,6 +403,115 @@ _ATTITUDE = TypeAdapter(Annotated[Annotated[PlanarAttitude, Tag("planar")] | Ann
 
 
 
+# --- [ephemeris] ----------------------------------------------------------------------------------
+#: The most epochs of one [ephemeris] section (a list, or a range's count).
+MAX_EPOCHS = 10_000
+_EPOCH_TEXT = "an ISO string with a time scale ('2030-01-01T00:00:00 TDB', or UTC, TT) or TDB seconds past J2000"
+EpochValue = Annotated[float | int | str, Field(description=_EPOCH_TEXT)]
+
+
+class EpochRange(Table):
+    """Epochs from ``start`` to ``stop`` (included when it falls on a step), every ``step_days``."""
+
+    start: float | int | str = Field(description="the first epoch: " + _EPOCH_TEXT)
+    stop: float | int | str = Field(description="the last epoch (included when it falls on a step): " + _EPOCH_TEXT + ", not before start")
+    step_days: float = Field(gt=0, le=36_525, description="a number in (0, 36525], the days between epochs (TDB)")
+
+
+def _epoch_tag(v: Any) -> str | None:
+    if isinstance(v, (dict, EpochRange)):
+        return "range"
+    if isinstance(v, (list, tuple)):
+        return "list"
+    if isinstance(v, (int, float, str)) and not isinstance(v, bool):
+        return "number"
+    return None
+
+
+_EPOCHS_MSG = "must be an epoch (an ISO string with a scale, or TDB seconds past J2000), a list of them or a table {start, stop, step_days}"
+Epochs = Annotated[
+    Annotated[EpochValue, Tag("number")] | Annotated[list[EpochValue], Field(min_length=1, max_length=MAX_EPOCHS), Tag("list")]
+    | Annotated[EpochRange, Tag("range")],
+    Discriminator(_epoch_tag, custom_error_type="grid", custom_error_message=_EPOCHS_MSG),
+]
+
+
+def _embedded_span() -> tuple[float, float]:
+    from ..ephemeris.model import Ephemeris
+
+    if not _SPAN:
+        _SPAN.append(Ephemeris().span)
+    return _SPAN[0]
+
+
+_SPAN: list[tuple[float, float]] = []
+
+
+class EphemerisSection(Table):
+    """[ephemeris]: the epochs at which the study's orbit is carried into the Earth-Moon-Sun
+    ephemeris model (``librate transition``), over how many revolutions, and the SPK file."""
+
+    epoch: Epochs = Field(description="an epoch (" + _EPOCH_TEXT + "), a list of them, or a table {start, stop, step_days} "
+                          f"(at most {MAX_EPOCHS} epochs), within the ephemeris file's span")
+    revolutions: int = Field(10, ge=1, le=100, description="an integer in [1, 100], the orbit's revolutions carried into the ephemeris model")
+    nodes_per_rev: int | None = Field(None, ge=2, le=100, description="an integer in [2, 100], the multiple-shooting nodes per revolution "
+                                      "(default: the transition's own choice for the orbit)")
+    file: str | None = Field(None, min_length=1, description="the path of a JPL SPK file with type-2 segments of the Sun, the Earth-Moon "
+                             "barycentre, the Moon and the Earth (relative paths from the study file's folder); default the embedded DE440 "
+                             "excerpt, 2020-2070")
+
+    def epochs_tdb(self) -> np.ndarray:
+        """The epochs in TDB seconds past J2000, (n,) (a range: start + k step, up to stop)."""
+        from ..ephemeris.epochs import tdb_seconds
+
+        e = self.epoch
+        if isinstance(e, EpochRange):
+            t0, t1, step = tdb_seconds(e.start), tdb_seconds(e.stop), e.step_days * 86400.0
+            n = int(math.floor((t1 - t0) / step * (1 + 1e-12) + 1e-9)) + 1
+            return t0 + step * np.arange(n)
+        return np.array([tdb_seconds(v) for v in (e if isinstance(e, list) else [e])], dtype=float)
+
+    @model_validator(mode="after")
+    def _rules(self) -> EphemerisSection:
+        """Every epoch readable, a range running forwards with at most MAX_EPOCHS steps, and
+        (with the embedded file) every epoch within its span."""
+        from ..ephemeris.epochs import iso_tdb, tdb_seconds
+
+        problems: list[str] = []
+        e = self.epoch
+        items = [("start", e.start), ("stop", e.stop)] if isinstance(e, EpochRange) else (
+            [(f"[{i}]", v) for i, v in enumerate(e)] if isinstance(e, list) else [("", e)])
+        bad = False
+        for where, v in items:
+            key = "ephemeris.epoch" + (f".{where}" if where and not where.startswith("[") else where)
+            try:
+                tdb_seconds(v)
+            except ValueError as err:
+                bad = True
+                problems.append(problem(key, v, str(err).removeprefix("epoch: "), _EPOCH_TEXT))
+        if not bad and isinstance(e, EpochRange):
+            t0, t1 = tdb_seconds(e.start), tdb_seconds(e.stop)
+            if t1 < t0:
+                bad = True
+                problems.append(problem("ephemeris.epoch.stop", e.stop, f"is before ephemeris.epoch.start = {show_value(e.start)}",
+                                        "an epoch not before ephemeris.epoch.start"))
+            elif (t1 - t0) / (e.step_days * 86400.0) + 1 > MAX_EPOCHS:
+                bad = True
+                problems.append(problem("ephemeris.epoch.step_days", e.step_days,
+                                        f"gives {int((t1 - t0) / (e.step_days * 86400.0)) + 1} epochs from start to stop",
+                                        f"a step giving at most {MAX_EPOCHS} epochs"))
+        if not bad and self.file is None:
+            lo, hi = _embedded_span()
+            t = self.epochs_tdb()
+            out = np.flatnonzero((t < lo) | (t >= hi))
+            if out.size:
+                key = "ephemeris.epoch" + ("" if not isinstance(e, list) else f"[{int(out[0])}]")
+                shown = e.model_dump() if isinstance(e, EpochRange) else (e[int(out[0])] if isinstance(e, list) else e)
+                problems.append(problem(key, shown, f"{iso_tdb(float(t[out[0]]))} is outside the embedded DE440 excerpt",
+                                        f"epochs from {iso_tdb(lo)} to {iso_tdb(hi)} (less the revolutions' duration), or ephemeris.file"))
+        return _rules_found(self, problems)
+
+
 class SolverSection(Table):
     """[solver]: tolerances, periods per solution, initial angle."""
 
@@ -417,7 +526,7 @@ class OutputSection(Table):
 
     folder: str = Field("librate-out", min_length=1, description="a non-empty path (relative paths are taken from the study file's folder)")
     format: Literal["zarr", "netcdf"] = Field("zarr", description="'zarr' or 'netcdf'")
-    figures: list[Literal["family", "period", "stability", "map", "residuals", "solutions", "multipliers", "body_axes"]] | None = Field(None, description=FIGURES_TEXT)
+    figures: list[Literal["family", "period", "stability", "map", "residuals", "solutions", "multipliers", "body_axes", "transition", "defects", "sweep"]] | None = Field(None, description=FIGURES_TEXT)
 
 
 SECTIONS: dict[str, type[Table]] = {
@@ -429,8 +538,9 @@ SECTIONS: dict[str, type[Table]] = {
     "attitude": AttitudeSection,
     "solver": SolverSection,
     "output": OutputSection,
+    "ephemeris": EphemerisSection,
 }
-TABLES: dict[str, type[Table]] = {**SECTIONS, "torques.srp": SrpSection}
+TABLES: dict[str, type[Table]] = {**SECTIONS, "torques.srp": SrpSection, "ephemeris.epoch": EpochRange}
 TOP_KEYS = ("title", "description", *SECTIONS)
 
 def _described(model: type[BaseModel], name: str) -> str | None:

@@ -48,6 +48,7 @@ from .schema import (
     SECTIONS,
     AttitudeSection,
     BodySection,
+    EphemerisSection,
     Header,
     OrbitsSection,
     OutputSection,
@@ -90,6 +91,7 @@ class Study(Header):
     attitude: AttitudeSection = Field(default_factory=PlanarAttitude)
     solver: SolverSection = Field(default_factory=SolverSection)
     output: OutputSection = Field(default_factory=OutputSection)
+    ephemeris: EphemerisSection | None = None
     base_dir: str = Field(".", exclude=True)
 
     # --- construction --------------------------------------------------------------------------
@@ -147,7 +149,7 @@ class Study(Header):
         for k, model in SECTIONS.items():
             if k in sections:
                 valid[k] = sections[k]
-            elif k not in data and k not in ("body", "rates"):
+            elif k not in data and k not in ("body", "rates", "ephemeris"):
                 valid[k] = model.model_validate({}, context=context)
         problems += check_sections(valid, data, purpose)
         if problems:
@@ -393,6 +395,22 @@ class Study(Header):
         wz = grid_values(r.wz0) if r.wz0 is not None else (None if r.phidot0 is None else grid_values(r.phidot0) + 1.0)
         out = {"wx0": grid_values(r.wx0), "wy0": grid_values(r.wy0), "wz0": wz}
         return {k: v for k, v in out.items() if v is not None}
+
+    def build_ephemeris(self):
+        """The :class:`~librate.Ephemeris` of ``ephemeris.file`` (relative to the study's
+        folder), or of the embedded DE440 excerpt; a StudyError names a file that cannot be read."""
+        from ..ephemeris.model import Ephemeris
+
+        f = self.ephemeris.file if self.ephemeris is not None else None
+        if f is None:
+            return Ephemeris()
+        path = Path(f) if Path(f).is_absolute() else Path(self.base_dir) / f
+        if not path.is_file():
+            raise StudyError([problem("ephemeris.file", f, f"no such file: {path}")])
+        try:
+            return Ephemeris(path)
+        except (OSError, ValueError) as err:
+            raise StudyError([problem("ephemeris.file", f, f"not a readable SPK file with type-2 segments: {err}")]) from None
 
     def output_dir(self, out: str | Path | None = None) -> Path:
         """The output folder, absolute: ``out`` if given (relative to the working directory),
