@@ -16,7 +16,7 @@ import numpy as np
 
 from .study import ATTITUDE_TOL, Study, StudyError, grid_raw, member_count, problem
 
-__all__ = ["run_family", "run_map", "run_solve"]
+__all__ = ["run_family", "run_map", "run_solve", "run_transition"]
 
 
 # --- jobs ----------------------------------------------------------------------------------
@@ -254,6 +254,49 @@ def run_map(study: Study, out: str | Path | None = None, *, scheduler=None, prog
 
         save_dataset(ds, folder / "map.nc")
     return ds, path
+
+
+def run_transition(study: Study, out: str | Path | None = None, *, scheduler=None, progress: bool | None = None, force: bool = False,
+                   say: Callable[[str], None] | None = None):
+    """The orbit of ``[orbits]`` (exactly one) carried into the Earth-Moon-Sun ephemeris model
+    at every epoch of ``[ephemeris]`` over ``ephemeris.revolutions`` (multiple shooting,
+    :func:`librate.orbits.transition.to_ephemeris`), saved epoch by epoch as
+    ``transition.zarr`` (or ``.nc``; :func:`librate.app.transition.run_transition_to`: resumable,
+    a killed run keeps every finished epoch). Returns ``(dataset, path)``.
+
+    Every epoch and the end of its revolutions must lie in the ephemeris file's span (a
+    StudyError names ``ephemeris.epoch`` and the allowed range). ``scheduler``: None (this
+    process), a Dask ``distributed.Client`` or its address: each epoch is one task, checksummed
+    on arrival; the result equals the local one bit for bit. A result of the same inputs is
+    resumed or reused; one of other inputs is refused unless ``force`` (``say`` names it)."""
+    from ..ephemeris.epochs import iso_tdb
+    from .results import check_output
+    from .transition import run_transition_to
+
+    path = _result_path(study, out, "transition")
+    if study.ephemeris is None:
+        raise StudyError(["ephemeris: missing section [ephemeris]: a transition needs the epoch(s) (ephemeris.epoch)"])
+    check_output(path, "transition", study.to_json(), force=force, say=say)
+    orbits = list(study.build_orbits())
+    if len(orbits) != 1:
+        sel = member_count(study.orbits)
+        key, value = (f"orbits.{sel[0]}", sel[1]) if sel else ("orbits.kind", study.orbits.kind)
+        raise StudyError([problem(key, value, f"selects {len(orbits)} orbits", "exactly one orbit: a transition carries one orbit into the ephemeris model")])
+    orbit = orbits[0]
+    e = study.ephemeris
+    eph = study.build_ephemeris()
+    epochs = e.epochs_tdb()
+    duration_s = e.revolutions * orbit.period * orbit.system.tu_s
+    lo, hi = eph.span
+    bad = np.flatnonzero((epochs < lo) | (epochs + duration_s > hi))
+    if bad.size:
+        raw = e.epoch.model_dump() if hasattr(e.epoch, "model_dump") else e.epoch
+        raise StudyError([problem("ephemeris.epoch", raw, f"{iso_tdb(float(epochs[bad[0]]))} and its {e.revolutions} revolutions "
+                                  f"({duration_s / 86400:.2f} d) leave the ephemeris file's span",
+                                  f"epochs from {iso_tdb(lo)} to {iso_tdb(hi - duration_s)} (the file's span less the revolutions' duration)")])
+    file = None if e.file is None else str(Path(e.file) if Path(e.file).is_absolute() else (Path(study.base_dir) / e.file).resolve())
+    return run_transition_to(orbit, path, epochs_tdb=epochs, revolutions=e.revolutions, nodes_per_rev=e.nodes_per_rev, ephemeris_file=file,
+                             resume=not force, scheduler=scheduler, progress=progress, attrs=study.result_attrs("transition", "transition"))
 
 
 def _family_of(fam, orbits):

@@ -33,7 +33,7 @@ __all__ = ["RESULT_INPUTS", "RESULT_KINDS", "RESULT_STEMS", "ResultExists", "che
 RESULT_KINDS = tuple(KINDS)
 #: The file each command writes its result to (``<stem>.zarr`` or ``<stem>.nc``): the name says
 #: which command made it. Its figures are ``<stem>_<figure>.png`` beside it.
-RESULT_STEMS = {"family": "family", "solve": "solve", "map": "map", "demo": "demo"}
+RESULT_STEMS = {"family": "family", "solve": "solve", "map": "map", "demo": "demo", "transition": "transition"}
 #: The study sections each kind of result depends on: a change elsewhere (e.g. ``output``, or
 #: ``body`` for a family) leaves the result valid, so it is resumed rather than refused.
 RESULT_INPUTS = {k: c.inputs for k, c in KINDS.items()}
@@ -163,8 +163,8 @@ def _existing_result(p: Path) -> tuple[str | None, dict] | None:
         except Exception:  # noqa: BLE001 - foreign or damaged: judged below
             attrs = {}
         marker = attrs.get("librate_store")
-        if marker in ("periodicity_map", "map_3d"):
-            return ("map" if marker == "periodicity_map" else "map_3d"), attrs
+        if marker in ("periodicity_map", "map_3d", "ephemeris_transition"):
+            return {"periodicity_map": "map", "map_3d": "map_3d", "ephemeris_transition": "transition"}[marker], attrs
     try:
         ds = _open_dataset(p)
     except ValueError:

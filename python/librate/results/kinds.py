@@ -14,7 +14,7 @@ import numpy as np
 from .store import StoreSchema, Var
 
 __all__ = ["FIGURE_FILES", "FamilyResult", "KINDS", "Map3DResult", "MAP_3D_VARIABLES", "MAP_VARIABLES", "MapResult", "ResultKind", "Solutions3DResult",
-           "SolutionsResult", "kind_of", "map3d_schema", "map_schema"]
+           "SolutionsResult", "TRANSITION_VARIABLES", "TransitionResult", "kind_of", "map3d_schema", "map_schema", "transition_schema"]
 
 #: The per-orbit variables of a planar map: units and long names (periodicity_map, run_map and
 #: the store all take them from here).
@@ -50,9 +50,40 @@ def map3d_schema(no: int, shape: tuple[int, ...], dims: tuple[str, ...], coords:
     return StoreSchema("map_3d", "orbit", no, v, coords)
 
 
+#: The per-epoch variables of an ephemeris transition (``librate transition``): dtype, the
+#: dimensions within an epoch, units and long name. ``status``: 0 converged, 1 not converged.
+TRANSITION_VARIABLES = {
+    "status": ("u1", (), {"flag_values": "0 converged, 1 not converged (ConvergenceError), 255 not computed"}),
+    "iterations": ("i8", (), {"long_name": "Newton iterations of the multiple shooting"}),
+    "max_departure_km": ("f8", (), {"units": "km", "long_name": "largest distance of the ephemeris trajectory from the CR3BP orbit"}),
+    "drift_km_per_rev": ("f8", (), {"units": "km", "long_name": "drift of the ephemeris trajectory from the CR3BP orbit per revolution"}),
+    "node_epochs_tdb": ("f8", ("node",), {"units": "s", "long_name": "node epochs, TDB seconds past J2000"}),
+    "states_km": ("f8", ("node", "component"), {"units": "km, km/s", "long_name": "node states, Moon-centred ICRF"}),
+    "synodic": ("f8", ("node", "component"), {"units": "LU, LU/TU", "long_name": "node states in the instantaneous Earth-Moon rotating frame, "
+                                              "nondimensional (barycentre origin, the CR3BP's synodic frame)"}),
+    "defects_km": ("f8", ("leg",), {"units": "km", "long_name": "position defect at the end of each leg, re-propagated from its node"}),
+    "defects_km_s": ("f8", ("leg",), {"units": "km/s", "long_name": "velocity defect at the end of each leg, re-propagated from its node"}),
+    "perilune_km": ("f8", ("revolution",), {"units": "km", "long_name": "closest approach to the Moon's centre in each revolution"}),
+    "track_t_tdb": ("f8", ("sample",), {"units": "s", "long_name": "epochs of the sampled ephemeris trajectory, TDB seconds past J2000"}),
+    "track_synodic": ("f8", ("sample", "component"), {"units": "LU, LU/TU", "long_name": "the sampled ephemeris trajectory in the rotating frame, "
+                                                      "nondimensional"}),
+}
+
+
+def transition_schema(n_epochs: int, sizes: dict, coords: dict) -> StoreSchema:
+    """The part store of ``librate transition``: one part per epoch; ``sizes`` the lengths of
+    node, leg, revolution, sample and component."""
+    v = {}
+    for k, (dtype, dims, attrs) in TRANSITION_VARIABLES.items():
+        fill = 255 if k == "status" else (-1 if dtype == "i8" else np.nan)
+        v[k] = Var(dtype, tuple(sizes[d] for d in dims), dims, fill, dict(attrs))
+    return StoreSchema("ephemeris_transition", "epoch", n_epochs, v, coords)
+
+
 #: The file suffix of each figure: a result STEM.zarr gets STEM_<suffix>.png beside it.
 FIGURE_FILES = {"family": "orbits", "period": "period", "stability": "stability", "map": "contours", "residuals": "residuals",
-                "solutions": "solutions", "multipliers": "multipliers", "body_axes": "body_axes"}
+                "solutions": "solutions", "multipliers": "multipliers", "body_axes": "body_axes",
+                "transition": "rotating", "defects": "defects", "sweep": "sweep"}
 
 #: A figure to draw: (its file suffix, a function that draws it and returns the Figure).
 Figure = tuple[str, Callable]
@@ -245,8 +276,69 @@ class Map3DResult(ResultKind):
         return ds.attrs.get("librate_result") == "map_3d" or ds.attrs.get("librate_store") == "map_3d"
 
 
+def _epochs_iso(result) -> list[str]:
+    """The epochs of a transition result as ISO strings (its ``epochs_iso`` attribute, JSON)."""
+    import json
+
+    return list(json.loads(result.attrs.get("epochs_iso", "[]"))) or [f"{t:.1f} s TDB" for t in result["epoch"].values]
+
+
+class TransitionResult(ResultKind):
+    """Orbit transitions into the ephemeris model at one or more epochs (``librate transition``,
+    a part store with one part per epoch)."""
+
+    kind = "transition"
+    inputs = ("system", "orbits", "ephemeris")
+    figure_names = ("transition", "defects", "sweep")
+    dtypes = {"status": "uint8", "iterations": "int64"}
+    dims = ("epoch",)
+
+    @classmethod
+    def figures(cls, result, names=None, skip=None, **data) -> list[Figure]:
+        """The orbit in the rotating frame in both models (the first converged epoch), the node
+        defects of every epoch, and (two epochs or more) the sweep's departure and perilune
+        range against the epoch."""
+        lp = _plotting()
+        ok = np.flatnonzero(np.asarray(result["status"].values) == 0)
+        out: list[Figure] = []
+        for name in cls.figure_names if names is None else names:
+            if name not in cls.figure_names:
+                continue
+            if ok.size == 0:
+                if skip is not None:
+                    skip(FIGURE_FILES[name], "no epoch converged")
+                continue
+            if name == "transition":
+                j = int(ok[0])
+                out.append((FIGURE_FILES[name], lambda j=j: lp.plot_transition_orbit(
+                    result["cr3bp_synodic"].values, result["track_synodic"].values[j], result["synodic"].values[j],
+                    mu=float(result.attrs["mu"]), lu_km=float(result.attrs["lu_km"]), label=_epochs_iso(result)[j])))
+            elif name == "defects":
+                out.append((FIGURE_FILES[name], lambda: lp.plot_node_defects(
+                    result["defects_km"].values[ok], result["defects_km_s"].values[ok], epochs_tdb=result["epoch"].values[ok])))
+            elif name == "sweep":
+                if ok.size < 2:
+                    if skip is not None:
+                        skip(FIGURE_FILES[name], "an epoch sweep figure needs at least 2 converged epochs")
+                    continue
+                out.append((FIGURE_FILES[name], lambda: lp.plot_transition_sweep(
+                    result["epoch"].values[ok], result["max_departure_km"].values[ok], result["perilune_km"].values[ok],
+                    result["iterations"].values[ok])))
+        return out
+
+    def summary(self) -> str:
+        ds = self.dataset
+        n = ds.sizes.get("epoch", 0)
+        conv = int((np.asarray(ds["status"].values) == 0).sum()) if "status" in ds.variables else 0
+        return f"a librate transition: {n} epoch(s), {conv} converged, {ds.attrs.get('revolutions', '?')} revolutions, librate {ds.attrs.get('librate_version', '?')}"
+
+    @classmethod
+    def recognise(cls, ds) -> bool:
+        return ds.attrs.get("librate_result") == "transition" or ds.attrs.get("librate_store") == "ephemeris_transition"
+
+
 #: The classes by kind, in the order they are recognised.
-KINDS: dict[str, type[ResultKind]] = {c.kind: c for c in (FamilyResult, SolutionsResult, Solutions3DResult, MapResult, Map3DResult)}
+KINDS: dict[str, type[ResultKind]] = {c.kind: c for c in (FamilyResult, SolutionsResult, Solutions3DResult, MapResult, Map3DResult, TransitionResult)}
 
 
 def kind_of(ds) -> type[ResultKind] | None:

@@ -108,7 +108,7 @@ def open_group(path: Path, kind: str, mode: str = "r"):
 
 
 def _what(kind: str) -> str:
-    return {"periodicity_map": "map store", "map_3d": "3-D map store"}.get(kind, f"{kind} store")
+    return {"periodicity_map": "map store", "map_3d": "3-D map store", "ephemeris_transition": "transition store"}.get(kind, f"{kind} store")
 
 
 def _array_meta(g, name: str) -> str:
@@ -409,12 +409,13 @@ class StoreReport:
         return not (self.damaged or self.not_done or self.problems) and self.complete
 
     def describe(self) -> str:
-        what = "map" if self.kind == "periodicity_map" else "3-D map"
+        what = {"periodicity_map": "map", "ephemeris_transition": "transition"}.get(self.kind, "3-D map")
         if self.ok:
             return f"{self.path}: ok: {self.rows} rows, every chunk matches its checksum"
         lines = [f"{self.path}: damaged or incomplete librate {_what(self.kind)}"]
         lines += [f"  {p}" for p in self.problems]
-        lines += [f"  row {i} (orbit {i}): {why}" for i, why in sorted(self.damaged.items())]
+        part = "epoch" if self.kind == "ephemeris_transition" else "orbit"
+        lines += [f"  row {i} ({part} {i}): {why}" for i, why in sorted(self.damaged.items())]
         if self.not_done:
             lines.append(f"  rows not computed yet: {self.not_done} (re-run the same {what} to resume it)")
         elif not self.complete and not self.problems and not self.damaged:
