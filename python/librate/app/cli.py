@@ -18,7 +18,7 @@ from .._core import __version__
 from .._errors import LibrateError
 from ..orbits.system import System
 from .commands import demo_summary, map_3d_summary, map_solutions_summary, solutions_table, solve_3d_summary
-from .jobs import run_family, run_map, run_solve
+from .jobs import run_family, run_map, run_solve, run_transition
 
 _CONTEXT = {"help_option_names": ["-h", "--help"], "max_content_width": 100}
 
@@ -51,6 +51,7 @@ def main() -> None:
       librate family study.toml            the orbit family (continuation), saved + figures
       librate solve study.toml             periodic attitude motions of each orbit, as a table
       librate map study.toml               the attitude periodicity map (thesis Fig. 24)
+      librate transition study.toml        the orbit carried into the Earth-Moon-Sun ephemeris
       librate plot librate-out/map.zarr    re-draw the figures of any saved result
       librate verify librate-out/map.zarr  checksums: name any damaged chunk or row
       librate dros --x0 0.9                correct DROs and check that they close
@@ -503,6 +504,54 @@ def map_(study, out_dir, quiet, scheduler, resume, sets) -> None:
     _figures(ds, path, _wanted(st, ("map", "residuals", "solutions")), quiet)
 
 
+@main.command(context_settings=_CONTEXT, short_help="Carry the study's orbit into the Earth-Moon-Sun ephemeris model at its epochs.")
+@click.argument("study", type=click.Path(exists=True, dir_okay=False))
+@click.option("--out", "out_dir", type=click.Path(file_okay=False), help="Output folder (default: output.folder of the study); the result goes to OUT/transition.zarr.")
+@click.option("--quiet", "-q", is_flag=True, help="No progress bar and no table; print only the written paths.")
+@click.option("--scheduler", metavar="tcp://HOST:PORT", help="Run each epoch as a task on this Dask scheduler (needs dask.distributed).")
+@click.option("--resume/--force", default=True, help=_FORCE_HELP)
+@click.option("--set", "sets", multiple=True, metavar="KEY=VALUE", help=_SET_HELP)
+def transition(study, out_dir, quiet, scheduler, resume, sets) -> None:
+    """Carry the orbit of STUDY into the Earth-Moon-Sun ephemeris model at each epoch of its
+    [ephemeris] section.
+
+    The one orbit selected by [orbits] (a DRO, Lyapunov or halo member, NRHOs included) is
+    placed at each epoch in the instantaneous Earth-Moon frame of the ephemeris (the embedded
+    DE440 excerpt, or ephemeris.file), and corrected by multiple shooting over
+    ephemeris.revolutions (ephemeris.nodes_per_rev nodes a revolution) into a continuous
+    trajectory under the Earth, Moon and Sun point masses. Prints per epoch the Newton
+    iterations, the largest node defects (position in m, velocity in km/s, re-propagated from
+    every node), the largest departure from the CR3BP orbit (km), the perilune range (km) and
+    the drift per revolution. An epoch that does not converge is kept as such and the sweep
+    goes on. The result is written epoch by epoch: re-running after an interruption keeps
+    every finished epoch.
+
+    \b
+    Writes to the output folder:
+      transition.zarr (or .nc)  over `epoch`: status, iterations, node epochs (TDB s past J2000),
+                   node states (Moon-centred ICRF, km, km/s) and in the rotating frame
+                   (nondimensional), the defects, perilunes, departure and drift, the sampled
+                   trajectory; the epochs (ISO), frames, GM values, ephemeris file, study and
+                   version as attributes
+      transition_rotating.png   the orbit in the rotating frame in both models (first epoch)
+      transition_defects.png    the node defects of every epoch
+      transition_sweep.png      departure and perilune range against the epoch (2+ epochs)
+    """
+    st = _load_study(study, "transition", _overrides(sets))
+    _check_writable(st.output_dir(out_dir), "--out" if out_dir else "output.folder")
+    t0 = time.perf_counter()
+    try:
+        ds, path = run_transition(st, out_dir, scheduler=scheduler, progress=_show(quiet), force=not resume, say=_say)
+    except _FAILURES as err:
+        raise _failure(err) from None
+    if not quiet:
+        from .transition import transition_summary
+
+        _lines(transition_summary(ds, time.perf_counter() - t0))
+    click.echo(f"written: {path}")
+    _figures(ds, path, _wanted(st, ("transition", "defects", "sweep")), quiet)
+
+
 @main.command(context_settings=_CONTEXT, short_help="Re-draw the figures of any saved result, without recomputing.")
 @click.argument("result_path", type=click.Path(exists=True))
 @click.option("--quiet", "-q", is_flag=True, help="Print only the written paths.")
@@ -526,6 +575,8 @@ def plot(result_path, quiet) -> None:
                  STEM_body_axes.png (body axes along the first member's orbit)
       a 3-D map  STEM_residual_norm.png (log10 of the residual max-norm over the two rate
                  grids, the first three orbits)
+      a transition  STEM_rotating.png (the orbit in the rotating frame in both models),
+                 STEM_defects.png (node defects), STEM_sweep.png (against the epoch)
     """
     from .results import open_result, resolve_result_path
 

@@ -39,6 +39,12 @@ label it wz(0)); ``rate="inertial"`` plots wz, and the axis label says which. Ar
   spacecraft (Fig. 39), computed by :func:`librate.periodicity.sun_pointing_accelerations` (also
   importable from here)
 
+- :func:`plot_transition_orbit`: an orbit in the rotating frame in the CR3BP and in the ephemeris model
+- :func:`plot_node_defects`: the continuity defects of a multiple-shooting transition, per leg and epoch
+- :func:`plot_transition_sweep`: an epoch sweep, departure and perilune range against the epoch
+- :func:`plot_ephemeris_attitude`, :func:`plot_pointing_error`: attitude in the ephemeris model
+  against the CR3BP motion
+
 This package only draws: the data come from :mod:`librate.periodicity` and the layers below.
 - :func:`save_figure`: write a figure to a file
 
@@ -58,6 +64,7 @@ except ImportError as exc:  # pragma: no cover - depends on the environment
 
 from ..periodicity.srp_motions import srp_map, sun_pointing_accelerations
 from ._attitude3d import plot_body_axes, plot_equilibrium_stability, plot_family_multipliers, plot_map_3d, plot_out_of_plane_stability
+from ._ephemeris import plot_ephemeris_attitude, plot_node_defects, plot_pointing_error, plot_transition_orbit, plot_transition_sweep
 from ._flexible import plot_flexible_body, plot_flexible_coordinate, plot_flexible_response, plot_frequency_scan
 from ._maps import plot_map, plot_residuals
 from ._orbits import plot_attitude, plot_eci, plot_family, plot_period, plot_stability
@@ -94,6 +101,11 @@ __all__ = [
     "plot_family_multipliers",
     "plot_body_axes",
     "plot_map_3d",
+    "plot_transition_orbit",
+    "plot_node_defects",
+    "plot_transition_sweep",
+    "plot_ephemeris_attitude",
+    "plot_pointing_error",
     "figure_axes",
     "n_color",
     "N_COLORS",

@@ -312,7 +312,7 @@ class TransitionResult(ResultKind):
                 j = int(ok[0])
                 out.append((FIGURE_FILES[name], lambda j=j: lp.plot_transition_orbit(
                     result["cr3bp_synodic"].values, result["track_synodic"].values[j], result["synodic"].values[j],
-                    mu=float(result.attrs["mu"]), lu_km=float(result.attrs["lu_km"]), label=_epochs_iso(result)[j])))
+                    mu=float(result.attrs["mu"]), lu_km=float(result.attrs["lu_km"]), label=_epochs_iso(result)[j][:19] + " TDB")))
             elif name == "defects":
                 out.append((FIGURE_FILES[name], lambda: lp.plot_node_defects(
                     result["defects_km"].values[ok], result["defects_km_s"].values[ok], epochs_tdb=result["epoch"].values[ok])))
