@@ -31,7 +31,12 @@ def test_example_runs(script, tmp_path):
         assert (tmp_path / rel).exists(), rel
 
 
+#: The command each example study is for (default `librate solve`).
+STUDY_PURPOSE = {"transition.toml": "transition"}
+
+
 @pytest.mark.parametrize("study", sorted(p.name for p in EXAMPLES.glob("*.toml")))
 def test_example_studies_are_valid(study):
-    """Every study file in examples/ validates for `librate solve` (tests/test_study3d.py runs them)."""
-    assert Study.from_toml(EXAMPLES / study, purpose="solve").title
+    """Every study file in examples/ validates for its command (`librate solve` unless
+    STUDY_PURPOSE says otherwise; tests/test_study3d.py and tests/test_transition_app.py run them)."""
+    assert Study.from_toml(EXAMPLES / study, purpose=STUDY_PURPOSE.get(study, "solve")).title
