@@ -722,6 +722,9 @@ def test_a_deleted_lock_file_lets_no_second_writer_in(tmp_path):
 # new one, whole and verified (never a half-deleted one), or a store the same run resumes; the
 # run again gives the uninterrupted result bit for bit and leaves no temporary or lock behind.
 
+#: The epochs of the transition kind (TDB s past J2000: 2030-01-01 and ten days apart).
+EPOCHS = [946728000.0, 947592000.0, 948456000.0]
+
 CAMPAIGN = textwrap.dedent("""
     import json, os, signal, sys, threading
     import numpy as np
@@ -735,6 +738,7 @@ CAMPAIGN = textwrap.dedent("""
     {NO_FSYNC}
     X0, WZ = {X0!r}, np.linspace(-1.0, 1.5, 40)
     RATES = {{"wx0": np.linspace(-0.05, 0.05, 5), "wy0": 0.0, "wz0": np.linspace(1.1, 1.4, 8)}}
+    EPOCHS = {EPOCHS!r}
 
     def job(kind, d):
         fam = librate.dro_family(librate.System.preset("earth-moon"), x0=X0)
@@ -743,6 +747,9 @@ CAMPAIGN = textwrap.dedent("""
         elif kind == "solve":
             rows = [(0, s) for s in librate.find_periodic_attitudes(fam[0], kz=0.8, wz0_range=(-1.0, 1.5), n_grid=40)]
             save_dataset(solutions_dataset(rows, list(fam), [0.8], {{"librate_result": "solutions", "study": "{{}}"}}), os.path.join(d, "solve.zarr"))
+        elif kind == "transition":
+            from librate.app.transition import run_transition_to
+            run_transition_to(fam[0], os.path.join(d, "transition.zarr"), epochs_tdb=EPOCHS, revolutions=2, nodes_per_rev=4, progress=False)
         elif kind.startswith("map3d"):
             run_map_3d_to(fam, os.path.join(d, "map.zarr"), body=librate.RigidBody(1.0, 1.02, 1.04), rates=RATES, q0=[0, 0, 0, 1.0],
                           tol=1e-10, resume=kind == "map3d", progress=False)
@@ -784,10 +791,13 @@ CAMPAIGN = textwrap.dedent("""
         _, st = os.waitpid(pid, 0)
         res.append([name, os.WIFSIGNALED(st) and os.WTERMSIG(st) == signal.SIGKILL])
     print(json.dumps(res))
-""").format(X0=X0, NO_FSYNC=NO_FSYNC)
+""").format(X0=X0, NO_FSYNC=NO_FSYNC, EPOCHS=EPOCHS)
 
-KINDS = ("family", "solve", "map3d", "map3d_replace", "map_replace")
-RESULT = {"family": "family.zarr", "solve": "solve.zarr", "map3d": "map.zarr", "map3d_replace": "map.zarr", "map_replace": "map.zarr"}
+KINDS = ("family", "solve", "map3d", "map3d_replace", "map_replace", "transition")
+RESULT = {"family": "family.zarr", "solve": "solve.zarr", "map3d": "map.zarr", "map3d_replace": "map.zarr", "map_replace": "map.zarr",
+          "transition": "transition.zarr"}
+#: The kinds written from scratch (no older result at the path): a kill leaves a store to resume.
+FRESH = ("map3d", "transition")
 
 
 def _campaign(root: Path, cases, workers: int = 2) -> dict:
@@ -834,14 +844,14 @@ def _content(kind: str, p: Path):
     if kind == "family":
         return librate.OrbitFamily.load(p).period.tolist()
     ds = librate.open_result(p, verify=True)
-    key = {"solve": "sol_wz0", "map_replace": "dwz"}.get(kind, "residual")
+    key = {"solve": "sol_wz0", "map_replace": "dwz", "transition": "states_km"}.get(kind, "residual")
     return np.asarray(ds[key].values).tobytes()
 
 
 @pytest.mark.slow
 def test_kill_campaign_loses_nothing(tmp_path, fam, em, good_store):
-    """At least 30 real SIGKILLs over family, solve, 3-D map and planar map writes, the replace
-    window included: 0 lost or silently wrong results (printed: kills per kind)."""
+    """At least 30 real SIGKILLs over family, solve, 3-D map, planar map and ephemeris transition
+    writes, the replace window included: 0 lost or silently wrong results (printed: kills per kind)."""
     calib = [(f"c-{k}", k, 0) for k in KINDS]
     for _, k, _ in calib:
         _old_result(k, tmp_path / f"c-{k}", fam, em, good_store)
@@ -851,12 +861,12 @@ def test_kill_campaign_loses_nothing(tmp_path, fam, em, good_store):
         d = tmp_path / f"c-{k}"
         n = json.loads((d / "count.json").read_text())
         new[k] = _content(k, d / RESULT[k])
-        if k != "map3d":
+        if k not in FRESH:
             ref = tmp_path / f"old-{k}"
             _old_result(k, ref, fam, em, good_store)
             old[k] = _content(k, ref / RESULT[k])
         window = sorted(set(n["replace"][-3:]))  # before the new result takes the name, after, once the old one is gone
-        spread = [int(x) for x in np.linspace(1, n["n"], 6 if k != "map3d" else 9)[:-1]]
+        spread = [int(x) for x in np.linspace(1, n["n"], 6 if k not in FRESH else 9)[:-1]]
         for j in sorted(set(spread) | set(window)):
             cases.append((f"{k}-{j}", k, j))
     for name, k, _ in cases:
@@ -866,7 +876,7 @@ def test_kill_campaign_loses_nothing(tmp_path, fam, em, good_store):
     counts = {k: 0 for k in KINDS}
     for name, k, _ in cases:  # what each kill left
         p = tmp_path / name / RESULT[k]
-        if k == "map3d":
+        if k in FRESH:
             assert not p.exists() or verify_map_store(p).problems == [], verify_map_store(p).describe()
         else:  # a replacement: the old result or the new one, whole
             assert _content(k, p) in (old[k], new[k]), name
@@ -878,6 +888,30 @@ def test_kill_campaign_loses_nothing(tmp_path, fam, em, good_store):
         _no_leftovers(p)
         counts[k] += 1
     print(f"kill campaign: {sum(counts.values())} SIGKILLs, {counts}; 0 lost or wrong")
+
+
+def test_a_killed_transition_resumes_to_the_same_arrays(tmp_path):
+    """`librate transition`'s store (one part per epoch): real SIGKILLs spread over its writes
+    (creation, each epoch's data, digests and flag, the finalisation); each store then verifies
+    or is a store to resume, and the same run gives the uninterrupted arrays bit for bit."""
+    d = tmp_path / "c-transition"
+    d.mkdir()
+    _campaign(tmp_path, [("c-transition", "transition", 0)], workers=1)
+    n = json.loads((d / "count.json").read_text())["n"]
+    new = _content("transition", d / "transition.zarr")
+    cases = [(f"t-{j}", "transition", j) for j in sorted({int(x) for x in np.linspace(1, n, 7)[:-1]} | {n - 1, n})]
+    for name, _, _ in cases:
+        (tmp_path / name).mkdir()
+    killed = _campaign(tmp_path, cases)
+    assert all(killed.values()), killed
+    for name, _, _ in cases:
+        p = tmp_path / name / "transition.zarr"
+        assert not p.exists() or verify_map_store(p).problems == [], verify_map_store(p).describe()
+    assert not any(_campaign(tmp_path, [(name, "transition", 0) for name, _, _ in cases]).values())
+    for name, _, _ in cases:
+        p = tmp_path / name / "transition.zarr"
+        assert _content("transition", p) == new, name
+        _no_leftovers(p)
 
 
 def test_results_written_by_main_still_open(tmp_path, fam, reference, good_store):
