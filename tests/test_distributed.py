@@ -1,5 +1,5 @@
-"""Long jobs on a Dask cluster (issue 22, items 1-2): planar maps, 3-D maps and solves over many
-orbits run as tasks on a LocalCluster of two worker processes, one worker is SIGKILLed in the
+"""Long jobs on a Dask cluster (issue 22, items 1-2): planar maps, 3-D maps, solves over many
+orbits and ephemeris epoch sweeps run as tasks on a LocalCluster of two worker processes, one worker is SIGKILLed in the
 middle of each run, and the run completes with arrays bit-identical to the local run (the
 reference: the same call with ``scheduler=None``; tolerance: exact equality, NaN = NaN).
 
@@ -271,6 +271,32 @@ def test_solve_survives_a_killed_worker_bit_identically(cluster, solve_study, tm
     assert ds.sizes["solution"] == ref.sizes["solution"] > 0
     for v in ds.data_vars:
         np.testing.assert_array_equal(ds[v].values, ref[v].values, err_msg=v)
+
+
+#: The epoch sweep: the 70,000 km DRO at 8 epochs two weeks apart from 2030-01-01 (TDB s past J2000).
+SWEEP_EPOCHS = 946728000.0 + 14 * 86400.0 * np.arange(8)
+
+
+@pytest.mark.slow
+def test_ephemeris_epoch_sweep_survives_a_killed_worker_bit_identically(cluster, em, tmp_path, monkeypatch):
+    """Issue 22 item 1: each epoch of a transition sweep is one task (written by the workers into
+    the store, the same filesystem), a worker SIGKILLed mid-run; the store equals the local
+    sweep's bit for bit."""
+    from librate.app.transition import run_transition_to
+    from librate.results.store import verify_store
+
+    _, client = cluster
+    _wait_workers(cluster)
+    orbit = librate.correct_dro(em, 0.8057)
+    written = _count_written(monkeypatch)
+    kw = dict(epochs_tdb=SWEEP_EPOCHS, revolutions=4, nodes_per_rev=8, progress=False)
+    with Killer(client, SWEEP_EPOCHS.size) as k:
+        ds, path = run_transition_to(orbit, tmp_path / "d" / "transition.zarr", scheduler=client, **kw)
+    assert k.killed is not None, "no worker was killed mid-run"
+    assert verify_store(path).ok and (ds["status"].values == 0).all()
+    assert sorted(i for i, ok in written if ok) == list(range(SWEEP_EPOCHS.size))
+    ref, _ = run_transition_to(orbit, tmp_path / "l" / "transition.zarr", **kw)
+    _same_map(ds, ref, [v for v in ref.data_vars])
 
 
 def test_solve_3d_refuses_a_scheduler(tmp_path):

@@ -150,8 +150,13 @@ def run_transition_to(orbit, store: str | Path, *, epochs_tdb, revolutions: int,
     from .progress import bar as progress_bar
     from .results import check_output, open_result, save_dataset
 
+    from ..orbits.periodic import PeriodicOrbit
+
     store = Path(store)
     attrs = dict(attrs or {})
+    # the orbit's public fields only: what a corrector keeps for itself does not pickle (Dask)
+    orbit = PeriodicOrbit(orbit.system, np.asarray(orbit.state0, dtype=float), float(orbit.period), float(orbit.jacobi), orbit.family,
+                          orbit.iterations, orbit.residual)
     epochs = np.atleast_1d(np.asarray(epochs_tdb, dtype=float))
     npr = _nodes_per_rev(orbit, nodes_per_rev)
     sizes = transition_sizes(int(revolutions), npr)
