@@ -172,3 +172,42 @@ def test_example_figures(script, tmp_path, written, monkeypatch, capsys):
     runpy.run_path(str(EXAMPLES / script), run_name="__main__")
     assert "written:" in capsys.readouterr().out
     check_figures(written, tmp_path, EXAMPLE_FIGURES[script])
+
+
+def test_cli_figures_transition(cli, tmp_path, written):
+    """`librate transition` on examples/transition.toml (2 revolutions): the orbit in the rotating
+    frame in both models (its ephemeris line is the stored track of the first epoch, in km about
+    the Moon), the node defects and the epoch sweep."""
+    import shutil
+
+    shutil.copy(EXAMPLES / "transition.toml", tmp_path / "t.toml")
+    cli("transition", tmp_path / "t.toml", "--set", "ephemeris.revolutions=2")
+    out = tmp_path / "librate-out"
+    check_figures(written, out, {"transition_rotating.png", "transition_defects.png", "transition_sweep.png"})
+    ds = librate.open_result(out / "transition.zarr")
+    (line,) = [ln for ln in written["transition_rotating.png"].axes[0].get_lines() if ln.get_gid() == "ephemeris"]
+    track = (ds["track_synodic"].values[0, :, 0] - (1 - float(ds.attrs["mu"]))) * float(ds.attrs["lu_km"])
+    np.testing.assert_allclose(line.get_xdata(), track, rtol=1e-12)
+    (defects,) = [a for a in written["transition_defects.png"].axes if "position" in a.get_ylabel()]
+    assert len([ln for ln in defects.get_lines() if ln.get_gid() == "defects"]) == ds.sizes["epoch"]
+
+
+def test_ephemeris_attitude_figures_hold_their_data(tmp_path):
+    """plot_ephemeris_attitude and plot_pointing_error draw the arrays they are given (angles of
+    two models, the pointing error of each body axis), one panel per angle; bad shapes are
+    refused naming the argument."""
+    t = np.linspace(0.0, 30.0, 200)
+    a = np.column_stack([10 * np.sin(t), 5 * np.cos(t), t])
+    b = a + 0.01 * t[:, None]
+    fig = lp.plot_ephemeris_attitude(t, a, b)
+    assert len(fig.axes) == 3 and all(holds_data(x) for x in fig.axes)
+    for j, x in enumerate(fig.axes):
+        (eph,) = [ln for ln in x.get_lines() if ln.get_gid() == "ephemeris"]
+        np.testing.assert_array_equal(eph.get_ydata(), b[:, j])
+    err = lp.plot_pointing_error(t, np.abs(b - a))
+    assert holds_data(err.axes[0]) and {ln.get_gid() for ln in err.axes[0].get_lines()} == {"pointing-x", "pointing-y", "pointing-z"}
+    with pytest.raises(ValueError, match="`error_deg`"):
+        lp.plot_pointing_error(t, np.ones((3, 3)))
+    with pytest.raises(ValueError, match="the angles must be"):
+        lp.plot_ephemeris_attitude(t, a[:, :2], b)
+    plt.close("all")
