@@ -142,6 +142,7 @@ def run_transition_to(orbit, store: str | Path, *, epochs_tdb, revolutions: int,
     import warnings
 
     from ..ephemeris.epochs import iso_tdb
+    from ..orbits.periodic import PeriodicOrbit
     from ..results.atomic import clean_orphans, remove_path, replace_path, temporary_sibling
     from ..results.kinds import transition_schema
     from ..results.lock import writer_lock
@@ -149,8 +150,6 @@ def run_transition_to(orbit, store: str | Path, *, epochs_tdb, revolutions: int,
     from .distribute import ArrivalError, Region, Task, run_tasks
     from .progress import bar as progress_bar
     from .results import check_output, open_result, save_dataset
-
-    from ..orbits.periodic import PeriodicOrbit
 
     store = Path(store)
     attrs = dict(attrs or {})
