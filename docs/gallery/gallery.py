@@ -154,6 +154,48 @@ def fig46():
     return lp.plot_frequency_scan(sc, index=[0, 4])
 
 
+# --- the ephemeris model (librate transition) -------------------------------------------------------
+def _dro_70000():
+    """The 70,000 km DRO (x0 = 0.8057 LU: 70,000 km from the Moon on the Earth side)."""
+    return librate.correct_dro(EM, 0.8057)
+
+
+def fig_ephemeris_orbit():
+    """The 70,000 km DRO at 2030-01-01 TDB over 10 revolutions, CR3BP and ephemeris, rotating frame."""
+    from librate.orbits.transition import to_ephemeris
+
+    eph, orbit = librate.Ephemeris(), _dro_70000()
+    r = to_ephemeris(orbit, "2030-01-01T00:00:00 TDB", revolutions=10, ephemeris=eph)
+    tr = r.sample(per_leg=16)
+    track = np.array([eph.ephemeris_to_synodic(x, t, EM.mu) for t, x in zip(tr.t_tdb, tr.states_km)])
+    cr3bp = librate.propagate(EM, orbit.state0, orbit.period, t_eval=np.linspace(0.0, orbit.period, 400)).y
+    return lp.plot_transition_orbit(cr3bp, track, r.synodic(), mu=EM.mu, lu_km=EM.lu_km, label="2030-01-01, 10 revolutions")
+
+
+def _sweep_2030():
+    """The 70,000 km DRO at 14 epochs four weeks apart through 2030, 4 revolutions each (librate transition's store)."""
+    import tempfile
+
+    from librate.app.transition import run_transition_to
+
+    epochs = librate.Ephemeris().rotating_frame("2030-01-01T00:00:00 TDB").epoch_tdb + 28 * 86400.0 * np.arange(14)
+    with tempfile.TemporaryDirectory() as d:
+        ds, _ = run_transition_to(_dro_70000(), Path(d) / "transition.zarr", epochs_tdb=epochs, revolutions=4, progress=False)
+    return ds.where(ds["status"] == 0, drop=True)
+
+
+def fig_ephemeris_defects():
+    """The node defects of the 2030 epoch sweep of the 70,000 km DRO, every epoch below 1 m and 1e-8 km/s."""
+    ds = _sweep_2030()
+    return lp.plot_node_defects(ds["defects_km"].values, ds["defects_km_s"].values, epochs_tdb=ds["epoch"].values)
+
+
+def fig_ephemeris_sweep():
+    """The 2030 epoch sweep of the 70,000 km DRO: departure from the CR3BP orbit, perilune range, iterations."""
+    ds = _sweep_2030()
+    return lp.plot_transition_sweep(ds["epoch"].values, ds["max_departure_km"].values, ds["perilune_km"].values, ds["iterations"].values)
+
+
 FIGURES = {name: f for name, f in sorted(globals().items()) if name.startswith("fig") and callable(f)}
 
 
