@@ -63,6 +63,7 @@ def fake_runner(monkeypatch):
     (["map"], ["wz(T) - wz0 (1/TU)", "map.zarr", "resumable", "--scheduler", "--quiet", "map_contours.png", "map_residuals.png", "--force"]),
     (["plot"], ["without recomputing", "STEM_orbits.png", "STEM_contours.png", "STEM_residuals.png", "demo"]),
     (["info"], ["presets"]),
+    (["transition"], ["[ephemeris]", "DE440", "multiple shooting", "transition.zarr", "Moon-centred ICRF", "--scheduler", "transition_rotating.png"]),
 ])
 def test_help_teaches(run, cmd, words):
     out = run(*cmd, "--help").output
@@ -76,7 +77,7 @@ def test_command_list_is_not_cut_mid_word(run):
     out = run("--help").output
     listing = out[out.index("Commands:"):].splitlines()[1:]
     names = [line.split()[0] for line in listing if line.strip()]
-    assert names == ["demo", "dros", "family", "info", "init", "map", "plot", "solve", "verify"]
+    assert names == ["demo", "dros", "family", "info", "init", "map", "plot", "solve", "transition", "verify"]
     for line in listing:
         if line.strip():
             assert line.rstrip().endswith(".") and not line.rstrip().endswith("...") and not line.rstrip().endswith("Fig."), line

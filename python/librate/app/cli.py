@@ -115,7 +115,7 @@ def _in_cli_words(message: str, keys: dict[str, str]) -> str:
     return message
 
 
-@main.command(context_settings=_CONTEXT, short_help="The DRO attitude periodicity map at Kz = 0.8, no study file needed.")
+@main.command(context_settings=_CONTEXT, short_help="The DRO attitude periodicity map at Kz = 0.8, no study needed.")
 @click.option("--system", "system_name", default="earth-moon", show_default=True, type=_PRESET, help="System preset.")
 @click.option("--kz", default=0.8, show_default=True, type=click.FloatRange(-1, 1), help="Inertia parameter Kz = (Iy - Ix)/Iz.")
 @click.option("--orbits", "n_orbits", default=60, show_default=True, type=click.IntRange(2, 2000), help="DRO family members, x0 from 0.95 to 0.15.")
@@ -504,7 +504,7 @@ def map_(study, out_dir, quiet, scheduler, resume, sets) -> None:
     _figures(ds, path, _wanted(st, ("map", "residuals", "solutions")), quiet)
 
 
-@main.command(context_settings=_CONTEXT, short_help="Carry the study's orbit into the Earth-Moon-Sun ephemeris model at its epochs.")
+@main.command(context_settings=_CONTEXT, short_help="Carry the study's orbit into the ephemeris model at its epochs.")
 @click.argument("study", type=click.Path(exists=True, dir_okay=False))
 @click.option("--out", "out_dir", type=click.Path(file_okay=False), help="Output folder (default: output.folder of the study); the result goes to OUT/transition.zarr.")
 @click.option("--quiet", "-q", is_flag=True, help="No progress bar and no table; print only the written paths.")
