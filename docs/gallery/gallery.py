@@ -166,8 +166,7 @@ def fig_ephemeris_orbit():
 
     eph, orbit = librate.Ephemeris(), _dro_70000()
     r = to_ephemeris(orbit, "2030-01-01T00:00:00 TDB", revolutions=10, ephemeris=eph)
-    tr = r.sample(per_leg=16)
-    track = np.array([eph.ephemeris_to_synodic(x, t, EM.mu) for t, x in zip(tr.t_tdb, tr.states_km)])
+    track = r.synodic(r.sample())  # every integration step, in the rotating frame
     cr3bp = librate.propagate(EM, orbit.state0, orbit.period, t_eval=np.linspace(0.0, orbit.period, 400)).y
     return lp.plot_transition_orbit(cr3bp, track, r.synodic(), mu=EM.mu, lu_km=EM.lu_km, label="2030-01-01, 10 revolutions")
 

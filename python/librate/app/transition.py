@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import math
 from pathlib import Path
 from typing import Any
 
@@ -55,12 +56,14 @@ def transition_sizes(revolutions: int, nodes_per_rev: int) -> dict[str, int]:
 
 
 def _nodes_per_rev(orbit, nodes_per_rev: int | None) -> int:
-    """``nodes_per_rev``, or the transition's own default for ``orbit``."""
+    """``nodes_per_rev``, or the transition's own default for ``orbit`` (its rule, with its
+    constants: legs of at most MAX_LEG_DAYS, at least MIN_NODES_PER_REV, an odd count)."""
     if nodes_per_rev is not None:
         return int(nodes_per_rev)
     from ..orbits import transition
 
-    return int(transition.default_nodes_per_rev(orbit))
+    n = max(transition.MIN_NODES_PER_REV, math.ceil(orbit.period_days / transition.MAX_LEG_DAYS))
+    return n + 1 - n % 2
 
 
 def _failed(sizes: dict) -> dict:
@@ -84,14 +87,14 @@ def _transition_epoch(orbit, epoch_tdb: float, revolutions: int, nodes_per_rev: 
         r = to_ephemeris(orbit, epoch_tdb, revolutions=revolutions, nodes_per_rev=nodes_per_rev, ephemeris=eph)
     except ConvergenceError as err:
         return {**_failed(sizes), "reason": f"{type(err).__name__}: {str(err).splitlines()[0] if str(err) else ''}"}
-    tr = r.sample(per_leg=PER_LEG)
+    t_track, x_track = _sampled(r, eph)
     mu = orbit.system.mu
-    track = np.array([eph.ephemeris_to_synodic(s, float(t), mu) for t, s in zip(tr.t_tdb, tr.states_km)])
+    track = np.array([eph.ephemeris_to_synodic(x, float(t), mu) for t, x in zip(t_track, x_track)])
     out = {"status": np.uint8(0), "iterations": np.int64(r.iterations), "max_departure_km": float(r.max_departure_km),
            "drift_km_per_rev": float(r.drift_km_per_rev), "node_epochs_tdb": np.asarray(r.epochs_tdb, dtype=float),
            "states_km": np.asarray(r.states_km, dtype=float), "synodic": np.asarray(r.synodic(), dtype=float),
            "defects_km": np.asarray(r.defects_km, dtype=float), "defects_km_s": np.asarray(r.defects_km_s, dtype=float),
-           "perilune_km": np.asarray(r.perilune_km, dtype=float), "track_t_tdb": np.asarray(tr.t_tdb, dtype=float), "track_synodic": track}
+           "perilune_km": np.asarray(r.perilune_km, dtype=float), "track_t_tdb": t_track, "track_synodic": track}
     from ..results.kinds import TRANSITION_VARIABLES
 
     for k, (_, dims, _) in TRANSITION_VARIABLES.items():
@@ -99,6 +102,21 @@ def _transition_epoch(orbit, epoch_tdb: float, revolutions: int, nodes_per_rev: 
         if np.shape(out[k]) != want:
             raise ValueError(f"the transition at {epoch_tdb!r} s TDB gave {k} of shape {np.shape(out[k])}, the store holds {want}")
     return out
+
+
+def _sampled(r, eph) -> tuple[np.ndarray, np.ndarray]:
+    """The continuous trajectory of the EphemerisOrbit ``r`` at PER_LEG equal steps of every
+    leg (each leg propagated from its node), the last node included: (t_tdb, states_km)."""
+    from ..ephemeris.model import propagate_ephemeris
+
+    t, x = np.asarray(r.epochs_tdb, dtype=float), np.asarray(r.states_km, dtype=float)
+    ts, xs = [], []
+    for i in range(t.size - 1):
+        dt = float(t[i + 1] - t[i])
+        leg = propagate_ephemeris(x[i], float(t[i]), dt, ephemeris=eph, t_eval=dt * np.arange(PER_LEG) / PER_LEG)
+        ts.append(leg.t_tdb)
+        xs.append(leg.states_km)
+    return np.concatenate([*ts, t[-1:]]), np.concatenate([*xs, x[-1:]])
 
 
 def _fingerprint(orbit, epochs, revolutions: int, nodes_per_rev: int, eph_digest: str) -> str:
