@@ -15,7 +15,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from .._checks import as_count, as_float_array, as_number, as_threads, as_tolerance, check_cells
+from .._checks import as_count, as_float_array, as_number, as_threads, as_tolerance, check_map_cells
 from .._core import __version__
 from .._errors import LibrateError
 from .._progress import as_progress
@@ -24,7 +24,6 @@ from ..orbits.periodic import PeriodicOrbit
 from ..results.kinds import MAP_VARIABLES
 from .solutions import (
     MAP_ATOL,
-    MAP_CELL_BYTES,
     MAP_METHOD,
     MAP_RTOL,
     AttitudeSolution,
@@ -150,7 +149,7 @@ def periodicity_map(
     srp = check_srp(srp)
     kzs, wz = map_grid(kz, wz0, n_periods)
     phi0 = as_number(phi0, "phi0")
-    check_cells((len(olist), kzs.size, wz.size), "`orbits`, `kz`, `wz0`", item_bytes=MAP_CELL_BYTES)
+    check_map_cells((len(olist), kzs.size, wz.size), "`orbits`, `kz`, `wz0`")
     chunk = as_count(chunk, "chunk", 1)
     threads = as_threads(threads)
     rtol, atol = as_tolerance(rtol, "rtol"), as_tolerance(atol, "atol")
