@@ -339,15 +339,18 @@ def _grid_for(T: float, lo: float, hi: float, n_grid: int | None) -> np.ndarray:
     return np.linspace(lo, hi, int(n_grid))
 
 
-def candidates(phi_t, phi0, wz, level):
+def candidates(phi_t, phi0, wz, level, max_crossings: int | None = None):
     """wz0 brackets where (phi(t) - phi0) / level crosses an integer; returns (k, wz_interp) in
-    order of the grid (linear interpolation)."""
+    order of the grid (linear interpolation). ``max_crossings``: an interval that crosses more
+    integers than that is left out (the grid does not resolve it)."""
     u = (np.asarray(phi_t, dtype=float) - phi0) / level
     wz = np.asarray(wz, dtype=float)
     a, b = u[:-1], u[1:]
     ok = np.isfinite(a) & np.isfinite(b) & (a != b)
     lo = np.ceil(np.minimum(a, b))
     hi = np.floor(np.maximum(a, b))
+    if max_crossings is not None:
+        ok &= hi - lo + 1 <= max_crossings
     out = []
     for i in np.flatnonzero(ok & (hi >= lo)):
         for k in range(int(lo[i]), int(hi[i]) + 1):
