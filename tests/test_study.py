@@ -442,7 +442,7 @@ def test_a_study_within_its_budget_is_not_refused_by_the_engine():
     guard of periodicity_map) are one estimate (map_bytes): a map study 1% under the 2 GiB limit
     passes both, 1% over is refused by both (before, the budget counted 25 bytes a cell and the
     API 57, so a study could pass its budget and then fail in the engine)."""
-    from librate._checks import MAX_ARRAY_BYTES, MAP_CELL_BYTES, MAP_ROW_CELL_BYTES, check_map_cells
+    from librate._checks import MAP_CELL_BYTES, MAP_ROW_CELL_BYTES, MAX_ARRAY_BYTES, check_map_cells
 
     for scale, refused in ((0.99, False), (1.01, True)):
         nw = int(scale * MAX_ARRAY_BYTES / (12 * 10 * MAP_CELL_BYTES + 10 * MAP_ROW_CELL_BYTES))
