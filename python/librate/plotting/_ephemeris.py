@@ -184,6 +184,9 @@ def plot_transition_sweep(epochs_tdb, max_departure_km, perilune_km, iterations=
         it = _array(iterations, "iterations", 1)
         axs[2].plot(t, it, color="0.3", marker="." if t.size < 60 else None, drawstyle="steps-mid", gid="iterations")
         axs[2].set_ylabel("Newton iterations")
+        from matplotlib.ticker import MaxNLocator
+
+        axs[2].yaxis.set_major_locator(MaxNLocator(integer=True))
     for panel in axs:
         panel.set_xlabel("epoch [yr, TDB]")
         panel.grid(True, alpha=0.3)
