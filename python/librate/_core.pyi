@@ -737,6 +737,6 @@ class EphemerisCore:
         scales: tuple[float, float],
         epoch_free: bool = False,
         max_iter: int = 30,
-        integration: tuple[float, float] = (1e-13, 1e-9),
+        integration: tuple[float, float] = ...,
         gm: tuple[float, float, float] | None = None,
     ) -> dict[str, Any]: ...

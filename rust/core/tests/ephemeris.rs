@@ -240,3 +240,19 @@ fn transition_input_is_checked() {
     let e = transition(&eph, gm, &states, &dro_nodes(&eph, 1, 4).1, &s, &opts).unwrap_err();
     assert!(e.to_string().contains("`tol_km`"), "{e}");
 }
+
+/// The position-only evaluation (Clenshaw) equals the position of the full evaluation (the
+/// recurrences of T_n) to 1e-9 km, across records.
+#[test]
+fn position_only_equals_the_full_evaluation() {
+    let eph = circular(0.3);
+    for seg in eph.segments() {
+        for k in 0..200 {
+            let t = seg.start + (seg.end - seg.start) * (k as f64 + 0.37) / 200.0;
+            let (p, full) = (seg.position(t), seg.evaluate(t)[0]);
+            for c in 0..3 {
+                assert!((p[c] - full[c]).abs() < 1e-9 * (1.0 + full[c].abs() * 1e-6), "{p:?} vs {full:?}");
+            }
+        }
+    }
+}
