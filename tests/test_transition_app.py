@@ -188,3 +188,29 @@ def test_netcdf_output_is_the_same_result(example, tmp_path):
     assert verify_result(path)[0]
     for v in ("states_km", "defects_km", "perilune_km", "status"):
         np.testing.assert_array_equal(librate.open_result(path)[v].values, ref[v].values, err_msg=v)
+
+
+def test_an_epoch_that_does_not_converge_is_kept_as_such_and_the_sweep_goes_on(tmp_path, monkeypatch):
+    """The second of three epochs stopped after one Newton step (the transition's own
+    ConvergenceError, as from a hard epoch): stored with status 1, NaN arrays and its reason;
+    the others converge; the summary and the figures say so."""
+    from librate.app.jobs import run_transition
+    from librate.app.transition import transition_summary
+    from librate.orbits import transition
+
+    real = transition.to_ephemeris
+    second = Study.from_toml(EXAMPLE, purpose="transition").ephemeris.epochs_tdb()[1]
+
+    def hard(orbit, epoch, **kw):
+        return real(orbit, epoch, **kw, max_iter=1) if epoch == second else real(orbit, epoch, **kw)
+
+    monkeypatch.setattr(transition, "to_ephemeris", hard)
+    st = Study.from_toml(EXAMPLE, purpose="transition", overrides={"ephemeris.revolutions": 2})
+    ds, path = run_transition(st, tmp_path)
+    assert ds["status"].values.tolist() == [0, 1, 0] and verify_result(path)[0]
+    assert np.isnan(ds["states_km"].values[1]).all() and ds["iterations"].values[1] == -1
+    assert np.isfinite(ds["states_km"].values[[0, 2]]).all()
+    (why,) = json.loads(ds.attrs["failures"]).values()
+    assert why.startswith("ConvergenceError: ephemeris transition of the dro") and "max iterations" in why
+    lines = transition_summary(ds, 1.0)
+    assert "3 epoch(s), 2 converged" in lines[0] and lines[3].endswith("did not converge") and lines[-1].startswith("  epoch 1: ConvergenceError")

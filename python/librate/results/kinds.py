@@ -54,7 +54,7 @@ def map3d_schema(no: int, shape: tuple[int, ...], dims: tuple[str, ...], coords:
 #: dimensions within an epoch, units and long name. ``status``: 0 converged, 1 not converged.
 TRANSITION_VARIABLES = {
     "status": ("u1", (), {"flag_values": "0 converged, 1 not converged (ConvergenceError), 255 not computed"}),
-    "iterations": ("i8", (), {"long_name": "Newton iterations of the multiple shooting"}),
+    "iterations": ("i8", (), {"long_name": "Newton iterations of the multiple shooting (-1: not converged)"}),
     "max_departure_km": ("f8", (), {"units": "km", "long_name": "largest distance of the ephemeris trajectory from the CR3BP orbit"}),
     "drift_km_per_rev": ("f8", (), {"units": "km", "long_name": "drift of the ephemeris trajectory from the CR3BP orbit per revolution"}),
     "node_epochs_tdb": ("f8", ("node",), {"units": "s", "long_name": "node epochs, TDB seconds past J2000"}),
@@ -75,7 +75,8 @@ def transition_schema(n_epochs: int, sizes: dict, coords: dict) -> StoreSchema:
     node, leg, revolution, sample and component."""
     v = {}
     for k, (dtype, dims, attrs) in TRANSITION_VARIABLES.items():
-        fill = 255 if k == "status" else (-1 if dtype == "i8" else np.nan)
+        # no fill value for the counts: xarray would read one (-1: not converged) as missing
+        fill = 255 if k == "status" else (None if dtype == "i8" else np.nan)
         v[k] = Var(dtype, tuple(sizes[d] for d in dims), dims, fill, dict(attrs))
     return StoreSchema("ephemeris_transition", "epoch", n_epochs, v, coords)
 
