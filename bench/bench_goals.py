@@ -28,6 +28,7 @@ exit status is 0 unless something fails.
     python bench/bench_goals.py --quick [--json FILE]  # CI: 200 rates, 4 DROs x 2000 rates for (b),
                                                        # 400 3-D trajectories; (d) at full size
     python bench/bench_goals.py --smoke --json FILE    # tiny sizes, for tests/test_bench.py
+    python bench/bench_goals.py --no-heyoka            # only (c) and (d)
 """
 
 import argparse
@@ -80,7 +81,7 @@ def goal(what, ratio, sense, value, **details):
 
 
 def not_measured(what, sense, value):
-    return goal(what, None, sense, value, note="heyoka not installed (pip install heyoka)")
+    return goal(what, None, sense, value, note="heyoka not installed (pip install heyoka)" if bm.hy is None else "heyoka left out (--no-heyoka)")
 
 
 def heyoka_configs(make, states, tol, n_threads=(1, 2)):
@@ -242,30 +243,32 @@ def main(argv=None):
     mode.add_argument("--quick", action="store_true", help="smaller sizes, under a minute on 2 cores (CI)")
     mode.add_argument("--smoke", action="store_true", help="tiny sizes, for the tests")
     ap.add_argument("--json", metavar="FILE", help="also write the results as JSON")
+    ap.add_argument("--no-heyoka", action="store_true", help="the librate-only ratios (c, d), as without heyoka")
     args = ap.parse_args(argv)
+    heyoka = None if args.no_heyoka else hy
     name = "quick" if args.quick else "smoke" if args.smoke else "full"
     sz = SIZES[name]
     info = librate.build_info()
     cpu = cpu_name()
     load0 = os.getloadavg()
-    print(f"librate {librate.__version__} ({info['profile']} build), heyoka {hy.__version__ if hy else 'not installed'}, "
+    print(f"librate {librate.__version__} ({info['profile']} build), heyoka {heyoka.__version__ if heyoka else 'not used' if hy else 'not installed'}, "
           f"python {platform.python_version()}, {name} sizes")
     print(f"CPU: {cpu}, {os.cpu_count()} cores, librate SIMD level {info['simd_active']}; load average {load0[0]:.2f}")
     print(f"equal accuracy: each side at the loosest tolerance meeting {TARGET:.0e} (map default rtol {MAP_RTOL:.0e} in c, d)")
     t0 = time.perf_counter()
     goals = {}
-    if hy is not None:
+    if heyoka is not None:
         print("\n[a] standard map")
         goals["a"], std = standard_map(sz)
         print("\n[b] large map")
         goals["b"] = large_map(sz, std)
     else:
-        print("\nheyoka is not installed (pip install heyoka): goals a, b and e are not measured")
+        print(f"\nheyoka {'left out (--no-heyoka)' if args.no_heyoka else 'is not installed (pip install heyoka)'}: goals a, b and e are not measured")
         goals["a"] = not_measured("the standard map against heyoka's batch mode", ">=", 4)
         goals["b"] = not_measured("the 600k map against heyoka's throughput", ">=", 4)
     print("\n[c, d] solutions and srp_map against the map alone")
     goals["c"], goals["d"] = solve_costs(sz)
-    if hy is not None:
+    if heyoka is not None:
         print("\n[e] 3-D map")
         goals["e"] = map_3d(sz)
     else:
@@ -280,7 +283,7 @@ def main(argv=None):
     if args.json:
         with open(args.json, "w") as f:
             json.dump(dict(cpu=cpu, cores=os.cpu_count(), simd=info["simd_active"], build=info, librate=librate.__version__,
-                           heyoka=hy.__version__ if hy else None, sizes=name, accuracy_target=TARGET, load_average=[load0[0], load1[0]],
+                           heyoka=heyoka.__version__ if heyoka else None, sizes=name, accuracy_target=TARGET, load_average=[load0[0], load1[0]],
                            goals=goals), f, indent=1)
     return 0
 
