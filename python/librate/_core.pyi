@@ -729,3 +729,14 @@ class EphemerisCore:
         atol: float = 1e-9,
         gm: tuple[float, float, float] | None = None,
     ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], npt.NDArray[np.float64] | None]: ...
+    def transition(
+        self,
+        states_km: npt.NDArray[np.float64],
+        epochs: npt.NDArray[np.float64],
+        tol: tuple[float, float],
+        scales: tuple[float, float],
+        epoch_free: bool = False,
+        max_iter: int = 30,
+        integration: tuple[float, float] = ...,
+        gm: tuple[float, float, float] | None = None,
+    ) -> dict[str, Any]: ...

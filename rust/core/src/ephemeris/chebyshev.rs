@@ -64,17 +64,39 @@ impl Segment {
         t >= self.start && t <= self.end
     }
 
+    /// The record covering t and the scaled time s in [-1, 1] within it.
+    #[inline]
+    fn record(&self, t: f64) -> (&[f64], f64) {
+        let off = t - self.init;
+        let k = (off / self.intlen).floor().clamp(0.0, (self.n_records - 1) as f64);
+        let ki = k as usize;
+        let s = 2.0 * (off - k * self.intlen) / self.intlen - 1.0;
+        (&self.coef[ki * 3 * self.n_coef..(ki + 1) * 3 * self.n_coef], s)
+    }
+
+    /// Position (km) at t only (Clenshaw's recurrence; the right-hand side needs no more).
+    #[inline]
+    pub fn position(&self, t: f64) -> [f64; 3] {
+        let (rec, s) = self.record(t);
+        let n = self.n_coef;
+        std::array::from_fn(|c| {
+            let a = &rec[c * n..(c + 1) * n];
+            let (mut b1, mut b2) = (0.0, 0.0);
+            for k in (1..n).rev() {
+                let b0 = 2.0 * s * b1 - b2 + a[k];
+                b2 = b1;
+                b1 = b0;
+            }
+            s * b1 - b2 + a[0]
+        })
+    }
+
     /// Position (km), velocity (km/s) and acceleration (km/s^2) at t (inside the coverage;
     /// the caller checks).
     #[inline]
     pub fn evaluate(&self, t: f64) -> [[f64; 3]; 3] {
-        let off = t - self.init;
-        let mut k = (off / self.intlen).floor();
-        k = k.clamp(0.0, (self.n_records - 1) as f64);
-        let ki = k as usize;
-        let s = 2.0 * (off - k * self.intlen) / self.intlen - 1.0;
+        let (rec, s) = self.record(t);
         let scale = 2.0 / self.intlen;
-        let rec = &self.coef[ki * 3 * self.n_coef..(ki + 1) * 3 * self.n_coef];
         let mut out = [[0.0; 3]; 3];
         // T_n, T'_n, T''_n by their recurrences.
         let (mut t0, mut t1) = (1.0, s);
@@ -218,8 +240,7 @@ impl Ephemeris {
     }
 }
 
-/// Earth and Sun relative to the Moon at t, for the right-hand side: position, velocity,
-/// acceleration of each. Precomputed chains keep it allocation-free.
+/// Earth and Sun relative to the Moon at t, for the right-hand side: their positions. Precomputed chains keep it allocation-free.
 #[derive(Debug, Clone)]
 pub(crate) struct MoonCentred {
     eph: Ephemeris,
@@ -242,28 +263,20 @@ impl MoonCentred {
     }
 
     #[inline]
-    fn eval(&self, b: i32, t: f64) -> [[f64; 3]; 3] {
+    fn position(&self, b: i32, t: f64) -> [f64; 3] {
         match self.eph.segment_of(b, t) {
-            Some(s) => s.evaluate(t),
-            None => [[f64::NAN; 3]; 3],
+            Some(s) => s.position(t),
+            None => [f64::NAN; 3],
         }
     }
 
-    /// (Earth rel. Moon, Sun rel. Moon) position/velocity/acceleration; NaN outside the span.
+    /// (Earth rel. Moon, Sun rel. Moon) positions (km); NaN outside the span.
     #[inline]
-    pub fn bodies(&self, t: f64) -> ([[f64; 3]; 3], [[f64; 3]; 3]) {
-        let e = self.eval(EARTH, t);
-        let m = self.eval(MOON, t);
-        let b = self.eval(EMB, t);
-        let s = self.eval(SUN, t);
-        let mut earth = [[0.0; 3]; 3];
-        let mut sun = [[0.0; 3]; 3];
-        for i in 0..3 {
-            for c in 0..3 {
-                earth[i][c] = e[i][c] - m[i][c];
-                sun[i][c] = (s[i][c] - b[i][c]) - m[i][c];
-            }
-        }
-        (earth, sun)
+    pub fn positions(&self, t: f64) -> ([f64; 3], [f64; 3]) {
+        let e = self.position(EARTH, t);
+        let m = self.position(MOON, t);
+        let b = self.position(EMB, t);
+        let s = self.position(SUN, t);
+        (std::array::from_fn(|c| e[c] - m[c]), std::array::from_fn(|c| (s[c] - b[c]) - m[c]))
     }
 }

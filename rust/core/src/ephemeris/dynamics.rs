@@ -55,7 +55,7 @@ impl EphemerisDynamics {
     /// Acceleration at (t, r) and, when `grad` is given, its gradient d a / d r.
     #[inline]
     pub fn acceleration(&self, t: f64, r: &[f64; 3], grad: Option<&mut [[f64; 3]; 3]>) -> [f64; 3] {
-        let (earth, sun) = self.bodies.bodies(self.epoch0 + t);
+        let (earth, sun) = self.bodies.positions(self.epoch0 + t);
         let mut a = [0.0; 3];
         let r2 = dot(r, r);
         let rn = r2.sqrt();
@@ -73,7 +73,7 @@ impl EphemerisDynamics {
                 }
             }
         }
-        for (gm, rb) in [(self.gm[0], earth[0]), (self.gm[2], sun[0])] {
+        for (gm, rb) in [(self.gm[0], earth), (self.gm[2], sun)] {
             if gm == 0.0 {
                 continue;
             }
