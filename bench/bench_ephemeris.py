@@ -11,7 +11,7 @@ i.  Ephemeris propagation: the 9:2 L2 southern NRHO (6.56 days, placed in the Ea
     position error is below 1e-4 km (10 cm) on every epoch. librate has no batch ephemeris
     propagation yet, so both run the epochs one after the other on one core. Goal >= 300x.
 ii. An NRHO transition over 20 revolutions, ``librate.to_ephemeris`` (multiple shooting from the
-    CR3BP orbit): goal < 1 s.
+    CR3BP orbit, default nodes and tolerances: continuity within 1 m and 1e-8 km/s): goal < 1 s.
 
 No timing is asserted; the CPU is named. Run:
 
@@ -120,8 +120,11 @@ def transition(revolutions, rounds):
     nrho = librate.halo("earth-moon", 2, "south", period_days=NRHO_DAYS)
     res = race({"to_ephemeris": lambda: librate.to_ephemeris(nrho, EPOCH, revolutions=revolutions)}, rounds)
     out, t = res["to_ephemeris"][0], res["to_ephemeris"][1]
-    print(f"  to_ephemeris: {t:.3f} s (best of {rounds}), {len(out.epochs_tdb)} nodes")
-    return dict(what=what, seconds=t, goal="< 1 s", met=t < 1.0, nodes=len(out.epochs_tdb))
+    d_km, d_kms = float(out.defects_km.max()), float(out.defects_km_s.max())
+    print(f"  to_ephemeris from {EPOCH}: {t:.3f} s (best of {rounds}), {len(out.epochs_tdb)} nodes, {out.iterations} Newton steps, "
+          f"largest defect {d_km * 1e3:.1e} m and {d_kms:.1e} km/s, largest departure from the CR3BP orbit {out.max_departure_km:.0f} km")
+    return dict(what=what, seconds=t, goal="< 1 s", met=t < 1.0, nodes=len(out.epochs_tdb), iterations=out.iterations,
+                max_defect_km=d_km, max_defect_km_s=d_kms, max_departure_km=float(out.max_departure_km))
 
 
 def main(argv=None):
