@@ -62,6 +62,16 @@ LADDER = tuple(float(f"{m}e{e}") for e in range(-8, -15, -1) for m in (5, 2, 1))
 REF_TOL = 1e-19
 
 
+def problem(nx, nz):
+    """(system, the 12-day L2 southern halo, the (nx * nz, 3) initial rates: nx wx0 in
+    [-0.2, 0.2] x nz wz0 in [w_tf - 0.5, w_tf + 0.5], wy0 = 0)."""
+    em = librate.System.preset("earth-moon")
+    halo = librate.halo(em, 2, "south", period_days=PERIOD_DAYS)
+    w_tf = 1 - 2 * math.pi / halo.period
+    wx, wz = np.linspace(-0.2, 0.2, nx), np.linspace(w_tf - 0.5, w_tf + 0.5, nz)
+    return em, halo, np.stack(np.meshgrid(wx, [0.0], wz, indexing="ij"), axis=-1).reshape(-1, 3)
+
+
 def accuracy(q, w, ref):
     """max over trajectories of max(|dq|, |dw|) / max(1, |w_ref|) (NaN -> inf)."""
     qr, wr = ref
@@ -185,14 +195,8 @@ def main():
     rounds = 3 if args.quick else 10
     cores = os.cpu_count()
 
-    em = librate.System.preset("earth-moon")
-    mu = em.mu
-    halo = librate.halo(em, 2, "south", period_days=PERIOD_DAYS)
-    T = halo.period
-    w_tf = 1 - 2 * math.pi / T
-    wx, wz = np.linspace(-0.2, 0.2, nx), np.linspace(w_tf - 0.5, w_tf + 0.5, nz)
-    w0 = np.stack(np.meshgrid(wx, [0.0], wz, indexing="ij"), axis=-1).reshape(-1, 3)
-    n = len(w0)
+    em, halo, w0 = problem(nx, nz)
+    mu, T, n = em.mu, halo.period, len(w0)
     print(f"librate {librate.__version__}, heyoka {hy.__version__}, numpy {np.__version__}, python {platform.python_version()}")
     print(f"CPU: {cpu_name()}, cores = {cores}, librate SIMD level = {_core.build_info()['simd_active']}, "
           f"load average at start = {' '.join(f'{v:.2f}' for v in os.getloadavg())}")

@@ -27,26 +27,34 @@ import numpy as np
 from timing import cpu_name, race
 
 
+def workloads(n_rates=2000, n_eps=41, n_srp_rates=400, family=True):
+    """The timed calls, {name: function}, after a warm-up (forcing table cached, imports done).
+    The defaults are the issue's sizes (``n_eps`` x ``n_srp_rates`` = the README's srp_map);
+    ``family=False`` leaves out the 300-member attitude family (its family is computed here)."""
+    em = librate.System.preset("earth-moon")
+    o7 = librate.dro(em, x0=0.70)
+    wz = np.linspace(-3.0, 2.0, n_rates)
+    o2 = librate.dro_family(em).resonant(2, "sun")
+    librate.periodicity_map(o7, kz=0.8, wz0=wz, solve=True)  # warm-up: forcing table cached, imports done
+    fns = {
+        f"map alone ({n_rates} rates)": lambda: librate.periodicity_map(o7, kz=0.8, wz0=wz, solve=False),
+        "map with its solutions": lambda: librate.periodicity_map(o7, kz=0.8, wz0=wz, solve=True),
+    }
+    if family:
+        fam300 = librate.dro_family(em, x0=np.linspace(0.95, 0.25, 300))
+        fns["attitude_family across 300 DROs"] = lambda: librate.attitude_family(fam300, kz=0.8, n=0)
+    fns[f"srp_map {n_eps} eps x {n_srp_rates} rates, K = 2"] = lambda: librate.srp_map(
+        o2, kz=0.6, wz0=np.linspace(-1.6, 1.2, n_srp_rates), eps=np.linspace(0, 2, n_eps), cs=0.4, cd=0.1)
+    return fns
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--rounds", type=int, default=5)
     args = ap.parse_args()
     print(f"librate {librate.__version__} on {cpu_name()}, {os.cpu_count()} cores, python {platform.python_version()}")
     print(f"SIMD and build: {librate.build_info() if hasattr(librate, 'build_info') else 'n/a'}")
-    em = librate.System.preset("earth-moon")
-    o7 = librate.dro(em, x0=0.70)
-    wz = np.linspace(-3.0, 2.0, 2000)
-    fam300 = librate.dro_family(em, x0=np.linspace(0.95, 0.25, 300))
-    o2 = librate.dro_family(em).resonant(2, "sun")
-    librate.periodicity_map(o7, kz=0.8, wz0=wz, solve=True)  # warm-up: forcing table cached, imports done
-
-    fns = {
-        "map alone (2000 rates)": lambda: librate.periodicity_map(o7, kz=0.8, wz0=wz, solve=False),
-        "map with its solutions": lambda: librate.periodicity_map(o7, kz=0.8, wz0=wz, solve=True),
-        "attitude_family across 300 DROs": lambda: librate.attitude_family(fam300, kz=0.8, n=0),
-        "srp_map 41 eps x 400 rates, K = 2": lambda: librate.srp_map(o2, kz=0.6, wz0=np.linspace(-1.6, 1.2, 400),
-                                                                      eps=np.linspace(0, 2, 41), cs=0.4, cd=0.1),
-    }
+    fns = workloads()
     res = race(fns, args.rounds)
     out = {k: v[0] for k, v in res.items()}
     t = {k: (v[1], v[2]) for k, v in res.items()}
