@@ -18,11 +18,12 @@ from __future__ import annotations
 
 import hashlib
 import json
-import math
 from pathlib import Path
 from typing import Any
 
 import numpy as np
+
+from ..orbits.transition import nodes_per_rev_for
 
 __all__ = ["COMPONENTS", "CR3BP_SAMPLES", "PER_LEG", "run_transition_to", "transition_sizes", "transition_summary"]
 
@@ -53,17 +54,6 @@ def transition_sizes(revolutions: int, nodes_per_rev: int) -> dict[str, int]:
     """The lengths of an epoch's dimensions: node, leg, revolution, sample, component."""
     nodes = revolutions * nodes_per_rev + 1
     return {"node": nodes, "leg": nodes - 1, "revolution": revolutions, "sample": (nodes - 1) * PER_LEG + 1, "component": 6}
-
-
-def _nodes_per_rev(orbit, nodes_per_rev: int | None) -> int:
-    """``nodes_per_rev``, or the transition's own default for ``orbit`` (its rule, with its
-    constants: legs of at most MAX_LEG_DAYS, at least MIN_NODES_PER_REV, an odd count)."""
-    if nodes_per_rev is not None:
-        return int(nodes_per_rev)
-    from ..orbits import transition
-
-    n = max(transition.MIN_NODES_PER_REV, math.ceil(orbit.period_days / transition.MAX_LEG_DAYS))
-    return n + 1 - n % 2
 
 
 def _failed(sizes: dict) -> dict:
@@ -175,7 +165,7 @@ def run_transition_to(orbit, store: str | Path, *, epochs_tdb, revolutions: int,
     orbit = PeriodicOrbit(orbit.system, np.asarray(orbit.state0, dtype=float), float(orbit.period), float(orbit.jacobi), orbit.family,
                           orbit.iterations, orbit.residual)
     epochs = np.atleast_1d(np.asarray(epochs_tdb, dtype=float))
-    npr = _nodes_per_rev(orbit, nodes_per_rev)
+    npr = nodes_per_rev_for(orbit, nodes_per_rev)
     sizes = transition_sizes(int(revolutions), npr)
     eph_path = None if ephemeris_file is None else str(ephemeris_file)
     eph_name, eph_digest = _file_digest(eph_path)

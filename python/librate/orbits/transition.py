@@ -21,7 +21,7 @@ from ..ephemeris.model import Ephemeris, EphemerisTrajectory, default_ephemeris,
 from .periodic import PeriodicOrbit
 from .propagation import propagate
 
-__all__ = ["EphemerisOrbit", "to_ephemeris", "ephemeris_sweep"]
+__all__ = ["EphemerisOrbit", "to_ephemeris", "ephemeris_sweep", "nodes_per_rev_for"]
 
 #: Nodes per revolution unless given: legs of at most about 1.7 days, at least 5 a revolution,
 #: and an odd number. The orbits start on their x-z plane crossing, so an odd count puts no node
@@ -109,7 +109,9 @@ class EphemerisOrbit:
                 f"max_departure={self.max_departure_km:.1f} km, perilune={float(self.perilune_km.min()):.0f}..{float(self.perilune_km.max()):.0f} km)")
 
 
-def _nodes_per_rev(orbit: PeriodicOrbit, nodes_per_rev) -> int:
+def nodes_per_rev_for(orbit: PeriodicOrbit, nodes_per_rev: int | None = None) -> int:
+    """``nodes_per_rev`` checked, or the default for ``orbit``: legs of at most MAX_LEG_DAYS, at
+    least MIN_NODES_PER_REV nodes a revolution, an odd number."""
     if nodes_per_rev is None:
         n = max(MIN_NODES_PER_REV, math.ceil(orbit.period_days / MAX_LEG_DAYS))
         return n + 1 - n % 2
@@ -218,7 +220,7 @@ def to_ephemeris(
     if not math.isclose(orbit.system.mu, mu_em, rel_tol=1e-3):
         raise ValueError(f"invalid argument `orbit`: the ephemeris model is the Earth-Moon-Sun one (mu = {mu_em:.9f}), got an orbit with mu = {orbit.system.mu!r}")
     revolutions = as_count(revolutions, "revolutions", 1, 1000)
-    npr = _nodes_per_rev(orbit, nodes_per_rev)
+    npr = nodes_per_rev_for(orbit, nodes_per_rev)
     for name, v in (("tol_km", tol_km), ("tol_km_s", tol_km_s)):
         as_real(v, name, positive=True)
     as_tolerance(rtol, "rtol")
