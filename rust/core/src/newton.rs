@@ -12,7 +12,8 @@
 //!   `RANK_TOL` times the largest treated as zero);
 //! - underdetermined (fewer rows than unknowns, e.g. multiple shooting with free node states and
 //!   epochs): the minimum-norm step d = J^T (J J^T)^-1 (-F), by Cholesky of J J^T, or by SVD when
-//!   J J^T is not positive definite.
+//!   J J^T is not positive definite; or, when the problem has an anchor, the step nearest it
+//!   (see [`Problem::anchor`]).
 //!
 //! Then a backtracking line search: the step is halved (at most `max_halvings` times) until the
 //! 2-norm of F decreases sufficiently (Armijo: |F(x + l d)|_2 <= (1 - 1e-4 l) |F(x)|_2). A trial
@@ -76,6 +77,14 @@ pub trait Problem {
     /// J(x) at the point of the last successful [`Problem::residual`] call (a problem that gets
     /// the Jacobian with the residual, from an STM, keeps it from that call).
     fn jacobian(&mut self, x: &DVector<f64>) -> Result<DMatrix<f64>>;
+    /// An underdetermined problem's anchor x_a: each step is then the one of least
+    /// |x + d - x_a| among the solutions of J d = -F (the minimum-norm step plus the projection
+    /// of x_a - x on the null space of J), so the iteration ends at the solution nearest the
+    /// anchor (to first order) instead of drifting along the null space step by step. None:
+    /// the plain minimum-norm step.
+    fn anchor(&self) -> Option<&DVector<f64>> {
+        None
+    }
 }
 
 /// The outcome: the last accepted point, its residual and Jacobian, and why the driver stopped.
@@ -106,17 +115,22 @@ fn max_norm(f: &DVector<f64>) -> f64 {
 }
 
 /// The Newton step d solving J d = -f (minimum-norm when underdetermined, least squares
-/// otherwise); None when J is zero, non-finite or its factorisation fails.
-pub fn newton_step(jac: &DMatrix<f64>, f: &DVector<f64>) -> Option<DVector<f64>> {
+/// otherwise); with `toward` = x_a - x (underdetermined only), the solution of J d = -f nearest
+/// x_a - x: d = J+ (-f) + (I - J+ J) (x_a - x). None when J is zero, non-finite or its
+/// factorisation fails.
+pub fn newton_step(jac: &DMatrix<f64>, f: &DVector<f64>, toward: Option<&DVector<f64>>) -> Option<DVector<f64>> {
     if !jac.iter().all(|v| v.is_finite()) || !f.iter().all(|v| v.is_finite()) {
         return None;
     }
     let (m, n) = jac.shape();
+    let toward = toward.filter(|_| m < n);
     if m < n {
         let jjt = jac * jac.transpose();
         if let Some(ch) = jjt.cholesky() {
-            let y = ch.solve(&(-f));
-            let d = jac.transpose() * y;
+            let mut d = jac.transpose() * ch.solve(&(-f));
+            if let Some(v) = toward {
+                d += v - jac.transpose() * ch.solve(&(jac * v));
+            }
             if d.iter().all(|v| v.is_finite()) {
                 return Some(d);
             }
@@ -127,7 +141,10 @@ pub fn newton_step(jac: &DMatrix<f64>, f: &DVector<f64>) -> Option<DVector<f64>>
     if !(s1 > 0.0 && s1.is_finite()) {
         return None;
     }
-    let d = svd.solve(&(-f), RANK_TOL * s1).ok()?;
+    let mut d = svd.solve(&(-f), RANK_TOL * s1).ok()?;
+    if let Some(v) = toward {
+        d += v - svd.solve(&(jac * v), RANK_TOL * s1).ok()?;
+    }
     d.iter().all(|v| v.is_finite()).then_some(d)
 }
 
@@ -162,7 +179,8 @@ pub fn solve<P: Problem>(problem: &mut P, x0: DVector<f64>, s: &Settings) -> Res
         if iterations >= s.max_iter {
             break StopReason::MaxIterations;
         }
-        let Some(d) = newton_step(jac.as_ref().expect("set above"), &f) else { break StopReason::SingularJacobian };
+        let toward = problem.anchor().map(|a| a - &x);
+        let Some(d) = newton_step(jac.as_ref().expect("set above"), &f, toward.as_ref()) else { break StopReason::SingularJacobian };
         let merit = f.norm();
         let mut lambda = 1.0;
         let mut accepted = None;
@@ -251,6 +269,33 @@ mod tests {
         let k = (3.0 - (1.0 + 2.0 - 2.0)) / 9.0;
         for (i, a) in [1.0, 2.0, -2.0].iter().enumerate() {
             assert!((o.x[i] - (1.0 + k * a)).abs() < 1e-14);
+        }
+    }
+
+    /// The plane again, anchored at a point off the start: the iteration ends at the anchor's
+    /// projection on the plane, x_a + a (b - a.x_a) / |a|^2 (analytic; tolerance 1e-14).
+    struct AnchoredPlane(DVector<f64>);
+    impl Problem for AnchoredPlane {
+        fn residual(&mut self, x: &DVector<f64>) -> Result<DVector<f64>> {
+            Plane.residual(x)
+        }
+        fn jacobian(&mut self, x: &DVector<f64>) -> Result<DMatrix<f64>> {
+            Plane.jacobian(x)
+        }
+        fn anchor(&self) -> Option<&DVector<f64>> {
+            Some(&self.0)
+        }
+    }
+
+    #[test]
+    fn anchored_step_ends_nearest_the_anchor() {
+        let s = Settings { tol: 1e-14, max_iter: 5, max_halvings: 4 };
+        let xa = DVector::from_vec(vec![5.0, -1.0, 2.0]);
+        let o = solve(&mut AnchoredPlane(xa.clone()), DVector::from_vec(vec![1.0, 1.0, 1.0]), &s).unwrap();
+        assert_eq!(o.reason, StopReason::Converged);
+        let k = (3.0 - (5.0 - 2.0 - 4.0)) / 9.0;
+        for (i, a) in [1.0, 2.0, -2.0].iter().enumerate() {
+            assert!((o.x[i] - (xa[i] + k * a)).abs() < 1e-13, "{:?}", o.x);
         }
     }
 

@@ -5,8 +5,11 @@
 //! full-state continuity at every interior junction, F_i = phi(t_{i+1}; t_i, X_i) - X_{i+1} = 0
 //! (6 n equations). The unknowns are every node state and every node epoch but the first, whose
 //! epoch is fixed unless `epoch_free` (7 (n + 1) - 1 or 7 (n + 1) unknowns): the system is
-//! underdetermined and each Newton step is the minimum-norm one ([`crate::newton`]), which keeps
-//! the solution near the guess (a CR3BP orbit placed at the epoch).
+//! underdetermined and each Newton step is the one nearest the guess among those that cancel the
+//! linearised defects ([`crate::newton`], anchored at the guess: a CR3BP orbit placed at the
+//! epoch), so the iteration ends at the continuous trajectory nearest the guess. (Plain
+//! minimum-norm steps let an unstable orbit's last, weakly held revolution drift away: the
+//! 12-day L2 halo's tenth revolution ended 178,000 km from the CR3BP orbit.)
 //!
 //! Partials of leg i (Phi its STM, f the right-hand side): d F_i / d X_i = Phi,
 //! d F_i / d X_{i+1} = -I, d F_i / d t_{i+1} = f(X_f, t_{i+1}),
@@ -82,6 +85,8 @@ struct Legs<'a> {
     rp: f64,
     rv: f64,
     jac: Option<DMatrix<f64>>,
+    /// The guess's unknowns: the solution nearest them is sought.
+    guess: DVector<f64>,
 }
 
 /// One leg's outcome: the final state, the STM, f at the start and at the end.
@@ -175,6 +180,9 @@ impl Problem for Legs<'_> {
     fn jacobian(&mut self, _: &DVector<f64>) -> Result<DMatrix<f64>> {
         self.jac.clone().ok_or_else(|| invalid("x", "no residual evaluated"))
     }
+    fn anchor(&self) -> Option<&DVector<f64>> {
+        Some(&self.guess)
+    }
 }
 
 /// Correct the guess `states`/`epochs` (n + 1 >= 2 nodes, increasing epochs) into a continuous
@@ -214,8 +222,10 @@ pub fn transition(eph: &Ephemeris, gm: [f64; 3], states: &[[f64; 6]], epochs: &[
         rp: l,
         rv: settings.tol_km_s * l / settings.tol_km,
         jac: None,
+        guess: DVector::zeros(0),
     };
     let x0 = problem.unknowns(states);
+    problem.guess = x0.clone();
     // the max-norm of a leg's 3 components below tol / sqrt 3 keeps its 2-norm below tol
     let ns = Settings { tol: settings.tol_km / l / 3f64.sqrt(), max_iter: settings.max_iter, max_halvings: 10 };
     let out = newton::solve(&mut problem, x0, &ns)?;
