@@ -30,6 +30,11 @@ __all__ = ["EphemerisOrbit", "to_ephemeris", "ephemeris_sweep", "nodes_per_rev_f
 #: (2030-01-01, 6 or 8 nodes), while 5, 7 or 9 converge in 4-5 steps at every epoch tried.
 MAX_LEG_DAYS = 1.7
 MIN_NODES_PER_REV = 5
+#: A continuous trajectory farther than this fraction of the orbit's size (its largest distance
+#: from the Moon) from the CR3BP orbit is refused: it is another trajectory, not the orbit's
+#: counterpart. (The 9:2 NRHO departs by about 6 % of its size over 10 revolutions, the 70,000 km
+#: DRO by 20 %; the 12-day L2 halo over 10 revolutions leaves in its last one, by 150 %.)
+MAX_DEPARTURE = 0.5
 
 
 @dataclass(frozen=True, eq=False)
@@ -204,7 +209,9 @@ def to_ephemeris(
     ValueError
         An argument out of range, or an epoch span outside the ephemeris (naming the span).
     ConvergenceError
-        The multiple shooting stopped before continuity (naming why, the steps and the defects).
+        The multiple shooting stopped before continuity (naming why, the steps and the defects),
+        or the continuous trajectory it found leaves the orbit (farther from it than half the
+        orbit's size: another trajectory, not this orbit's counterpart).
 
     Examples
     --------
@@ -260,6 +267,15 @@ def _with_figures(eo: EphemerisOrbit) -> EphemerisOrbit:
 
     # the distance of each sample to the nearest point of the densely sampled CR3BP orbit
     dmin = cKDTree(ref).query(syn)[0]
+    size = float(np.linalg.norm(ref - [1.0 - s.mu, 0.0, 0.0], axis=1).max())
+    worst = int(np.argmax(dmin))
+    if dmin[worst] > MAX_DEPARTURE * size:
+        rev = min(int(np.searchsorted(eo.epochs_tdb, traj.t_tdb[worst], side="right") - 1) // eo.nodes_per_rev, eo.revolutions - 1)
+        raise ConvergenceError(
+            f"ephemeris transition of the {orbit.family} (period {orbit.period_days:.3f} d) at {eo.epoch_tdb:.1f} TDB s over {eo.revolutions} revolutions: "
+            f"the multiple shooting made the trajectory continuous, but it leaves the orbit: in revolution {rev + 1} it passes "
+            f"{dmin[worst] * s.lu_km:,.0f} km from the CR3BP orbit, more than {MAX_DEPARTURE:.0%} of the orbit's size ({size * s.lu_km:,.0f} km "
+            "from the Moon at most); that is not this orbit's ephemeris counterpart. An orbit this unstable holds over fewer revolutions")
     starts = eo.synodic()[:: eo.nodes_per_rev, :3]
     departure = np.linalg.norm(starts - orbit.state0[:3], axis=1) * s.lu_km
     drift = float(np.polyfit(np.arange(len(departure)), departure, 1)[0]) if len(departure) > 1 else 0.0
