@@ -10,6 +10,7 @@
 //! - [`scalar`]: the scalar traits equations are written over (f64, dual numbers, SIMD lanes).
 //! - [`fourier`]: periodic orbits as truncated Fourier series, with analytic derivatives.
 //! - [`simd`]: runtime CPU dispatch of the hot kernels (baseline, AVX2, AVX-512, NEON).
+//! - [`interrupt`]: the Ctrl-C request the long loops poll.
 
 pub mod attitude;
 pub mod constants;
@@ -19,6 +20,7 @@ pub mod error;
 pub mod flexible;
 pub mod fourier;
 pub mod integrate;
+pub mod interrupt;
 pub mod map;
 pub mod orbit;
 pub mod propagation;

@@ -88,6 +88,7 @@ pub fn correct_flexible_periodic(
         let mut jac = DMatrix::<f64>::from_element(m, m, f64::NAN);
         let mut iterations = 0;
         let reason = loop {
+            crate::interrupt::check()?;
             // the Jacobian of the scaled residual w.r.t. the scaled unknowns, column by column
             let cols: Vec<Option<Vec<f64>>> = (0..m)
                 .into_par_iter()

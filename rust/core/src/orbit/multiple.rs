@@ -126,6 +126,7 @@ pub fn correct_multiple_shooting(
     let (mut r, mut jm) = residual_and_jacobian(&x)?;
     let mut norm = r.amax();
     for it in 0..=max_iter {
+        crate::interrupt::check()?;
         if norm <= tol {
             let patches = (0..n).map(|i| std::array::from_fn(|j| x[6 * i + j])).collect::<Vec<[f64; 6]>>();
             let jc = jacobi(mu, &patches[0]);
