@@ -217,7 +217,7 @@ def main():
     inertia = np.tile(BODY, (n, 1))
 
     def lib(tol, threads=None):
-        return _core.map_sweep_3d(table, float(T), q0, w0, inertia, rtol=tol, atol=tol, threads=threads)
+        return _core.map_sweep_3d(table, float(T), q0, w0, inertia, lanes=_core.LaneOptions(rtol=tol, atol=tol, threads=threads))
 
     lib(1e-10)
     lib_tol = None

@@ -21,7 +21,7 @@ def _frozen(record, field):
 def test_propagate_returns_a_trajectory_record(em):
     """One output row per accepted step plus the start (every step is output without t_eval);
     the y = 0 crossings are located to 1e-12 (the event tolerance of librate.propagate)."""
-    r = _core.propagate(em.mu, S0, 0.0, 3.0, options=OPTS, stm=True, t_eval=None, events=[("crossing", [1.0, 0.0], 0, False)])
+    r = _core.propagate(em.mu, S0, (0.0, 3.0), options=OPTS, stm=True, t_eval=None, events=[("crossing", [1.0, 0.0], 0, False)])
     assert isinstance(r, _core.Trajectory) and r.status == "completed" and r.event_index is None and r.collision is None
     assert isinstance(r.stats, _core.Stats) and len(r) == r.stats.accepted + 1 == r.y.shape[0]
     assert r.y.shape == (len(r), 6) and r.stm.shape == (6, 6) and r.t_final == 3.0
@@ -41,7 +41,7 @@ def test_propagate_many_returns_a_batch_record(em):
     assert isinstance(b, _core.BatchResult) and len(b) == 2 and b.stm is None
     assert list(b.ok) == [True, False] and list(b.status) == [0, 2] and b.stats.shape == (2, 3)
     assert set(b.errors) == {1} and isinstance(b.errors[1], _core.CollisionError) and b.errors[1].primary == 2
-    one = _core.propagate(em.mu, S0, 0.0, 1.0, options=OPTS, stm=False, t_eval=None, events=[])
+    one = _core.propagate(em.mu, S0, (0.0, 1.0), options=OPTS, stm=False, t_eval=None, events=[])
     np.testing.assert_array_equal(b.y[0], one.y_final)
     assert np.all(np.isnan(b.y[1]))
     _frozen(b, "ok")
@@ -51,8 +51,8 @@ def test_symmetric_correct_returns_an_orbit_record(dro_085):
     """The half-period crossing is on the x-z plane (x-z symmetry: y = xdot = zdot = 0 there, to
     the corrector's 1e-12 residual plus the propagation error, 1e-10 allowed)."""
     o = dro_085
-    r = _core.symmetric_correct(o.system.mu, [o.x0, 0.0, o.vy0], spatial=False, constraint="fix", values=[0.0, o.x0],
-                                tol=1e-12, max_iter=25, t_max=20.0, rtol=1e-13, atol=1e-13)
+    r = _core.symmetric_correct(o.system.mu, [o.x0, 0.0, o.vy0], spatial=False, constraint="fix", values=[0.0, o.x0], t_max=20.0,
+                                newton=_core.NewtonOptions(tol=1e-12, max_iter=25), options=_core.IntegrationOptions(rtol=1e-13, atol=1e-13))
     assert isinstance(r, _core.SymmetricOrbit) and isinstance(r.evaluation, _core.ShootingEvaluation)
     e = r.evaluation
     assert r.period == pytest.approx(o.period, rel=1e-10) and e.half_period == pytest.approx(0.5 * r.period, rel=1e-12)
@@ -82,26 +82,27 @@ def dros_small(em):
 def test_attitude_and_flexible_records(em, dro_085):
     """The attitude and flexible bindings return records; a rigid body is a flexible one with
     stiff appendages, so both start from the same attitude."""
-    p = _core.planar_propagate(em.mu, 0.5, [True, True], False, list(dro_085.state0), 0.1, -1.0, 0.0, 1.0,
+    p = _core.planar_propagate(_core.PlanarModel(em.mu, 0.5), list(dro_085.state0), (0.1, -1.0), (0.0, 1.0),
                                options=OPTS, stm=True, t_eval=np.linspace(0.0, 1.0, 5))
     assert isinstance(p, _core.PlanarTrajectory) and len(p) == 5 and p.orbit.shape == (5, 6) and p.stm.shape == (2, 2)
     assert p.phi[0] == 0.1 and p.wz[0] == -1.0 and isinstance(p.stats, _core.Stats)
-    a = _core.attitude_propagate(em.mu, [1.0, 2.0, 3.0], ["gravity_gradient"], "integrate", [*dro_085.state0, 0, 0, 0, 1, 0, 0, 1],
-                                 0.0, 1.0, options=OPTS, stm=False, t_eval=None)
+    a = _core.attitude_propagate(_core.AttitudeModel(em.mu, [1.0, 2.0, 3.0], ["gravity_gradient"], orbit=_core.OrbitMode.INTEGRATE),
+                                 [*dro_085.state0, 0, 0, 0, 1, 0, 0, 1], (0.0, 1.0), options=OPTS, stm=False, t_eval=None)
     assert isinstance(a, _core.AttitudeTrajectory) and a.states.shape == (len(a), 13) and a.stm is None
     body = (100.0, [10.0, 20.0, 30.0], [(1.0, [1.0, 0.0], [0.0, 1.0], 1e6, 0.0), (1.0, [-1.0, 0.0], [0.0, 1.0], 1e6, 0.0)])
     c = _core.flexible_body_check(body)
     assert isinstance(c, _core.FlexibleBodyConstants) and c.total_mass == 102.0 and c.mass_matrix.shape == (2, 2)
     assert isinstance(c.asymmetry, complex) and abs(c.asymmetry) == pytest.approx(c.kz * c.inertia, rel=1e-14)
-    f = _core.flexible_propagate(em.mu, body, [True, True], False, list(dro_085.state0), 0.1, -1.0, [0.0, 0.0], [0.0, 0.0], 0.0, 0.5,
+    model = _core.FlexibleModel(em.mu, body, primaries=[True, True], held=False)
+    f = _core.flexible_propagate(model, list(dro_085.state0), (0.1, -1.0), [0.0, 0.0], [0.0, 0.0], (0.0, 0.5),
                                  options=OPTS, t_eval=np.linspace(0.0, 0.5, 4))
     assert isinstance(f, _core.FlexibleTrajectory) and f.q.shape == (4, 2) and f.phi[0] == 0.1
-    e = _core.flexible_energies(em.mu, body, [True, True], f.orbit, f.phi, f.wz, f.q, f.qdot)
+    e = _core.flexible_energies(model, f.orbit, f.phi, f.wz, f.q, f.qdot)
     assert isinstance(e, _core.FlexibleEnergies) and len(e) == 4 and e.inertia.shape == (4,)
-    q = _core.flexible_quasi_static(em.mu, body, [True, True], False, list(dro_085.state0), 0.1, -1.0, 0.0, 0.5,
+    q = _core.flexible_quasi_static(model, list(dro_085.state0), (0.1, -1.0), (0.0, 0.5),
                                     options=OPTS, t_eval=np.linspace(0.0, 0.5, 4))
     assert isinstance(q, _core.QuasiStaticTrajectory) and q.qddot.shape == (4, 2) and q.dtau.shape == (4,)
-    pt = _core.flexible_quasi_static_point(em.mu, body, [True, True], False, list(dro_085.state0), 0.1, -1.0)
+    pt = _core.flexible_quasi_static_point(model, list(dro_085.state0), 0.1, -1.0)
     assert isinstance(pt, _core.QuasiStaticPoint)
     np.testing.assert_array_equal(pt.q, q.q[0])  # the closed form at the start of the solution
     for r in (p, a, c, f, e, q, pt):

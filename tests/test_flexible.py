@@ -126,8 +126,8 @@ def test_equations_of_motion_match_an_independent_lagrangian():
     mixed = (dl_dv(x + eps * v, v) - dl_dv(x - eps * v, v)) / (2 * eps)
     rhs = grad_x - c * v - mixed
     acc = np.linalg.solve(hess, rhs)
-    wzd, qdd = librate._core.flexible_rates(mu, body._core_arg(TU), [True, True], [*pos, 0.0, 0.0, 0.0], x[0], v[0] + 1.0,
-                                           list(x[1:]), list(v[1:]))
+    model = librate._core.FlexibleModel(mu, body._core_arg(TU), primaries=[True, True])
+    wzd, qdd = librate._core.flexible_rates(model, [*pos, 0.0, 0.0, 0.0], x[0], v[0] + 1.0, list(x[1:]), list(v[1:]))
     ours = np.array([wzd, *qdd])
     scale = np.max(np.abs(acc))
     assert np.max(np.abs(ours - acc)) < 1e-7 * scale, (ours, acc)

@@ -43,7 +43,9 @@ def test_build_info():
     b = librate.build_info()
     assert set(b) >= {"simd_available", "simd_active", "version", "profile"}
     assert b["version"] == librate.__version__
-    assert b["profile"] in ("release", "dev")
+    assert b["profile"] in ("dev", "release", "dist")
+    # the profile is the one cargo built with: debug assertions are on in dev builds only
+    assert (b["profile"] == "dev") == b["debug_assertions"]
     assert b["simd_active"] in b["simd_available"]
     assert b["simd_available"] == [lv for lv in b["simd_known"] if lv in b["simd_available"]]
     if b["target_arch"] == "x86_64":

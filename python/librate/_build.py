@@ -24,8 +24,9 @@ def build_info() -> dict[str, Any]:
     - ``simd_available``: the levels this CPU supports, lowest first (e.g. ``["baseline",
       "avx2", "avx512"]``); ``simd_known``: the levels of this architecture;
     - ``simd_active``: the level the kernels run at;
-    - ``version``: the package version; ``profile``: the Rust build profile (``"release"`` or
-      ``"dev"``); ``target_arch``: the CPU architecture.
+    - ``version``: the package version; ``profile``: the cargo profile the extension was built
+      with (``"dev"``, ``"release"`` or ``"dist"``, the published wheels'); ``debug_assertions``:
+      whether Rust's debug assertions are on (dev builds); ``target_arch``: the CPU architecture.
 
     Raises ValueError naming ``LIBRATE_SIMD`` when it asks for an unknown or unavailable level.
     """

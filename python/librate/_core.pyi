@@ -139,20 +139,154 @@ class _BuildInfo(TypedDict):
     simd_active: str
     version: str
     profile: str
+    debug_assertions: bool
     target_arch: str
 
 def build_info() -> _BuildInfo: ...
 def simd_set_active(level: str) -> str: ...
 
-class _Options(TypedDict):
-    rtol: float
-    atol: float
-    h0: float | None
-    h_min: float
-    h_max: float
-    max_steps: int
-    safety: float
-    fixed_step: float | None
+# --- typed arguments (rust/py/src/options.rs) ---
+__all__ += ["IntegrationOptions", "NewtonOptions", "LaneMethod", "LaneOptions", "CorrectorOptions", "CorrectorOptions3D", "Closure", "Free",
+            "BorderedParameter", "Bordered", "Plates", "PlanarCases", "AttitudeCases3D"]
+
+@final
+class IntegrationOptions:
+    def __new__(
+        cls, *, rtol: float = 1e-12, atol: float = 1e-12, h0: float | None = None, h_min: float = 0.0, h_max: float = ...,
+        max_steps: int = 1000000, safety: float | None = None, fixed_step: float | None = None,
+    ) -> IntegrationOptions: ...
+    @property
+    def rtol(self) -> float: ...
+    @property
+    def atol(self) -> float: ...
+    @property
+    def h0(self) -> float | None: ...
+    @property
+    def h_min(self) -> float: ...
+    @property
+    def h_max(self) -> float: ...
+    @property
+    def max_steps(self) -> int: ...
+    @property
+    def safety(self) -> float: ...
+    @property
+    def fixed_step(self) -> float | None: ...
+
+@final
+class NewtonOptions:
+    def __new__(
+        cls, *, tol: float = 1e-12, max_iter: int = 40, max_halvings: int = 10, max_angle_step: float = 0.5, max_rate_step: float = 0.5
+    ) -> NewtonOptions: ...
+    @property
+    def tol(self) -> float: ...
+    @property
+    def max_iter(self) -> int: ...
+    @property
+    def max_halvings(self) -> int: ...
+    @property
+    def max_angle_step(self) -> float: ...
+    @property
+    def max_rate_step(self) -> float: ...
+
+@final
+class LaneMethod:
+    RKF78: LaneMethod
+    RKN86: LaneMethod
+    DP87: LaneMethod
+    def __int__(self) -> int: ...
+
+@final
+class LaneOptions:
+    def __new__(
+        cls, *, rtol: float = 1e-12, atol: float = 1e-12, max_steps: int = 200000, method: LaneMethod = ..., chunk: int = 64,
+        threads: int | None = None,
+    ) -> LaneOptions: ...
+    @property
+    def rtol(self) -> float: ...
+    @property
+    def atol(self) -> float: ...
+    @property
+    def max_steps(self) -> int: ...
+    @property
+    def method(self) -> LaneMethod: ...
+    @property
+    def chunk(self) -> int: ...
+    @property
+    def threads(self) -> int | None: ...
+
+@final
+class CorrectorOptions:
+    def __new__(cls, newton: NewtonOptions, lanes: LaneOptions, *, monodromy: bool = True) -> CorrectorOptions: ...
+    @property
+    def newton(self) -> NewtonOptions: ...
+    @property
+    def lanes(self) -> LaneOptions: ...
+    @property
+    def monodromy(self) -> bool: ...
+
+@final
+class CorrectorOptions3D:
+    def __new__(
+        cls, newton: NewtonOptions, *, rtol: float = 1e-13, atol: float = 1e-13, primaries: list[bool] = ..., half: bool = False,
+        max_period_step: float = 0.5, threads: int | None = None,
+    ) -> CorrectorOptions3D: ...
+    @property
+    def newton(self) -> NewtonOptions: ...
+    @property
+    def rtol(self) -> float: ...
+    @property
+    def atol(self) -> float: ...
+    @property
+    def primaries(self) -> list[bool]: ...
+    @property
+    def half(self) -> bool: ...
+    @property
+    def max_period_step(self) -> float: ...
+    @property
+    def threads(self) -> int | None: ...
+
+@final
+class Closure:
+    HALF: Closure
+    FULL: Closure
+    def __int__(self) -> int: ...
+
+@final
+class Free:
+    PHI0: Free
+    SUN_PHASE: Free
+    def __int__(self) -> int: ...
+
+@final
+class BorderedParameter:
+    KZ: BorderedParameter
+    EPS: BorderedParameter
+    ORBIT_X0: BorderedParameter
+    def __int__(self) -> int: ...
+
+@final
+class Bordered:
+    def __new__(
+        cls, parameter: BorderedParameter, condition: tuple[float, float, float, float], *, step: float = 1e-6, max_step: float = 0.5,
+        conditions: _F64 | None = None,
+    ) -> Bordered: ...
+
+@final
+class Plates:
+    def __new__(cls, eps: _F64, cs: _F64, cd: _F64, theta_sun0: _F64) -> Plates: ...
+    def __len__(self) -> int: ...
+
+@final
+class PlanarCases:
+    def __new__(cls, phi0: _F64, wz0: _F64, kz: _F64, *, turns: _F64 | None = None, plates: Plates | None = None) -> PlanarCases: ...
+    def __len__(self) -> int: ...
+
+@final
+class AttitudeCases3D:
+    def __new__(
+        cls, q: _F64, w: _F64, *, period: _F64 | None = None, a: _F64 | None = None, b: _F64 | None = None
+    ) -> AttitudeCases3D: ...
+    def __len__(self) -> int: ...
 
 @final
 class Stats:
@@ -217,10 +351,9 @@ class BatchResult:
 def propagate(
     mu: float,
     state: _F64,
-    t0: float,
-    tf: float,
+    t_span: tuple[float, float],
     *,
-    options: _Options,
+    options: IntegrationOptions,
     stm: bool,
     t_eval: _F64 | None,
     events: list[tuple[str, list[float], int, bool]],
@@ -232,7 +365,7 @@ def propagate_many(
     t0: float,
     t_final: _F64,
     *,
-    options: _Options,
+    options: IntegrationOptions,
     stm: bool,
     threads: int | None,
     collision: tuple[float, float] | None = None,
@@ -307,11 +440,11 @@ class MultipleShooting:
     def residual(self) -> float: ...
 
 def symmetric_correct(
-    mu: float, p: list[float], *, spatial: bool, constraint: str, values: list[float], tol: float, max_iter: int, t_max: float, rtol: float, atol: float
+    mu: float, p: list[float], *, spatial: bool, constraint: str, values: list[float], t_max: float, newton: NewtonOptions, options: IntegrationOptions
 ) -> SymmetricOrbit: ...
 def stability(m: _F64, planar: bool) -> tuple[npt.NDArray[np.complex128], npt.NDArray[np.complex128]]: ...
 def multiple_shooting(
-    mu: float, patches: _F64, period: float, *, condition: str, value: float, tol: float, max_iter: int, rtol: float, atol: float
+    mu: float, patches: _F64, period: float, *, condition: str, value: float, newton: NewtonOptions, options: IntegrationOptions
 ) -> MultipleShooting: ...
 def fourier_evaluate(
     period: float, a0: _F64, cos: _F64, sin: _F64, t: _F64, *, quantity: str
@@ -346,16 +479,41 @@ class PlanarTrajectory:
     def stats(self) -> Stats: ...
     def __len__(self) -> int: ...
 
+__all__ += ["OrbitMode", "SrpModel", "AttitudeModel", "PlanarModel", "FlexibleModel"]
+
+@final
+class OrbitMode:
+    INTEGRATE: OrbitMode
+    HELD: OrbitMode
+    COUPLED: OrbitMode
+    def __int__(self) -> int: ...
+
+@final
+class SrpModel:
+    def __new__(
+        cls, facets: list[_FacetTuple], *, sun: tuple[float, float, float] = ..., tu_s: float = 1.0, force: tuple[float, float] | None = None
+    ) -> SrpModel: ...
+
+@final
+class AttitudeModel:
+    def __new__(
+        cls, mu: float, inertia: list[float], torques: list[str], *, orbit: OrbitMode = ..., inertia_nd: list[float] | None = None,
+        srp: SrpModel | None = None,
+    ) -> AttitudeModel: ...
+
+@final
+class PlanarModel:
+    def __new__(
+        cls, mu: float, kz: float, *, primaries: list[bool] = ..., held: bool = False, plate: tuple[float, float, float, float, float] | None = None
+    ) -> PlanarModel: ...
+
 def attitude_propagate(
-    mu: float, inertia: list[float], torques: list[str], orbit_mode: str, state0: list[float], t0: float, tf: float, *,
-    options: _Options, stm: bool, t_eval: _F64 | None, inertia_nd: list[float] | None = None,
-    facets: list[_FacetTuple] | None = None, sun: tuple[float, float, float] = ..., tu_s: float = 1.0,
-    srp_force: tuple[float, float] | None = None,
+    model: AttitudeModel, state0: list[float], t_span: tuple[float, float], *, options: IntegrationOptions, stm: bool, t_eval: _F64 | None
 ) -> AttitudeTrajectory: ...
 def facets_force_torque(facets: list[_FacetTuple], s_body: list[float]) -> tuple[list[float], list[float]]: ...
 def planar_propagate(
-    mu: float, kz: float, primaries: list[bool], held: bool, orbit0: list[float], phi0: float, wz0: float, t0: float, tf: float, *,
-    options: _Options, stm: bool, t_eval: _F64 | None, plate: tuple[float, float, float, float, float] | None = None
+    model: PlanarModel, orbit0: list[float], attitude0: tuple[float, float], t_span: tuple[float, float], *,
+    options: IntegrationOptions, stm: bool, t_eval: _F64 | None
 ) -> PlanarTrajectory: ...
 def attitude_torques(mu: float, inertia: list[float], torques: list[str], t: _F64, states: _F64) -> _F64: ...
 def rigid_body_kz(ix: float, iy: float, iz: float) -> float: ...
@@ -391,12 +549,7 @@ class SweepResult:
     def keys(self) -> list[str]: ...
     def __len__(self) -> int: ...
 
-def map_sweep(
-    forcing: OrbitForcing, t_final: float, phi0: _F64, wz0: _F64, kz: _F64, *,
-    rtol: float, atol: float, max_steps: int, stm: bool, chunk: int, threads: int | None,
-    eps: _F64 | None = None, cs: _F64 | None = None, cd: _F64 | None = None, theta_sun0: _F64 | None = None,
-    method: str = "rkf78",
-) -> SweepResult: ...
+def map_sweep(forcing: OrbitForcing, t_final: float, cases: PlanarCases, *, lanes: LaneOptions, stm: bool) -> SweepResult: ...
 
 @final
 class CorrectionBatch:
@@ -425,14 +578,8 @@ class CorrectionBatch:
     def __len__(self) -> int: ...
 
 def attitude_correct(
-    forcing: OrbitForcing, phi0: _F64, wz0: _F64, kz: _F64, turns: _F64, *,
-    t_final: float, closure: str, free: str = "phi0",
-    eps: _F64 | None = None, cs: _F64 | None = None, cd: _F64 | None = None, theta_sun0: _F64 | None = None,
-    tol: float = 1e-12, max_iter: int = 40, rtol: float = 1e-13, atol: float = 1e-13, max_steps: int = 200000,
-    max_wz_step: float = 0.5, max_angle_step: float = 0.5, threads: int | None = None, chunk: int = 64,
-    parameter: str | None = None, condition: tuple[float, float, float, float] | None = None,
-    parameter_step: float = 1e-6, max_parameter_step: float = 0.5, monodromy: bool = True, max_halvings: int = 10,
-    conditions: _F64 | None = None,
+    forcing: OrbitForcing, cases: PlanarCases, *, t_final: float, closure: Closure, free: Free, options: CorrectorOptions,
+    bordered: Bordered | None = None,
 ) -> CorrectionBatch: ...
 
 @final
@@ -443,10 +590,7 @@ class PlanarFamily:
     def orbit_at(self, x0: float) -> tuple[list[float], float]: ...
 
 def attitude_correct_across(
-    family: PlanarFamily, wz0: _F64, kz: _F64, turns: _F64, x0: _F64, *,
-    condition: tuple[float, float, float], phi0: float = 0.0, tol: float = 1e-12, max_iter: int = 40, rtol: float = 1e-13,
-    atol: float = 1e-13, max_steps: int = 200000, max_wz_step: float = 0.5, parameter_step: float = 1e-6,
-    max_parameter_step: float = 0.05, threads: int | None = None, max_halvings: int = 10,
+    family: PlanarFamily, cases: PlanarCases, x0: _F64, *, bordered: Bordered, options: CorrectorOptions
 ) -> CorrectionBatch: ...
 
 @final
@@ -462,9 +606,7 @@ class PlanarVerification:
     def __len__(self) -> int: ...
 
 def planar_verify(
-    mu: float, orbit_state0: list[float], t_final: float, kz: _F64, phi0: _F64, wz0: _F64, *,
-    eps: _F64 | None = None, cs: _F64 | None = None, cd: _F64 | None = None, theta_sun0: _F64 | None = None,
-    primaries: list[bool] = ..., threads: int | None = None,
+    mu: float, orbit_state0: list[float], t_final: float, cases: PlanarCases, *, primaries: list[bool] = ..., threads: int | None = None
 ) -> PlanarVerification: ...
 
 _FlexBody = tuple[float, list[float], list[tuple[float, list[float], list[float], float, float]]]
@@ -550,14 +692,18 @@ class FlexibleEnergies:
     def inertia(self) -> _F64: ...
     def __len__(self) -> int: ...
 
+@final
+class FlexibleModel:
+    def __new__(cls, mu: float, body_arg: _FlexBody, *, primaries: list[bool] = ..., held: bool = False) -> FlexibleModel: ...
+
 def flexible_body_check(body_arg: _FlexBody) -> FlexibleBodyConstants: ...
 def flexible_propagate(
-    mu: float, body_arg: _FlexBody, primaries: list[bool], held: bool, orbit0: list[float], phi0: float, wz0: float,
-    q0: list[float], qdot0: list[float], t0: float, tf: float, *, options: _Options, t_eval: _F64 | None
+    model: FlexibleModel, orbit0: list[float], attitude0: tuple[float, float], q0: list[float], qdot0: list[float],
+    t_span: tuple[float, float], *, options: IntegrationOptions, t_eval: _F64 | None
 ) -> FlexibleTrajectory: ...
 def flexible_quasi_static(
-    mu: float, body_arg: _FlexBody, primaries: list[bool], held: bool, orbit0: list[float], phi0: float, wz0: float,
-    t0: float, tf: float, *, options: _Options, t_eval: _F64 | None
+    model: FlexibleModel, orbit0: list[float], attitude0: tuple[float, float], t_span: tuple[float, float], *,
+    options: IntegrationOptions, t_eval: _F64 | None
 ) -> QuasiStaticTrajectory: ...
 @final
 class QuasiStaticPoint:
@@ -572,14 +718,10 @@ class QuasiStaticPoint:
     @property
     def dtau(self) -> float: ...
 
-def flexible_quasi_static_point(
-    mu: float, body_arg: _FlexBody, primaries: list[bool], held: bool, orbit: list[float], phi: float, wz: float
-) -> QuasiStaticPoint: ...
-def flexible_energies(
-    mu: float, body_arg: _FlexBody, primaries: list[bool], orbit: _F64, phi: _F64, wz: _F64, q: _F64, qdot: _F64
-) -> FlexibleEnergies: ...
+def flexible_quasi_static_point(model: FlexibleModel, orbit: list[float], phi: float, wz: float) -> QuasiStaticPoint: ...
+def flexible_energies(model: FlexibleModel, orbit: _F64, phi: _F64, wz: _F64, q: _F64, qdot: _F64) -> FlexibleEnergies: ...
 def flexible_rates(
-    mu: float, body_arg: _FlexBody, primaries: list[bool], orbit: list[float], phi: float, wz: float, q: list[float], qdot: list[float]
+    model: FlexibleModel, orbit: list[float], phi: float, wz: float, q: list[float], qdot: list[float]
 ) -> tuple[float, list[float]]: ...
 
 def planar_gravity_gradient(kz: float, s: _F64, c: _F64, phi: _F64) -> _F64: ...
@@ -599,8 +741,8 @@ class FlexiblePeriodicCorrection:
     def monodromy(self) -> _F64: ...
 
 def flexible_correct_periodic(
-    mu: float, body_arg: _FlexBody, primaries: list[bool], orbit0: list[float], period: float, x0: list[float], turns: float,
-    scale: list[float], *, options: _Options, tol: float, max_iter: int, threads: int | None = None,
+    model: FlexibleModel, orbit: tuple[list[float], float], x0: list[float], turns: float, scale: list[float], *,
+    options: IntegrationOptions, newton: NewtonOptions, threads: int | None = None,
 ) -> FlexiblePeriodicCorrection: ...
 
 # --- 3-D attitude: equilibria and periodic motions (rust/py/src/attitude3d.rs) ---
@@ -637,8 +779,7 @@ class CorrectionBatch3D:
 
 def attitude_equilibrium(mu: float, inertia: list[float], point: int, q0: list[float]) -> LinearisedEquilibrium: ...
 def attitude_correct_3d(
-    mu: float, inertia: list[float], orbit0: list[float], t_final: float, q: _F64, w: _F64, *, tol: float, max_iter: int,
-    rtol: float, atol: float, max_halvings: int = 10, primaries: list[bool] = ..., threads: int | None = None, half: bool = False,
+    mu: float, inertia: list[float], orbit0: list[float], t_final: float, cases: AttitudeCases3D, *, options: CorrectorOptions3D
 ) -> CorrectionBatch3D: ...
 
 @final
@@ -666,9 +807,8 @@ class CorrectionAcross3D:
     def __len__(self) -> int: ...
 
 def attitude_correct_3d_across(
-    mu: float, inertia: list[float], member0: list[float], period0: float, n_periods: int, q: _F64, w: _F64, period: _F64, a: _F64,
-    b: _F64, *, tol: float, max_iter: int, rtol: float, atol: float, max_period_step: float = 0.5, max_halvings: int = 10,
-    primaries: list[bool] = ..., threads: int | None = None,
+    mu: float, inertia: list[float], member0: list[float], period0: float, n_periods: int, cases: AttitudeCases3D, *,
+    options: CorrectorOptions3D
 ) -> CorrectionAcross3D: ...
 
 # --- 3-D attitude map engine (rust/py/src/map3d.rs) ---
@@ -699,10 +839,7 @@ class Sweep3DResult:
     def steps(self) -> npt.NDArray[np.uint32]: ...
     def __len__(self) -> int: ...
 
-def map_sweep_3d(
-    table: TidalTable, t_final: float, q0: _F64, w0: _F64, inertia: _F64, *, rtol: float, atol: float, max_steps: int = 200000,
-    chunk: int = 64, threads: int | None = None,
-) -> Sweep3DResult: ...
+def map_sweep_3d(table: TidalTable, t_final: float, q0: _F64, w0: _F64, inertia: _F64, *, lanes: LaneOptions) -> Sweep3DResult: ...
 
 __all__ += ["EphemerisCore", "GM_EARTH", "GM_MOON", "GM_SUN"]
 

@@ -272,6 +272,11 @@ class FlexibleBody:
         apps = [(a.mass, list(a.position), list(a.direction), a.stiffness * tu_s * tu_s, a.damping * tu_s) for a in self.appendages]
         return (float(self.hub.mass_kg), list(self.hub.moments), apps)
 
+    def _core_model(self, system, primaries, held: bool = False) -> _core.FlexibleModel:
+        """The core's model of this body in ``system`` with the enabled ``primaries``, the orbit
+        held or integrated."""
+        return _core.FlexibleModel(system.mu, self._core_arg(system.tu_s), primaries=[bool(p) for p in primaries], held=bool(held))
+
     # --- derived quantities ------------------------------------------------------------------
     @property
     def n(self) -> int:
@@ -520,7 +525,7 @@ class FlexibleResponse:
         (J: kinetic + elastic - momentum^2 / (2 I), the energy above rigid rotation with the same
         momentum), ``torque`` (N m, tidal torque on the deformed body), ``inertia`` (kg m^2,
         I(q))."""
-        e = _core.flexible_energies(self.system.mu, self.body._core_arg(self.system.tu_s), list(self.primaries),
+        e = _core.flexible_energies(self.body._core_model(self.system, self.primaries),
                                     np.ascontiguousarray(self.orbit), np.ascontiguousarray(self.phi), np.ascontiguousarray(self.wz),
                                     np.ascontiguousarray(self.q), np.ascontiguousarray(self.qdot))
         tu = self.system.tu_s
@@ -556,7 +561,7 @@ def initial_deflection(deflection, sys_, body, primaries, held, s, phi0, wz0):
     if isinstance(deflection, str):
         if deflection != "quasi-static":
             raise ValueError(f"invalid argument `deflection`: must be None/'rest', 'quasi-static' or (q0, qdot0), got {deflection!r}")
-        p = _core.flexible_quasi_static_point(sys_.mu, body._core_arg(sys_.tu_s), primaries, held, [float(v) for v in s], phi0, wz0)
+        p = _core.flexible_quasi_static_point(body._core_model(sys_, primaries, held), [float(v) for v in s], phi0, wz0)
         return p.q, p.qdot
     try:
         q0, qd0 = deflection
@@ -667,8 +672,8 @@ def quasi_static(
     phi0, wz0 = flexible_attitude(attitude)
     opts = integration_options(rtol, atol, None, 0.0, math.inf, max_steps, 0.8, None)
     te = None if t_eval is None else np.ascontiguousarray(t_eval, dtype=np.float64).ravel()
-    r = _core.flexible_quasi_static(sys_.mu, body._core_arg(sys_.tu_s), enabled_primaries(names), orbit == "held", [float(v) for v in s],
-                                    phi0, wz0, t0, tf, options=opts, t_eval=te)
+    r = _core.flexible_quasi_static(body._core_model(sys_, enabled_primaries(names), orbit == "held"), [float(v) for v in s],
+                                    (phi0, wz0), (t0, tf), options=opts, t_eval=te)
     tu2 = sys_.tu_s**2
     return QuasiStaticResponse(sys_, body, r.t, r.orbit, r.phi, r.wz, r.dphi, r.dwz, r.q, r.qdot, r.qddot,
                                r.dtau / tu2, Stats.from_core(r.stats))

@@ -23,6 +23,9 @@ from .body import EULER_SEQUENCES, RigidBody, torque_names
 from .flexible import FlexibleBody, FlexibleResponse, enabled_primaries, flexible_attitude, initial_deflection
 from .srp import FacetBody, FlatPlate, Sun
 
+#: The core's orbit modes by the names of ``propagate_attitude(orbit=...)``.
+_ORBIT_MODES = {"integrate": _core.OrbitMode.INTEGRATE, "held": _core.OrbitMode.HELD, "coupled": _core.OrbitMode.COUPLED}
+
 __all__ = ["AttitudeTrajectory", "propagate_attitude"]
 
 
@@ -252,8 +255,8 @@ def propagate_attitude(
         phi0, wz0 = _pair(attitude)
         primaries = [any(n in ("gravity_gradient", "gravity_gradient_earth") for n in names),
                      any(n in ("gravity_gradient", "gravity_gradient_moon") for n in names)]
-        r = _core.planar_propagate(sys_.mu, body.kz, primaries, orbit == "held", [float(v) for v in s], phi0, wz0, t0, tf,
-                                   options=opts, stm=bool(stm), t_eval=te, plate=None if srp is None else srp._plate())
+        model = _core.PlanarModel(sys_.mu, body.kz, primaries=primaries, held=orbit == "held", plate=None if srp is None else srp._plate())
+        r = _core.planar_propagate(model, [float(v) for v in s], (phi0, wz0), (t0, tf), options=opts, stm=bool(stm), t_eval=te)
         phi, wz = r.phi, r.wz
         zero = np.zeros_like(phi)
         q = np.stack([zero, zero, np.sin(0.5 * phi), np.cos(0.5 * phi)], axis=1)
@@ -271,16 +274,18 @@ def propagate_attitude(
         lu_m = sys_.lu_km * 1e3
         inertia_nd = [m / (body.mass_kg * lu_m * lu_m) for m in body.moments]
     state0 = [*map(float, s), *map(float, q0), *map(float, w0)]
-    extra = {}
+    srp_model = None
     if isinstance(body, FacetBody):
         sun = sun or Sun()
-        extra = dict(facets=[f._tuple() for f in body.facets], sun=(float(sun.theta0), float(sun.omega), float(sun.pressure)), tu_s=float(sys_.tu_s))
+        force = None
         if srp_force:
             if body.mass_kg is None:
                 raise ValueError("invalid argument `body`: srp_force needs body.mass_kg")
-            extra["srp_force"] = (float(body.mass_kg), sys_.lu_km * 1e3)
-    r = _core.attitude_propagate(sys_.mu, list(body.moments), list(names), orbit, state0, t0, tf,
-                                 options=opts, stm=bool(stm), t_eval=te, inertia_nd=inertia_nd, **extra)
+            force = (float(body.mass_kg), sys_.lu_km * 1e3)
+        srp_model = _core.SrpModel([f._tuple() for f in body.facets], sun=(float(sun.theta0), float(sun.omega), float(sun.pressure)),
+                                   tu_s=float(sys_.tu_s), force=force)
+    model = _core.AttitudeModel(sys_.mu, list(body.moments), list(names), orbit=_ORBIT_MODES[orbit], inertia_nd=inertia_nd, srp=srp_model)
+    r = _core.attitude_propagate(model, state0, (t0, tf), options=opts, stm=bool(stm), t_eval=te)
     st = r.states
     return AttitudeTrajectory(sys_, body, names, False, r.t, st[:, :6], st[:, 6:10], st[:, 10:], None, None, r.stm, Stats.from_core(r.stats))
 
@@ -320,8 +325,8 @@ def _propagate_flexible(sys_, s, attitude, body, t0, tf, names, orbit, opts, te,
     primaries = enabled_primaries(names)
     held = orbit == "held"
     q0, qd0 = initial_deflection(deflection, sys_, body, primaries, held, s, phi0, wz0)
-    r = _core.flexible_propagate(sys_.mu, body._core_arg(sys_.tu_s), primaries, held, [float(v) for v in s], phi0, wz0, q0, qd0,
-                                 t0, tf, options=opts, t_eval=te)
+    r = _core.flexible_propagate(body._core_model(sys_, primaries, held), [float(v) for v in s], (phi0, wz0), list(q0), list(qd0),
+                                 (t0, tf), options=opts, t_eval=te)
     phi, wz = r.phi, r.wz
     zero = np.zeros_like(phi)
     quat = np.stack([zero, zero, np.sin(0.5 * phi), np.cos(0.5 * phi)], axis=1)

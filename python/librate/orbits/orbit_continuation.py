@@ -21,6 +21,10 @@ from ..solving.continuation import Bifurcation, Branch, Constraint, Point, StepR
 from .periodic import SHOOT_ATOL, SHOOT_RTOL, Geometry, PeriodicOrbit, geometry, index_tests, orbit_from_core, symmetric_monodromy
 from .system import System
 
+#: The shooting's Newton and integrator settings of every continuation step.
+_SHOOT_NEWTON = _core.NewtonOptions(tol=1e-12, max_iter=25)
+_SHOOT_OPTIONS = _core.IntegrationOptions(rtol=SHOOT_RTOL, atol=SHOOT_ATOL)
+
 __all__ = ["Geometry", "geometry", "continue_natural", "continue_arclength", "ContinuationResult"]
 
 _VAR_INDEX = {"x0": 0, "z0": 1, "vy0": 2}
@@ -42,8 +46,8 @@ class ContinuationResult:
 
 def _correct(system: System, p, spatial: bool, kind: str, values, family: str, t_max: float) -> PeriodicOrbit:
     r = _core.symmetric_correct(
-        system.mu, [float(v) for v in p], spatial=spatial, constraint=kind, values=[float(v) for v in values],
-        tol=1e-12, max_iter=25, t_max=t_max, rtol=SHOOT_RTOL, atol=SHOOT_ATOL,
+        system.mu, [float(v) for v in p], spatial=spatial, constraint=kind, values=[float(v) for v in values], t_max=t_max,
+        newton=_SHOOT_NEWTON, options=_SHOOT_OPTIONS,
     )
     return orbit_from_core(system, r, family)
 

@@ -396,8 +396,8 @@ def correct_symmetric(
             raise ValueError(f"invalid argument `{kind}`: must be finite{' and > 0' if kind == 'period' else ''}, got {value!r}")
         values = [float(value)]
     r = _core.symmetric_correct(
-        sys_.mu, [float(v) for v in g], spatial=bool(spatial), constraint=kind, values=values,
-        tol=float(tol), max_iter=int(max_iter), t_max=float(t_max), rtol=float(rtol), atol=float(atol),
+        sys_.mu, [float(v) for v in g], spatial=bool(spatial), constraint=kind, values=values, t_max=float(t_max),
+        newton=_core.NewtonOptions(tol=float(tol), max_iter=int(max_iter)), options=_core.IntegrationOptions(rtol=float(rtol), atol=float(atol)),
     )
     return check_outside_primaries(orbit_from_core(sys_, r, family), collision)
 
@@ -508,6 +508,7 @@ def correct_periodic(
     else:
         cond, value = "jacobi", float(sys_.jacobi(patches[0]) if jacobi is None else jacobi)
         _check_jacobi_reachable(sys_, patches, value)
-    r = _core.multiple_shooting(sys_.mu, patches, float(period), condition=cond, value=value, tol=float(tol),
-                                max_iter=int(max_iter), rtol=float(rtol), atol=float(atol))
+    r = _core.multiple_shooting(sys_.mu, patches, float(period), condition=cond, value=value,
+                                newton=_core.NewtonOptions(tol=float(tol), max_iter=int(max_iter)),
+                                options=_core.IntegrationOptions(rtol=float(rtol), atol=float(atol)))
     return check_outside_primaries(PeriodicOrbit(sys_, r.patches[0].copy(), r.period, r.jacobi, family, r.iterations, r.residual), collision)

@@ -186,7 +186,7 @@ def _primary_name(system: System, k: int) -> str:
     return ("the larger primary", "the smaller primary")[k - 1]
 
 
-def integration_options(rtol, atol, h0, h_min, h_max, max_steps, safety, fixed_step) -> dict:
+def integration_options(rtol, atol, h0, h_min, h_max, max_steps, safety, fixed_step) -> _core.IntegrationOptions:
     """The integrator settings, each checked for its type here (the core checks the ranges);
     every error names the parameter. With ``fixed_step`` the adaptive step options (h0, h_min,
     h_max, safety) do not apply: giving any of them is an error, not silently ignored."""
@@ -194,7 +194,7 @@ def integration_options(rtol, atol, h0, h_min, h_max, max_steps, safety, fixed_s
         for name, value, default in (("h0", h0, None), ("h_min", h_min, 0.0), ("h_max", h_max, math.inf), ("safety", safety, 0.8)):
             if value != default:
                 raise ValueError(f"invalid argument `{name}`: adaptive step options do not apply with fixed_step; got {name} = {value!r}")
-    return dict(
+    return _core.IntegrationOptions(
         rtol=as_tolerance(rtol, "rtol"),
         atol=as_tolerance(atol, "atol"),
         h0=None if h0 is None else as_real(h0, "h0", positive=True),
@@ -291,24 +291,25 @@ def propagate(
 
 
 @functools.lru_cache(maxsize=16)
-def _tolerance_options(rtol: float, atol: float) -> tuple:
-    return tuple(integration_options(rtol, atol, None, 0.0, math.inf, 1_000_000, 0.8, None).items())
+def _tolerance_options(rtol: float, atol: float) -> _core.IntegrationOptions:
+    return integration_options(rtol, atol, None, 0.0, math.inf, 1_000_000, 0.8, None)
 
 
-def tolerance_options(rtol: float, atol: float) -> dict:
+def tolerance_options(rtol: float, atol: float) -> _core.IntegrationOptions:
     """The integrator settings of :func:`propagate` with the tolerances ``rtol``, ``atol`` and the
-    default step control, checked once per pair (for internal callers with fixed settings)."""
-    return dict(_tolerance_options(float(rtol), float(atol)))
+    default step control, checked once per pair (for internal callers with fixed settings; the
+    frozen object is shared)."""
+    return _tolerance_options(float(rtol), float(atol))
 
 
-def integrate(system: System, state: np.ndarray, t0: float, tf: float, options: dict, radii: tuple[float, float] | None, *,
+def integrate(system: System, state: np.ndarray, t0: float, tf: float, options: _core.IntegrationOptions, radii: tuple[float, float] | None, *,
               stm: bool = False, t_eval: np.ndarray | None = None, events: Sequence[Event] = ()) -> Trajectory:
     """The one call of the core's propagator behind :func:`propagate`, on arguments already
     checked where they entered (a System, a (6,) float state, ``options`` from
     :func:`integration_options` or :func:`tolerance_options`, ``radii`` from
     :func:`collision_radii`): internal callers with known-good values call it directly."""
     r = _core.propagate(
-        system.mu, state, t0, tf, stm=stm, t_eval=t_eval, events=[e._spec(system) for e in events], options=options, collision=radii,
+        system.mu, state, (t0, tf), stm=stm, t_eval=t_eval, events=[e._spec(system) for e in events], options=options, collision=radii,
     )
     err = r.collision
     tr = Trajectory(

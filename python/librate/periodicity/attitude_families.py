@@ -19,6 +19,10 @@ from .solutions import KINDS, SOLVE_ATOL, SOLVE_RTOL, STEP_MAX_HALVINGS, STEP_MA
 
 __all__ = ["AttitudeFamily", "attitude_family"]
 
+#: The corrector's settings of each step across an orbit family.
+_ACROSS_OPTIONS = _core.CorrectorOptions(_core.NewtonOptions(tol=1e-12, max_iter=STEP_MAX_ITER, max_halvings=STEP_MAX_HALVINGS),
+                                         _core.LaneOptions(rtol=SOLVE_RTOL, atol=SOLVE_ATOL))
+
 
 @dataclass
 class AttitudeFamily:
@@ -67,9 +71,10 @@ class OrbitFamilyBranch:
 
     def correct(self, guess, c):
         a_x, a_w = c.a
-        b = _core.attitude_correct_across(self.table, np.array([float(guess[1])]), np.array([self.kz]), np.array([self.turns]),
-                                          np.array([float(np.clip(guess[0], self.lo, self.hi))]), condition=(a_w, a_x, c.b),
-                                          rtol=SOLVE_RTOL, atol=SOLVE_ATOL, max_iter=STEP_MAX_ITER, max_halvings=STEP_MAX_HALVINGS)
+        cases = _core.PlanarCases(np.zeros(1), np.array([float(guess[1])]), np.array([self.kz]), turns=np.array([self.turns]))
+        border = _core.Bordered(_core.BorderedParameter.ORBIT_X0, (0.0, a_w, a_x, c.b), step=1e-6, max_step=0.05)
+        b = _core.attitude_correct_across(self.table, cases, np.array([float(np.clip(guess[0], self.lo, self.hi))]), bordered=border,
+                                          options=_ACROSS_OPTIONS)
         if not b.converged[0]:
             raise CorrectionFailed(f"orbit-family branch: {b.reason[0]}")
         g = b.jacobian[0, 0]

@@ -80,10 +80,11 @@ class OrbitFamilyBranch3D:
         a = np.asarray(c.a, dtype=float)
         a_chart = np.concatenate([rotvec_jacobian(rv).T @ a[1:4], a[4:7], [a[0] * self.days]])
         b_chart = float(c.b) - float(a[1:4] @ rv)
+        cases = _core.AttitudeCases3D(Rotation.from_rotvec(rv).as_quat()[None, :], np.asarray(guess[None, 4:7], dtype=float),
+                                      period=np.array([float(ref.period)]), a=a_chart[None, :], b=np.array([b_chart]))
+        options = _core.CorrectorOptions3D(_core.NewtonOptions(tol=float(self.tol), max_iter=int(self.max_iter)), rtol=SOLVE_RTOL, atol=SOLVE_RTOL)
         r = _core.attitude_correct_3d_across(self.orbits.system.mu, list(self.body.moments), [float(v) for v in ref.state0], float(ref.period),
-                                             self.n_periods, Rotation.from_rotvec(rv).as_quat()[None, :], guess[None, 4:7],
-                                             np.array([float(ref.period)]), a_chart[None, :], np.array([b_chart]), tol=float(self.tol),
-                                             max_iter=int(self.max_iter), rtol=SOLVE_RTOL, atol=SOLVE_RTOL)
+                                             self.n_periods, cases, options=options)
         if r.reason[0] != "converged":
             raise CorrectionFailed(f"3-D attitude across the orbit family: {r.reason[0].replace('_', ' ')} after {int(r.iterations[0])} steps, "
                                    f"residual {float(r.residual_norm[0]):.2e}")

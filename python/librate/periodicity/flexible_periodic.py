@@ -159,13 +159,13 @@ def flexible_periodic(
         return FlexiblePeriodic(**out)
 
     opts = integration_options(rtol, atol, None, 0.0, math.inf, max_steps, 0.8, None)
-    arg = body._core_arg(sys_.tu_s)
+    model = body._core_model(sys_, [True, True])
     s0 = [float(v) for v in orbit.state0]
     n = body.n
 
     def flow(x, t_eval=None):
-        return _core.flexible_propagate(sys_.mu, arg, [True, True], False, s0, float(x[0]), float(x[1]), list(x[2:2 + n]), list(x[2 + n:]),
-                                        0.0, T, options=opts, t_eval=t_eval)
+        return _core.flexible_propagate(model, s0, (float(x[0]), float(x[1])), list(x[2:2 + n]), list(x[2 + n:]),
+                                        (0.0, T), options=opts, t_eval=t_eval)
 
     x = np.concatenate([[phi0, wz0], qs.q[0], qs.qdot[0]])
     r = flow(x, te)
@@ -229,9 +229,9 @@ class CompliancePath:
         f = 1.0 / math.sqrt(s)
         b = self.body if s == 1.0 else self.body.scaled(f)
         scale = np.concatenate([[1.0, 1.0], self.qscale * s, self.qscale * s * self.omega * f])
-        r = _core.flexible_correct_periodic(self.sys.mu, b._core_arg(self.sys.tu_s), [True, True], self.s0, self.T,
+        r = _core.flexible_correct_periodic(b._core_model(self.sys, [True, True]), (self.s0, self.T),
                                             [float(v) for v in guess[1:]], float(self.turns), [float(v) for v in scale],
-                                            options=self.opts, tol=float(self.tol), max_iter=int(self.max_iter))
+                                            options=self.opts, newton=_core.NewtonOptions(tol=float(self.tol), max_iter=int(self.max_iter)))
         if r.reason != "converged":
             raise CorrectionFailed(f"flexible re-solve at compliance {s:.6g}: {r.reason}")
         return Point(np.concatenate([[s], r.x]), {"residual": float(r.residual), "reason": r.reason, "monodromy": np.asarray(r.monodromy)},

@@ -169,7 +169,8 @@ def map3d_chunk(orbit: PeriodicOrbit, grid: Map3DGrid, start: int, stop: int, *,
         raise ValueError(f"invalid argument `start`: need a multiple of {LANES} with start <= stop <= {grid.n_cases}, got ({start}, {stop})")
     inertia, w0 = grid.cases(start, stop)
     q = np.ascontiguousarray(np.broadcast_to(grid.q0, (stop - start, 4)))
-    return _core.map_sweep_3d(tidal_table(orbit), n_periods * float(orbit.period), q, w0, inertia, rtol=tol, atol=tol, threads=threads)
+    lanes = _core.LaneOptions(rtol=tol, atol=tol, threads=threads)
+    return _core.map_sweep_3d(tidal_table(orbit), n_periods * float(orbit.period), q, w0, inertia, lanes=lanes)
 
 
 def map3d_dataset(orbit: PeriodicOrbit, grid: Map3DGrid, residual: np.ndarray, status: np.ndarray, *, n_periods: int, tol: float,
@@ -360,8 +361,9 @@ def find_periodic_attitudes_3d(orbit: PeriodicOrbit, body: RigidBody, dataset, *
     q0 = np.asarray(ds.attrs["q0"], dtype=float)
     q = np.ascontiguousarray(np.broadcast_to(q0 / np.linalg.norm(q0), (len(idx), 4)))
     T = n_periods * float(orbit.period)
-    r = _core.attitude_correct_3d(orbit.system.mu, list(body.moments), [float(v) for v in orbit.state0], T, q, w,
-                                  tol=float(tol), max_iter=int(max_iter), rtol=SOLVE_RTOL, atol=SOLVE_RTOL)
+    options = _core.CorrectorOptions3D(_core.NewtonOptions(tol=float(tol), max_iter=int(max_iter)), rtol=SOLVE_RTOL, atol=SOLVE_RTOL)
+    r = _core.attitude_correct_3d(orbit.system.mu, list(body.moments), [float(v) for v in orbit.state0], T, _core.AttitudeCases3D(q, w),
+                                  options=options)
     sols: list[AttitudeSolution3D] = []
     for i, reason in enumerate(r.reason):
         if reason != "converged":

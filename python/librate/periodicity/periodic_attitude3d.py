@@ -218,8 +218,9 @@ def periodic_attitude_3d(orbit: PeriodicOrbit, body: RigidBody, *, guess, n_peri
         w = w.copy()
         w[1] = 0.0  # symmetric to 1e-12: exactly so
     T = n_periods * float(orbit.period)
-    r = _core.attitude_correct_3d(orbit.system.mu, list(body.moments), [float(v) for v in orbit.state0], T, q[None, :], w[None, :],
-                                  tol=float(tol), max_iter=int(max_iter), rtol=SOLVE_RTOL, atol=SOLVE_RTOL, half=half)
+    options = _core.CorrectorOptions3D(_core.NewtonOptions(tol=float(tol), max_iter=int(max_iter)), rtol=SOLVE_RTOL, atol=SOLVE_RTOL, half=bool(half))
+    r = _core.attitude_correct_3d(orbit.system.mu, list(body.moments), [float(v) for v in orbit.state0], T,
+                                  _core.AttitudeCases3D(q[None, :], w[None, :]), options=options)
     if r.reason[0] != "converged":
         raise ConvergenceError(f"periodic 3-D attitude: the corrector stopped ({r.reason[0].replace('_', ' ')}) after {int(r.iterations[0])} "
                                f"Newton steps, residual {float(r.residual_norm[0]):.3e} (tolerance {tol:.1e})")

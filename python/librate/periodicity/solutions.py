@@ -66,6 +66,30 @@ def clear_forcing_cache() -> None:
     _FORCINGS.clear()
 
 
+_METHODS = {"rkf78": _core.LaneMethod.RKF78, "rkn86": _core.LaneMethod.RKN86, "dp87": _core.LaneMethod.DP87}
+_CLOSURES = {"half": _core.Closure.HALF, "full": _core.Closure.FULL}
+_FREE = {"phi0": _core.Free.PHI0, "sun_phase": _core.Free.SUN_PHASE}
+_PARAMETERS = {"kz": _core.BorderedParameter.KZ, "eps": _core.BorderedParameter.EPS}
+
+
+def _choice(table: dict, value, name: str):
+    """The core's enum member for the string ``value`` of the argument ``name``."""
+    if not isinstance(value, str) or value not in table:
+        allowed = ", ".join(repr(k) for k in table)
+        raise ValueError(f"invalid argument `{name}`: must be one of {allowed}, got {value!r}")
+    return table[value]
+
+
+def lane_method(method) -> _core.LaneMethod:
+    """The lane engine's method of its name "rkf78", "rkn86" or "dp87" (ValueError naming `method`)."""
+    return _choice(_METHODS, method, "method")
+
+
+def plates_of(eps, cs, cd, theta_sun0) -> _core.Plates:
+    """The core's per-case plates of four arrays of one length."""
+    return _core.Plates(*(np.ascontiguousarray(v, dtype=np.float64) for v in (eps, cs, cd, theta_sun0)))
+
+
 def sweep(forcing, t_final, phi0, wz0, kz, *, stm=False, rtol=MAP_RTOL, atol=MAP_ATOL, chunk=64, threads=None, srp=None, eps=None,
           method=MAP_METHOD):
     """The engine over broadcast (phi0, wz0, kz[, eps]) arrays; ``srp`` a FlatPlate (its eps
@@ -79,11 +103,9 @@ def sweep(forcing, t_final, phi0, wz0, kz, *, stm=False, rtol=MAP_RTOL, atol=MAP
     n = np.broadcast(np.asarray(phi0), np.asarray(wz0), np.asarray(kz), np.asarray(0.0 if eps is None else eps)).shape
     flat = lambda a: np.ascontiguousarray(np.broadcast_to(np.asarray(a, dtype=np.float64), n)).ravel()  # noqa: E731
     p, w, k = flat(phi0), flat(wz0), flat(kz)
-    extra = {}
-    if srp is not None:
-        extra = dict(eps=flat(srp.eps if eps is None else eps), cs=flat(srp.cs), cd=flat(srp.cd), theta_sun0=flat(srp.sun.theta0))
-    return _core.map_sweep(forcing, float(t_final), p, w, k, rtol=float(rtol), atol=float(atol), max_steps=200_000,
-                           stm=bool(stm), chunk=int(chunk), threads=threads, method=str(method), **extra)
+    plates = None if srp is None else plates_of(flat(srp.eps if eps is None else eps), flat(srp.cs), flat(srp.cd), flat(srp.sun.theta0))
+    lanes = _core.LaneOptions(rtol=float(rtol), atol=float(atol), max_steps=200_000, method=lane_method(method), chunk=int(chunk), threads=threads)
+    return _core.map_sweep(forcing, float(t_final), _core.PlanarCases(p, w, k, plates=plates), lanes=lanes, stm=bool(stm))
 
 
 def check_orbit(orbit) -> PeriodicOrbit:
@@ -283,22 +305,25 @@ def correct(orbit: PeriodicOrbit, *, kz, n_total, kind, phi0, wz0, n_periods: in
                                np.asarray(wz0, dtype=float), np.asarray(0.0 if eps is None else eps, dtype=float),
                                np.asarray(0.0 if theta_sun0 is None else theta_sun0, dtype=float))
     k, nt, kd, p, w, e, th = (np.ascontiguousarray(c).ravel() for c in cols)
-    extra = {}
+    plates = None
     if srp is not None:
-        extra = dict(eps=np.ascontiguousarray(np.full(k.size, srp.eps) if eps is None else e),
-                     cs=np.full(k.size, float(srp.cs)), cd=np.full(k.size, float(srp.cd)),
-                     theta_sun0=np.ascontiguousarray(np.full(k.size, float(srp.sun.theta0)) if theta_sun0 is None else th))
+        plates = plates_of(np.full(k.size, srp.eps) if eps is None else e, np.full(k.size, float(srp.cs)), np.full(k.size, float(srp.cd)),
+                           np.full(k.size, float(srp.sun.theta0)) if theta_sun0 is None else th)
     T = n_periods * orbit.period
-    kw = {}
+    border = None
     if bordered is not None:
+        parameter = _choice(_PARAMETERS, bordered[0], "parameter")
         cond = np.asarray(bordered[1], dtype=float)
         if cond.ndim == 2:  # one condition per candidate (branches corrected together)
-            kw = dict(parameter=bordered[0], condition=tuple(cond[0]), conditions=np.ascontiguousarray(np.broadcast_to(cond, (k.size, 4))))
+            border = _core.Bordered(parameter, tuple(cond[0]), conditions=np.ascontiguousarray(np.broadcast_to(cond, (k.size, 4))))
         else:
-            kw = dict(parameter=bordered[0], condition=tuple(float(v) for v in cond))
-    return _core.attitude_correct(orbit_forcing(orbit), p, w, k, turns_of(nt, kd), t_final=0.5 * T if closure == "half" else T,
-                                  closure=closure, free=free, tol=float(tol), max_iter=int(max_iter), rtol=SOLVE_RTOL, atol=SOLVE_ATOL,
-                                  monodromy=monodromy, max_halvings=int(max_halvings), **extra, **kw)
+            border = _core.Bordered(parameter, tuple(float(v) for v in cond))
+    options = _core.CorrectorOptions(_core.NewtonOptions(tol=float(tol), max_iter=int(max_iter), max_halvings=int(max_halvings)),
+                                     _core.LaneOptions(rtol=SOLVE_RTOL, atol=SOLVE_ATOL), monodromy=bool(monodromy))
+    cases = _core.PlanarCases(p, w, k, turns=turns_of(nt, kd), plates=plates)
+    return _core.attitude_correct(orbit_forcing(orbit), cases, t_final=0.5 * T if closure == "half" else T,
+                                  closure=_choice(_CLOSURES, closure, "closure"), free=_choice(_FREE, free, "free"), options=options,
+                                  bordered=border)
 
 
 def verified(orbit: PeriodicOrbit, *, kz, n_total, kind, phi0, wz0, n_periods: int = 1, plates=None, iterations=None,
@@ -314,13 +339,13 @@ def verified(orbit: PeriodicOrbit, *, kz, n_total, kind, phi0, wz0, n_periods: i
     if m == 0:
         return []
     plates = [None] * m if plates is None else list(plates)
-    extra = {}
+    per_plate = None
     if any(pl is not None for pl in plates):
-        extra = dict(eps=np.array([pl.eps if pl else 0.0 for pl in plates]), cs=np.array([pl.cs if pl else 0.0 for pl in plates]),
-                     cd=np.array([pl.cd if pl else 0.0 for pl in plates]), theta_sun0=np.array([pl.sun.theta0 if pl else 0.0 for pl in plates]))
+        per_plate = plates_of([pl.eps if pl else 0.0 for pl in plates], [pl.cs if pl else 0.0 for pl in plates],
+                              [pl.cd if pl else 0.0 for pl in plates], [pl.sun.theta0 if pl else 0.0 for pl in plates])
     T = n_periods * orbit.period
-    v = _core.planar_verify(orbit.system.mu, [float(x) for x in orbit.state0], T, np.ascontiguousarray(kz), np.ascontiguousarray(phi0),
-                            np.ascontiguousarray(wz0), threads=threads, **extra)
+    cases = _core.PlanarCases(np.ascontiguousarray(phi0), np.ascontiguousarray(wz0), np.ascontiguousarray(kz), plates=per_plate)
+    v = _core.planar_verify(orbit.system.mu, [float(x) for x in orbit.state0], T, cases, threads=threads)
     turns = turns_of(n_total, kind)
     its = np.zeros(m, dtype=int) if iterations is None else np.asarray(iterations)
     out = []

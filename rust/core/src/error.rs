@@ -51,6 +51,9 @@ pub enum Error {
     /// An iterative solver (Newton, shooting) did not converge.
     #[error("{what} did not converge after {iterations} iterations (residual {residual:.3e}, tolerance {tolerance:.1e})")]
     Convergence { what: &'static str, iterations: usize, residual: f64, tolerance: f64 },
+    /// The caller asked the computation to stop ([`crate::interrupt::request`], Ctrl-C).
+    #[error("interrupted")]
+    Interrupted,
 }
 
 pub type Result<T> = std::result::Result<T, Error>;

@@ -11,6 +11,7 @@
 //! - [`newton`]: the dense Newton driver of the multiple-shooting and flexible correctors.
 //! - [`fourier`]: periodic orbits as truncated Fourier series, with analytic derivatives.
 //! - [`simd`]: runtime CPU dispatch of the hot kernels (baseline, AVX2, AVX-512, NEON).
+//! - [`interrupt`]: the Ctrl-C request the long loops poll.
 
 pub mod attitude;
 pub mod constants;
@@ -20,6 +21,7 @@ pub mod error;
 pub mod flexible;
 pub mod fourier;
 pub mod integrate;
+pub mod interrupt;
 pub mod map;
 pub mod newton;
 pub mod orbit;

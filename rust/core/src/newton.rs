@@ -165,6 +165,8 @@ pub fn solve<P: Problem>(problem: &mut P, x0: DVector<f64>, s: &Settings) -> Res
     let mut last_error = None;
     let mut jac: Option<DMatrix<f64>>;
     let reason = loop {
+        // Ctrl-C: the finished work is the caller's to keep
+        crate::interrupt::check()?;
         match problem.jacobian(&x) {
             Ok(j) => jac = Some(j),
             Err(e) => {

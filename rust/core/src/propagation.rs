@@ -283,6 +283,7 @@ pub fn propagate_many(
     }
     check_finite("t_final", t_final)?;
     let run = |i: usize| -> Result<FinalState> {
+        crate::interrupt::check()?;
         let tf = if t_final.len() == 1 { t_final[0] } else { t_final[i] };
         let tr = match collision {
             Some(c) => propagate_checked(mu, &states[i], t0, tf, opts, with_stm, Output::Final, &[], c)?,
@@ -293,5 +294,8 @@ pub fn propagate_many(
         }
         Ok(FinalState { state: tr.state_final, stm: tr.stm_final, stats: tr.stats })
     };
-    with_threads(threads, || (0..states.len()).into_par_iter().map(run).collect())
+    let out: Vec<Result<FinalState>> = with_threads(threads, || (0..states.len()).into_par_iter().map(run).collect())?;
+    // an interrupted batch is an error of the call, not of its members
+    crate::interrupt::check()?;
+    Ok(out)
 }

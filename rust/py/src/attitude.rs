@@ -1,20 +1,15 @@
 //! Bindings of the attitude models: convert, call the core with the GIL released, convert.
 
 use librate_core::attitude::{self, gravity_gradient_by_name, Facet, FacetBody, FlatPlate, GravityGradient, OrbitMode, RigidBody, Sun, Torque};
-use librate_core::integrate::{Options, Output};
+use librate_core::integrate::Options;
 use numpy::{IntoPyArray, PyArrayMethods, PyReadonlyArray1};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
+use crate::convert::{output, times};
+use crate::options::IntegrationOptions;
 use crate::records::PyStats;
-use crate::{to_py, OptionsArg};
-
-fn output<'a>(t_eval: &'a Option<Vec<f64>>) -> Output<'a> {
-    match t_eval {
-        Some(t) => Output::At(t),
-        None => Output::Steps,
-    }
-}
+use crate::to_py;
 
 /// Facets as (area, normal[3], center[3], ca, cs, cd) tuples -> validated core facets.
 type FacetTuple = (f64, [f64; 3], [f64; 3], f64, f64, f64);
@@ -81,57 +76,102 @@ impl PyPlanarTrajectory {
     }
 }
 
-/// Coupled 3-D orbit-attitude propagation.
+/// How the orbit moves under a 3-D attitude (librate_core::attitude::OrbitMode).
+#[pyclass(eq, eq_int, frozen, hash, from_py_object, name = "OrbitMode", module = "librate._core")]
+#[derive(Clone, Copy, PartialEq, Eq, Hash)]
+pub enum PyOrbitMode {
+    /// Integrated with the attitude (point-mass CR3BP).
+    #[pyo3(name = "INTEGRATE")]
+    Integrate,
+    /// Held at its initial state.
+    #[pyo3(name = "HELD")]
+    Held,
+    /// Integrated with the extended-body acceleration (needs the nondimensional inertia).
+    #[pyo3(name = "COUPLED")]
+    Coupled,
+}
+
+/// Solar radiation pressure on a faceted body: facets as (area, normal[3], center[3], ca, cs,
+/// cd) tuples, the Sun (theta0, omega, pressure), the system's TU (s), and the SRP force on the
+/// orbit as (mass_kg, lu_m) or None.
+#[pyclass(frozen, name = "SrpModel", module = "librate._core")]
+pub struct PySrpModel {
+    body: FacetBody,
+    force: Option<(f64, f64)>,
+}
+
+#[pymethods]
+impl PySrpModel {
+    #[new]
+    #[pyo3(signature = (facets, *, sun=(0.0, librate_core::constants::OMEGA_SUN, librate_core::constants::SOLAR_PRESSURE_1AU), tu_s=1.0, force=None))]
+    fn new(facets: Vec<FacetTuple>, sun: (f64, f64, f64), tu_s: f64, force: Option<(f64, f64)>) -> PyResult<Self> {
+        Ok(Self { body: facet_model(facets, sun, tu_s)?, force })
+    }
+}
+
+/// A coupled 3-D orbit-attitude model: mu, principal moments, torque names ("gravity_gradient",
+/// "gravity_gradient_earth", "gravity_gradient_moon", "srp"), the orbit's mode (COUPLED needs
+/// `inertia_nd`, the moments / (m LU^2)) and the SRP model ("srp" torque or its force).
+#[pyclass(frozen, name = "AttitudeModel", module = "librate._core")]
+pub struct PyAttitudeModel {
+    mu: f64,
+    body: RigidBody,
+    gravity: Vec<GravityGradient>,
+    mode: OrbitMode,
+    srp: Option<FacetBody>,
+    srp_torque: bool,
+    srp_force: Option<(f64, f64)>,
+}
+
+#[pymethods]
+impl PyAttitudeModel {
+    #[new]
+    #[pyo3(signature = (mu, inertia, torques, *, orbit=PyOrbitMode::Integrate, inertia_nd=None, srp=None))]
+    fn new(mu: f64, inertia: [f64; 3], torques: Vec<String>, orbit: PyOrbitMode, inertia_nd: Option<[f64; 3]>, srp: Option<PyRef<'_, PySrpModel>>) -> PyResult<Self> {
+        let body = RigidBody::new(inertia[0], inertia[1], inertia[2]).map_err(to_py)?;
+        let gravity: Vec<GravityGradient> = torques.iter().filter(|n| n.as_str() != "srp").map(|n| gravity_gradient_by_name(n)).collect::<Result<_, _>>().map_err(to_py)?;
+        let srp_torque = torques.iter().any(|n| n == "srp");
+        let srp_force = srp.as_ref().and_then(|m| m.force);
+        if (srp_torque || srp_force.is_some()) && srp.is_none() {
+            return Err(PyValueError::new_err("invalid argument `srp`: the SRP torque or force needs the body's facets"));
+        }
+        let mode = match (orbit, inertia_nd) {
+            (PyOrbitMode::Integrate, _) => OrbitMode::Integrate,
+            (PyOrbitMode::Held, _) => OrbitMode::Held,
+            (PyOrbitMode::Coupled, Some(i)) => OrbitMode::Coupled { inertia_nd: i },
+            (PyOrbitMode::Coupled, None) => return Err(PyValueError::new_err("invalid argument `orbit`: 'coupled' (coupling needs the body's mass)")),
+        };
+        Ok(Self { mu, body, gravity, mode, srp: srp.map(|m| m.body.clone()), srp_torque, srp_force })
+    }
+}
+
+/// Coupled 3-D orbit-attitude propagation of `model` from state0 (orbit, q scalar last, w) over
+/// t_span = (t0, tf).
 #[pyfunction]
-#[pyo3(signature = (mu, inertia, torques, orbit_mode, state0, t0, tf, *, options, stm, t_eval, inertia_nd=None, facets=None, sun=(0.0, librate_core::constants::OMEGA_SUN, librate_core::constants::SOLAR_PRESSURE_1AU), tu_s=1.0, srp_force=None))]
+#[pyo3(signature = (model, state0, t_span, *, options, stm, t_eval))]
 fn attitude_propagate<'py>(
     py: Python<'py>,
-    mu: f64,
-    inertia: [f64; 3],
-    torques: Vec<String>,
-    orbit_mode: &str,
+    model: PyRef<'py, PyAttitudeModel>,
     state0: [f64; 13],
-    t0: f64,
-    tf: f64,
-    options: OptionsArg,
+    t_span: (f64, f64),
+    options: PyRef<'py, IntegrationOptions>,
     stm: bool,
     t_eval: Option<PyReadonlyArray1<'py, f64>>,
-    inertia_nd: Option<[f64; 3]>,
-    facets: Option<Vec<FacetTuple>>,
-    sun: (f64, f64, f64),
-    tu_s: f64,
-    srp_force: Option<(f64, f64)>,
 ) -> PyResult<PyAttitudeTrajectory> {
-    let body = RigidBody::new(inertia[0], inertia[1], inertia[2]).map_err(to_py)?;
-    let gg_names: Vec<&String> = torques.iter().filter(|n| n.as_str() != "srp").collect();
-    let models: Vec<GravityGradient> = gg_names.iter().map(|n| gravity_gradient_by_name(n)).collect::<Result<_, _>>().map_err(to_py)?;
-    let srp_model = match facets {
-        Some(f) => Some(facet_model(f, sun, tu_s)?),
-        None => None,
-    };
-    let srp_torque = torques.iter().any(|n| n == "srp");
-    if (srp_torque || srp_force.is_some()) && srp_model.is_none() {
-        return Err(PyValueError::new_err("invalid argument `srp`: the SRP torque or force needs the body's facets"));
-    }
-    let mode = match (orbit_mode, inertia_nd) {
-        ("integrate", _) => OrbitMode::Integrate,
-        ("held", _) => OrbitMode::Held,
-        ("coupled", Some(i)) => OrbitMode::Coupled { inertia_nd: i },
-        _ => return Err(PyValueError::new_err(format!("invalid argument `orbit`: {orbit_mode:?} (coupling needs the body's mass)"))),
-    };
-    let opts = Options::from(options);
-    let times = t_eval.map(|a| a.as_array().to_vec());
+    let opts = Options::from(&*options);
+    let times = times(t_eval);
+    let m = &*model;
     let tr = py
         .detach(|| {
-            let mut refs: Vec<&dyn Torque> = models.iter().map(|m| m as &dyn Torque).collect();
-            if let (true, Some(m)) = (srp_torque, &srp_model) {
-                refs.push(m as &dyn Torque);
+            let mut refs: Vec<&dyn Torque> = m.gravity.iter().map(|g| g as &dyn Torque).collect();
+            if let (true, Some(s)) = (m.srp_torque, &m.srp) {
+                refs.push(s as &dyn Torque);
             }
-            let force = match (srp_force, &srp_model) {
-                (Some((mass, lu_m)), Some(m)) => Some((m, mass, lu_m)),
+            let force = match (m.srp_force, &m.srp) {
+                (Some((mass, lu_m)), Some(s)) => Some((s, mass, lu_m)),
                 _ => None,
             };
-            attitude::propagate_attitude(mu, body, &refs, mode, &state0, t0, tf, &opts, stm, output(&times), force, srp_model.as_ref().filter(|_| srp_torque))
+            attitude::propagate_attitude(m.mu, m.body, &refs, m.mode, &state0, t_span.0, t_span.1, &opts, stm, output(&times), force, m.srp.as_ref().filter(|_| m.srp_torque))
         })
         .map_err(to_py)?;
     let n = tr.t.len();
@@ -146,33 +186,50 @@ fn attitude_propagate<'py>(
     })
 }
 
-/// Planar reduced attitude model along an integrated (or held) orbit.
-#[pyfunction]
-#[pyo3(signature = (mu, kz, primaries, held, orbit0, phi0, wz0, t0, tf, *, options, stm, t_eval, plate=None))]
-fn planar_propagate<'py>(
-    py: Python<'py>,
+/// The planar reduced attitude model: mu, Kz, the enabled primaries [larger, smaller], the
+/// orbit held (or integrated), and a flat plate (eps, cs, cd, theta0, omega) or None.
+#[pyclass(frozen, name = "PlanarModel", module = "librate._core")]
+pub struct PyPlanarModel {
     mu: f64,
     kz: f64,
     primaries: [bool; 2],
     held: bool,
+    plate: Option<FlatPlate>,
+}
+
+#[pymethods]
+impl PyPlanarModel {
+    #[new]
+    #[pyo3(signature = (mu, kz, *, primaries=[true, true], held=false, plate=None))]
+    fn new(mu: f64, kz: f64, primaries: [bool; 2], held: bool, plate: Option<(f64, f64, f64, f64, f64)>) -> PyResult<Self> {
+        let plate = match plate {
+            Some((eps, cs, cd, theta0, omega)) => Some(FlatPlate::new(eps, cs, cd, Sun { theta0, omega, pressure: librate_core::constants::SOLAR_PRESSURE_1AU }).map_err(to_py)?),
+            None => None,
+        };
+        Ok(Self { mu, kz, primaries, held, plate })
+    }
+}
+
+/// The planar reduced attitude model along an integrated (or held) orbit from orbit0 and
+/// attitude0 = (phi0, wz0) over t_span = (t0, tf).
+#[pyfunction]
+#[pyo3(signature = (model, orbit0, attitude0, t_span, *, options, stm, t_eval))]
+fn planar_propagate<'py>(
+    py: Python<'py>,
+    model: PyRef<'py, PyPlanarModel>,
     orbit0: [f64; 6],
-    phi0: f64,
-    wz0: f64,
-    t0: f64,
-    tf: f64,
-    options: OptionsArg,
+    attitude0: (f64, f64),
+    t_span: (f64, f64),
+    options: PyRef<'py, IntegrationOptions>,
     stm: bool,
     t_eval: Option<PyReadonlyArray1<'py, f64>>,
-    plate: Option<(f64, f64, f64, f64, f64)>,
 ) -> PyResult<PyPlanarTrajectory> {
-    let opts = Options::from(options);
-    let times = t_eval.map(|a| a.as_array().to_vec());
-    let srp = match plate {
-        Some((eps, cs, cd, theta0, omega)) => Some(FlatPlate::new(eps, cs, cd, Sun { theta0, omega, pressure: librate_core::constants::SOLAR_PRESSURE_1AU }).map_err(to_py)?),
-        None => None,
-    };
+    let opts = Options::from(&*options);
+    let times = times(t_eval);
+    let m = &*model;
+    let ((phi0, wz0), (t0, tf)) = (attitude0, t_span);
     let tr = py
-        .detach(|| attitude::propagate_planar(mu, kz, primaries, held, &orbit0, phi0, wz0, t0, tf, &opts, stm, output(&times), srp))
+        .detach(|| attitude::propagate_planar(m.mu, m.kz, m.primaries, m.held, &orbit0, phi0, wz0, t0, tf, &opts, stm, output(&times), m.plate))
         .map_err(to_py)?;
     let n = tr.t.len();
     Ok(PyPlanarTrajectory {
@@ -262,6 +319,10 @@ fn sun_angle<'py>(py: Python<'py>, theta_sun0: f64, t: PyReadonlyArray1<'py, f64
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyAttitudeTrajectory>()?;
     m.add_class::<PyPlanarTrajectory>()?;
+    m.add_class::<PyOrbitMode>()?;
+    m.add_class::<PySrpModel>()?;
+    m.add_class::<PyAttitudeModel>()?;
+    m.add_class::<PyPlanarModel>()?;
     m.add_function(wrap_pyfunction!(planar_gravity_gradient, m)?)?;
     m.add_function(wrap_pyfunction!(flat_plate_wzdot, m)?)?;
     m.add_function(wrap_pyfunction!(sun_angle, m)?)?;

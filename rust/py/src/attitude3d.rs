@@ -2,12 +2,15 @@
 //! released, convert.
 
 use librate_core::attitude::{collinear_equilibrium, RigidBody};
-use librate_core::attitude::{correct_attitudes_3d, correct_attitudes_3d_across, Options3d, Start3d, StartAcross3d};
+use librate_core::attitude::{correct_attitudes_3d, correct_attitudes_3d_across, Start3d, StartAcross3d};
 use numpy::ndarray::{Array2, Array3};
-use numpy::{IntoPyArray, PyReadonlyArray1, PyReadonlyArray2};
-use pyo3::exceptions::PyValueError;
+use numpy::IntoPyArray;
 use pyo3::prelude::*;
 
+use crate::convert::matrix;
+use crate::errors::invalid;
+use crate::options::{AttitudeCases3D, CorrectorOptions3D};
+use crate::interrupt::interruptible;
 use crate::to_py;
 
 /// The linearised attitude at a collinear point (librate_core::attitude::collinear_equilibrium).
@@ -59,10 +62,6 @@ impl PyCorrectionBatch3D {
     }
 }
 
-fn mat<'py, const R: usize, const C: usize>(py: Python<'py>, m: &[[f64; C]; R]) -> Bound<'py, PyAny> {
-    Array2::from_shape_fn((R, C), |(i, j)| m[i][j]).into_pyarray(py).into_any()
-}
-
 /// The linearised attitude of a body held at a collinear point with its principal axes on the
 /// synodic axes.
 #[pyfunction]
@@ -71,42 +70,30 @@ fn attitude_equilibrium(py: Python<'_>, mu: f64, inertia: [f64; 3], point: u8, q
     let e = py.detach(|| collinear_equilibrium(mu, body, point, &q0)).map_err(to_py)?;
     Ok(PyLinearisedEquilibrium {
         state: e.state.to_vec().into_pyarray(py).into_any().unbind(),
-        matrix: mat(py, &e.matrix).unbind(),
+        matrix: matrix(py, &e.matrix).unbind(),
         sigma: e.sigma,
         residual: e.residual,
     })
 }
 
-/// Batched 3-D periodic-attitude corrector: guesses q (n x 4, scalar last) and w (n x 3) along
-/// the orbit started at `orbit0`, closure over `t_final` (K T; `half`: the mirror-symmetric
-/// half-period form).
+/// Batched 3-D periodic-attitude corrector: the cases' guesses q (n x 4, scalar last) and w
+/// (n x 3) along the orbit started at `orbit0`, closure over `t_final` (K T; options.half: the
+/// mirror-symmetric half-period form).
 #[pyfunction]
-#[pyo3(signature = (mu, inertia, orbit0, t_final, q, w, *, tol, max_iter, rtol, atol, max_halvings=10, primaries=[true, true], threads=None, half=false))]
+#[pyo3(signature = (mu, inertia, orbit0, t_final, cases, *, options))]
 fn attitude_correct_3d<'py>(
     py: Python<'py>,
     mu: f64,
     inertia: [f64; 3],
     orbit0: [f64; 6],
     t_final: f64,
-    q: PyReadonlyArray2<'py, f64>,
-    w: PyReadonlyArray2<'py, f64>,
-    tol: f64,
-    max_iter: usize,
-    rtol: f64,
-    atol: f64,
-    max_halvings: u32,
-    primaries: [bool; 2],
-    threads: Option<usize>,
-    half: bool,
+    cases: PyRef<'py, AttitudeCases3D>,
+    options: PyRef<'py, CorrectorOptions3D>,
 ) -> PyResult<PyCorrectionBatch3D> {
     let body = RigidBody::new(inertia[0], inertia[1], inertia[2]).map_err(to_py)?;
-    let (qa, wa) = (q.as_array(), w.as_array());
-    if qa.ncols() != 4 || wa.ncols() != 3 || qa.nrows() != wa.nrows() {
-        return Err(PyValueError::new_err(format!("invalid argument `guess`: need q of shape (n, 4) and w of shape (n, 3), got {:?} and {:?}", qa.shape(), wa.shape())));
-    }
-    let starts: Vec<Start3d> = (0..qa.nrows()).map(|i| Start3d { q: std::array::from_fn(|k| qa[(i, k)]), w: std::array::from_fn(|k| wa[(i, k)]) }).collect();
-    let opts = Options3d { tol, max_iter, max_halvings, rtol, atol, threads, primaries, half, ..Options3d::default() };
-    let out = py.detach(|| correct_attitudes_3d(mu, body, &orbit0, t_final, &starts, &opts)).map_err(to_py)?;
+    let starts: Vec<Start3d> = cases.q.iter().zip(&cases.w).map(|(&q, &w)| Start3d { q, w }).collect();
+    let opts = options.core();
+    let out = interruptible(py, || correct_attitudes_3d(mu, body, &orbit0, t_final, &starts, &opts))?;
     let n = out.len();
     Ok(PyCorrectionBatch3D {
         q0: Array2::from_shape_fn((n, 4), |(i, k)| out[i].q0[k]).into_pyarray(py).into_any().unbind(),
@@ -151,10 +138,10 @@ impl PyCorrectionAcross3D {
 }
 
 /// Bordered 3-D periodic-attitude corrector across an x-z-symmetric orbit family (the orbit
-/// period freed): guesses q (n x 4), w (n x 3), periods (n,), conditions a (n x 7) . (theta, w0,
-/// T) = b (n,); the family through the member `member0` of period `period0`.
+/// period freed): the cases' guesses q (n x 4), w (n x 3), periods (n,) and conditions a (n x 7)
+/// . (theta, w0, T) = b (n,); the family through the member `member0` of period `period0`.
 #[pyfunction]
-#[pyo3(signature = (mu, inertia, member0, period0, n_periods, q, w, period, a, b, *, tol, max_iter, rtol, atol, max_period_step=0.5, max_halvings=10, primaries=[true, true], threads=None))]
+#[pyo3(signature = (mu, inertia, member0, period0, n_periods, cases, *, options))]
 fn attitude_correct_3d_across<'py>(
     py: Python<'py>,
     mu: f64,
@@ -162,38 +149,17 @@ fn attitude_correct_3d_across<'py>(
     member0: [f64; 6],
     period0: f64,
     n_periods: usize,
-    q: PyReadonlyArray2<'py, f64>,
-    w: PyReadonlyArray2<'py, f64>,
-    period: PyReadonlyArray1<'py, f64>,
-    a: PyReadonlyArray2<'py, f64>,
-    b: PyReadonlyArray1<'py, f64>,
-    tol: f64,
-    max_iter: usize,
-    rtol: f64,
-    atol: f64,
-    max_period_step: f64,
-    max_halvings: u32,
-    primaries: [bool; 2],
-    threads: Option<usize>,
+    cases: PyRef<'py, AttitudeCases3D>,
+    options: PyRef<'py, CorrectorOptions3D>,
 ) -> PyResult<PyCorrectionAcross3D> {
     let body = RigidBody::new(inertia[0], inertia[1], inertia[2]).map_err(to_py)?;
-    let (qa, wa, pa, aa, ba) = (q.as_array(), w.as_array(), period.as_array(), a.as_array(), b.as_array());
-    let n = qa.nrows();
-    if qa.ncols() != 4 || wa.ncols() != 3 || aa.ncols() != 7 || wa.nrows() != n || pa.len() != n || aa.nrows() != n || ba.len() != n {
-        return Err(PyValueError::new_err(format!(
-            "invalid argument `guess`: need q (n, 4), w (n, 3), period (n,), a (n, 7), b (n,), got {:?}, {:?}, {:?}, {:?}, {:?}",
-            qa.shape(),
-            wa.shape(),
-            pa.shape(),
-            aa.shape(),
-            ba.shape()
-        )));
-    }
-    let starts: Vec<StartAcross3d> = (0..n)
-        .map(|i| StartAcross3d { q: std::array::from_fn(|k| qa[(i, k)]), w: std::array::from_fn(|k| wa[(i, k)]), period: pa[i], a: std::array::from_fn(|k| aa[(i, k)]), b: ba[i] })
-        .collect();
-    let opts = Options3d { tol, max_iter, max_halvings, rtol, atol, threads, primaries, ..Options3d::default() };
-    let out = py.detach(|| correct_attitudes_3d_across(mu, body, &member0, period0, n_periods, &starts, max_period_step, &opts)).map_err(to_py)?;
+    let Some((period, a, b)) = &cases.across else {
+        return Err(invalid("invalid argument `cases`: the correction across a family needs each case's period, a and b"));
+    };
+    let n = cases.q.len();
+    let starts: Vec<StartAcross3d> = (0..n).map(|i| StartAcross3d { q: cases.q[i], w: cases.w[i], period: period[i], a: a[i], b: b[i] }).collect();
+    let (opts, max_period_step) = (options.core(), options.max_period_step);
+    let out = interruptible(py, || correct_attitudes_3d_across(mu, body, &member0, period0, n_periods, &starts, max_period_step, &opts))?;
     Ok(PyCorrectionAcross3D {
         q0: Array2::from_shape_fn((n, 4), |(i, k)| out[i].q0[k]).into_pyarray(py).into_any().unbind(),
         w0: Array2::from_shape_fn((n, 3), |(i, k)| out[i].w0[k]).into_pyarray(py).into_any().unbind(),

@@ -9,7 +9,8 @@ use crate::to_py;
 
 /// The build and the SIMD levels: simd_known (levels of this architecture), simd_available
 /// (those the CPU supports), simd_active (raises ValueError if LIBRATE_SIMD is invalid),
-/// version, profile ("release" or "dev"), target_arch.
+/// version, profile (the cargo profile built with: "dev", "release" or "dist"; rust/py/build.rs),
+/// debug_assertions (on in dev builds), target_arch.
 #[pyfunction]
 fn build_info(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
     let active = simd::active().map_err(to_py)?;
@@ -18,7 +19,8 @@ fn build_info(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
     d.set_item("simd_available", simd::available().iter().map(|l| l.name()).collect::<Vec<_>>())?;
     d.set_item("simd_active", active.name())?;
     d.set_item("version", env!("CARGO_PKG_VERSION"))?;
-    d.set_item("profile", if cfg!(debug_assertions) { "dev" } else { "release" })?;
+    d.set_item("profile", option_env!("LIBRATE_PROFILE").unwrap_or("unknown"))?;
+    d.set_item("debug_assertions", cfg!(debug_assertions))?;
     d.set_item("target_arch", std::env::consts::ARCH)?;
     Ok(d)
 }

@@ -8,11 +8,8 @@ use numpy::{IntoPyArray, PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1, P
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use crate::to_py;
-
-fn arr6(name: &str, v: &[f64]) -> PyResult<[f64; 6]> {
-    v.try_into().map_err(|_| pyo3::exceptions::PyValueError::new_err(format!("`{name}` must have 6 components, got {}", v.len())))
-}
+use crate::convert::fixed;
+use crate::errors::{invalid, to_py};
 
 /// The ephemeris (Chebyshev segments evaluated in Rust).
 #[pyclass(module = "librate._core", frozen)]
@@ -29,7 +26,7 @@ impl EphemerisCore {
         for (t, c, s, e, i, l, coef) in segments {
             let sh = coef.shape();
             if sh[1] != 3 {
-                return Err(pyo3::exceptions::PyValueError::new_err(format!("`coefficients` must have shape (n_records, 3, n_coef), got {sh:?}")));
+                return Err(invalid(format!("`coefficients` must have shape (n_records, 3, n_coef), got {sh:?}")));
             }
             let v: Vec<f64> = coef.as_array().iter().copied().collect();
             out.push(Segment::new(t, c, s, e, i, l, sh[0], sh[2], v).map_err(to_py)?);
@@ -62,14 +59,14 @@ impl EphemerisCore {
     /// Synodic (nondimensional) state -> Moon-centred ICRF state at t.
     fn synodic_to_ephemeris<'py>(&self, py: Python<'py>, t: f64, mu: f64, state: PyReadonlyArray1<'_, f64>) -> PyResult<Bound<'py, PyArray1<f64>>> {
         let f = RotatingFrame::at(&self.inner, t).map_err(to_py)?;
-        let s = arr6("state", state.as_slice()?)?;
+        let s = fixed::<6>("state", state.as_slice()?)?;
         Ok(eph::synodic_to_ephemeris(&f, mu, &s).map_err(to_py)?.to_vec().into_pyarray(py))
     }
 
     /// Moon-centred ICRF state at t -> synodic state.
     fn ephemeris_to_synodic<'py>(&self, py: Python<'py>, t: f64, mu: f64, state_km: PyReadonlyArray1<'_, f64>) -> PyResult<Bound<'py, PyArray1<f64>>> {
         let f = RotatingFrame::at(&self.inner, t).map_err(to_py)?;
-        let s = arr6("state_km", state_km.as_slice()?)?;
+        let s = fixed::<6>("state_km", state_km.as_slice()?)?;
         Ok(eph::ephemeris_to_synodic(&f, mu, &s).map_err(to_py)?.to_vec().into_pyarray(py))
     }
 
@@ -88,7 +85,7 @@ impl EphemerisCore {
         atol: f64,
         gm: Option<[f64; 3]>,
     ) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray2<f64>>, Option<Bound<'py, PyArray2<f64>>>)> {
-        let s = arr6("state_km", state_km.as_slice()?)?;
+        let s = fixed::<6>("state_km", state_km.as_slice()?)?;
         let te: Option<Vec<f64>> = match &t_eval {
             Some(a) => Some(a.as_slice()?.to_vec()),
             None => None,

@@ -3,14 +3,17 @@
 //! mass / TU^2 and c in mass / TU (the Python facade converts SI with the system's TU).
 
 use librate_core::flexible::{self, Appendage, FlexibleBody};
-use librate_core::integrate::{Options, Output};
-use numpy::{IntoPyArray, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
+use librate_core::integrate::Options;
+use numpy::{PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyComplex;
 
+use crate::convert::{array, output, table as rows, times};
+use crate::options::{IntegrationOptions, NewtonOptions};
 use crate::records::PyStats;
-use crate::{to_py, OptionsArg};
+use crate::interrupt::interruptible;
+use crate::to_py;
 
 type AppendageArg = (f64, [f64; 2], [f64; 2], f64, f64);
 type BodyArg = (f64, [f64; 3], Vec<AppendageArg>);
@@ -20,19 +23,23 @@ fn body(b: BodyArg) -> PyResult<FlexibleBody> {
     FlexibleBody::new(b.0, b.1, &apps).map_err(to_py)
 }
 
-fn output<'a>(t_eval: &'a Option<Vec<f64>>) -> Output<'a> {
-    match t_eval {
-        Some(t) => Output::At(t),
-        None => Output::Steps,
+/// The planar flexible model: mu, the body (validated here), the enabled primaries [larger,
+/// smaller] and the orbit held (or integrated).
+#[pyclass(frozen, name = "FlexibleModel", module = "librate._core")]
+pub struct PyFlexibleModel {
+    mu: f64,
+    body: FlexibleBody,
+    primaries: [bool; 2],
+    held: bool,
+}
+
+#[pymethods]
+impl PyFlexibleModel {
+    #[new]
+    #[pyo3(signature = (mu, body_arg, *, primaries=[true, true], held=false))]
+    fn new(mu: f64, body_arg: BodyArg, primaries: [bool; 2], held: bool) -> PyResult<Self> {
+        Ok(Self { mu, body: body(body_arg)?, primaries, held })
     }
-}
-
-fn rows(py: Python<'_>, v: Vec<f64>, m: usize, n: usize) -> PyResult<Py<PyAny>> {
-    Ok(v.into_pyarray(py).reshape([m, n])?.into_any().unbind())
-}
-
-fn array(py: Python<'_>, v: Vec<f64>) -> Py<PyAny> {
-    v.into_pyarray(py).into_any().unbind()
 }
 
 /// The derived constants of a validated flexible body (`flexible_body_check`), in the units of
@@ -180,28 +187,24 @@ fn flexible_body_check(py: Python<'_>, body_arg: BodyArg) -> PyResult<PyFlexible
 
 /// Coupled flexible propagation along an integrated (or held) orbit.
 #[pyfunction]
-#[pyo3(signature = (mu, body_arg, primaries, held, orbit0, phi0, wz0, q0, qdot0, t0, tf, *, options, t_eval))]
+#[pyo3(signature = (model, orbit0, attitude0, q0, qdot0, t_span, *, options, t_eval))]
 fn flexible_propagate<'py>(
     py: Python<'py>,
-    mu: f64,
-    body_arg: BodyArg,
-    primaries: [bool; 2],
-    held: bool,
+    model: PyRef<'py, PyFlexibleModel>,
     orbit0: [f64; 6],
-    phi0: f64,
-    wz0: f64,
+    attitude0: (f64, f64),
     q0: Vec<f64>,
     qdot0: Vec<f64>,
-    t0: f64,
-    tf: f64,
-    options: OptionsArg,
+    t_span: (f64, f64),
+    options: PyRef<'py, IntegrationOptions>,
     t_eval: Option<PyReadonlyArray1<'py, f64>>,
 ) -> PyResult<PyFlexibleTrajectory> {
-    let b = body(body_arg)?;
-    let opts = Options::from(options);
-    let times = t_eval.map(|a| a.as_array().to_vec());
+    let (m, b) = (&*model, &model.body);
+    let opts = Options::from(&*options);
+    let times = times(t_eval);
+    let ((phi0, wz0), (t0, tf)) = (attitude0, t_span);
     let tr = py
-        .detach(|| flexible::propagate_flexible(mu, &b, primaries, held, &orbit0, phi0, wz0, &q0, &qdot0, t0, tf, &opts, output(&times)))
+        .detach(|| flexible::propagate_flexible(m.mu, b, m.primaries, m.held, &orbit0, phi0, wz0, &q0, &qdot0, t0, tf, &opts, output(&times)))
         .map_err(to_py)?;
     let (m, n) = (tr.t.len(), b.n());
     Ok(PyFlexibleTrajectory {
@@ -217,26 +220,22 @@ fn flexible_propagate<'py>(
 
 /// Rigid composite solution, closed-form deflections along it and the first-order attitude perturbation.
 #[pyfunction]
-#[pyo3(signature = (mu, body_arg, primaries, held, orbit0, phi0, wz0, t0, tf, *, options, t_eval))]
+#[pyo3(signature = (model, orbit0, attitude0, t_span, *, options, t_eval))]
 fn flexible_quasi_static<'py>(
     py: Python<'py>,
-    mu: f64,
-    body_arg: BodyArg,
-    primaries: [bool; 2],
-    held: bool,
+    model: PyRef<'py, PyFlexibleModel>,
     orbit0: [f64; 6],
-    phi0: f64,
-    wz0: f64,
-    t0: f64,
-    tf: f64,
-    options: OptionsArg,
+    attitude0: (f64, f64),
+    t_span: (f64, f64),
+    options: PyRef<'py, IntegrationOptions>,
     t_eval: Option<PyReadonlyArray1<'py, f64>>,
 ) -> PyResult<PyQuasiStaticTrajectory> {
-    let b = body(body_arg)?;
-    let opts = Options::from(options);
-    let times = t_eval.map(|a| a.as_array().to_vec());
+    let (m, b) = (&*model, &model.body);
+    let opts = Options::from(&*options);
+    let times = times(t_eval);
+    let ((phi0, wz0), (t0, tf)) = (attitude0, t_span);
     let tr = py
-        .detach(|| flexible::propagate_quasi_static(mu, &b, primaries, held, &orbit0, phi0, wz0, t0, tf, &opts, output(&times)))
+        .detach(|| flexible::propagate_quasi_static(m.mu, b, m.primaries, m.held, &orbit0, phi0, wz0, t0, tf, &opts, output(&times)))
         .map_err(to_py)?;
     let (m, n) = (tr.t.len(), b.n());
     Ok(PyQuasiStaticTrajectory {
@@ -278,9 +277,8 @@ impl PyQuasiStaticPoint {
 
 /// The closed form at one state.
 #[pyfunction]
-fn flexible_quasi_static_point(mu: f64, body_arg: BodyArg, primaries: [bool; 2], held: bool, orbit: [f64; 6], phi: f64, wz: f64) -> PyResult<PyQuasiStaticPoint> {
-    let b = body(body_arg)?;
-    let p = flexible::quasi_static_point(mu, &b, primaries, held, &orbit, phi, wz).map_err(to_py)?;
+fn flexible_quasi_static_point(model: PyRef<'_, PyFlexibleModel>, orbit: [f64; 6], phi: f64, wz: f64) -> PyResult<PyQuasiStaticPoint> {
+    let p = flexible::quasi_static_point(model.mu, &model.body, model.primaries, model.held, &orbit, phi, wz).map_err(to_py)?;
     Ok(PyQuasiStaticPoint { q: p.q, qdot: p.qdot, qddot: p.qddot, wzdot: p.wzdot, dtau: p.dtau })
 }
 
@@ -288,21 +286,19 @@ fn flexible_quasi_static_point(mu: f64, body_arg: BodyArg, primaries: [bool; 2],
 #[pyfunction]
 fn flexible_energies<'py>(
     py: Python<'py>,
-    mu: f64,
-    body_arg: BodyArg,
-    primaries: [bool; 2],
+    model: PyRef<'py, PyFlexibleModel>,
     orbit: PyReadonlyArray2<'py, f64>,
     phi: PyReadonlyArray1<'py, f64>,
     wz: PyReadonlyArray1<'py, f64>,
     q: PyReadonlyArray2<'py, f64>,
     qdot: PyReadonlyArray2<'py, f64>,
 ) -> PyResult<PyFlexibleEnergies> {
-    let b = body(body_arg)?;
+    let (mu, b, primaries) = (model.mu, &model.body, model.primaries);
     let flat = |a: &PyReadonlyArray2<'py, f64>| -> Vec<f64> { a.as_array().iter().copied().collect() };
     if q.shape()[1] != b.n() || qdot.shape()[1] != b.n() || orbit.shape()[1] != 6 {
         return Err(PyValueError::new_err(format!("invalid argument `states`: orbit must be (m, 6) and q, qdot (m, {})", b.n())));
     }
-    let e = flexible::evaluate_energies(mu, &b, primaries, &flat(&orbit), phi.as_slice()?, wz.as_slice()?, &flat(&q), &flat(&qdot)).map_err(to_py)?;
+    let e = flexible::evaluate_energies(mu, b, primaries, &flat(&orbit), phi.as_slice()?, wz.as_slice()?, &flat(&q), &flat(&qdot)).map_err(to_py)?;
     let col = |f: fn(&flexible::Energies) -> f64| array(py, e.iter().map(f).collect());
     Ok(PyFlexibleEnergies {
         kinetic: col(|e| e.kinetic),
@@ -317,12 +313,12 @@ fn flexible_energies<'py>(
 
 /// The right-hand side at one state (orbit held): (wzdot, qddot).
 #[pyfunction]
-fn flexible_rates(mu: f64, body_arg: BodyArg, primaries: [bool; 2], orbit: [f64; 6], phi: f64, wz: f64, q: Vec<f64>, qdot: Vec<f64>) -> PyResult<(f64, Vec<f64>)> {
-    let b = body(body_arg)?;
+fn flexible_rates(model: PyRef<'_, PyFlexibleModel>, orbit: [f64; 6], phi: f64, wz: f64, q: Vec<f64>, qdot: Vec<f64>) -> PyResult<(f64, Vec<f64>)> {
+    let (mu, b, primaries) = (model.mu, &model.body, model.primaries);
     if q.len() != b.n() || qdot.len() != b.n() {
         return Err(PyValueError::new_err(format!("invalid argument `q`: need {} values", b.n())));
     }
-    Ok(flexible::flexible_rates(mu, &b, primaries, &orbit, phi, wz, &q, &qdot))
+    Ok(flexible::flexible_rates(mu, b, primaries, &orbit, phi, wz, &q, &qdot))
 }
 
 /// The outcome of `flexible_correct_periodic`.
@@ -350,32 +346,27 @@ impl PyFlexiblePeriodicCorrection {
 /// Correct (phi0, wz0, q0, qdot0) to a periodic motion of the coupled flexible model over one
 /// orbit period (librate_core::flexible::correct_flexible_periodic).
 #[pyfunction]
-#[pyo3(signature = (mu, body_arg, primaries, orbit0, period, x0, turns, scale, *, options, tol, max_iter, threads=None))]
+#[pyo3(signature = (model, orbit, x0, turns, scale, *, options, newton, threads=None))]
 fn flexible_correct_periodic<'py>(
     py: Python<'py>,
-    mu: f64,
-    body_arg: BodyArg,
-    primaries: [bool; 2],
-    orbit0: [f64; 6],
-    period: f64,
+    model: PyRef<'py, PyFlexibleModel>,
+    orbit: ([f64; 6], f64),
     x0: Vec<f64>,
     turns: f64,
     scale: Vec<f64>,
-    options: OptionsArg,
-    tol: f64,
-    max_iter: usize,
+    options: PyRef<'py, IntegrationOptions>,
+    newton: PyRef<'py, NewtonOptions>,
     threads: Option<usize>,
 ) -> PyResult<PyFlexiblePeriodicCorrection> {
-    let b = body(body_arg)?;
-    let opts = Options::from(options);
-    let r = py
-        .detach(|| flexible::correct_flexible_periodic(mu, &b, primaries, &orbit0, period, &x0, turns, &scale, &opts, tol, max_iter, threads))
-        .map_err(to_py)?;
+    let (m, b) = (&*model, &model.body);
+    let ((orbit0, period), opts, tol, max_iter) = (orbit, Options::from(&*options), newton.tol, newton.max_iter);
+    let r = interruptible(py, || flexible::correct_flexible_periodic(m.mu, b, m.primaries, &orbit0, period, &x0, turns, &scale, &opts, tol, max_iter, threads))?;
     let m = r.x.len();
     Ok(PyFlexiblePeriodicCorrection { x: array(py, r.x), residual: r.residual, iterations: r.iterations, reason: r.reason.as_str(), monodromy: rows(py, r.monodromy, m, m)? })
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<PyFlexibleModel>()?;
     m.add_class::<PyFlexibleBodyConstants>()?;
     m.add_class::<PyFlexibleTrajectory>()?;
     m.add_class::<PyQuasiStaticTrajectory>()?;

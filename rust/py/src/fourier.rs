@@ -5,7 +5,7 @@ use numpy::{IntoPyArray, PyArray2, PyArrayMethods, PyReadonlyArray1, PyReadonlyA
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
-use super::to_py;
+use crate::to_py;
 
 fn rows3(name: &str, a: &PyReadonlyArray2<'_, f64>) -> PyResult<Vec<f64>> {
     if a.shape()[1] != 3 {

@@ -1,116 +1,44 @@
+#![deny(clippy::too_many_arguments)] // no binding takes more than 8 parameters (rust/py/clippy.toml, tests/test_boundary.py)
 //! `librate._core`: thin PyO3 bindings over librate-core. Each function converts its arguments,
 //! calls the core with the GIL released, and converts the result; no numerics live here.
-//! The public, documented API is the `librate` Python package, which wraps these.
-
+//! The public, documented API is the `librate` Python package, which wraps these. Errors map
+//! to Python in `errors`, arrays convert in `convert`, and the typed arguments (options,
+//! enums, case containers) are the classes of `options`.
 
 use librate_core::cr3bp::{self, SystemConstants, PRESETS};
 use librate_core::error::Error;
-use librate_core::integrate::{Options, Output, Status};
+use librate_core::integrate::{Options, Status};
 use librate_core::orbit::{correct_multiple_shooting, MemberCondition, Constraint, Stability, SymmetricShooting, Var};
 use numpy::Complex64;
 use librate_core::propagation::{self, Collision, EventKind, EventSpec};
 use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray1, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
-use pyo3::create_exception;
-use pyo3::exceptions::{PyException, PyValueError};
+use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
 
 mod attitude;
 mod attitude3d;
 mod build;
+mod convert;
 mod ephemeris;
+mod errors;
 mod flexible;
 mod fourier;
+mod interrupt;
 mod map;
 mod map3d;
+mod options;
 mod records;
 
-use records::{PyBatchResult, PyEventHit, PyMultipleShooting, PyShootingEvaluation, PyStats, PySymmetricOrbit, PySystemConstants, PyTrajectory};
-
-create_exception!(librate, LibrateError, PyException, "Base class of librate's errors.");
-create_exception!(
-    librate,
-    IntegrationError,
-    LibrateError,
-    "An integration stopped before its final time (step-size underflow, too many steps, non-finite state). Attributes: t, steps."
-);
-create_exception!(
-    librate,
-    CollisionError,
-    IntegrationError,
-    "The trajectory reached a primary (the system's radius, or a tiny sphere for point masses). Attributes: t, steps, primary (1 or 2), distance, radius."
-);
-create_exception!(
-    librate,
-    ConvergenceError,
-    LibrateError,
-    "An iterative solver did not converge. Attributes: iterations, residual, tolerance."
-);
-
-/// Core error -> typed Python exception carrying its context as attributes.
-pub(crate) fn to_py(e: Error) -> PyErr {
-    Python::attach(|py| match &e {
-        Error::InvalidArgument { .. } => PyValueError::new_err(e.to_string()),
-        Error::Integration(ie) => {
-            let err = match ie {
-                librate_core::IntegrationError::Collision { .. } => CollisionError::new_err(e.to_string()),
-                _ => IntegrationError::new_err(e.to_string()),
-            };
-            let v = err.value(py);
-            let kind = match ie {
-                librate_core::IntegrationError::StepSizeUnderflow { .. } => "step_size_underflow",
-                librate_core::IntegrationError::MaxStepsExceeded { .. } => "max_steps_exceeded",
-                librate_core::IntegrationError::NonFinite { .. } => "non_finite",
-                librate_core::IntegrationError::Collision { primary, distance, radius, .. } => {
-                    let _ = v.setattr("primary", *primary);
-                    let _ = v.setattr("distance", *distance);
-                    let _ = v.setattr("radius", *radius);
-                    "collision"
-                }
-            };
-            let _ = v.setattr("t", ie.t());
-            let _ = v.setattr("steps", ie.steps());
-            let _ = v.setattr("kind", kind);
-            err
-        }
-        Error::Convergence { iterations, residual, tolerance, .. } => {
-            let err = ConvergenceError::new_err(e.to_string());
-            let v = err.value(py);
-            let _ = v.setattr("iterations", *iterations);
-            let _ = v.setattr("residual", *residual);
-            let _ = v.setattr("tolerance", *tolerance);
-            err
-        }
-    })
-}
-
-/// Integrator settings as the Python facade passes them: a dict with these keys.
-#[derive(FromPyObject)]
-#[pyo3(from_item_all)]
-pub(crate) struct OptionsArg {
-    rtol: f64,
-    atol: f64,
-    h0: Option<f64>,
-    h_min: f64,
-    h_max: f64,
-    max_steps: usize,
-    safety: f64,
-    fixed_step: Option<f64>,
-}
-
-impl From<OptionsArg> for Options {
-    fn from(o: OptionsArg) -> Self {
-        Options { rtol: o.rtol, atol: o.atol, h0: o.h0, h_min: o.h_min, h_max: o.h_max, max_steps: o.max_steps, safety: o.safety, fixed_step: o.fixed_step, ..Options::default() }
-    }
-}
-
-fn state6(name: &'static str, v: &[f64]) -> PyResult<[f64; 6]> {
-    <[f64; 6]>::try_from(v).map_err(|_| PyValueError::new_err(format!("invalid argument `{name}`: must have 6 components (x, y, z, xd, yd, zd), got {}", v.len())))
-}
+pub(crate) use errors::to_py;
+use interrupt::interruptible;
+use convert::{output, rows, state6, times};
+use options::{IntegrationOptions, NewtonOptions};
+use records::{PyBatchResult, PyEventHit, PyMultipleShooting, PyShootingEvaluation, PyStats, PySystemConstants, PySymmetricOrbit, PyTrajectory};
 
 fn mat6<'py>(py: Python<'py>, m: &[[f64; 6]; 6]) -> Bound<'py, PyAny> {
-    Array2::from_shape_fn((6, 6), |(i, j)| m[i][j]).into_pyarray(py).into_any()
+    convert::matrix(py, m)
 }
 
 fn event_specs(events: Vec<(String, Vec<f64>, i8, bool)>) -> PyResult<Vec<EventSpec>> {
@@ -130,30 +58,27 @@ fn event_specs(events: Vec<(String, Vec<f64>, i8, bool)>) -> PyResult<Vec<EventS
 
 /// Propagate one CR3BP state (see `librate.propagate`).
 #[pyfunction]
-#[pyo3(signature = (mu, state, t0, tf, *, options, stm, t_eval, events, collision=None))]
+#[pyo3(signature = (mu, state, t_span, *, options, stm, t_eval, events, collision=None))]
 fn propagate<'py>(
     py: Python<'py>,
     mu: f64,
     state: PyReadonlyArray1<'py, f64>,
-    t0: f64,
-    tf: f64,
-    options: OptionsArg,
+    t_span: (f64, f64),
+    options: PyRef<'py, IntegrationOptions>,
     stm: bool,
     t_eval: Option<PyReadonlyArray1<'py, f64>>,
     events: Vec<(String, Vec<f64>, i8, bool)>,
     collision: Option<(f64, f64)>,
 ) -> PyResult<PyTrajectory> {
     let s = state6("state", state.as_slice()?)?;
-    let opts = Options::from(options);
+    let (t0, tf) = t_span;
+    let opts = Options::from(&*options);
     let specs = event_specs(events)?;
     let spheres = collision.map(|(a, b)| Collision::new([a, b])).transpose().map_err(to_py)?;
-    let times: Option<Vec<f64>> = t_eval.map(|a| a.as_array().to_vec());
+    let times = times(t_eval);
     let tr = py
         .detach(|| {
-            let output = match &times {
-                Some(t) => Output::At(t),
-                None => Output::Steps,
-            };
+            let output = output(&times);
             match &spheres {
                 Some(c) => propagation::propagate_checked(mu, &s, t0, tf, &opts, stm, output, &specs, c),
                 None => propagation::propagate(mu, &s, t0, tf, &opts, stm, output, &specs),
@@ -194,19 +119,16 @@ fn propagate_many<'py>(
     states: PyReadonlyArray2<'py, f64>,
     t0: f64,
     t_final: PyReadonlyArray1<'py, f64>,
-    options: OptionsArg,
+    options: PyRef<'py, IntegrationOptions>,
     stm: bool,
     threads: Option<usize>,
     collision: Option<(f64, f64)>,
 ) -> PyResult<PyBatchResult> {
     let spheres = collision.map(|(a, b)| Collision::new([a, b])).transpose().map_err(to_py)?;
-    if states.shape()[1] != 6 {
-        return Err(PyValueError::new_err(format!("invalid argument `states`: must have shape (n, 6), got {:?}", states.shape())));
-    }
-    let rows: Vec<[f64; 6]> = states.as_array().rows().into_iter().map(|r| std::array::from_fn(|j| r[j])).collect();
+    let rows = rows::<6>(&states, "states", None)?;
     let tf: Vec<f64> = t_final.as_array().to_vec();
-    let opts = Options::from(options);
-    let results = py.detach(|| propagation::propagate_many(mu, &rows, t0, &tf, &opts, stm, threads, spheres.as_ref())).map_err(to_py)?;
+    let opts = Options::from(&*options);
+    let results = interruptible(py, || propagation::propagate_many(mu, &rows, t0, &tf, &opts, stm, threads, spheres.as_ref()))?;
     let n = results.len();
     let mut y = Vec::with_capacity(n * 6);
     let mut m = Vec::with_capacity(if stm { n * 36 } else { 0 });
@@ -306,17 +228,10 @@ fn constraint(kind: &str, v: &[f64]) -> PyResult<Constraint> {
     })
 }
 
-fn shooting(mu: f64, spatial: bool, tol: f64, max_iter: usize, t_max: f64, rtol: f64, atol: f64) -> SymmetricShooting {
-    let mut sh = SymmetricShooting::new(mu, spatial, Options::with_tolerances(rtol, atol));
-    sh.tol = tol;
-    sh.max_iter = max_iter;
-    sh.t_max = t_max;
-    sh
-}
 
 /// Newton correction of an x-z-symmetric orbit from p = (x0, z0, vy0) under one extra constraint.
 #[pyfunction]
-#[pyo3(signature = (mu, p, *, spatial, constraint, values, tol, max_iter, t_max, rtol, atol))]
+#[pyo3(signature = (mu, p, *, spatial, constraint, values, t_max, newton, options))]
 fn symmetric_correct<'py>(
     py: Python<'py>,
     mu: f64,
@@ -324,15 +239,16 @@ fn symmetric_correct<'py>(
     spatial: bool,
     constraint: &str,
     values: Vec<f64>,
-    tol: f64,
-    max_iter: usize,
     t_max: f64,
-    rtol: f64,
-    atol: f64,
+    newton: PyRef<'py, NewtonOptions>,
+    options: PyRef<'py, IntegrationOptions>,
 ) -> PyResult<PySymmetricOrbit> {
     let c = self::constraint(constraint, &values)?;
-    let sh = shooting(mu, spatial, tol, max_iter, t_max, rtol, atol);
-    let o = py.detach(|| sh.correct(p, c)).map_err(to_py)?;
+    let mut sh = SymmetricShooting::new(mu, spatial, Options::from(&*options));
+    sh.tol = newton.tol;
+    sh.max_iter = newton.max_iter;
+    sh.t_max = t_max;
+    let o = interruptible(py, || sh.correct(p, c))?;
     Ok(PySymmetricOrbit {
         state0: o.state0.to_vec().into_pyarray(py).into_any().unbind(),
         period: o.period,
@@ -360,7 +276,7 @@ fn stability<'py>(py: Python<'py>, m: PyReadonlyArray2<'py, f64>, planar: bool) 
 
 /// Multiple shooting: patches (n, 6), period guess, member condition ("jacobi" or "period", value).
 #[pyfunction]
-#[pyo3(signature = (mu, patches, period, *, condition, value, tol, max_iter, rtol, atol))]
+#[pyo3(signature = (mu, patches, period, *, condition, value, newton, options))]
 fn multiple_shooting<'py>(
     py: Python<'py>,
     mu: f64,
@@ -368,22 +284,20 @@ fn multiple_shooting<'py>(
     period: f64,
     condition: &str,
     value: f64,
-    tol: f64,
-    max_iter: usize,
-    rtol: f64,
-    atol: f64,
+    newton: PyRef<'py, NewtonOptions>,
+    options: PyRef<'py, IntegrationOptions>,
 ) -> PyResult<PyMultipleShooting> {
     if patches.shape()[1] != 6 || patches.shape()[0] == 0 {
         return Err(PyValueError::new_err(format!("invalid argument `states`: must have shape (n, 6) with n >= 1, got {:?}", patches.shape())));
     }
-    let rows: Vec<[f64; 6]> = patches.as_array().rows().into_iter().map(|r| std::array::from_fn(|j| r[j])).collect();
+    let rows = rows::<6>(&patches, "states", None)?;
     let cond = match condition {
         "jacobi" => MemberCondition::Jacobi(value),
         "period" => MemberCondition::Period(value),
         _ => return Err(PyValueError::new_err(format!("invalid argument `condition`: must be 'jacobi' or 'period', got {condition:?}"))),
     };
-    let opts = Options::with_tolerances(rtol, atol);
-    let o = py.detach(|| correct_multiple_shooting(mu, &rows, period, cond, tol, max_iter, &opts)).map_err(to_py)?;
+    let (opts, tol, max_iter) = (Options::from(&*options), newton.tol, newton.max_iter);
+    let o = interruptible(py, || correct_multiple_shooting(mu, &rows, period, cond, tol, max_iter, &opts))?;
     let n = o.patches.len();
     let flat: Vec<f64> = o.patches.iter().flatten().copied().collect();
     Ok(PyMultipleShooting { patches: flat.into_pyarray(py).reshape([n, 6])?.into_any().unbind(), period: o.period, jacobi: o.jacobi, iterations: o.iterations, residual: o.residual })
@@ -391,11 +305,8 @@ fn multiple_shooting<'py>(
 
 #[pymodule]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
-    let py = m.py();
-    m.add("LibrateError", py.get_type::<LibrateError>())?;
-    m.add("IntegrationError", py.get_type::<IntegrationError>())?;
-    m.add("CollisionError", py.get_type::<CollisionError>())?;
-    m.add("ConvergenceError", py.get_type::<ConvergenceError>())?;
+    errors::register(m)?;
+    options::register(m)?;
     m.add_function(wrap_pyfunction!(propagate, m)?)?;
     m.add_function(wrap_pyfunction!(propagate_many, m)?)?;
     m.add_function(wrap_pyfunction!(jacobi, m)?)?;

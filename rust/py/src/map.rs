@@ -2,16 +2,17 @@
 
 use librate_core::attitude::{FlatPlate, Sun};
 use librate_core::integrate::forcing::OrbitForcing;
-use librate_core::integrate::lanes::{Case, LaneOptions, Method};
+use librate_core::integrate::lanes::Case;
 use librate_core::map;
-use librate_core::attitude::{
-    correct_across_family, correct_bordered, correct_planar_attitudes, verify_planar_attitudes, Bordered, Candidate, Closure, CorrectorOptions, Free, Parameter, PlanarFamily,
-    PlanarStart,
-};
-use numpy::{IntoPyArray, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2};
-use pyo3::exceptions::{PyKeyError, PyValueError};
+use librate_core::attitude::{correct_across_family, correct_bordered, correct_planar_attitudes, verify_planar_attitudes, Candidate, Parameter, PlanarFamily, PlanarStart};
+use numpy::{IntoPyArray, PyArrayMethods, PyReadonlyArray1};
+use pyo3::exceptions::PyKeyError;
 use pyo3::prelude::*;
 
+use crate::convert::vector;
+use crate::errors::invalid;
+use crate::options::{Bordered, Closure, CorrectorOptions, Free, LaneOptions, PlanarCases};
+use crate::interrupt::interruptible;
 use crate::to_py;
 
 /// Gravity-gradient forcing S(t), C(t) of one planar periodic orbit, tabulated once (piecewise
@@ -49,14 +50,21 @@ impl PyOrbitForcing {
 }
 
 /// The outcome of `map_sweep`: arrays over the cases (also readable as `r["phi_t"]`).
-#[pyclass(frozen, name = "SweepResult", module = "librate._core")]
+#[pyclass(frozen, get_all, name = "SweepResult", module = "librate._core")]
 pub struct PySweepResult {
+    /// Unwrapped phi at t_final, (n,).
     phi_t: Py<PyAny>,
+    /// wz at t_final, (n,).
     wz_t: Py<PyAny>,
+    /// wz(t_final) - wz0, (n,).
     dwz: Py<PyAny>,
+    /// phi(t_final) - phi0 wrapped to (-pi, pi], (n,).
     dphi: Py<PyAny>,
+    /// The 2x2 STMs (n, 2, 2), or None when not asked.
     stm: Option<Py<PyAny>>,
+    /// Lane status per case (0 ok, 1 max steps, 2 failed), uint8 (n,).
     status: Py<PyAny>,
+    /// Accepted and rejected steps per case, (n, 2).
     steps: Py<PyAny>,
 }
 
@@ -64,53 +72,19 @@ const SWEEP_FIELDS: [&str; 7] = ["phi_t", "wz_t", "dwz", "dphi", "stm", "status"
 
 #[pymethods]
 impl PySweepResult {
-    /// Unwrapped phi at t_final, (n,).
-    #[getter]
-    fn phi_t(&self, py: Python<'_>) -> Py<PyAny> {
-        self.phi_t.clone_ref(py)
-    }
-    /// wz at t_final, (n,).
-    #[getter]
-    fn wz_t(&self, py: Python<'_>) -> Py<PyAny> {
-        self.wz_t.clone_ref(py)
-    }
-    /// wz(t_final) - wz0, (n,).
-    #[getter]
-    fn dwz(&self, py: Python<'_>) -> Py<PyAny> {
-        self.dwz.clone_ref(py)
-    }
-    /// phi(t_final) - phi0 wrapped to (-pi, pi], (n,).
-    #[getter]
-    fn dphi(&self, py: Python<'_>) -> Py<PyAny> {
-        self.dphi.clone_ref(py)
-    }
-    /// The 2x2 STMs (n, 2, 2), or None when not asked.
-    #[getter]
-    fn stm(&self, py: Python<'_>) -> Option<Py<PyAny>> {
-        self.stm.as_ref().map(|m| m.clone_ref(py))
-    }
-    /// Lane status per case (0 ok, 1 max steps, 2 failed), uint8 (n,).
-    #[getter]
-    fn status(&self, py: Python<'_>) -> Py<PyAny> {
-        self.status.clone_ref(py)
-    }
-    /// Accepted and rejected steps per case, (n, 2).
-    #[getter]
-    fn steps(&self, py: Python<'_>) -> Py<PyAny> {
-        self.steps.clone_ref(py)
-    }
     /// `r[name]` is `r.name` (the fields of the former dict result).
     fn __getitem__(&self, py: Python<'_>, name: &str) -> PyResult<Option<Py<PyAny>>> {
-        Ok(match name {
-            "phi_t" => Some(self.phi_t(py)),
-            "wz_t" => Some(self.wz_t(py)),
-            "dwz" => Some(self.dwz(py)),
-            "dphi" => Some(self.dphi(py)),
-            "stm" => self.stm(py),
-            "status" => Some(self.status(py)),
-            "steps" => Some(self.steps(py)),
+        let field = match name {
+            "phi_t" => &self.phi_t,
+            "wz_t" => &self.wz_t,
+            "dwz" => &self.dwz,
+            "dphi" => &self.dphi,
+            "stm" => return Ok(self.stm.as_ref().map(|m| m.clone_ref(py))),
+            "status" => &self.status,
+            "steps" => &self.steps,
             _ => return Err(PyKeyError::new_err(format!("{name:?}: SweepResult has {}", SWEEP_FIELDS.join(", ")))),
-        })
+        };
+        Ok(Some(field.clone_ref(py)))
     }
     fn keys(&self) -> Vec<&'static str> {
         SWEEP_FIELDS.to_vec()
@@ -123,48 +97,20 @@ impl PySweepResult {
     }
 }
 
-/// A per-case float array: the given one (length checked) or zeros.
-fn per_case(a: &Option<PyReadonlyArray1<'_, f64>>, name: &str, n: usize) -> PyResult<Vec<f64>> {
-    match a {
-        None => Ok(vec![0.0; n]),
-        Some(v) if v.as_array().len() == n => Ok(v.as_array().to_vec()),
-        Some(v) => Err(PyValueError::new_err(format!("invalid argument `{name}`: must have the length of wz0 ({n}), got {}", v.as_array().len()))),
-    }
+/// The lane cases of planar cases.
+fn lane_cases(c: &PlanarCases) -> Vec<Case> {
+    (0..c.wz0.len()).map(|i| Case { eps: c.eps[i], cs: c.cs[i], cd: c.cd[i], theta_sun0: c.theta_sun0[i], ..Case::new(c.phi0[i], c.wz0[i], c.kz[i]) }).collect()
 }
 
-/// Integrate planar attitude trajectories (phi0, wz0, kz arrays of one length) over t_final.
+/// Integrate planar attitude trajectories (the cases' phi0, wz0, kz and plates) over t_final.
 #[pyfunction]
-#[pyo3(signature = (forcing, t_final, phi0, wz0, kz, *, rtol, atol, max_steps, stm, chunk, threads, eps=None, cs=None, cd=None, theta_sun0=None, method="rkf78"))]
-fn map_sweep<'py>(
-    py: Python<'py>,
-    forcing: PyRef<'py, PyOrbitForcing>,
-    t_final: f64,
-    phi0: PyReadonlyArray1<'py, f64>,
-    wz0: PyReadonlyArray1<'py, f64>,
-    kz: PyReadonlyArray1<'py, f64>,
-    rtol: f64,
-    atol: f64,
-    max_steps: u32,
-    stm: bool,
-    chunk: usize,
-    threads: Option<usize>,
-    eps: Option<PyReadonlyArray1<'py, f64>>,
-    cs: Option<PyReadonlyArray1<'py, f64>>,
-    cd: Option<PyReadonlyArray1<'py, f64>>,
-    theta_sun0: Option<PyReadonlyArray1<'py, f64>>,
-    method: &str,
-) -> PyResult<PySweepResult> {
-    let method = Method::parse(method).ok_or_else(|| PyValueError::new_err(format!("invalid argument `method`: must be 'rkf78', 'rkn86' or 'dp87', got {method:?}")))?;
-    let (p, w, k) = (phi0.as_array(), wz0.as_array(), kz.as_array());
-    if p.len() != w.len() || k.len() != w.len() {
-        return Err(PyValueError::new_err(format!("invalid argument: phi0, wz0 and kz must have one length, got {}, {}, {}", p.len(), w.len(), k.len())));
-    }
-    let n = w.len();
-    let (e, s, d, th) = (per_case(&eps, "eps", n)?, per_case(&cs, "cs", n)?, per_case(&cd, "cd", n)?, per_case(&theta_sun0, "theta_sun0", n)?);
-    let cases: Vec<Case> = (0..n).map(|i| Case { eps: e[i], cs: s[i], cd: d[i], theta_sun0: th[i], ..Case::new(p[i], w[i], k[i]) }).collect();
-    let opts = LaneOptions { rtol, atol, max_steps, method, ..LaneOptions::default() };
+#[pyo3(signature = (forcing, t_final, cases, *, lanes, stm))]
+fn map_sweep<'py>(py: Python<'py>, forcing: PyRef<'py, PyOrbitForcing>, t_final: f64, cases: PyRef<'py, PlanarCases>, lanes: PyRef<'py, LaneOptions>, stm: bool) -> PyResult<PySweepResult> {
+    let cases = lane_cases(&cases);
+    let n = cases.len();
+    let (opts, chunk, threads) = (lanes.core(), lanes.chunk, lanes.threads);
     let f = &forcing.inner;
-    let out = py.detach(|| map::sweep(f, t_final, &cases, &opts, stm, chunk, threads)).map_err(to_py)?;
+    let out = interruptible(py, || map::sweep(f, t_final, &cases, &opts, stm, chunk, threads))?;
     let (mut phi_t, mut wz_t, mut dwz, mut dphi) = (Vec::with_capacity(n), Vec::with_capacity(n), Vec::with_capacity(n), Vec::with_capacity(n));
     let mut m = Vec::with_capacity(if stm { 4 * n } else { 0 });
     let mut status = Vec::with_capacity(n);
@@ -193,79 +139,35 @@ fn map_sweep<'py>(
 }
 
 /// The outcome of `attitude_correct`: arrays over the candidates.
-#[pyclass(frozen, name = "CorrectionBatch", module = "librate._core")]
+#[pyclass(frozen, get_all, name = "CorrectionBatch", module = "librate._core")]
 pub struct PyCorrectionBatch {
+    /// Final phi0 (kept unless free=PHI0 with closure=FULL), (n,).
     phi0: Py<PyAny>,
+    /// Final inertial wz0, (n,).
     wz0: Py<PyAny>,
+    /// Final Sun phase (kept unless free=SUN_PHASE; not wrapped), (n,).
     theta_sun0: Py<PyAny>,
+    /// Residuals (n, 2): full (dphi, dwz); half (phi(KT/2) - phi0 - pi turns, NaN).
     residual: Py<PyAny>,
+    /// Max-norm of the residual, (n,) (NaN when the start could not be integrated).
     residual_norm: Py<PyAny>,
+    /// Accepted Newton steps, int64 (n,).
     iterations: Py<PyAny>,
+    /// reason == "converged", bool (n,).
     converged: Py<PyAny>,
+    /// Why each candidate stopped: "converged", "max_iterations", "singular_jacobian",
+    /// "no_descent" or "integration_failed".
     reason: Vec<&'static str>,
+    /// Full-period (K T) 2x2 monodromy at the final point, (n, 2, 2).
     monodromy: Py<PyAny>,
+    /// The freed parameter's final value (bordered corrections; else each candidate's Kz), (n,).
     parameter: Py<PyAny>,
+    /// d F / d (angle, wz0, parameter) at the final point, (n, 2, 3); NaN where not computed.
     jacobian: Py<PyAny>,
 }
 
 #[pymethods]
 impl PyCorrectionBatch {
-    /// Final phi0 (kept unless free="phi0" with closure="full"), (n,).
-    #[getter]
-    fn phi0(&self, py: Python<'_>) -> Py<PyAny> {
-        self.phi0.clone_ref(py)
-    }
-    /// Final inertial wz0, (n,).
-    #[getter]
-    fn wz0(&self, py: Python<'_>) -> Py<PyAny> {
-        self.wz0.clone_ref(py)
-    }
-    /// Final Sun phase (kept unless free="sun_phase"; not wrapped), (n,).
-    #[getter]
-    fn theta_sun0(&self, py: Python<'_>) -> Py<PyAny> {
-        self.theta_sun0.clone_ref(py)
-    }
-    /// Residuals (n, 2): full (dphi, dwz); half (phi(KT/2) - phi0 - pi turns, NaN).
-    #[getter]
-    fn residual(&self, py: Python<'_>) -> Py<PyAny> {
-        self.residual.clone_ref(py)
-    }
-    /// Max-norm of the residual, (n,) (NaN when the start could not be integrated).
-    #[getter]
-    fn residual_norm(&self, py: Python<'_>) -> Py<PyAny> {
-        self.residual_norm.clone_ref(py)
-    }
-    /// Accepted Newton steps, int64 (n,).
-    #[getter]
-    fn iterations(&self, py: Python<'_>) -> Py<PyAny> {
-        self.iterations.clone_ref(py)
-    }
-    /// reason == "converged", bool (n,).
-    #[getter]
-    fn converged(&self, py: Python<'_>) -> Py<PyAny> {
-        self.converged.clone_ref(py)
-    }
-    /// Why each candidate stopped: "converged", "max_iterations", "singular_jacobian",
-    /// "no_descent" or "integration_failed".
-    #[getter]
-    fn reason(&self) -> Vec<&'static str> {
-        self.reason.clone()
-    }
-    /// Full-period (K T) 2x2 monodromy at the final point, (n, 2, 2).
-    #[getter]
-    fn monodromy(&self, py: Python<'_>) -> Py<PyAny> {
-        self.monodromy.clone_ref(py)
-    }
-    /// The freed parameter's final value (bordered corrections; else each candidate's Kz), (n,).
-    #[getter]
-    fn parameter(&self, py: Python<'_>) -> Py<PyAny> {
-        self.parameter.clone_ref(py)
-    }
-    /// d F / d (angle, wz0, parameter) at the final point, (n, 2, 3); NaN where not computed.
-    #[getter]
-    fn jacobian(&self, py: Python<'_>) -> Py<PyAny> {
-        self.jacobian.clone_ref(py)
-    }
     fn __len__(&self) -> usize {
         self.reason.len()
     }
@@ -275,92 +177,48 @@ impl PyCorrectionBatch {
     }
 }
 
+/// The corrector's candidates of planar cases (their turns and plates), with the bordered
+/// conditions per candidate when given.
+fn candidates(c: &PlanarCases, bordered: Option<&Bordered>) -> PyResult<Vec<Candidate>> {
+    let n = c.wz0.len();
+    let mut cands: Vec<Candidate> = (0..n).map(|i| Candidate::new(c.phi0[i], c.wz0[i], c.kz[i], c.turns[i]).with_plate(c.eps[i], c.cs[i], c.cd[i], c.theta_sun0[i])).collect();
+    if let Some(rows) = bordered.and_then(|b| b.conditions.as_ref()) {
+        if rows.len() != n {
+            return Err(invalid(format!("invalid argument `conditions`: one row (a_angle, a_wz0, a_parameter, b) per candidate, shape ({n}, 4); got shape ({}, 4)", rows.len())));
+        }
+        for (cand, r) in cands.iter_mut().zip(rows) {
+            *cand = cand.with_condition([r[0], r[1], r[2]], r[3]);
+        }
+    }
+    Ok(cands)
+}
+
 /// Correct many candidates at once to periodic planar attitude motions along the forcing's orbit
-/// (one Rust call for all Newton iterations; see librate_core::attitude::correct_planar_attitudes).
+/// (one Rust call for all Newton iterations; see librate_core::attitude::correct_planar_attitudes);
+/// `bordered`: the parameter freed with its condition(s).
 #[pyfunction]
-#[pyo3(signature = (forcing, phi0, wz0, kz, turns, *, t_final, closure, free="phi0", eps=None, cs=None, cd=None, theta_sun0=None,
-    tol=1e-12, max_iter=40, rtol=1e-13, atol=1e-13, max_steps=200_000, max_wz_step=0.5, max_angle_step=0.5, threads=None, chunk=64,
-    parameter=None, condition=None, parameter_step=1e-6, max_parameter_step=0.5, monodromy=true, max_halvings=10, conditions=None))]
+#[pyo3(signature = (forcing, cases, *, t_final, closure, free, options, bordered=None))]
 fn attitude_correct<'py>(
     py: Python<'py>,
     forcing: PyRef<'py, PyOrbitForcing>,
-    phi0: PyReadonlyArray1<'py, f64>,
-    wz0: PyReadonlyArray1<'py, f64>,
-    kz: PyReadonlyArray1<'py, f64>,
-    turns: PyReadonlyArray1<'py, f64>,
+    cases: PyRef<'py, PlanarCases>,
     t_final: f64,
-    closure: &str,
-    free: &str,
-    eps: Option<PyReadonlyArray1<'py, f64>>,
-    cs: Option<PyReadonlyArray1<'py, f64>>,
-    cd: Option<PyReadonlyArray1<'py, f64>>,
-    theta_sun0: Option<PyReadonlyArray1<'py, f64>>,
-    tol: f64,
-    max_iter: usize,
-    rtol: f64,
-    atol: f64,
-    max_steps: u32,
-    max_wz_step: f64,
-    max_angle_step: f64,
-    threads: Option<usize>,
-    chunk: usize,
-    parameter: Option<&str>,
-    condition: Option<(f64, f64, f64, f64)>,
-    parameter_step: f64,
-    max_parameter_step: f64,
-    monodromy: bool,
-    max_halvings: u32,
-    conditions: Option<PyReadonlyArray2<'py, f64>>,
+    closure: Closure,
+    free: Free,
+    options: PyRef<'py, CorrectorOptions>,
+    bordered: Option<PyRef<'py, Bordered>>,
 ) -> PyResult<PyCorrectionBatch> {
-    let bordered = match (parameter, condition) {
-        (None, None) => None,
-        (Some(name), Some((a0, a1, a2, b))) => {
-            let parameter = match name {
-                "kz" => Parameter::Kz,
-                "eps" => Parameter::Eps,
-                other => return Err(PyValueError::new_err(format!("invalid argument `parameter`: must be 'kz' or 'eps', got {other:?}"))),
-            };
-            Some(Bordered { parameter, a: [a0, a1, a2], b, step: parameter_step, max_step: max_parameter_step })
-        }
-        _ => return Err(PyValueError::new_err("invalid argument `condition`: `parameter` and `condition` (a_angle, a_wz0, a_parameter, b) go together")),
-    };
-    let closure = match closure {
-        "half" => Closure::Half,
-        "full" => Closure::Full,
-        other => return Err(PyValueError::new_err(format!("invalid argument `closure`: must be 'half' or 'full', got {other:?}"))),
-    };
-    let free = match free {
-        "phi0" => Free::Phi0,
-        "sun_phase" => Free::SunPhase,
-        other => return Err(PyValueError::new_err(format!("invalid argument `free`: must be 'phi0' or 'sun_phase', got {other:?}"))),
-    };
-    let (p, w, k, tu) = (phi0.as_array(), wz0.as_array(), kz.as_array(), turns.as_array());
-    let n = w.len();
-    if p.len() != n || k.len() != n || tu.len() != n {
-        return Err(PyValueError::new_err(format!("invalid argument: phi0, wz0, kz and turns must have one length, got {}, {}, {}, {}", p.len(), n, k.len(), tu.len())));
+    if bordered.as_ref().is_some_and(|b| b.inner.parameter == Parameter::OrbitX0) {
+        return Err(invalid("invalid argument `bordered`: the orbit's x0 is freed by attitude_correct_across"));
     }
-    let (e, s, d, th) = (per_case(&eps, "eps", n)?, per_case(&cs, "cs", n)?, per_case(&cd, "cd", n)?, per_case(&theta_sun0, "theta_sun0", n)?);
-    let mut cands: Vec<Candidate> = (0..n).map(|i| Candidate::new(p[i], w[i], k[i], tu[i]).with_plate(e[i], s[i], d[i], th[i])).collect();
-    if let Some(c) = &conditions {
-        let c = c.as_array();
-        if bordered.is_none() || c.shape() != [n, 4] {
-            return Err(PyValueError::new_err(format!(
-                "invalid argument `conditions`: one row (a_angle, a_wz0, a_parameter, b) per candidate, shape ({n}, 4), with `parameter` and `condition`; got shape {:?}",
-                c.shape()
-            )));
-        }
-        for (i, cand) in cands.iter_mut().enumerate() {
-            *cand = cand.with_condition([c[[i, 0]], c[[i, 1]], c[[i, 2]]], c[[i, 3]]);
-        }
-    }
-    let opts = CorrectorOptions { tol, max_iter, rtol, atol, max_steps, max_wz_step, max_angle_step, threads, chunk, monodromy, max_halvings, ..CorrectorOptions::default() };
+    let cands = candidates(&cases, bordered.as_deref())?;
+    let (closure, free, opts) = (closure.into(), free.into(), options.core());
+    let border = bordered.as_ref().map(|b| b.inner);
     let f = &forcing.inner;
-    let out = py
-        .detach(|| match &bordered {
-            None => correct_planar_attitudes(f, t_final, closure, free, &cands, &opts),
-            Some(b) => correct_bordered(f, t_final, closure, free, b, &cands, &opts),
-        })
-        .map_err(to_py)?;
+    let out = interruptible(py, || match &border {
+        None => correct_planar_attitudes(f, t_final, closure, free, &cands, &opts),
+        Some(b) => correct_bordered(f, t_final, closure, free, b, &cands, &opts),
+    })?;
     batch_from(py, &out)
 }
 
@@ -407,75 +265,46 @@ impl PyPlanarFamily {
     }
 }
 
-/// The half-period correction with the orbit's x0 freed across a planar family, closed by the
-/// linear condition a_wz0 wz0 + a_x0 x0 = b (librate_core::attitude::correct_across_family).
+/// The half-period correction with the orbit's x0 freed across a planar family (the cases'
+/// phi0, wz0, kz and turns, the orbits' x0 guesses), closed by the bordered condition
+/// (parameter ORBIT_X0) a_wz0 wz0 + a_x0 x0 = b (librate_core::attitude::correct_across_family).
 #[pyfunction]
-#[pyo3(signature = (family, wz0, kz, turns, x0, *, condition, phi0=0.0, tol=1e-12, max_iter=40, rtol=1e-13, atol=1e-13, max_steps=200_000,
-    max_wz_step=0.5, parameter_step=1e-6, max_parameter_step=0.05, threads=None, max_halvings=10))]
+#[pyo3(signature = (family, cases, x0, *, bordered, options))]
 fn attitude_correct_across<'py>(
     py: Python<'py>,
     family: PyRef<'py, PyPlanarFamily>,
-    wz0: PyReadonlyArray1<'py, f64>,
-    kz: PyReadonlyArray1<'py, f64>,
-    turns: PyReadonlyArray1<'py, f64>,
+    cases: PyRef<'py, PlanarCases>,
     x0: PyReadonlyArray1<'py, f64>,
-    condition: (f64, f64, f64),
-    phi0: f64,
-    tol: f64,
-    max_iter: usize,
-    rtol: f64,
-    atol: f64,
-    max_steps: u32,
-    max_wz_step: f64,
-    parameter_step: f64,
-    max_parameter_step: f64,
-    threads: Option<usize>,
-    max_halvings: u32,
+    bordered: PyRef<'py, Bordered>,
+    options: PyRef<'py, CorrectorOptions>,
 ) -> PyResult<PyCorrectionBatch> {
-    let (w, k, tu, x) = (wz0.as_array(), kz.as_array(), turns.as_array(), x0.as_array());
-    let n = w.len();
-    if k.len() != n || tu.len() != n || x.len() != n {
-        return Err(PyValueError::new_err(format!("invalid argument: wz0, kz, turns and x0 must have one length, got {}, {}, {}, {}", n, k.len(), tu.len(), x.len())));
+    if bordered.inner.parameter != Parameter::OrbitX0 || bordered.conditions.is_some() {
+        return Err(invalid("invalid argument `bordered`: the correction across a family frees ORBIT_X0 under one condition"));
     }
-    let cands: Vec<Candidate> = (0..n).map(|i| Candidate::new(phi0, w[i], k[i], tu[i]).with_x0(x[i])).collect();
-    let bordered = Bordered { parameter: Parameter::OrbitX0, a: [0.0, condition.0, condition.1], b: condition.2, step: parameter_step, max_step: max_parameter_step };
-    let opts = CorrectorOptions { tol, max_iter, rtol, atol, max_steps, max_wz_step, threads, max_halvings, ..CorrectorOptions::default() };
+    let n = cases.wz0.len();
+    let x = vector(&x0, "x0", Some(n))?;
+    let cands: Vec<Candidate> = (0..n).map(|i| Candidate::new(cases.phi0[i], cases.wz0[i], cases.kz[i], cases.turns[i]).with_x0(x[i])).collect();
+    let (border, opts) = (bordered.inner, options.core());
     let fam = &family.inner;
-    let out = py.detach(|| correct_across_family(fam, &bordered, &cands, &opts)).map_err(to_py)?;
+    let out = interruptible(py, || correct_across_family(fam, &border, &cands, &opts))?;
     batch_from(py, &out)
 }
 
 /// The outcome of `planar_verify`: arrays over the items.
-#[pyclass(frozen, name = "PlanarVerification", module = "librate._core")]
+#[pyclass(frozen, get_all, name = "PlanarVerification", module = "librate._core")]
 pub struct PyPlanarVerification {
+    /// Unwrapped phi at t_final, (n,) (NaN where the integration failed).
     phi_t: Py<PyAny>,
+    /// wz at t_final, (n,).
     wz_t: Py<PyAny>,
+    /// d(phi, wz)(t_final) / d(phi0, wz0), (n, 2, 2).
     stm: Py<PyAny>,
+    /// The integration error message per item, or None.
     error: Vec<Option<String>>,
 }
 
 #[pymethods]
 impl PyPlanarVerification {
-    /// Unwrapped phi at t_final, (n,) (NaN where the integration failed).
-    #[getter]
-    fn phi_t(&self, py: Python<'_>) -> Py<PyAny> {
-        self.phi_t.clone_ref(py)
-    }
-    /// wz at t_final, (n,).
-    #[getter]
-    fn wz_t(&self, py: Python<'_>) -> Py<PyAny> {
-        self.wz_t.clone_ref(py)
-    }
-    /// d(phi, wz)(t_final) / d(phi0, wz0), (n, 2, 2).
-    #[getter]
-    fn stm(&self, py: Python<'_>) -> Py<PyAny> {
-        self.stm.clone_ref(py)
-    }
-    /// The integration error message per item, or None.
-    #[getter]
-    fn error(&self) -> Vec<Option<String>> {
-        self.error.clone()
-    }
     fn __len__(&self) -> usize {
         self.error.len()
     }
@@ -485,37 +314,27 @@ impl PyPlanarVerification {
 }
 
 /// Independent re-propagation of planar attitude motions (scalar model, orbit integrated
-/// alongside, rtol = atol = 1e-14) in parallel; a plate where eps is given and non-zero.
+/// alongside, rtol = atol = 1e-14) in parallel; a plate where the case's eps is non-zero.
 #[pyfunction]
-#[pyo3(signature = (mu, orbit_state0, t_final, kz, phi0, wz0, *, eps=None, cs=None, cd=None, theta_sun0=None, primaries=[true, true], threads=None))]
+#[pyo3(signature = (mu, orbit_state0, t_final, cases, *, primaries=[true, true], threads=None))]
 fn planar_verify<'py>(
     py: Python<'py>,
     mu: f64,
     orbit_state0: [f64; 6],
     t_final: f64,
-    kz: PyReadonlyArray1<'py, f64>,
-    phi0: PyReadonlyArray1<'py, f64>,
-    wz0: PyReadonlyArray1<'py, f64>,
-    eps: Option<PyReadonlyArray1<'py, f64>>,
-    cs: Option<PyReadonlyArray1<'py, f64>>,
-    cd: Option<PyReadonlyArray1<'py, f64>>,
-    theta_sun0: Option<PyReadonlyArray1<'py, f64>>,
+    cases: PyRef<'py, PlanarCases>,
     primaries: [bool; 2],
     threads: Option<usize>,
 ) -> PyResult<PyPlanarVerification> {
-    let (p, w, k) = (phi0.as_array(), wz0.as_array(), kz.as_array());
-    let n = w.len();
-    if p.len() != n || k.len() != n {
-        return Err(PyValueError::new_err(format!("invalid argument: kz, phi0 and wz0 must have one length, got {}, {}, {}", k.len(), p.len(), n)));
-    }
-    let (e, s, d, th) = (per_case(&eps, "eps", n)?, per_case(&cs, "cs", n)?, per_case(&cd, "cd", n)?, per_case(&theta_sun0, "theta_sun0", n)?);
+    let c = &*cases;
+    let n = c.wz0.len();
     let items = (0..n)
         .map(|i| {
-            let plate = if e[i] != 0.0 { Some(FlatPlate::new(e[i], s[i], d[i], Sun { theta0: th[i], ..Sun::default() }).map_err(to_py)?) } else { None };
-            Ok(PlanarStart { kz: k[i], phi0: p[i], wz0: w[i], plate })
+            let plate = if c.eps[i] != 0.0 { Some(FlatPlate::new(c.eps[i], c.cs[i], c.cd[i], Sun { theta0: c.theta_sun0[i], ..Sun::default() }).map_err(to_py)?) } else { None };
+            Ok(PlanarStart { kz: c.kz[i], phi0: c.phi0[i], wz0: c.wz0[i], plate })
         })
         .collect::<PyResult<Vec<_>>>()?;
-    let out = py.detach(|| verify_planar_attitudes(mu, &orbit_state0, t_final, &items, primaries, threads)).map_err(to_py)?;
+    let out = interruptible(py, || verify_planar_attitudes(mu, &orbit_state0, t_final, &items, primaries, threads))?;
     Ok(PyPlanarVerification {
         phi_t: out.iter().map(|o| o.phi_t).collect::<Vec<f64>>().into_pyarray(py).into_any().unbind(),
         wz_t: out.iter().map(|o| o.wz_t).collect::<Vec<f64>>().into_pyarray(py).into_any().unbind(),

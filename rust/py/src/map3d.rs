@@ -3,7 +3,6 @@
 
 use librate_core::attitude::RigidBody;
 use librate_core::integrate::forcing::TidalTable;
-use librate_core::integrate::lanes::LaneOptions;
 use librate_core::integrate::lanes3d::Case3d;
 use librate_core::map::sweep_3d;
 use numpy::ndarray::Array2;
@@ -11,6 +10,9 @@ use numpy::{IntoPyArray, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
+use crate::convert::rows;
+use crate::options::LaneOptions;
+use crate::interrupt::interruptible;
 use crate::to_py;
 
 /// The synodic-frame tidal tensor of one periodic orbit (planar or spatial), tabulated once
@@ -48,52 +50,24 @@ impl PyTidalTable {
     }
 }
 
-fn rows<const N: usize>(a: &PyReadonlyArray2<'_, f64>, name: &str, n: usize) -> PyResult<Vec<[f64; N]>> {
-    let a = a.as_array();
-    if a.nrows() != n || a.ncols() != N {
-        return Err(PyValueError::new_err(format!("invalid argument `{name}`: must have shape ({n}, {N}), got {:?}", a.shape())));
-    }
-    Ok((0..n).map(|i| std::array::from_fn(|k| a[(i, k)])).collect())
-}
-
 /// The outcome of `map_sweep_3d`: arrays over the cases.
-#[pyclass(frozen, name = "Sweep3DResult", module = "librate._core")]
+#[pyclass(frozen, get_all, name = "Sweep3DResult", module = "librate._core")]
 pub struct PySweep3DResult {
+    /// The six closure residuals (n, 6): the rotation vector of R(0)' R(t_final) in body axes,
+    /// then w(t_final) - w0.
     residual: Py<PyAny>,
+    /// The attitude at t_final (n, 4), scalar last.
     q_t: Py<PyAny>,
+    /// The inertial rate at t_final in body axes (n, 3).
     w_t: Py<PyAny>,
+    /// Lane status per case (0 ok, 1 max steps, 2 failed), uint8 (n,).
     status: Py<PyAny>,
+    /// Accepted and rejected steps per case, (n, 2).
     steps: Py<PyAny>,
 }
 
 #[pymethods]
 impl PySweep3DResult {
-    /// The six closure residuals (n, 6): the rotation vector of R(0)' R(t_final) in body axes,
-    /// then w(t_final) - w0.
-    #[getter]
-    fn residual(&self, py: Python<'_>) -> Py<PyAny> {
-        self.residual.clone_ref(py)
-    }
-    /// The attitude at t_final (n, 4), scalar last.
-    #[getter]
-    fn q_t(&self, py: Python<'_>) -> Py<PyAny> {
-        self.q_t.clone_ref(py)
-    }
-    /// The inertial rate at t_final in body axes (n, 3).
-    #[getter]
-    fn w_t(&self, py: Python<'_>) -> Py<PyAny> {
-        self.w_t.clone_ref(py)
-    }
-    /// Lane status per case (0 ok, 1 max steps, 2 failed), uint8 (n,).
-    #[getter]
-    fn status(&self, py: Python<'_>) -> Py<PyAny> {
-        self.status.clone_ref(py)
-    }
-    /// Accepted and rejected steps per case, (n, 2).
-    #[getter]
-    fn steps(&self, py: Python<'_>) -> Py<PyAny> {
-        self.steps.clone_ref(py)
-    }
     fn __len__(&self, py: Python<'_>) -> PyResult<usize> {
         self.status.bind(py).len()
     }
@@ -107,7 +81,7 @@ impl PySweep3DResult {
 /// `Sweep3DResult`: residual (n, 6), q_t (n, 4), w_t (n, 3), status (n,) uint8 (0 ok, 1 max
 /// steps, 2 failed), steps (n, 2) accepted and rejected.
 #[pyfunction]
-#[pyo3(signature = (table, t_final, q0, w0, inertia, *, rtol, atol, max_steps=200_000, chunk=64, threads=None))]
+#[pyo3(signature = (table, t_final, q0, w0, inertia, *, lanes))]
 fn map_sweep_3d<'py>(
     py: Python<'py>,
     table: PyRef<'py, PyTidalTable>,
@@ -115,18 +89,14 @@ fn map_sweep_3d<'py>(
     q0: PyReadonlyArray2<'py, f64>,
     w0: PyReadonlyArray2<'py, f64>,
     inertia: PyReadonlyArray2<'py, f64>,
-    rtol: f64,
-    atol: f64,
-    max_steps: u32,
-    chunk: usize,
-    threads: Option<usize>,
+    lanes: PyRef<'py, LaneOptions>,
 ) -> PyResult<PySweep3DResult> {
     let n = q0.as_array().nrows();
-    let (q, w, m) = (rows::<4>(&q0, "q0", n)?, rows::<3>(&w0, "w0", n)?, rows::<3>(&inertia, "inertia", n)?);
+    let (q, w, m) = (rows::<4>(&q0, "q0", Some(n))?, rows::<3>(&w0, "w0", Some(n))?, rows::<3>(&inertia, "inertia", Some(n))?);
     let cases: Vec<Case3d> = (0..n).map(|i| Case3d { q0: q[i], w0: w[i], body: RigidBody { ix: m[i][0], iy: m[i][1], iz: m[i][2] } }).collect();
-    let opts = LaneOptions { rtol, atol, max_steps, ..LaneOptions::default() };
+    let (opts, chunk, threads) = (lanes.core(), lanes.chunk, lanes.threads);
     let f = &table.inner;
-    let out = py.detach(|| sweep_3d(f, t_final, &cases, &opts, chunk, threads)).map_err(to_py)?;
+    let out = interruptible(py, || sweep_3d(f, t_final, &cases, &opts, chunk, threads))?;
     let flat = |k: usize, g: &dyn Fn(&librate_core::integrate::lanes3d::Outcome3d) -> Vec<f64>| -> PyResult<Py<PyAny>> {
         let v: Vec<f64> = out.iter().flat_map(g).collect();
         Ok(Array2::from_shape_vec((n, k), v).map_err(|e| PyValueError::new_err(e.to_string()))?.into_pyarray(py).into_any().unbind())

@@ -232,6 +232,7 @@ pub(crate) fn solve<const N: usize, P: Problem<N>>(
     let mut batch: Vec<P::Traj> = Vec::with_capacity(per * tracks.len());
     let mut active: Vec<(usize, [f64; N], Option<usize>)> = Vec::with_capacity(tracks.len());
     loop {
+        crate::interrupt::check()?;
         batch.clear();
         active.clear();
         for (i, t) in tracks.iter().enumerate() {

@@ -164,7 +164,10 @@ pub fn sweep_3d_at(level: Level, table: &TidalTable, t_final: f64, cases: &[Case
         crate::simd::parse(Some(level.name()))?;
     }
     let chunk = chunk.div_ceil(LANES) * LANES;
-    let run = |part: &[Case3d]| crate::simd::run_at(level, Groups3d { table, t_final, cases: part, opts });
+    let run = |part: &[Case3d]| {
+        crate::interrupt::check()?;
+        crate::simd::run_at(level, Groups3d { table, t_final, cases: part, opts })
+    };
     let parts = with_threads(threads, || cases.par_chunks(chunk).map(run).collect::<Result<Vec<_>>>())??;
     Ok(parts.concat())
 }

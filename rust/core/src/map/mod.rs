@@ -82,6 +82,7 @@ pub fn sweep_at(
         crate::simd::parse(Some(level.name()))?;
     }
     let run = |part: &[Case]| -> Result<Vec<Outcome>> {
+        crate::interrupt::check()?;
         let srp = opts.sensitivity == lanes::Sensitivity::Eps || part.chunks(lanes::LANES).any(|g| g.iter().any(|c| c.eps != 0.0));
         match (with_stm, srp) {
             (true, false) => integrate_cases::<8, false>(level, forcing, t_final, part, opts),

@@ -240,6 +240,7 @@ impl SymmetricShooting {
         let (mut r, mut j) = self.system(&e, &constraint);
         let mut norm = r.amax();
         for it in 0..=self.max_iter {
+            crate::interrupt::check()?;
             if norm <= self.tol {
                 let s0 = [e.p[0], 0.0, e.p[1], 0.0, e.p[2], 0.0];
                 return Ok(SymmetricOrbit { state0: s0, period: 2.0 * e.half_period, jacobi: e.jacobi, iterations: it, residual: norm, evaluation: e });
