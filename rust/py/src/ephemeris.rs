@@ -17,7 +17,7 @@ fn arr6(name: &str, v: &[f64]) -> PyResult<[f64; 6]> {
 /// The ephemeris (Chebyshev segments evaluated in Rust).
 #[pyclass(module = "librate._core", frozen)]
 pub struct EphemerisCore {
-    inner: Ephemeris,
+    pub(crate) inner: Ephemeris,
 }
 
 #[pymethods]

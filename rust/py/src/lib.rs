@@ -20,6 +20,7 @@ mod attitude;
 mod attitude3d;
 mod build;
 mod ephemeris;
+mod ephemeris_attitude;
 mod flexible;
 mod fourier;
 mod map;
@@ -408,6 +409,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(multiple_shooting, m)?)?;
     fourier::register(m)?;
     ephemeris::register(m)?;
+    ephemeris_attitude::register(m)?;
     attitude::register(m)?;
     map::register(m)?;
     flexible::register(m)?;
