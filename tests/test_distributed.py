@@ -274,14 +274,17 @@ def test_solve_survives_a_killed_worker_bit_identically(cluster, solve_study, tm
 
 
 def test_solve_3d_refuses_a_scheduler(tmp_path):
-    """A 3-D solve is one sequential continuation: a scheduler is refused before any work."""
-    from types import SimpleNamespace
-
+    """A 3-D solve is one sequential continuation: a scheduler is refused before any work (the
+    3-D study's type picks the 3-D job; nothing is written)."""
     from librate.app.jobs import run_solve
+    from librate.app.study import Study, Study3D
 
-    study = SimpleNamespace(attitude=SimpleNamespace(model="3d"))
+    study = Study.from_dict({"attitude": {"model": "3d", "start": "spin", "n": 0}, "orbits": {"x0": [0.85]},
+                             "body": {"ix": 12.12e6, "iy": 89.68e6, "iz": 96.95e6}}, purpose="solve")
+    assert isinstance(study, Study3D)
     with pytest.raises(ValueError, match="`scheduler`: a 3-D solve is one continuation"):
         run_solve(study, tmp_path, scheduler="tcp://127.0.0.1:1")
+    assert not any(tmp_path.iterdir())
 
 
 # --- every worker restarted, and a scheduler gone for good ------------------------------------------

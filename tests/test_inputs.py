@@ -128,6 +128,25 @@ def test_tol_and_max_iter_are_checked(em, kw, name):
             librate.correct_periodic(em, [0.85, 0, 0, 0, 0.5, 0], 3.0, **kw)
 
 
+@pytest.mark.parametrize("dc", [5.0, 10.0])
+def test_an_unreachable_jacobi_target_fails_at_once(em, dc):
+    """Issue 24: correct_periodic from the x0 = 0.3 DRO with its Jacobi constant raised by 5 or
+    10 took 26 s and 139 s to end in a ConvergenceError (Newton drives the state toward the
+    Earth, whose trajectories run to the step limit). The target exceeds 2U(r) at the guess's
+    position (6.4547: C = 2U - |v|^2 is at most 2U there, an analytic bound), so no state of the
+    member wanted is there: a ValueError names `jacobi` and the bound, in well under a second
+    (tolerance: 1 s on a loaded machine). A reachable far target (+1) still converges."""
+    import time
+
+    dro = librate.correct_dro(em, 0.3)
+    t0 = time.perf_counter()
+    with pytest.raises(ValueError, match=r"invalid argument `jacobi`: .* out of reach of the guess: .* above 2U\(r\) = 6\.4546563"):
+        librate.correct_periodic(em, dro.state0, dro.period, jacobi=dro.jacobi + dc)
+    assert time.perf_counter() - t0 < 1.0
+    far = librate.correct_periodic(em, dro.state0, dro.period, jacobi=dro.jacobi + 1.0)
+    assert far.jacobi == pytest.approx(dro.jacobi + 1.0, abs=1e-9)
+
+
 def test_errors_name_the_users_parameters(em):
     """Guard: the user's parameter names, not the core's (already so for these two)."""
     with pytest.raises(ValueError, match="invalid argument `t_span`"):

@@ -206,3 +206,50 @@ def test_map_methods_agree_with_rkf78(method):
         a, b = ref[v].values, got[v].values
         assert np.all(np.isfinite(b))
         assert np.max(np.abs(a - b)) < 1e-10 * max(1.0, np.max(np.abs(a))), v
+
+
+def test_a_long_refinement_reports_progress_between_batches(em, monkeypatch):
+    """Issue 24 #12: a 16-rate map over 1000 periods refined for 14 minutes in one corrector
+    call, without a progress note. A batch past REFINE_BATCH_PERIODS candidate-periods is split
+    (here the limit is lowered so that 91 candidates over 2 periods make 6 batches of 16): the
+    progress callback runs after each batch, and the solutions are those of the single batch
+    (the same 23, wz0 to 1e-10: only the batch companions' last bits, ~1e-13, differ)."""
+    import librate.periodicity.maps as maps
+
+    o = librate.correct_dro(em, 0.6)
+    wz = np.linspace(-3.0, 2.0, 200)
+    row = librate.periodicity_map([o], kz=0.8, wz0=wz, n_periods=2, solve=False).phi_T.values[0]
+    one = maps.solutions_from_rows(o, [0.8], 0.0, wz, row, 2)
+    monkeypatch.setattr(maps, "REFINE_BATCH_PERIODS", 16)
+    calls = []
+    split = maps.solutions_from_rows(o, [0.8], 0.0, wz, row, 2, progress=lambda done, total: calls.append((done, total)))
+    assert calls == [(16, 91), (32, 91), (48, 91), (64, 91), (80, 91), (91, 91)]
+    assert len(one) == len(split) == 23
+    assert [(a.n, a.kind) for a in one] == [(b.n, b.kind) for b in split]
+    assert max(abs(a.wz0 - b.wz0) for a, b in zip(one, split)) < 1e-10
+
+
+def test_a_rate_grid_that_does_not_resolve_the_angle_is_named_not_refined(em):
+    """Issue 24 #12: 16 rates over K = 1000 periods gave 94,000 candidates on the example study's
+    12 DROs (up to ~2000 half-turns of phi(KT) between neighbouring rates): linear guesses of
+    nothing, refined for hours. An interval of more than MAX_CROSSINGS half-turns is left out
+    with a RuntimeWarning naming `wz0` and the orbit (here x0 = 0.9, K = 200: 7 of 15 intervals,
+    667 crossings in all). A grid that resolves the angle (300 rates, K = 1: at most 1.4
+    half-turns an interval) keeps every candidate, as before."""
+    import math
+
+    import librate.periodicity.maps as maps
+    from librate.periodicity.solutions import candidates
+
+    o = librate.correct_dro(em, 0.9)
+    wz = np.linspace(-3.0, 2.0, 16)
+    with pytest.warns(RuntimeWarning, match=r"does not resolve phi\(KT\) on the orbit x0 = 0.9 LU \(K = 200 periods\): 7 interval\(s\) of `wz0`"):
+        ds = librate.periodicity_map([o], kz=0.8, wz0=wz, n_periods=200)
+    row = ds.phi_T.values[0]
+    assert len(candidates(row[0], 0.0, wz, math.pi)) == 667
+    kept, _, unresolved = maps.row_candidates([0.8], 0.0, wz, row)
+    assert unresolved == 7 and len(kept) <= 8 * 8
+    fine = np.linspace(-3.0, 2.0, 300)
+    row = librate.periodicity_map([o], kz=0.8, wz0=fine, solve=False).phi_T.values[0]
+    kept, _, unresolved = maps.row_candidates([0.8], 0.0, fine, row)
+    assert unresolved == 0 and kept == candidates(row[0], 0.0, fine, math.pi)

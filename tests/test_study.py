@@ -410,21 +410,25 @@ def _giant(kz_num: int, wz_num: int, x0_num: int = 12) -> dict:
 
 
 def test_giant_map_is_refused_naming_the_keys_before_any_allocation():
-    """1000 Kz x 1e6 rates x 12 orbits: 1.2e10 trajectories and ~300 GB of map arrays (25 bytes
-    a cell), refused by the schema with a StudyError naming the keys, never a MemoryError."""
+    """1000 Kz x 1e6 rates x 12 orbits: 1.2e10 trajectories and ~556 GB of map memory (the
+    result arrays, 25 bytes a cell, and the row in flight, 256 bytes a case of one orbit's row:
+    librate._checks.map_bytes, the estimate the API refuses by too), refused by the schema with
+    a StudyError naming the keys, never a MemoryError."""
+    from librate._checks import MAP_CELL_BYTES, MAP_ROW_CELL_BYTES, map_bytes
     from librate.app.budget import MAX_MAP_BYTES, MAX_WORK
 
+    assert (MAP_CELL_BYTES, MAP_ROW_CELL_BYTES) == (3 * 8 + 1, 256)
     with pytest.raises(StudyError) as e:
         Study.from_dict(_giant(1000, 1_000_000), purpose="map")
     (msg,) = e.value.problems
     for text in ("orbits.x0 = 12 values", "body.kz = 1,000 values", "rates.wz0 = 1,000,000 values", "12,000,000,000 trajectories",
-                 f"limit of {MAX_WORK:.3g}", "300 GB", "--force"):
+                 f"limit of {MAX_WORK:.3g}", "556 GB", "--force"):
         assert text in msg, (text, msg)
-    assert 12e9 * 25 > MAX_MAP_BYTES
+    assert map_bytes(12, 10**9) == 12e9 * 25 + 1e9 * 256 > MAX_MAP_BYTES
     # force=True lifts the limit: the study validates (nothing is allocated by validation)
     st = Study.from_dict(_giant(1000, 1_000_000), purpose="map", force=True)
     est = st.estimate("map")
-    assert est.trajectories == 12_000_000_000 and est.bytes == 12_000_000_000 * 25
+    assert est.trajectories == 12_000_000_000 and est.bytes == 12_000_000_000 * 25 + 10**9 * 256
     with pytest.raises(StudyError, match="too large"):
         st.check("map")
     assert st.check("map", force=True) is not None
@@ -433,12 +437,32 @@ def test_giant_map_is_refused_naming_the_keys_before_any_allocation():
         Study.from_dict(_giant(1000, 1_000_000), purpose="solve")
 
 
+def test_a_study_within_its_budget_is_not_refused_by_the_engine():
+    """The study's budget and the API's refusal of a map (librate._checks.check_map_cells, the
+    guard of periodicity_map) are one estimate (map_bytes): a map study 1% under the 2 GiB limit
+    passes both, 1% over is refused by both (before, the budget counted 25 bytes a cell and the
+    API 57, so a study could pass its budget and then fail in the engine)."""
+    from librate._checks import MAP_CELL_BYTES, MAP_ROW_CELL_BYTES, MAX_ARRAY_BYTES, check_map_cells
+
+    for scale, refused in ((0.99, False), (1.01, True)):
+        nw = int(scale * MAX_ARRAY_BYTES / (12 * 10 * MAP_CELL_BYTES + 10 * MAP_ROW_CELL_BYTES))
+        data = {**_giant(10, nw), "solver": {"n_periods": 1}}
+        if refused:
+            with pytest.raises(StudyError, match="the map's memory .* exceeds the limit of 2.15 GB"):
+                Study.from_dict(data, purpose="map")
+            with pytest.raises(ValueError, match=r"invalid arguments `orbits`, `kz`, `wz0`: .* \(limit 2.15 GB\)"):
+                check_map_cells((12, 10, nw), "`orbits`, `kz`, `wz0`")
+        else:
+            assert Study.from_dict(data, purpose="map", force=True).estimate("map").bytes <= MAX_ARRAY_BYTES
+            assert check_map_cells((12, 10, nw), "`orbits`, `kz`, `wz0`") == 12 * 10 * nw
+
+
 def test_ordinary_studies_pass_and_grid_sizes_are_bounded():
     """The example study (12 orbits x 1 Kz x 300 rates) is far within the limits; every grid is
     bounded at 1e6 values (a table's num and a list's length)."""
     st = Study.from_dict(_giant(1, 300), purpose="map")
     est = st.estimate("map")
-    assert est.trajectories == 3600 and est.periods == 1 and est.bytes == 3600 * 25
+    assert est.trajectories == 3600 and est.periods == 1 and est.bytes == 3600 * 25 + 300 * 256  # results and the row in flight
     assert "3,600 trajectories" in est.text()
     with pytest.raises(StudyError, match=r"rates\.wz0\.num = 2000000: .*1000000"):
         Study.from_dict(_giant(1, 2_000_000), purpose="map")

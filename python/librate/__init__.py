@@ -29,6 +29,7 @@ from .attitude import (
 from .ephemeris import Ephemeris, EphemerisTrajectory, propagate_ephemeris
 from .orbits import (
     BatchResult,
+    EphemerisOrbit,
     Event,
     EventHit,
     FourierOrbit,
@@ -45,6 +46,7 @@ from .orbits import (
     dro,
     dro_family,
     eci_to_synodic,
+    ephemeris_sweep,
     fit_fourier,
     halo,
     halo_family,
@@ -55,6 +57,7 @@ from .orbits import (
     propagate,
     propagate_many,
     synodic_to_eci,
+    to_ephemeris,
 )
 from .periodicity import (
     AttitudeFamily,
@@ -94,6 +97,9 @@ __all__ = [
     "Ephemeris",
     "EphemerisTrajectory",
     "propagate_ephemeris",
+    "EphemerisOrbit",
+    "to_ephemeris",
+    "ephemeris_sweep",
     "EphemerisAttitude",
     "attitude_to_ephemeris",
     "System",

@@ -29,6 +29,27 @@ MAX_COUNT = 2**31 - 1
 #: The most memory (bytes) the arrays sized by one grid-size argument may take (the same limit
 #: as a study's map arrays, app/budget.py): 2 GiB.
 MAX_ARRAY_BYTES = 2 * 1024**3
+#: Bytes per (orbit, kz, wz0) cell of a planar map's result arrays, held for the whole map by
+#: ``periodicity_map``, the study runner and the ``librate map`` store alike: dwz, dphi and
+#: phi_T (float64) and status (uint8), 3 * 8 + 1 = 25.
+MAP_CELL_BYTES = 3 * 8 + 1
+#: Bytes per case of the one row (an orbit's kz x wz0 cases) in flight: its case grids (two
+#: float64 meshgrids), the engine's per-case records and outputs (phi_T, wz_T, dwz, dphi, status,
+#: steps). Measured: the peak RSS of a one-orbit map grows by 278 B per case from 2e5 to 1e6
+#: cases (25 B of them the result arrays), i.e. 253 B; rounded up.
+MAP_ROW_CELL_BYTES = 256
+#: Bytes per (body, wx0, wy0, wz0) case of a 3-D map's result arrays: six closure residuals and
+#: their norm (float64) and status (uint8), 7 * 8 + 1 = 57 (the cases run in chunks of a bounded
+#: size, so the results are what grows with the grid).
+MAP3D_CELL_BYTES = 7 * 8 + 1
+
+
+def map_bytes(n_orbits: int, row_cells: int) -> int:
+    """The peak memory of a planar map of ``n_orbits`` rows of ``row_cells`` cases each (bytes):
+    the result arrays of every row and the working set of the row in flight. The one estimate
+    behind the API's refusal (:func:`check_map_cells`) and a study's budget
+    (``librate.app.budget``)."""
+    return int(n_orbits) * int(row_cells) * MAP_CELL_BYTES + int(row_cells) * MAP_ROW_CELL_BYTES
 
 
 def as_real(value, name: str, *, positive: bool = False, nonnegative: bool = False, allow_inf: bool = False) -> float:
@@ -164,8 +185,21 @@ def check_cells(shape, names: str, *, item_bytes: float, what: str = "result arr
     overflows), refused with a ValueError naming ``names`` when its ``what`` would take more than
     MAX_ARRAY_BYTES at ``item_bytes`` per cell."""
     n = math.prod(int(k) for k in shape)
-    if n * item_bytes > MAX_ARRAY_BYTES:
-        dims = " x ".join(f"{int(k):,}" for k in shape)
-        raise ValueError(f"invalid arguments {names}: a grid of {dims} = {n:,} cases would need about {_bytes(n * item_bytes)} of "
-                         f"{what} (limit {_bytes(MAX_ARRAY_BYTES)}); use fewer values")
+    _refuse(shape, names, n, n * item_bytes, what)
     return n
+
+
+def check_map_cells(shape, names: str) -> int:
+    """:func:`check_cells` for a planar map of ``shape`` = (orbits, *row): its memory is
+    :func:`map_bytes` (the results of every row and the working set of one)."""
+    n = math.prod(int(k) for k in shape)
+    row = math.prod(int(k) for k in shape[1:])
+    _refuse(shape, names, n, map_bytes(int(shape[0]), row), "memory (result arrays and the row in flight)")
+    return n
+
+
+def _refuse(shape, names: str, n: int, nbytes: float, what: str) -> None:
+    if nbytes > MAX_ARRAY_BYTES:
+        dims = " x ".join(f"{int(k):,}" for k in shape)
+        raise ValueError(f"invalid arguments {names}: a grid of {dims} = {n:,} cases would need about {_bytes(nbytes)} of "
+                         f"{what} (limit {_bytes(MAX_ARRAY_BYTES)}); use fewer values")

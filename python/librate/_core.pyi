@@ -730,6 +730,16 @@ class EphemerisCore:
         atol: float = 1e-9,
         gm: tuple[float, float, float] | None = None,
     ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], npt.NDArray[np.float64] | None]: ...
+    def transition(
+        self,
+        states_km: npt.NDArray[np.float64],
+        epochs: npt.NDArray[np.float64],
+        tol: tuple[float, float],
+        scales: tuple[float, float],
+        epoch_free: bool = False,
+        max_iter: int = 30,
+        integration: tuple[float, float] = (1e-13, 1e-9),
+        gm: tuple[float, float, float] | None = None,
 
 __all__ += ["EphemerisAttitudeModel", "eclipse_fraction", "R_SUN_KM", "R_EARTH_KM", "R_MOON_KM", "AU_KM"]
 

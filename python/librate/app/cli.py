@@ -19,6 +19,7 @@ from .._errors import LibrateError
 from ..orbits.system import System
 from .commands import demo_summary, map_3d_summary, map_solutions_summary, solutions_table, solve_3d_summary
 from .jobs import run_family, run_map, run_solve
+from .study import Study3D
 
 _CONTEXT = {"help_option_names": ["-h", "--help"], "max_content_width": 100}
 
@@ -424,7 +425,7 @@ def solve(study, sets, out_dir, resume, quiet, scheduler) -> None:
 
     st = _load_study(study, "solve", _overrides(sets), force=not resume, quiet=quiet)
     _check_writable(st.output_dir(out_dir), "--out" if out_dir else "output.folder")
-    three_d = st.attitude.model == "3d"
+    three_d = isinstance(st, Study3D)
     t0 = time.perf_counter()
     try:
         ds, path = run_solve(st, out_dir, progress=reporter("3-D solutions" if three_d else "solutions", "member" if three_d else "orbit-Kz",

@@ -3,18 +3,22 @@
 Each job takes a valid :class:`~librate.app.study.Study` (the schema) and an output folder, reuses
 or refuses an existing result of the same name (:func:`librate.app.results.check_output`),
 computes, and saves the result with the study and the package version as attributes.
+``run_solve`` and ``run_map`` dispatch on the study's type (:func:`functools.singledispatch`):
+one implementation per attitude model (:class:`~librate.app.study.PlanarStudy`,
+:class:`~librate.app.study.Study3D`), registered below.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
 
-from .study import ATTITUDE_TOL, Study, StudyError, grid_raw, member_count, problem
+from .study import PlanarStudy, Study, Study3D, StudyError, grid_raw, member_count, problem
 
 __all__ = ["run_family", "run_map", "run_solve"]
 
@@ -60,8 +64,18 @@ def run_family(study: Study, out: str | Path | None = None, *, force: bool = Fal
     path = save_family(sel, path, study.result_attrs("family", "family"))
     return sel, path
 
+@functools.singledispatch
 def run_solve(study: Study, out: str | Path | None = None, progress: Callable[[int, int], None] | None = None, *, force: bool = False,
               say: Callable[[str], None] | None = None, scheduler=None):
+    """``librate solve``: one implementation per attitude model, by the study's type (the
+    planar one: :func:`_run_solve_planar`; the 3-D one: :func:`_run_solve_3d`). Returns
+    ``(dataset, path)``."""
+    raise TypeError(f"invalid argument `study`: must be a librate Study, got {type(study).__name__}")
+
+
+@run_solve.register
+def _run_solve_planar(study: PlanarStudy, out: str | Path | None = None, progress: Callable[[int, int], None] | None = None, *,
+                      force: bool = False, say: Callable[[str], None] | None = None, scheduler=None):
     """The periodic attitude solutions of every selected orbit and Kz with wz0 in the rate
     window (:func:`librate.find_periodic_attitudes`, scanning on the study's rate grid),
     saved as ``solve.zarr`` (or ``.nc``). Returns ``(dataset, path)``; the Dataset has a
@@ -71,15 +85,7 @@ def run_solve(study: Study, out: str | Path | None = None, progress: Callable[[i
 
     ``scheduler``: None (this process), a Dask ``distributed.Client`` or its address: each
     (orbit, Kz) is one task (:func:`librate.app.distribute.run_tasks`, checksummed on arrival,
-    resubmitted when lost with its worker); the table equals the local one bit for bit.
-
-    With ``[attitude] model = "3d"`` see the 3-D branch below instead (one continuation: it
-    runs in this process, and a ``scheduler`` is refused)."""
-    if study.attitude.model == "3d":
-        if scheduler is not None:
-            raise ValueError("invalid argument `scheduler`: a 3-D solve is one continuation along the members (sequential); "
-                             "it runs in this process (use scheduler=None)")
-        return _run_solve_3d(study, out, progress, force=force, say=say)
+    resubmitted when lost with its worker); the table equals the local one bit for bit."""
     from .distribute import Task, run_tasks
     from .results import save_dataset, solutions_dataset
 
@@ -134,8 +140,9 @@ def _solution_of(orbit, srp, fields: dict):
     return AttitudeSolution(orbit=orbit, srp=srp, **fields)
 
 
-def _run_solve_3d(study: Study, out: str | Path | None = None, progress: Callable[[int, int], None] | None = None, *, force: bool = False,
-                 say: Callable[[str], None] | None = None):
+@run_solve.register
+def _run_solve_3d(study: Study3D, out: str | Path | None = None, progress: Callable[[int, int], None] | None = None, *, force: bool = False,
+                  say: Callable[[str], None] | None = None, scheduler=None):
     """``librate solve`` on a ``[attitude] model = "3d"`` study: one periodic 3-D attitude
     motion of the body (body.ix/iy/iz) over ``solver.n_periods`` orbit periods, continued
     along the selected members in their order (:func:`librate.attitude_family_3d`, natural
@@ -148,7 +155,11 @@ def _run_solve_3d(study: Study, out: str | Path | None = None, progress: Callabl
     ``solver.phi0`` (the body's Kz; exactly one must be there); "spin", the torque-free spin
     (1 + 2 pi n / (K T)) e_Z at :meth:`Study.q0_3d`; "given", (:meth:`Study.q0_3d`, ``attitude.w0``).
     Returns ``(dataset, path)``; reuse and ``force`` as in :func:`run_family`.
-    ``progress(done, total)`` after each member reached."""
+    ``progress(done, total)`` after each member reached. It is one continuation: it runs in
+    this process, and a ``scheduler`` is refused."""
+    if scheduler is not None:
+        raise ValueError("invalid argument `scheduler`: a 3-D solve is one continuation along the members (sequential); "
+                         "it runs in this process (use scheduler=None)")
     from .._errors import ConvergenceError
     from ..periodicity.attitude3d import attitude_family_3d
     from .results import save_dataset, solutions_3d_dataset
@@ -166,7 +177,7 @@ def _run_solve_3d(study: Study, out: str | Path | None = None, progress: Callabl
     k = study.n_periods()
     guess, start = _start_3d(study, members[0], body, k)
     periods = [o.period_days for o in members]
-    tol = study.attitude.tol or ATTITUDE_TOL
+    tol = study.tol
     try:
         ds = attitude_family_3d(fam, body, guess=guess, period_days=periods, n_periods=k, tol=tol, progress=progress, method="natural")
     except ConvergenceError as err:
@@ -176,7 +187,7 @@ def _run_solve_3d(study: Study, out: str | Path | None = None, progress: Callabl
     path = save_dataset(ds, path)
     return ds, path
 
-def _start_3d(study: Study, orbit, body, n_periods: int):
+def _start_3d(study: Study3D, orbit, body, n_periods: int):
     """The guess of the first member's 3-D motion and its description (attributes)."""
     from scipy.spatial.transform import Rotation
 
@@ -218,8 +229,29 @@ def _start_3d(study: Study, orbit, body, n_periods: int):
     return (q0, w0), {"start": start, **extra, "start_q0": [float(v) for v in q0], "start_w0": [float(v) for v in w0],
                       "start_description": desc}
 
+@functools.singledispatch
 def run_map(study: Study, out: str | Path | None = None, *, scheduler=None, progress: bool | None = None, force: bool = False,
             say: Callable[[str], None] | None = None):
+    """``librate map``: one implementation per attitude model, by the study's type (the planar
+    one: :func:`_run_map_planar`; the 3-D one: :func:`_run_map_3d`). Returns ``(dataset, path)``."""
+    raise TypeError(f"invalid argument `study`: must be a librate Study, got {type(study).__name__}")
+
+
+@run_map.register
+def _run_map_3d(study: Study3D, out: str | Path | None = None, *, scheduler=None, progress: bool | None = None, force: bool = False,
+                say: Callable[[str], None] | None = None):
+    """The six 3-D closure residuals over (orbit, two rate grids) into ``map.zarr`` (or ``.nc``),
+    orbit by orbit, resumable (:func:`librate.app.results.run_map_3d_to`); ``force``: recomputed."""
+    from .results import run_map_3d_to
+
+    return run_map_3d_to(study.build_orbits(), _result_path(study, out, "map"), body=study.build_body(), rates=study.rates_3d(), q0=study.q0_3d(),
+                         n_periods=study.n_periods(), tol=study.tol, resume=not force, scheduler=scheduler,
+                         progress=progress, attrs=study.result_attrs("map_3d", "map"))
+
+
+@run_map.register
+def _run_map_planar(study: PlanarStudy, out: str | Path | None = None, *, scheduler=None, progress: bool | None = None,
+                    force: bool = False, say: Callable[[str], None] | None = None):
     """The attitude periodicity map (grids of wz(T) - wz0 and phi(T) - phi0 over orbit x Kz
     x wz0, and the refined solutions) through ``librate.app.runner.run_map`` into
     ``map.zarr`` in the output folder (resumable), or, when the runner is not installed,
@@ -231,13 +263,9 @@ def run_map(study: Study, out: str | Path | None = None, *, scheduler=None, prog
     raises :class:`~librate.app.results.ResultExists` naming the changed keys, unless
     ``force``: then it is replaced (after ``say`` names it) once the new map is complete.
     ``progress``: progress bars on stderr (None: only when stderr is a terminal)."""
-    from .results import check_output, run_map_3d_to, run_map_to
+    from .results import check_output, run_map_to
 
     folder = study.output_dir(out)
-    if study.attitude.model == "3d":
-        return run_map_3d_to(study.build_orbits(), _result_path(study, out, "map"), body=study.build_body(), rates=study.rates_3d(), q0=study.q0_3d(),
-                             n_periods=study.n_periods(), tol=study.attitude.tol or ATTITUDE_TOL, resume=not force, scheduler=scheduler,
-                             progress=progress, attrs=study.result_attrs("map_3d", "map"))
     store = folder / "map.zarr"
     # validated before the store is touched: a study error never costs an existing map
     orbits = study.build_orbits()

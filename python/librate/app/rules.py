@@ -26,79 +26,87 @@ def _check_increasing(key: str, g, problems: list[str]) -> None:
             problems.append(problem(key, g, "must be strictly increasing"))
 
 
-def check_sections(s: dict[str, Table], given: dict, purpose: str | None) -> list[str]:
-    """Consistency checks on the sections that passed type validation (``s``); ``given`` is the
-    raw study as written (to tell a missing section from a defaulted one). The rules within one
-    section are its model's validator; the rules between sections are here."""
+def common_rules(s: dict[str, Table], given: dict, purpose: str | None) -> list[str]:
+    """The rules between sections that hold for every attitude model, on the sections that
+    passed type validation (``s``); ``given`` is the raw study as written (to tell a missing
+    section from a defaulted one). The rules within one section are its model's validator; each
+    attitude model's own rules between sections are :func:`planar_rules` and :func:`rules_3d`
+    (the study's class, :class:`librate.app.study.PlanarStudy` or ``Study3D``, picks one)."""
     problems: list[str] = []
-    orb = s.get("orbits")
-    body = s.get("body")
-    tq = s.get("torques")
+    body, tq, rates = s.get("body"), s.get("torques"), s.get("rates")
     if tq is not None:
         srp = tq.srp  # one rule between [torques.srp] and [body]:
         if srp is not None and srp.eps is None and srp.area_m2 is not None and srp.offset_m is not None \
                 and body is not None and body.iz is None and body.kz is not None:
             problems.append(problem("torques.srp.area_m2", srp.area_m2, "the plate's geometry needs the body's Iz in kg m^2 (body.ix, body.iy, body.iz); with body.kz alone give torques.srp.eps",
                                      "torques.srp.eps with body.kz, or the geometry with body.ix/iy/iz"))
+    if rates is not None and rates.wz0 is not None and rates.phidot0 is not None:
+        problems.append(problem("rates.phidot0", grid_raw(rates.phidot0), "cannot be combined with rates.wz0 (phidot0 = wz0 - 1)", "either rates.wz0 or rates.phidot0"))
+    return problems
 
-    # [attitude] (a section that failed type validation counts as the default planar model)
-    att = s.get("attitude")
-    three_d = att is not None and att.model == "3d"
-    start = start_of(att, orb) if three_d else None
 
-    # [rates]
-    rates = s.get("rates")
+def planar_rules(s: dict[str, Table], given: dict, purpose: str | None) -> list[str]:
+    """The planar model's rules between sections (a study whose [attitude] failed type
+    validation is checked as planar, the default), and what ``purpose`` needs from it."""
+    problems: list[str] = []
+    orb, body, tq, rates = s.get("orbits"), s.get("body"), s.get("torques"), s.get("rates")
     if rates is not None:
-        if rates.wz0 is not None and rates.phidot0 is not None:
-            problems.append(problem("rates.phidot0", grid_raw(rates.phidot0), "cannot be combined with rates.wz0 (phidot0 = wz0 - 1)", "either rates.wz0 or rates.phidot0"))
-        elif rates.wz0 is None and rates.phidot0 is None and not three_d:
+        if rates.wz0 is None and rates.phidot0 is None:
             problems.append(missing("rates.wz0", "missing: give rates.wz0 (inertial) or rates.phidot0 (relative to the synodic frame)"))
-        if not three_d:
-            for k in ("wx0", "wy0"):
-                if getattr(rates, k) is not None:
-                    problems.append(problem(f"rates.{k}", grid_raw(getattr(rates, k)), "applies only to attitude.model = \"3d\" (the planar model has the one rate wz)",
-                                             "rates.wz0 or rates.phidot0 with the planar model; rates.wx0 and rates.wy0 with [attitude] model = '3d'"))
+        for k in ("wx0", "wy0"):
+            if getattr(rates, k) is not None:
+                problems.append(problem(f"rates.{k}", grid_raw(getattr(rates, k)), "applies only to attitude.model = \"3d\" (the planar model has the one rate wz)",
+                                         "rates.wz0 or rates.phidot0 with the planar model; rates.wx0 and rates.wy0 with [attitude] model = '3d'"))
+        for k in ("wz0", "phidot0"):
+            if getattr(rates, k) is not None:
+                _check_increasing(f"rates.{k}", getattr(rates, k), problems)
+    if purpose not in ("solve", "map"):
+        return problems
+    what, need = ("periodic solutions", "need") if purpose == "solve" else ("a periodicity map", "needs")
+    if "body" not in given:
+        problems.append(missing("body", f"missing section [body]: {what} {need} the body (body.kz, or body.ix/iy/iz)"))
+    if "rates" not in given:
+        problems.append(missing("rates", f"missing section [rates]: {what} {need} the initial rates (rates.wz0 or rates.phidot0)"))
+    if orb is not None and orb.kind == "halo":
+        problems.append(problem("orbits.kind", orb.kind, f"{what} use{'s' if need == 'needs' else ''} the planar attitude model, which needs a planar family",
+                                 "'dro' or 'lyapunov' with the planar model, or any family with [attitude] model = '3d'"))
+    if purpose == "map" and body is not None and body.flexible is not None:
+        problems.append(problem("body.flexible", body.flexible, "the periodicity-map engine integrates rigid bodies; "
+                                 "`librate solve` reports how flexibility moves each periodic solution", "body.kz or body.ix/iy/iz for a map"))
+    if body is not None and body.flexible is not None and tq is not None and tq.srp is not None:
+        problems.append(problem("torques.srp", "[torques.srp]", "the flexible model has no solar radiation pressure yet", "no [torques.srp] with body.flexible"))
+    if tq is not None and sorted(tq.gravity_gradient) != ["earth", "moon"]:
+        problems.append(problem("torques.gravity_gradient", tq.gravity_gradient,
+                                 f"the planar engine behind {what} models the gravity gradient of both primaries", "[\"earth\", \"moon\"]"))
+    if tq is not None and tq.srp is not None and orb is not None:
+        why = "with torques.srp the forcing is periodic only on a Sun-resonant orbit (T = Ts / k): select exactly one"
+        if orb.sun_resonance is None:
+            problems.append(missing("orbits.sun_resonance", f"missing: {why}, e.g. orbits.sun_resonance = [2]"))
+        elif len(orb.sun_resonance) != 1:
+            problems.append(problem("orbits.sun_resonance", orb.sun_resonance, why, "a list of one integer k >= 1, e.g. [2]"))
+        else:
+            k = orb.sun_resonance[0]
+            sol = s.get("solver")
+            if sol is not None and sol.n_periods is not None and sol.n_periods % k:
+                problems.append(problem("solver.n_periods", sol.n_periods, f"with torques.srp on the 1:{k} Sun-resonant orbit the attitude period must cover whole Sun periods",
+                                         f"a multiple of {k}"))
+    return problems
+
+
+def rules_3d(s: dict[str, Table], given: dict, purpose: str | None) -> list[str]:
+    """The 3-D model's rules between sections (``s["attitude"]`` an
+    :class:`~librate.app.schema.Attitude3D`), and what ``purpose`` needs from it."""
+    problems: list[str] = []
+    att, rates = s["attitude"], s.get("rates")
+    start = start_of(att, s.get("orbits"))
+    if rates is not None:
         for k in ("wz0", "phidot0", "wx0", "wy0"):
             g = getattr(rates, k)
-            # a number is a fixed rate of a 3-D map; every grid increases
-            if g is not None and not (three_d and isinstance(g, (int, float))) and (k in ("wz0", "phidot0") or three_d):
+            if g is not None and not isinstance(g, (int, float)):  # a number is a fixed rate of a 3-D map; every grid increases
                 _check_increasing(f"rates.{k}", g, problems)
-
-    if three_d:
-        problems += _check_3d(att, start, s, given)
-
-    # what the command needs
-    if purpose in ("solve", "map") and three_d:
+    problems += _check_3d(att, start, s, given)
+    if purpose in ("solve", "map"):
         problems += _needs_3d(purpose, start, s, given)
-    elif purpose in ("solve", "map"):
-        what, need = ("periodic solutions", "need") if purpose == "solve" else ("a periodicity map", "needs")
-        if "body" not in given:
-            problems.append(missing("body", f"missing section [body]: {what} {need} the body (body.kz, or body.ix/iy/iz)"))
-        if "rates" not in given:
-            problems.append(missing("rates", f"missing section [rates]: {what} {need} the initial rates (rates.wz0 or rates.phidot0)"))
-        if orb is not None and orb.kind == "halo":
-            problems.append(problem("orbits.kind", orb.kind, f"{what} use{'s' if need == 'needs' else ''} the planar attitude model, which needs a planar family",
-                                     "'dro' or 'lyapunov' with the planar model, or any family with [attitude] model = '3d'"))
-        if purpose == "map" and body is not None and body.flexible is not None:
-            problems.append(problem("body.flexible", body.flexible, "the periodicity-map engine integrates rigid bodies; "
-                                     "`librate solve` reports how flexibility moves each periodic solution", "body.kz or body.ix/iy/iz for a map"))
-        if body is not None and body.flexible is not None and tq is not None and tq.srp is not None:
-            problems.append(problem("torques.srp", "[torques.srp]", "the flexible model has no solar radiation pressure yet", "no [torques.srp] with body.flexible"))
-        if tq is not None and sorted(tq.gravity_gradient) != ["earth", "moon"]:
-            problems.append(problem("torques.gravity_gradient", tq.gravity_gradient,
-                                     f"the planar engine behind {what} models the gravity gradient of both primaries", "[\"earth\", \"moon\"]"))
-        if tq is not None and tq.srp is not None and orb is not None:
-            why = "with torques.srp the forcing is periodic only on a Sun-resonant orbit (T = Ts / k): select exactly one"
-            if orb.sun_resonance is None:
-                problems.append(missing("orbits.sun_resonance", f"missing: {why}, e.g. orbits.sun_resonance = [2]"))
-            elif len(orb.sun_resonance) != 1:
-                problems.append(problem("orbits.sun_resonance", orb.sun_resonance, why, "a list of one integer k >= 1, e.g. [2]"))
-            else:
-                k = orb.sun_resonance[0]
-                sol = s.get("solver")
-                if sol is not None and sol.n_periods is not None and sol.n_periods % k:
-                    problems.append(problem("solver.n_periods", sol.n_periods, f"with torques.srp on the 1:{k} Sun-resonant orbit the attitude period must cover whole Sun periods",
-                                             f"a multiple of {k}"))
     return problems
 
 

@@ -22,7 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..periodicity.maps import map_coords, map_dataset, map_grid, map_solutions_dataset, orbits_of, solutions_from_rows
+from ..periodicity.maps import map_coords, map_dataset, map_grid, map_solutions_dataset, orbits_of, row_candidates, solutions_from_rows
 from ..periodicity.solutions import MAP_ATOL, MAP_RTOL, check_orbit, check_srp, orbit_forcing, sweep
 from ..results.atomic import clean_orphans, remove_path, replace_path, temporary_sibling
 from ..results.kinds import map_schema
@@ -204,11 +204,14 @@ def _run(olist, family, kzs, wz, coords, fp, args, out, resume, scheduler, progr
                       complete=done.all(), attrs={"fingerprint": fp, **(attrs or {})})
     if solve:
         sols = []
-        with progress_bar(no, "solutions (Newton)", "orbit", progress) as sbar:
+        total = sum(len(row_candidates(kzs, float(phi0), wz, grid["phi_T"][i])[0]) for i in range(no))
+        with progress_bar(total, "solutions (Newton)", "candidate", progress) as sbar:
             for i, o in enumerate(olist):
-                # one batch per orbit, as periodicity_map does (the same lock-step companions: the same bits)
-                sols += [(i, s) for s in solutions_from_rows(o, kzs, float(phi0), wz, grid["phi_T"][i], int(n_periods), srp)]
-                sbar.update(1)
+                # the batches of periodicity_map (the same lock-step companions: the same bits); the
+                # bar moves after each batch, also within a long orbit's refinement
+                start = sbar.n
+                sols += [(i, s) for s in solutions_from_rows(o, kzs, float(phi0), wz, grid["phi_T"][i], int(n_periods), srp,
+                                                             progress=lambda done, _, start=start: sbar.update(start + done - sbar.n))]
         ds = ds.merge(map_solutions_dataset(sols))
     if store is not None:
         sol = {v: (("solution",), np.ascontiguousarray(ds[v].values), dict(ds[v].attrs)) for v in ds.data_vars if v.startswith("sol_")}

@@ -550,6 +550,14 @@ def grid_values(g) -> np.ndarray | None:
     return np.asarray(g, dtype=float)
 
 
+def grid_size(g) -> int:
+    """The number of values of a grid (a number: 1; a list; a table {start, stop, num}), from
+    its size alone (nothing is allocated)."""
+    if g is None or isinstance(g, (int, float)):
+        return 1
+    return int(g.num) if isinstance(g, Range) else len(g)
+
+
 def grid_raw(g) -> Any:
     if isinstance(g, Range):
         return g.model_dump()

@@ -39,13 +39,14 @@ import numpy as np
 from pydantic import ConfigDict, Field, ValidationError
 
 from .._errors import LibrateError
-from .rules import check_sections, member_count, start_of
+from .rules import common_rules, member_count, planar_rules, rules_3d, start_of
 from .schema import (
     ATTITUDE_TOL,
     FIGURES,
     FLEXIBLE_PRESETS,
     PURPOSES,
     SECTIONS,
+    Attitude3D,
     AttitudeSection,
     BodySection,
     Header,
@@ -60,6 +61,7 @@ from .schema import (
     Table,
     TorquesSection,
     grid_raw,
+    grid_size,
     grid_values,
     problem,
     pydantic_problems,
@@ -72,13 +74,18 @@ else:  # pragma: no cover - Python 3.10
     import tomli as tomllib
 
 # ATTITUDE_TOL, grid_raw, member_count and problem: the jobs (librate.app.jobs) read them from here.
-__all__ = ["ATTITUDE_TOL", "EXAMPLE_STUDY", "FIGURES", "PURPOSES", "Study", "StudyError", "grid_raw", "member_count", "problem"]
+__all__ = ["ATTITUDE_TOL", "EXAMPLE_STUDY", "FIGURES", "PURPOSES", "PlanarStudy", "Study", "Study3D", "StudyError", "grid_raw", "member_count", "problem"]
 
 # --- the study -----------------------------------------------------------------------------------
 class Study(Header):
     """A validated study (see the module docstring). Build it with :meth:`from_toml` or
     :meth:`from_dict`; it is immutable. ``base_dir`` is the folder relative output paths are
-    taken from (the study file's folder, or the working directory)."""
+    taken from (the study file's folder, or the working directory).
+
+    A study is one of a union discriminated by its attitude model, ``[attitude] model``: a
+    :class:`PlanarStudy` or a :class:`Study3D` (a third model is one more subclass, with its
+    [attitude] section, its rules between sections and its sizes). The jobs
+    (:mod:`librate.app.jobs`) dispatch on that type."""
 
     model_config = ConfigDict(extra="forbid", strict=True, frozen=True, allow_inf_nan=False)
 
@@ -149,11 +156,14 @@ class Study(Header):
                 valid[k] = sections[k]
             elif k not in data and k not in ("body", "rates"):
                 valid[k] = model.model_validate({}, context=context)
-        problems += check_sections(valid, data, purpose)
+        model = _STUDY_OF.get(type(valid.get("attitude")), PlanarStudy)  # a failed [attitude] is checked as the default model
+        problems += common_rules(valid, data, purpose) + model.rules_between(valid, data, purpose)
         if problems:
             raise StudyError(problems, source)
+        if not issubclass(model, cls):
+            raise StudyError([problem("attitude.model", valid["attitude"].model, f"a {cls.__name__} has another attitude model")], source)
         kwargs = {k: v for k, v in data.items() if k in ("title", "description")}
-        study = cls.model_construct(**kwargs, **valid, base_dir=str(base_dir if base_dir is not None else "."))
+        study = model.model_construct(**kwargs, **valid, base_dir=str(base_dir if base_dir is not None else "."))
         if purpose in ("solve", "map") and not force:
             from .budget import estimate, refusal
 
@@ -207,12 +217,11 @@ class Study(Header):
         if self.orbits.kind == "halo":
             d["orbits"].setdefault("branch", "south")
         d["solver"]["n_periods"] = self.n_periods()
-        if self.attitude.model == "planar":
-            d.pop("attitude", None)  # the default model: the stored study of a planar job is unchanged
-        else:
-            d["attitude"]["start"] = self.attitude_start()
-            d["attitude"].setdefault("tol", ATTITUDE_TOL)
-        return d
+        return self._with_attitude(d)
+
+    def _with_attitude(self, d: dict) -> dict:
+        """``d`` (:meth:`to_dict`) with the model's [attitude] and its defaults written out."""
+        raise NotImplementedError  # each model's subclass
 
     def to_json(self) -> str:
         """The full study as a JSON string (stored as the ``study`` attribute of every result)."""
@@ -373,26 +382,23 @@ class Study(Header):
     def attitude_start(self) -> str | None:
         """How a 3-D solve starts ("planar", "spin" or "given"; see ``attitude.start``), None
         with the planar model."""
-        return start_of(self.attitude, self.orbits) if self.attitude.model == "3d" else None
+        return None
 
-    def q0_3d(self) -> np.ndarray:
-        """The initial attitude of a 3-D study (scalar-last quaternion, body relative to the
-        synodic frame): ``attitude.q0``, else the rotation by ``solver.phi0`` about Z."""
-        if self.attitude.q0 is not None:
-            q = np.asarray(self.attitude.q0, dtype=float)
-            return q / np.linalg.norm(q)
-        h = 0.5 * self.solver.phi0
-        return np.array([0.0, 0.0, math.sin(h), math.cos(h)])
+    # --- the model's part: its rules between sections and its sizes -----------------------------
+    @classmethod
+    def rules_between(cls, s: dict[str, Table], given: dict, purpose: str | None) -> list[str]:
+        """This model's rules between the sections that passed type validation (``s``; ``given``:
+        the study as written), and what ``purpose`` needs (:mod:`librate.app.rules`)."""
+        raise NotImplementedError  # each model's subclass
 
-    def rates_3d(self) -> dict[str, np.ndarray]:
-        """The initial rates of a 3-D map, ``{"wx0", "wy0", "wz0"}`` -> values (1/TU, inertial,
-        body axes; a fixed rate is one value; ``rates.phidot0`` + 1 for wz0)."""
-        r = self.rates
-        if r is None:
-            raise ValueError("the study has no [rates]")
-        wz = grid_values(r.wz0) if r.wz0 is not None else (None if r.phidot0 is None else grid_values(r.phidot0) + 1.0)
-        out = {"wx0": grid_values(r.wx0), "wy0": grid_values(r.wy0), "wz0": wz}
-        return {k: v for k, v in out.items() if v is not None}
+    def grid_factors(self, purpose: str) -> list[tuple[str, int]]:
+        """(key, count) of each grid a ``purpose`` ("solve" or "map") runs over, besides the
+        orbits (:func:`librate.app.budget.estimate`)."""
+        raise NotImplementedError  # each model's subclass
+
+    def map_bytes(self, n_orbits: int, row_cells: int) -> int:
+        """The memory a map of ``n_orbits`` rows of ``row_cells`` cases takes (bytes)."""
+        raise NotImplementedError  # each model's subclass
 
     def output_dir(self, out: str | Path | None = None) -> Path:
         """The output folder, absolute: ``out`` if given (relative to the working directory),
@@ -414,6 +420,93 @@ class Study(Header):
 
         return {"librate_result": kind, **({"librate_command": command} if command else {}), "study": self.to_json(),
                 "librate_version": __version__}
+
+
+class PlanarStudy(Study):
+    """A study of the planar attitude model (phi and wz; ``[attitude] model = "planar"``, the
+    default: every study without [attitude])."""
+
+    attitude: PlanarAttitude = Field(default_factory=PlanarAttitude)
+
+    @classmethod
+    def rules_between(cls, s: dict[str, Table], given: dict, purpose: str | None) -> list[str]:
+        return planar_rules(s, given, purpose)
+
+    def _with_attitude(self, d: dict) -> dict:
+        d.pop("attitude", None)  # the default model: the stored study of a planar job is unchanged
+        return d
+
+    def grid_factors(self, purpose: str) -> list[tuple[str, int]]:
+        out = []
+        b, r = self.body, self.rates
+        if b is not None and b.kz is not None:
+            out.append(("body.kz", grid_size(b.kz)))
+        if r is not None:
+            k = "wz0" if r.wz0 is not None else "phidot0"
+            out.append((f"rates.{k}", grid_size(getattr(r, k))))
+        return out
+
+    def map_bytes(self, n_orbits: int, row_cells: int) -> int:
+        from .._checks import map_bytes
+
+        return map_bytes(n_orbits, row_cells)
+
+
+class Study3D(Study):
+    """A study of the 3-D rigid body (quaternion and three rates; ``[attitude] model = "3d"``)."""
+
+    attitude: Attitude3D
+
+    @classmethod
+    def rules_between(cls, s: dict[str, Table], given: dict, purpose: str | None) -> list[str]:
+        return rules_3d(s, given, purpose)
+
+    def _with_attitude(self, d: dict) -> dict:
+        d["attitude"]["start"] = self.attitude_start()
+        d["attitude"].setdefault("tol", ATTITUDE_TOL)
+        return d
+
+    def attitude_start(self) -> str:
+        return start_of(self.attitude, self.orbits)
+
+    @property
+    def tol(self) -> float:
+        """The 3-D corrector's tolerance: ``attitude.tol``, else :data:`ATTITUDE_TOL`."""
+        return self.attitude.tol or ATTITUDE_TOL
+
+    def q0_3d(self) -> np.ndarray:
+        """The initial attitude (scalar-last quaternion, body relative to the synodic frame):
+        ``attitude.q0``, else the rotation by ``solver.phi0`` about Z."""
+        if self.attitude.q0 is not None:
+            q = np.asarray(self.attitude.q0, dtype=float)
+            return q / np.linalg.norm(q)
+        h = 0.5 * self.solver.phi0
+        return np.array([0.0, 0.0, math.sin(h), math.cos(h)])
+
+    def rates_3d(self) -> dict[str, np.ndarray]:
+        """The initial rates of a 3-D map, ``{"wx0", "wy0", "wz0"}`` -> values (1/TU, inertial,
+        body axes; a fixed rate is one value; ``rates.phidot0`` + 1 for wz0)."""
+        r = self.rates
+        if r is None:
+            raise ValueError("the study has no [rates]")
+        wz = grid_values(r.wz0) if r.wz0 is not None else (None if r.phidot0 is None else grid_values(r.phidot0) + 1.0)
+        out = {"wx0": grid_values(r.wx0), "wy0": grid_values(r.wy0), "wz0": wz}
+        return {k: v for k, v in out.items() if v is not None}
+
+    def grid_factors(self, purpose: str) -> list[tuple[str, int]]:
+        if purpose == "solve" or self.rates is None:
+            return []  # a solve is one continuation along the members
+        return [(f"rates.{k}", grid_size(g)) for k in ("wx0", "wy0", "wz0", "phidot0")
+                if (g := getattr(self.rates, k)) is not None and grid_size(g) > 1]
+
+    def map_bytes(self, n_orbits: int, row_cells: int) -> int:
+        from .._checks import MAP3D_CELL_BYTES
+
+        return n_orbits * row_cells * MAP3D_CELL_BYTES
+
+
+#: The study's class by its [attitude] section's class (the union's discriminator).
+_STUDY_OF: dict[type, type[Study]] = {PlanarAttitude: PlanarStudy, Attitude3D: Study3D}
 
 
 def _sun_period() -> float:

@@ -12,13 +12,13 @@ from .. import _core
 from .epochs import tdb_seconds
 from .spk import embedded_spk_path, read_spk
 
-__all__ = ["Ephemeris", "EphemerisTrajectory", "RotatingFrame", "propagate_ephemeris", "sun_phase"]
+__all__ = ["Ephemeris", "EphemerisTrajectory", "RotatingFrame", "default_ephemeris", "epoch_seconds", "propagate_ephemeris", "sun_phase"]
 
 #: NAIF ids
 SUN, EMB, MOON, EARTH = 10, 3, 301, 399
 
 
-def _epoch_seconds(epoch) -> float:
+def epoch_seconds(epoch) -> float:
     """TDB seconds past J2000 of a float or an ISO string with a scale (epochs.tdb_seconds)."""
     if isinstance(epoch, (int, float, np.floating, np.integer)) and not isinstance(epoch, bool):
         t = float(epoch)
@@ -81,27 +81,37 @@ class Ephemeris:
 
     def state(self, target: int, center: int, epoch) -> np.ndarray:
         """State of NAIF body ``target`` relative to ``center`` (km, km/s)."""
-        return self._core.state(int(target), int(center), _epoch_seconds(epoch))
+        return self._core.state(int(target), int(center), epoch_seconds(epoch))
 
     def rotating_frame(self, epoch) -> RotatingFrame:
-        t = _epoch_seconds(epoch)
+        t = epoch_seconds(epoch)
         d = self._core.frame(t)
         return RotatingFrame(t, d["distance_km"], d["distance_rate_km_s"], d["rate_rad_s"], d["axes"], d["omega"])
 
     def synodic_to_ephemeris(self, state, epoch, mu: float) -> np.ndarray:
         """A synodic CR3BP state (nondimensional) -> Moon-centred ICRF state (km, km/s) at epoch,
         with the instantaneous distance, rate and frame rotation."""
-        return self._core.synodic_to_ephemeris(_epoch_seconds(epoch), float(mu), np.ascontiguousarray(state, dtype=float).ravel())
+        return self._core.synodic_to_ephemeris(epoch_seconds(epoch), float(mu), np.ascontiguousarray(state, dtype=float).ravel())
 
     def ephemeris_to_synodic(self, state_km, epoch, mu: float) -> np.ndarray:
         """The inverse of :meth:`synodic_to_ephemeris`."""
-        return self._core.ephemeris_to_synodic(_epoch_seconds(epoch), float(mu), np.ascontiguousarray(state_km, dtype=float).ravel())
+        return self._core.ephemeris_to_synodic(epoch_seconds(epoch), float(mu), np.ascontiguousarray(state_km, dtype=float).ravel())
+
+    def transition(self, states_km, epochs_tdb, *, tol: tuple[float, float], scales: tuple[float, float], epoch_free: bool = False,
+                   max_iter: int = 30, integration: tuple[float, float] = (1e-13, 1e-9)) -> dict:
+        """Multiple shooting of guess nodes (n, 6) at ``epochs_tdb`` (n,) into a continuous trajectory
+        (the Rust corrector; :func:`librate.to_ephemeris` is the user's entry): ``tol`` (km, km/s)
+        per leg, ``scales`` (km, s) of the unknowns, ``integration`` (rtol, atol). A dict of
+        states_km, epochs_tdb, iterations, reason, defects_km, defects_km_s, history."""
+        return self._core.transition(np.ascontiguousarray(states_km, dtype=float), np.ascontiguousarray(epochs_tdb, dtype=float).ravel(), tol, scales,
+                                     epoch_free, max_iter, integration)
 
 
 _DEFAULT: list[Ephemeris] = []
 
 
-def _default(ephemeris: Ephemeris | None) -> Ephemeris:
+def default_ephemeris(ephemeris: Ephemeris | None = None) -> Ephemeris:
+    """``ephemeris``, or the embedded DE440 excerpt (loaded once) when None."""
     if ephemeris is not None:
         return ephemeris
     if not _DEFAULT:
@@ -115,8 +125,8 @@ def propagate_ephemeris(
     """Propagate a Moon-centred ICRF state (km, km/s) from ``epoch`` for ``duration_s`` seconds
     under Earth, Moon and Sun point masses (DE440 GM values). ``t_eval``: offsets from the epoch
     (s) at which to record (default: every step)."""
-    e = _default(ephemeris)
-    t0 = _epoch_seconds(epoch)
+    e = default_ephemeris(ephemeris)
+    t0 = epoch_seconds(epoch)
     te = None if t_eval is None else np.ascontiguousarray(t_eval, dtype=float).ravel()
     t, y, phi = e._core.propagate(np.ascontiguousarray(state_km, dtype=float).ravel(), t0, float(duration_s), bool(stm), te, float(rtol), float(atol))
     return EphemerisTrajectory(t, y, phi)
@@ -125,8 +135,8 @@ def propagate_ephemeris(
 def sun_phase(epoch, ephemeris: Ephemeris | None = None) -> float:
     """The Sun's angle (rad, in [0, 2 pi)) seen from the Earth-Moon barycentre in the rotating
     frame's x-y plane, from x towards y, at the epoch."""
-    e = _default(ephemeris)
-    t = _epoch_seconds(epoch)
+    e = default_ephemeris(ephemeris)
+    t = epoch_seconds(epoch)
     f = e.rotating_frame(t)
     s = e._core.state(SUN, EMB, t)[:3]
     return float(np.arctan2(f.axes[1] @ s, f.axes[0] @ s) % (2 * np.pi))

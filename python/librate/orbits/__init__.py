@@ -1,5 +1,6 @@
 """The orbit layer: the CR3BP system, trajectory propagation, periodic orbits, their
-continuation into families, Fourier fits and frame conversions."""
+continuation into families, Fourier fits, frame conversions, and their transition to the
+Earth-Moon-Sun ephemeris model."""
 
 from .families import OrbitFamily, correct_dro, dro, dro_family, halo, halo_family, lyapunov, lyapunov_family
 from .fourier import FourierOrbit, fit_fourier
@@ -8,6 +9,7 @@ from .orbit_continuation import ContinuationResult, Geometry, continue_arclength
 from .periodic import PeriodicOrbit, correct_periodic, correct_symmetric
 from .propagation import BatchResult, Event, EventHit, Stats, Trajectory, propagate, propagate_many
 from .system import System
+from .transition import EphemerisOrbit, ephemeris_sweep, to_ephemeris
 
 __all__ = [
     "System",
@@ -42,4 +44,7 @@ __all__ = [
     "osculating_elements",
     "MeanElements",
     "mean_elements",
+    "EphemerisOrbit",
+    "to_ephemeris",
+    "ephemeris_sweep",
 ]

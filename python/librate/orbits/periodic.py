@@ -406,6 +406,24 @@ def orbit_from_core(system: System, r: _core.SymmetricOrbit, family: str) -> Per
     return PeriodicOrbit(system, r.state0, r.period, r.jacobi, family, r.iterations, r.residual, r.evaluation)
 
 
+def _check_jacobi_reachable(system: System, patches: np.ndarray, target: float) -> None:
+    """Refuse a Jacobi target that no state at the patches' positions has: C = 2U - |v|^2 is at
+    most 2U(r) (its zero-velocity value) at a position r, so a target above 2U(r_i) puts patch i
+    in the forbidden region of the member wanted. Newton then drives the patches toward a
+    primary, where U grows without bound, and each step's trajectories pass near the
+    singularity: they run to the integrator's step limit, and the correction took 26 s (target
+    +5) to 139 s (+10) from the x0 = 0.3 DRO before failing. A ValueError says so at once."""
+    at_rest = patches.copy()
+    at_rest[:, 3:] = 0.0
+    reach = np.atleast_1d(system.jacobi(at_rest))  # 2U(r_i), the largest C at each position
+    i = int(np.argmin(reach))
+    if target > reach[i]:
+        raise ValueError(f"invalid argument `jacobi`: {target:.10g} is out of reach of the guess: at patch {i} (r = "
+                         f"{', '.join(f'{v:.6g}' for v in patches[i, :3])} LU) no state has a Jacobi constant above 2U(r) = {reach[i]:.10g} "
+                         f"(C = 2U - |v|^2), so the member wanted does not pass there; the guess has C = {float(system.jacobi(patches[0])):.10g}. "
+                         "Give a guess on that member, or reach it by continuation (small steps in `jacobi`)")
+
+
 def correct_periodic(
     system: System | str,
     states,
@@ -437,7 +455,8 @@ def correct_periodic(
     period : float
         The period guess (TU).
     jacobi : float, optional
-        The target Jacobi constant (default: the first patch's).
+        The target Jacobi constant (default: the first patch's). It must not exceed 2U at any
+        patch's position (the largest Jacobi constant a state there can have).
     fixed_period : bool, default False
         Hold the period instead of the Jacobi constant.
     family : str, default "periodic"
@@ -488,6 +507,7 @@ def correct_periodic(
         cond, value = "period", float(period)
     else:
         cond, value = "jacobi", float(sys_.jacobi(patches[0]) if jacobi is None else jacobi)
+        _check_jacobi_reachable(sys_, patches, value)
     r = _core.multiple_shooting(sys_.mu, patches, float(period), condition=cond, value=value, tol=float(tol),
                                 max_iter=int(max_iter), rtol=float(rtol), atol=float(atol))
     return check_outside_primaries(PeriodicOrbit(sys_, r.patches[0].copy(), r.period, r.jacobi, family, r.iterations, r.residual), collision)

@@ -26,7 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import _core
-from .._checks import as_count, as_float_array, as_number, as_threads, as_tolerance, check_cells
+from .._checks import MAP3D_CELL_BYTES, as_count, as_float_array, as_number, as_threads, as_tolerance, check_cells
 from .._core import __version__
 from .._display import fmt, html_summary, short_repr
 from .._progress import as_progress
@@ -96,10 +96,6 @@ class Map3DGrid:
         return np.ascontiguousarray(moments[idx[0]]), np.ascontiguousarray(w0)
 
 
-#: Bytes per case of a 3-D map: six residuals and their norm (float64) and the status (uint8).
-CELL_BYTES = 7 * 8 + 1
-
-
 def _bodies(body) -> tuple[tuple[RigidBody, ...], bool]:
     lst = list(body) if isinstance(body, (list, tuple)) else [body]
     if not lst:
@@ -133,7 +129,7 @@ def map3d_grid(body, *, wx0, wy0, wz0, q0=None) -> Map3DGrid:
     """The validated grid of :func:`attitude_map_3d` (a ValueError naming the argument)."""
     bodies, body_dim = _bodies(body)
     rates, dims = zip(*(_rate(v, n) for v, n in ((wx0, "wx0"), (wy0, "wy0"), (wz0, "wz0"))))
-    check_cells((len(bodies), *(r.size for r in rates)), "`body`, `wx0`, `wy0`, `wz0`", item_bytes=CELL_BYTES)
+    check_cells((len(bodies), *(r.size for r in rates)), "`body`, `wx0`, `wy0`, `wz0`", item_bytes=MAP3D_CELL_BYTES)
     return Map3DGrid(bodies, body_dim, tuple(rates), tuple(dims), _quaternion(q0))
 
 

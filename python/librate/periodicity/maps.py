@@ -15,7 +15,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from .._checks import as_count, as_float_array, as_number, as_threads, as_tolerance, check_cells
+from .._checks import as_count, as_float_array, as_number, as_threads, as_tolerance, check_map_cells
 from .._core import __version__
 from .._errors import LibrateError
 from .._progress import as_progress
@@ -24,7 +24,6 @@ from ..orbits.periodic import PeriodicOrbit
 from ..results.kinds import MAP_VARIABLES
 from .solutions import (
     MAP_ATOL,
-    MAP_CELL_BYTES,
     MAP_METHOD,
     MAP_RTOL,
     AttitudeSolution,
@@ -39,7 +38,7 @@ from .solutions import (
 )
 
 __all__ = ["periodicity_map", "zero_contours", "orbits_of", "map_grid", "map_coords", "map_dataset", "solutions_from_row",
-           "solutions_from_rows", "map_solutions_dataset", "solution_variables"]
+           "solutions_from_rows", "row_candidates", "map_solutions_dataset", "solution_variables", "REFINE_BATCH_PERIODS", "MAX_CROSSINGS"]
 
 
 def orbits_of(orbits) -> tuple[list[PeriodicOrbit], OrbitFamily | None]:
@@ -150,7 +149,7 @@ def periodicity_map(
     srp = check_srp(srp)
     kzs, wz = map_grid(kz, wz0, n_periods)
     phi0 = as_number(phi0, "phi0")
-    check_cells((len(olist), kzs.size, wz.size), "`orbits`, `kz`, `wz0`", item_bytes=MAP_CELL_BYTES)
+    check_map_cells((len(olist), kzs.size, wz.size), "`orbits`, `kz`, `wz0`")
     chunk = as_count(chunk, "chunk", 1)
     threads = as_threads(threads)
     rtol, atol = as_tolerance(rtol, "rtol"), as_tolerance(atol, "atol")
@@ -286,22 +285,77 @@ def _stack_srp(maps, plates):
     return out
 
 
-def solutions_from_rows(orbit, kzs, phi0, wz, phi_t_rows, n_periods, srp=None) -> list[AttitudeSolution]:
-    """The solutions of one orbit's rows (one per Kz): the candidates where phi(KT) - phi0 crosses
-    a multiple of pi, all refined in ONE call of the Rust corrector (the half-period form where
-    the orbit and phi0 are symmetric and there is no SRP, else the full-period form with phi0
-    free) and verified in one more; kept inside the row's rate window."""
+#: The most candidate-periods (candidates x orbit periods each) refined in one corrector call.
+#: A longer batch is split, in order, into batches of at most that work (and at least
+#: REFINE_BATCH_MIN candidates: two lock-step lane groups), so that progress is reported between
+#: them: 1504 candidates over 20 periods took 19 s in one call, and a 16-rate map over 1000
+#: periods refined for 14 minutes without a note. Batches within the limit are refined in one
+#: call, as before (a candidate's last bits, ~1e-14, depend on its batch companions).
+REFINE_BATCH_PERIODS = 4096
+REFINE_BATCH_MIN = 16
+
+
+#: The most multiples of pi that phi(KT) - phi0 may cross between two neighbouring rates of a
+#: map row for its crossings to be candidates. Past that the rate grid does not resolve the
+#: angle and the linear guesses are noise: a grid that resolves it crosses at most 1.4 (the demo,
+#: 1000 rates; the tutorial, 300), while 16 rates over 1000 periods cross up to ~2000 per interval
+#: (29,392 candidates on one DRO, 94,000 on the example study's 12) and 16 rates over 20 periods
+#: gave 1504 candidates that refined in 19 s to no solution.
+MAX_CROSSINGS = 8
+
+
+def row_candidates(kzs, phi0, wz, phi_t_rows) -> tuple[list, list[float], int]:
+    """The candidates of one orbit's rows (one per Kz: where phi(KT) - phi0 crosses a multiple of
+    pi), the Kz of each, and the number of rate intervals left out as unresolved (more than
+    :data:`MAX_CROSSINGS` crossings)."""
     kzs = np.atleast_1d(np.asarray(kzs, dtype=float))
     rows = np.atleast_2d(phi_t_rows)
-    cands, kk = [], []
+    cands, kk, unresolved = [], [], 0
     for j, k in enumerate(kzs):
-        c = candidates(rows[j], phi0, wz, math.pi)
+        c = candidates(rows[j], phi0, wz, math.pi, max_crossings=MAX_CROSSINGS)
         cands += c
         kk += [float(k)] * len(c)
+        u = (np.asarray(rows[j], dtype=float) - phi0) / math.pi
+        a, b = u[:-1], u[1:]
+        with np.errstate(invalid="ignore"):
+            crossed = np.floor(np.maximum(a, b)) - np.ceil(np.minimum(a, b)) + 1  # as candidates() counts them
+        unresolved += int(np.sum(np.isfinite(crossed) & (crossed > MAX_CROSSINGS)))
+    return cands, kk, unresolved
+
+
+def solutions_from_rows(orbit, kzs, phi0, wz, phi_t_rows, n_periods, srp=None, progress: Callable[[int, int], None] | None = None) -> list[AttitudeSolution]:
+    """The solutions of one orbit's rows (one per Kz): the candidates where phi(KT) - phi0 crosses
+    a multiple of pi (:func:`row_candidates`), refined in ONE call of the Rust corrector (the
+    half-period form where the orbit and phi0 are symmetric and there is no SRP, else the
+    full-period form with phi0 free) and verified in one more; kept inside the row's rate window.
+    A batch of more than :data:`REFINE_BATCH_PERIODS` candidate-periods is refined in several
+    calls, in order (solutions found twice kept once). ``progress(done, total)``: after each
+    call, in candidates."""
+    cands, kk, unresolved = row_candidates(kzs, phi0, wz, phi_t_rows)
+    if unresolved:
+        warnings.warn(f"the rate grid does not resolve phi(KT) on the orbit x0 = {orbit.x0:.6g} LU (K = {int(n_periods)} periods): "
+                      f"{unresolved} interval(s) of `wz0` where it turns through more than {MAX_CROSSINGS} half-turns are left out "
+                      "of the solutions; a finer wz0 grid finds them", RuntimeWarning, stacklevel=3)
     symmetric = is_symmetric(orbit, phi0) and (srp is None or srp.eps == 0.0)
-    sols = refine(orbit, np.array(kk), phi0, cands, n_periods=n_periods, srp=srp, closure="half" if symmetric else "full",
-                  window=(float(wz[0]), float(wz[-1])), quick=symmetric)
+    size = max(REFINE_BATCH_MIN, REFINE_BATCH_PERIODS // max(int(n_periods), 1))
+    sols: list[AttitudeSolution] = []
+    for a in range(0, len(cands), size):
+        sols += refine(orbit, np.array(kk[a:a + size]), phi0, cands[a:a + size], n_periods=n_periods, srp=srp, closure="half" if symmetric else "full",
+                       window=(float(wz[0]), float(wz[-1])), quick=symmetric)
+        if progress is not None:
+            progress(min(a + size, len(cands)), len(cands))
+    if len(cands) > size:  # candidates of two batches that converged onto one solution: kept once
+        sols = _distinct(sols)
     return sorted(sols, key=lambda s: (s.kz, s.wz0))
+
+
+def _distinct(sols: list[AttitudeSolution]) -> list[AttitudeSolution]:
+    """One solution per (Kz, turns, kind, wz0 to 1e-8), as :func:`refine` keeps within a batch."""
+    out: list[AttitudeSolution] = []
+    for s in sols:
+        if not any(o.kz == s.kz and o.n_total == s.n_total and o.kind == s.kind and abs(o.wz0 - s.wz0) < 1e-8 for o in out):
+            out.append(s)
+    return out
 
 
 def solutions_from_row(orbit, kz, phi0, wz, phi_t_row, n_periods, srp=None) -> list[AttitudeSolution]:

@@ -32,16 +32,13 @@ from ..orbits.periodic import PeriodicOrbit
 __all__ = ["AttitudeSolution", "find_periodic_attitudes", "orbit_forcing", "clear_forcing_cache", "sweep", "candidates",
            "check_orbit", "check_kz", "check_kinds", "KINDS", "check_srp", "is_symmetric", "MAP_RTOL", "MAP_ATOL", "correct", "verified", "refine", "refine_groups",
            "turns_of", "n_total_of", "per_period", "turns_array", "SOLVE_RTOL", "SOLVE_ATOL", "STEP_MAX_ITER", "MAP_METHOD",
-           "STEP_MAX_HALVINGS", "MAP_CELL_BYTES"]
+           "STEP_MAX_HALVINGS"]
 
 MAP_RTOL = 1e-12
 #: The lanes' method of the maps: RKF7(8); RKN8(6) is within 0.9-1.0x of its time at equal
 #: accuracy (bench/bench_lanes.py), not enough to change the defaults' results.
 MAP_METHOD = "rkf78"
 MAP_ATOL = 1e-12
-#: Bytes per (orbit, kz, wz0) cell of a map: dwz, dphi, phi_T (float64), status (uint8), and the
-#: case grids and engine outputs (float64) of one orbit's row.
-MAP_CELL_BYTES = 3 * 8 + 1 + 4 * 8
 #: A continuation step's corrector: a good prediction converges in a few Newton steps; one that
 #: does not is a step too long (the driver halves it), not worth forty iterations.
 STEP_MAX_ITER = 10
@@ -342,15 +339,18 @@ def _grid_for(T: float, lo: float, hi: float, n_grid: int | None) -> np.ndarray:
     return np.linspace(lo, hi, int(n_grid))
 
 
-def candidates(phi_t, phi0, wz, level):
+def candidates(phi_t, phi0, wz, level, max_crossings: int | None = None):
     """wz0 brackets where (phi(t) - phi0) / level crosses an integer; returns (k, wz_interp) in
-    order of the grid (linear interpolation)."""
+    order of the grid (linear interpolation). ``max_crossings``: an interval that crosses more
+    integers than that is left out (the grid does not resolve it)."""
     u = (np.asarray(phi_t, dtype=float) - phi0) / level
     wz = np.asarray(wz, dtype=float)
     a, b = u[:-1], u[1:]
     ok = np.isfinite(a) & np.isfinite(b) & (a != b)
     lo = np.ceil(np.minimum(a, b))
     hi = np.floor(np.maximum(a, b))
+    if max_crossings is not None:
+        ok &= hi - lo + 1 <= max_crossings
     out = []
     for i in np.flatnonzero(ok & (hi >= lo)):
         for k in range(int(lo[i]), int(hi[i]) + 1):

@@ -13,7 +13,7 @@ from concurrent.futures import ThreadPoolExecutor
 import numpy as np
 
 from .. import _core
-from .._checks import as_count, as_float_array, as_number, check_cells
+from .._checks import as_count, as_float_array, as_number, check_map_cells
 from .._core import __version__
 from .._progress import as_progress
 from ..attitude.srp import FacetBody, FlatPlate, Sun, force_torque
@@ -22,7 +22,6 @@ from ..orbits.periodic import PeriodicOrbit
 from ..orbits.system import check_system
 from .branches import branch_fold, eps_branches
 from .solutions import (
-    MAP_CELL_BYTES,
     check_kinds,
     check_kz,
     check_orbit,
@@ -151,7 +150,7 @@ def srp_map(
     wz = as_float_array(wz0, "wz0").ravel()
     if wz.size < 2 or not np.all(np.isfinite(wz)) or np.any(np.diff(wz) <= 0):
         raise ValueError("invalid argument `wz0`: must be a finite, strictly increasing array of at least 2 rates")
-    check_cells((es.size, wz.size), "`eps`, `wz0`", item_bytes=MAP_CELL_BYTES)
+    check_map_cells((1, es.size, wz.size), "`eps`, `wz0`")
     phi0 = as_number(phi0, "phi0")
     plate = FlatPlate(0.0, cs, cd, Sun(theta0=as_number(theta_sun0, "theta_sun0")))
     e_grid, w_grid = np.meshgrid(es, wz, indexing="ij")

@@ -8,6 +8,7 @@
 //! - [`map`]: the periodicity maps (sweeps of the SIMD lane integrator, [`integrate::lanes`]).
 //! - [`constants`]: physical constants (the Sun's motion, solar pressure).
 //! - [`scalar`]: the scalar traits equations are written over (f64, dual numbers, SIMD lanes).
+//! - [`newton`]: the dense Newton driver of the multiple-shooting and flexible correctors.
 //! - [`fourier`]: periodic orbits as truncated Fourier series, with analytic derivatives.
 //! - [`simd`]: runtime CPU dispatch of the hot kernels (baseline, AVX2, AVX-512, NEON).
 
@@ -20,6 +21,7 @@ pub mod flexible;
 pub mod fourier;
 pub mod integrate;
 pub mod map;
+pub mod newton;
 pub mod orbit;
 pub mod propagation;
 pub mod scalar;

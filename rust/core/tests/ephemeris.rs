@@ -6,7 +6,9 @@
 
 use librate_core::cr3bp::Cr3bp;
 use librate_core::ephemeris::{ephemeris_to_synodic, propagate_ephemeris, synodic_to_ephemeris, Ephemeris, EphemerisDynamics, RotatingFrame, Segment, GM_EARTH, GM_MOON};
+use librate_core::ephemeris::{transition, TransitionSettings};
 use librate_core::integrate::{solve, Options, Output};
+use librate_core::newton::StopReason;
 
 const L: f64 = 384400.0;
 const DEG: usize = 18;
@@ -145,4 +147,96 @@ fn circular_ephemeris_is_the_cr3bp() {
     for i in 0..6 {
         assert!((sf[i] - cr[i]).abs() < 1e-9, "{i}: {} vs {}", sf[i], cr[i]);
     }
+}
+
+/// Guess nodes: a CR3BP DRO (x0 = 0.9) sampled `per_rev` times a revolution over `revs`
+/// revolutions, mapped to the ephemeris at its epochs (dimensional time t = tau / n).
+fn dro_nodes(eph: &Ephemeris, revs: usize, per_rev: usize) -> (Vec<[f64; 6]>, Vec<f64>) {
+    let m = mu();
+    let n = ((GM_EARTH + GM_MOON) / L.powi(3)).sqrt();
+    let opts = Options::with_tolerances(1e-13, 1e-13);
+    let d = 1.0 - m - 0.9;
+    let o = librate_core::orbit::correct_planar_symmetric(m, 0.9, (m / d).sqrt() + d, 1e-12, 30, &opts).unwrap();
+    let k = revs * per_rev;
+    let ts: Vec<f64> = (0..=k).map(|i| o.period * i as f64 / per_rev as f64).collect();
+    let tr = librate_core::propagation::propagate(m, &o.state0, 0.0, ts[k], &opts, false, Output::At(&ts), &[]).unwrap();
+    let mut states = Vec::new();
+    let mut epochs = Vec::new();
+    for (i, t) in ts.iter().enumerate() {
+        let s: [f64; 6] = std::array::from_fn(|a| tr.states[6 * i + a]);
+        let f = RotatingFrame::at(eph, t / n).unwrap();
+        states.push(synodic_to_ephemeris(&f, m, &s).unwrap());
+        epochs.push(t / n);
+    }
+    (states, epochs)
+}
+
+fn settings(epoch_free: bool) -> TransitionSettings {
+    let n = ((GM_EARTH + GM_MOON) / L.powi(3)).sqrt();
+    TransitionSettings { tol_km: 1e-3, tol_km_s: 1e-8, max_iter: 20, epoch_free, length_km: L, time_s: 1.0 / n }
+}
+
+/// Analytic check: in the circular ephemeris with the Sun's GM = 0 the model is the CR3BP, so a
+/// CR3BP DRO placed there is already continuous (defects below 1e-5 km: the fit's error) and the
+/// transition moves no node by more than 1e-4 km.
+#[test]
+fn a_cr3bp_orbit_is_continuous_in_the_circular_ephemeris() {
+    let eph = circular(0.3);
+    let (states, epochs) = dro_nodes(&eph, 3, 4);
+    let opts = Options::with_tolerances(1e-13, 1e-12);
+    let tr = transition(&eph, [GM_EARTH, GM_MOON, 0.0], &states, &epochs, &settings(false), &opts).unwrap();
+    assert_eq!(tr.reason, StopReason::Converged);
+    assert!(tr.history[0] < 1e-2 / 1e-3, "start defects {:?}", tr.history);
+    for (a, b) in tr.states.iter().zip(&states) {
+        for i in 0..3 {
+            assert!((a[i] - b[i]).abs() < 1e-4, "{a:?} vs {b:?}");
+        }
+    }
+}
+
+/// With the Sun (GM_SUN at 1.5e8 km) the DRO's guess is discontinuous by kilometres; the
+/// transition converges (quadratically) and every converged leg, re-propagated from its node,
+/// meets the next node within 1 m and 1e-8 km/s. Fixed and free first epoch.
+#[test]
+fn the_transition_converges_with_the_sun_and_its_legs_meet() {
+    use librate_core::ephemeris::GM_SUN;
+    let eph = circular(0.3);
+    let (states, epochs) = dro_nodes(&eph, 3, 4);
+    let opts = Options::with_tolerances(1e-13, 1e-12);
+    let gm = [GM_EARTH, GM_MOON, GM_SUN];
+    for free in [false, true] {
+        let tr = transition(&eph, gm, &states, &epochs, &settings(free), &opts).unwrap();
+        assert_eq!(tr.reason, StopReason::Converged, "{:?}", tr.history);
+        assert!(tr.history[0] > 10.0, "the guess should be discontinuous: {:?}", tr.history);
+        assert!(tr.iterations <= 8, "{:?}", tr.history);
+        if !free {
+            assert_eq!(tr.epochs[0], epochs[0]);
+        }
+        for i in 0..tr.states.len() - 1 {
+            let d = EphemerisDynamics::with_gm(eph.clone(), tr.epochs[i], gm).unwrap();
+            let end = propagate_ephemeris(&d, &tr.states[i], tr.epochs[i + 1] - tr.epochs[i], false, None, &opts).unwrap().state_final;
+            let dr = (0..3).map(|a| (end[a] - tr.states[i + 1][a]).powi(2)).sum::<f64>().sqrt();
+            let dv = (3..6).map(|a| (end[a] - tr.states[i + 1][a]).powi(2)).sum::<f64>().sqrt();
+            assert!(dr < 1e-3 && dv < 1e-8, "leg {i}: {dr} km, {dv} km/s");
+            assert!(tr.defects_km[i] < 1e-3 && tr.defects_km_s[i] < 1e-8);
+        }
+    }
+}
+
+/// Bad input is refused naming the parameter.
+#[test]
+fn transition_input_is_checked() {
+    let eph = circular(0.3);
+    let (states, mut epochs) = dro_nodes(&eph, 1, 4);
+    let opts = Options::with_tolerances(1e-13, 1e-12);
+    let gm = [GM_EARTH, GM_MOON, 0.0];
+    let e = transition(&eph, gm, &states[..1], &epochs[..1], &settings(false), &opts).unwrap_err();
+    assert!(e.to_string().contains("`states`"), "{e}");
+    epochs[2] = epochs[1];
+    let e = transition(&eph, gm, &states, &epochs, &settings(false), &opts).unwrap_err();
+    assert!(e.to_string().contains("`epochs`"), "{e}");
+    let mut s = settings(false);
+    s.tol_km = 0.0;
+    let e = transition(&eph, gm, &states, &dro_nodes(&eph, 1, 4).1, &s, &opts).unwrap_err();
+    assert!(e.to_string().contains("`tol_km`"), "{e}");
 }

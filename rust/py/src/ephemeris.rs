@@ -1,10 +1,10 @@
 //! Thin wrappers of librate_core::ephemeris: an `EphemerisCore` built from SPK type-2 segments
 //! (read in Python), its states, rotating frame, synodic maps and propagation.
 
-use librate_core::ephemeris::{self as eph, Ephemeris, EphemerisDynamics, RotatingFrame, Segment};
+use librate_core::ephemeris::{self as eph, Ephemeris, EphemerisDynamics, RotatingFrame, Segment, TransitionSettings};
 use librate_core::integrate::Options;
 use numpy::ndarray::Array2;
-use numpy::{IntoPyArray, PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray3, PyUntypedArrayMethods};
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
@@ -103,6 +103,45 @@ impl EphemerisCore {
             None => None,
         };
         Ok((tr.t_tdb.into_pyarray(py), states, phi))
+    }
+    /// The multiple-shooting transition of guess nodes (n, 6) at `epochs` (n,) to a continuous
+    /// trajectory of the model. `tol` = (km, km/s) per leg; `scales` = (length km, time s) of
+    /// the unknowns; `integration` = (rtol, atol). Returns a dict: states_km, epochs_tdb,
+    /// iterations, reason, defects_km, defects_km_s, history.
+    #[pyo3(signature = (states_km, epochs, tol, scales, epoch_free=false, max_iter=30, integration=(1e-13, 1e-9), gm=None))]
+    fn transition<'py>(
+        &self,
+        py: Python<'py>,
+        states_km: PyReadonlyArray2<'_, f64>,
+        epochs: PyReadonlyArray1<'_, f64>,
+        tol: (f64, f64),
+        scales: (f64, f64),
+        epoch_free: bool,
+        max_iter: usize,
+        integration: (f64, f64),
+        gm: Option<[f64; 3]>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let a = states_km.as_array();
+        if a.ncols() != 6 {
+            return Err(pyo3::exceptions::PyValueError::new_err(format!("`states_km` must have shape (n, 6), got {:?}", a.shape())));
+        }
+        let states: Vec<[f64; 6]> = a.rows().into_iter().map(|r| std::array::from_fn(|j| r[j])).collect();
+        let epochs = epochs.as_slice()?.to_vec();
+        let settings = TransitionSettings { tol_km: tol.0, tol_km_s: tol.1, max_iter, epoch_free, length_km: scales.0, time_s: scales.1 };
+        let opts = Options::with_tolerances(integration.0, integration.1);
+        let gm = gm.unwrap_or([eph::GM_EARTH, eph::GM_MOON, eph::GM_SUN]);
+        let tr = py.detach(|| eph::transition(&self.inner, gm, &states, &epochs, &settings, &opts)).map_err(to_py)?;
+        let n = tr.states.len();
+        let flat: Vec<f64> = tr.states.iter().flatten().copied().collect();
+        let d = PyDict::new(py);
+        d.set_item("states_km", Array2::from_shape_vec((n, 6), flat).map_err(|e| pyo3::exceptions::PyRuntimeError::new_err(e.to_string()))?.into_pyarray(py))?;
+        d.set_item("epochs_tdb", tr.epochs.into_pyarray(py))?;
+        d.set_item("iterations", tr.iterations)?;
+        d.set_item("reason", tr.reason.as_str())?;
+        d.set_item("defects_km", tr.defects_km.into_pyarray(py))?;
+        d.set_item("defects_km_s", tr.defects_km_s.into_pyarray(py))?;
+        d.set_item("history", tr.history.into_pyarray(py))?;
+        Ok(d)
     }
 }
 

@@ -138,6 +138,29 @@ impl EphemerisAttitudeModel {
         let s = py.detach(|| librate_core::ephemeris::attitude_shooting::evaluate_attitude_legs(model, &nodes, &opts)).map_err(to_py)?;
         shooting_dict(py, &s)
     }
+
+    /// Multiple-shooting correction through the nodes (q, w the guess); a dict with q, w,
+    /// defects, monodromy, iterations, reason, converged.
+    #[pyo3(signature = (epochs, orbits, q, w, tol=1e-9, max_iter=30, tolerances=(1e-12, 1e-15)))]
+    fn correct<'py>(
+        &self,
+        py: Python<'py>,
+        epochs: PyReadonlyArray1<'_, f64>,
+        orbits: PyReadonlyArray2<'_, f64>,
+        q: PyReadonlyArray2<'_, f64>,
+        w: PyReadonlyArray2<'_, f64>,
+        tol: f64,
+        max_iter: usize,
+        tolerances: (f64, f64),
+    ) -> PyResult<Bound<'py, PyDict>> {
+        use librate_core::ephemeris::attitude_shooting::{correct_attitude, ShootingOptions};
+        let nodes = nodes(&epochs, &orbits, &q, &w)?;
+        let opts = ShootingOptions { tol, max_iter, integration: Options::with_tolerances(tolerances.0, tolerances.1) };
+        let model = &self.inner;
+        let s = py.detach(|| correct_attitude(model, &nodes, &opts)).map_err(to_py)?;
+        shooting_dict(py, &s)
+    }
+}
 }
 
 /// The sunlit fraction of the solar disc at `r` with the Sun at `sun` and a sphere of

@@ -11,38 +11,7 @@ use nalgebra::{DMatrix, DVector};
 
 use crate::error::Result;
 
-/// Why the corrector stopped on a candidate.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum StopReason {
-    /// Residual max-norm <= tol; or, where no Newton step descends any more, <= tol times the
-    /// largest |d F / d x| of the closure rows (at least 1): the integration's noise floor
-    /// amplified by the motion's instability (|trace| of the monodromy ~ 1e3 for some
-    /// SRP-dominated motions), the unknowns then being known to about tol.
-    Converged,
-    /// `max_iter` Newton steps taken without convergence.
-    MaxIterations,
-    /// The Jacobian is zero or non-finite, or rank-deficient with no decrease along its
-    /// minimum-norm step (e.g. a fold: trace of the monodromy = 2).
-    SingularJacobian,
-    /// The line search found no sufficient decrease after `max_halvings` halvings.
-    NoDescent,
-    /// The integration failed (lane status not Ok, or non-finite results) at the starting
-    /// point, or at every trial point of the last line search.
-    IntegrationFailed,
-}
-
-impl StopReason {
-    /// "converged", "max_iterations", "singular_jacobian", "no_descent", "integration_failed".
-    pub fn as_str(&self) -> &'static str {
-        match self {
-            Self::Converged => "converged",
-            Self::MaxIterations => "max_iterations",
-            Self::SingularJacobian => "singular_jacobian",
-            Self::NoDescent => "no_descent",
-            Self::IntegrationFailed => "integration_failed",
-        }
-    }
-}
+pub use crate::newton::StopReason;
 
 /// The residual rows and Jacobian of one point, and what the form keeps of its trajectories
 /// (e.g. the monodromy).

@@ -18,11 +18,14 @@
 //! (theta, w) ([`crate::attitude::linear`]): d(theta, w)(t_end) / d(theta, w)(t_0) of the
 //! corrected motion.
 
+use nalgebra::{DMatrix, DVector};
+
 use super::attitude::{propagate_attitude_batch, AttitudeModel, Leg, Quat, ATT, DIM};
 use crate::attitude::linear::xi;
 use crate::attitude::{conj, lmat, qexp, qlog, qmul, rmat};
 use crate::error::{check_finite, invalid, Result};
 use crate::integrate::Options;
+use crate::newton::{self, Problem, Settings, StopReason};
 
 /// One attitude node: epoch (TDB s), the orbit state there (km, km/s, Moon-centred ICRF), the
 /// attitude guess (q body -> ICRF, w rad/s).
@@ -221,4 +224,64 @@ fn finish(model: &AttitudeModel, nodes: &[Node], p: &Point, opts: &Options, iter
         mono = matmul6(&reduced(&end.1, &p.q[i], &qf), &mono);
     }
     Ok(Shooting { q: p.q.clone(), w: p.w.clone(), defects, monodromy: mono, iterations, reason, converged })
+}
+
+/// The multiple-shooting problem for the driver: the residual and, from the same legs, the
+/// Jacobian.
+struct Legs<'a> {
+    model: &'a AttitudeModel,
+    nodes: &'a [Node],
+    omega_ref: f64,
+    opts: Options,
+    jac: Option<DMatrix<f64>>,
+}
+
+impl Legs<'_> {
+    fn residual_and_jacobian(&self, x: &DVector<f64>) -> Result<(DVector<f64>, DMatrix<f64>)> {
+        let n = self.nodes.len();
+        let p = point(self.nodes, x.as_slice(), self.omega_ref);
+        let ends = integrate_legs(self.model, self.nodes, &p, &self.opts)?;
+        let mut f = DVector::zeros(6 * (n - 1));
+        let mut jac = DMatrix::zeros(6 * (n - 1), 6 * n);
+        for (i, end) in ends.iter().enumerate() {
+            let (fi, jf, jt) = link(&p, i, end, self.omega_ref);
+            for a in 0..6 {
+                f[6 * i + a] = fi[a];
+                for b in 0..6 {
+                    jac[(6 * i + a, 6 * i + b)] = jf[a][b];
+                    jac[(6 * i + a, 6 * (i + 1) + b)] = jt[a][b];
+                }
+            }
+        }
+        Ok((f, jac))
+    }
+}
+
+impl Problem for Legs<'_> {
+    fn residual(&mut self, x: &DVector<f64>) -> Result<DVector<f64>> {
+        let (f, j) = self.residual_and_jacobian(x)?;
+        self.jac = Some(j);
+        Ok(f)
+    }
+    fn jacobian(&mut self, _: &DVector<f64>) -> Result<DMatrix<f64>> {
+        self.jac.clone().ok_or_else(|| invalid("x", "no residual evaluated"))
+    }
+}
+
+/// Correct the attitude through `nodes` (their q, w the starting guess, e.g. the placed CR3BP
+/// motion) into a continuous motion by multiple shooting (module docs), with the project's
+/// Newton driver (minimum-norm steps, backtracking). A stop that is not a convergence is
+/// returned with its reason (`reason`, `converged`) and the last accepted point; an error only
+/// for invalid input or a guess whose legs cannot be integrated.
+pub fn correct_attitude(model: &AttitudeModel, nodes: &[Node], opts: &ShootingOptions) -> Result<Shooting> {
+    check_nodes(model, nodes)?;
+    opts.integration.validate()?;
+    let frame = super::frame::RotatingFrame::at(&model.eph, nodes[0].epoch)?;
+    let omega_ref = frame.rate_rad_s;
+    let x0 = DVector::from_iterator(6 * nodes.len(), nodes.iter().flat_map(|nd| [0.0, 0.0, 0.0, nd.w[0] / omega_ref, nd.w[1] / omega_ref, nd.w[2] / omega_ref]));
+    let mut problem = Legs { model, nodes, omega_ref, opts: opts.integration, jac: None };
+    let settings = Settings { tol: opts.tol, max_iter: opts.max_iter, max_halvings: 10 };
+    let out = newton::solve(&mut problem, x0, &settings)?;
+    let p = point(nodes, out.x.as_slice(), omega_ref);
+    finish(model, nodes, &p, &opts.integration, out.iterations, out.reason.as_str().to_string(), out.reason == StopReason::Converged)
 }

@@ -6,7 +6,7 @@
 //!   r(x) = (y(T; x) - x - (2 pi turns, 0, ...)) / scale.
 //! Jacobian: central differences of the flow, one column per unknown, integrated in parallel
 //! (rayon; each column independent, so the result does not depend on the thread count).
-//! Newton step by SVD (minimum-norm where the Jacobian is rank-deficient), backtracking line
+//! The project's dense Newton driver ([`crate::newton`]): Newton step by SVD, backtracking line
 //! search on |r|_2 (Armijo). Stops with a reason ([`StopReason`]). The monodromy of the coupled
 //! model, d y(T) / d x, is the unscaled Jacobian plus the identity at the last point.
 
@@ -17,7 +17,7 @@ use super::body::FlexibleBody;
 use super::propagate::propagate_flexible;
 use crate::error::{check_finite, check_positive, invalid, Result};
 use crate::integrate::{Options, Output};
-use crate::attitude::StopReason;
+use crate::newton::{self, Problem, Settings, StopReason};
 use crate::propagation::with_threads;
 
 /// The outcome of [`correct_flexible_periodic`].
@@ -66,88 +66,81 @@ pub fn correct_flexible_periodic(
         return Err(invalid("max_iter", "must be >= 1"));
     }
     let n = body.n();
-    let flow = |x: &[f64]| -> Option<Vec<f64>> {
-        let tr = propagate_flexible(mu, body, primaries, false, orbit0, x[0], x[1], &x[2..2 + n], &x[2 + n..], 0.0, period, opts, Output::Final).ok()?;
+    let flow = |x: &[f64]| -> Result<Vec<f64>> {
+        let tr = propagate_flexible(mu, body, primaries, false, orbit0, x[0], x[1], &x[2..2 + n], &x[2 + n..], 0.0, period, opts, Output::Final)?;
         let k = tr.phi.len() - 1;
         let mut y = vec![tr.phi[k], tr.wz[k]];
         y.extend_from_slice(&tr.q[k * n..(k + 1) * n]);
         y.extend_from_slice(&tr.qdot[k * n..(k + 1) * n]);
-        y.iter().all(|v| v.is_finite()).then_some(y)
-    };
-    let residual = |x: &[f64], y: &[f64]| -> Vec<f64> {
-        (0..m).map(|i| (y[i] - x[i] - if i == 0 { 2.0 * std::f64::consts::PI * turns } else { 0.0 }) / scale[i]).collect()
-    };
-    let norm2 = |r: &[f64]| r.iter().map(|v| v * v).sum::<f64>().sqrt();
-    let max_norm = |r: &[f64]| r.iter().fold(0.0f64, |a, v| a.max(v.abs()));
-    with_threads(threads, || -> Result<FlexiblePeriodic> {
-        let mut x = x0.to_vec();
-        let Some(y) = flow(&x) else {
-            return Ok(FlexiblePeriodic { x, residual: f64::NAN, iterations: 0, reason: StopReason::IntegrationFailed, monodromy: vec![f64::NAN; m * m] });
-        };
-        let mut r = residual(&x, &y);
-        let mut jac = DMatrix::<f64>::from_element(m, m, f64::NAN);
-        let mut iterations = 0;
-        let reason = loop {
-            // the Jacobian of the scaled residual w.r.t. the scaled unknowns, column by column
-            let cols: Vec<Option<Vec<f64>>> = (0..m)
-                .into_par_iter()
-                .map(|j| {
-                    let h = 1e-6 * scale[j];
-                    let (mut xp, mut xm) = (x.clone(), x.clone());
-                    xp[j] += h;
-                    xm[j] -= h;
-                    let (yp, ym) = (flow(&xp)?, flow(&xm)?);
-                    let (rp, rm) = (residual(&xp, &yp), residual(&xm, &ym));
-                    Some((0..m).map(|i| (rp[i] - rm[i]) / 2e-6).collect())
-                })
-                .collect();
-            if cols.iter().any(|c| c.is_none()) {
-                break StopReason::IntegrationFailed;
-            }
-            for (j, c) in cols.into_iter().enumerate() {
-                jac.set_column(j, &DVector::from_vec(c.expect("checked")));
-            }
-            if max_norm(&r) <= tol {
-                break StopReason::Converged;
-            }
-            if iterations >= max_iter {
-                break StopReason::MaxIterations;
-            }
-            let Some(svd) = jac.clone().try_svd(true, true, f64::EPSILON, 500) else { break StopReason::SingularJacobian };
-            let smax = svd.singular_values.max();
-            if !(smax > 0.0 && smax.is_finite()) {
-                break StopReason::SingularJacobian;
-            }
-            let Ok(d) = svd.solve(&DVector::from_iterator(m, r.iter().map(|v| -v)), 1e-12 * smax) else { break StopReason::SingularJacobian };
-            let mut lambda = 1.0;
-            let mut accepted = None;
-            for _ in 0..10 {
-                let xt: Vec<f64> = (0..m).map(|i| x[i] + lambda * d[i] * scale[i]).collect();
-                if let Some(yt) = flow(&xt) {
-                    let rt = residual(&xt, &yt);
-                    if norm2(&rt) <= (1.0 - 1e-4 * lambda) * norm2(&r) {
-                        accepted = Some((xt, rt));
-                        break;
-                    }
-                }
-                lambda *= 0.5;
-            }
-            match accepted {
-                Some((xt, rt)) => {
-                    x = xt;
-                    r = rt;
-                    iterations += 1;
-                }
-                None => break StopReason::NoDescent,
-            }
-        };
-        // unscaled: d y / d x = (scale_i / scale_j) dr_i/dx~_j + I
-        let mut mono = vec![0.0; m * m];
-        for i in 0..m {
-            for j in 0..m {
-                mono[i * m + j] = jac[(i, j)] * scale[i] / scale[j] + if i == j { 1.0 } else { 0.0 };
-            }
+        match y.iter().all(|v| v.is_finite()) {
+            true => Ok(y),
+            false => Err(invalid("x0", "the flexible motion's final state is not finite")),
         }
-        Ok(FlexiblePeriodic { residual: max_norm(&r), x, iterations, reason, monodromy: mono })
+    };
+    // the driver's unknowns are the scaled ones, u = x / scale
+    let residual = |u: &DVector<f64>| -> Result<DVector<f64>> {
+        let x: Vec<f64> = (0..m).map(|i| u[i] * scale[i]).collect();
+        let y = flow(&x)?;
+        Ok(DVector::from_fn(m, |i, _| (y[i] - x[i] - if i == 0 { 2.0 * std::f64::consts::PI * turns } else { 0.0 }) / scale[i]))
+    };
+    with_threads(threads, || -> Result<FlexiblePeriodic> {
+        let mut problem = Closure {
+            residual: &residual,
+            jacobian: &|u: &DVector<f64>| -> Result<DMatrix<f64>> {
+                // central differences, one column per unknown, in parallel
+                let cols: Vec<Result<DVector<f64>>> = (0..m)
+                    .into_par_iter()
+                    .map(|j| {
+                        let (mut up, mut um) = (u.clone(), u.clone());
+                        up[j] += 1e-6;
+                        um[j] -= 1e-6;
+                        Ok((residual(&up)? - residual(&um)?) / 2e-6)
+                    })
+                    .collect();
+                let mut jac = DMatrix::<f64>::zeros(m, m);
+                for (j, c) in cols.into_iter().enumerate() {
+                    jac.set_column(j, &c?);
+                }
+                Ok(jac)
+            },
+        };
+        let u0 = DVector::from_fn(m, |i, _| x0[i] / scale[i]);
+        let settings = Settings { tol, max_iter, max_halvings: 9 };
+        let out = match newton::solve(&mut problem, u0, &settings) {
+            Ok(o) => o,
+            Err(crate::Error::Integration(_)) | Err(crate::Error::InvalidArgument { name: "x0", .. }) => {
+                return Ok(FlexiblePeriodic { x: x0.to_vec(), residual: f64::NAN, iterations: 0, reason: StopReason::IntegrationFailed, monodromy: vec![f64::NAN; m * m] });
+            }
+            Err(e) => return Err(e),
+        };
+        let x: Vec<f64> = (0..m).map(|i| out.x[i] * scale[i]).collect();
+        // unscaled: d y / d x = (scale_i / scale_j) dr_i/du_j + I
+        let mono = match &out.jac {
+            Some(jac) => (0..m * m).map(|k| {
+                let (i, j) = (k / m, k % m);
+                jac[(i, j)] * scale[i] / scale[j] + if i == j { 1.0 } else { 0.0 }
+            }).collect(),
+            None => vec![f64::NAN; m * m],
+        };
+        Ok(FlexiblePeriodic { residual: out.norm, x, iterations: out.iterations, reason: out.reason, monodromy: mono })
     })?
+}
+
+/// A problem of the Newton driver given by two closures.
+struct Closure<'a, R, J> {
+    residual: &'a R,
+    jacobian: &'a J,
+}
+
+impl<R, J> Problem for Closure<'_, R, J>
+where
+    R: Fn(&DVector<f64>) -> Result<DVector<f64>>,
+    J: Fn(&DVector<f64>) -> Result<DMatrix<f64>>,
+{
+    fn residual(&mut self, x: &DVector<f64>) -> Result<DVector<f64>> {
+        (self.residual)(x)
+    }
+    fn jacobian(&mut self, x: &DVector<f64>) -> Result<DMatrix<f64>> {
+        (self.jacobian)(x)
+    }
 }

@@ -7,13 +7,14 @@
 //! and either a target Jacobi constant C(X_0) = C* or a fixed period T = T* (selects the member
 //! of the family). The system has 6N + 2 equations in 6N + 1 unknowns and is consistent (the
 //! Jacobi constant is conserved, so one closure equation is redundant); Newton steps solve it
-//! in the least-squares sense by SVD. Segments are propagated in parallel on rayon.
+//! in the least-squares sense by SVD, with the project's dense Newton driver ([`crate::newton`]). Segments are propagated in parallel on rayon.
 
 use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
 
 use crate::cr3bp::{check_mu, jacobi, potential_gradient, Cr3bp};
 use crate::error::{check_finite, check_positive, invalid, Error, Result};
+use crate::newton::{self, Problem, Settings, StopReason};
 use crate::integrate::{Options, Output, System};
 use crate::propagation::propagate;
 
@@ -64,14 +65,65 @@ pub fn correct_multiple_shooting(
     }
     let n = patches.len();
     let nu = 6 * n + 1;
-    let ne = 6 * n + 2;
-    let mut x = DVector::from_fn(nu, |k, _| if k < 6 * n { patches[k / 6][k % 6] } else { period });
     let x_ref: [f64; 6] = patches[0];
     let mut f_ref = [0.0; 6];
     Cr3bp { mu }.derivative(0.0, &x_ref, &mut f_ref);
-    let sys = Cr3bp { mu };
+    let x0 = DVector::from_fn(nu, |k, _| if k < 6 * n { patches[k / 6][k % 6] } else { period });
+    let mut problem = Shooting { mu, n, x_ref, f_ref, condition, opts, jac: None };
+    let settings = Settings { tol, max_iter, max_halvings: 7 };
+    let out = newton::solve(&mut problem, x0, &settings)?;
+    match out.reason {
+        StopReason::Converged => {
+            let x = out.x;
+            let patches = (0..n).map(|i| std::array::from_fn(|j| x[6 * i + j])).collect::<Vec<[f64; 6]>>();
+            let jc = jacobi(mu, &patches[0]);
+            Ok(ShotOrbit { patches, period: x[6 * n], jacobi: jc, iterations: out.iterations, residual: out.norm })
+        }
+        StopReason::IntegrationFailed if out.last_error.is_some() => Err(out.last_error.expect("checked")),
+        reason => Err(Error::Convergence { what: stop_what(reason), iterations: out.iterations, residual: out.norm, tolerance: tol }),
+    }
+}
 
-    let residual_and_jacobian = |x: &DVector<f64>| -> Result<(DVector<f64>, DMatrix<f64>)> {
+fn stop_what(reason: StopReason) -> &'static str {
+    match reason {
+        StopReason::NoDescent => "multiple shooting (no step reduces the residual)",
+        StopReason::SingularJacobian => "multiple shooting (least-squares Newton step failed)",
+        _ => "multiple shooting",
+    }
+}
+
+/// The multiple-shooting conditions as a problem of the Newton driver: the residual and its
+/// Jacobian come from one propagation of the segments with their STMs.
+struct Shooting<'a> {
+    mu: f64,
+    n: usize,
+    x_ref: [f64; 6],
+    f_ref: [f64; 6],
+    condition: MemberCondition,
+    opts: &'a Options,
+    jac: Option<DMatrix<f64>>,
+}
+
+impl Problem for Shooting<'_> {
+    fn residual(&mut self, x: &DVector<f64>) -> Result<DVector<f64>> {
+        let (r, j) = self.residual_and_jacobian(x)?;
+        self.jac = Some(j);
+        Ok(r)
+    }
+    fn jacobian(&mut self, _: &DVector<f64>) -> Result<DMatrix<f64>> {
+        self.jac.clone().ok_or_else(|| invalid("x", "no residual evaluated"))
+    }
+}
+
+impl Shooting<'_> {
+    fn residual_and_jacobian(&self, x: &DVector<f64>) -> Result<(DVector<f64>, DMatrix<f64>)> {
+        let (mu, n, opts, condition) = (self.mu, self.n, self.opts, self.condition);
+        let (f_ref, x_ref) = (&self.f_ref, &self.x_ref);
+        let (nu, ne) = (6 * n + 1, 6 * n + 2);
+        if !(x[6 * n] > 0.0) {
+            return Err(invalid("period", format!("must stay > 0, got {}", x[6 * n])));
+        }
+        let sys = Cr3bp { mu };
         let t_seg = x[6 * n] / n as f64;
         let segs: Vec<Result<([f64; 6], [[f64; 6]; 6])>> = (0..n)
             .into_par_iter()
@@ -121,48 +173,5 @@ pub fn correct_multiple_shooting(
             }
         }
         Ok((r, jm))
-    };
-
-    let (mut r, mut jm) = residual_and_jacobian(&x)?;
-    let mut norm = r.amax();
-    for it in 0..=max_iter {
-        if norm <= tol {
-            let patches = (0..n).map(|i| std::array::from_fn(|j| x[6 * i + j])).collect::<Vec<[f64; 6]>>();
-            let jc = jacobi(mu, &patches[0]);
-            return Ok(ShotOrbit { patches, period: x[6 * n], jacobi: jc, iterations: it, residual: norm });
-        }
-        if it == max_iter {
-            break;
-        }
-        let svd = jm.clone().svd(true, true);
-        let dx = svd.solve(&(-&r), 1e-13).map_err(|_| Error::Convergence {
-            what: "multiple shooting (least-squares Newton step failed)",
-            iterations: it,
-            residual: norm,
-            tolerance: tol,
-        })?;
-        let mut lambda = 1.0;
-        let mut accepted = false;
-        for _ in 0..8 {
-            let xt = &x + &dx * lambda;
-            if xt[6 * n] > 0.0 {
-                if let Ok((rt, jt)) = residual_and_jacobian(&xt) {
-                    let nt = rt.amax();
-                    if nt.is_finite() && (nt < norm || lambda < 0.01) {
-                        x = xt;
-                        r = rt;
-                        jm = jt;
-                        norm = nt;
-                        accepted = true;
-                        break;
-                    }
-                }
-            }
-            lambda *= 0.5;
-        }
-        if !accepted {
-            return Err(Error::Convergence { what: "multiple shooting (no step reduces the residual)", iterations: it, residual: norm, tolerance: tol });
-        }
     }
-    Err(Error::Convergence { what: "multiple shooting", iterations: max_iter, residual: norm, tolerance: tol })
 }
