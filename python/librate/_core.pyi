@@ -1,7 +1,7 @@
 """Type stubs of the private Rust extension. Use the `librate` package API instead."""
 
-from typing import Any, Literal, TypedDict, final
 from collections.abc import Sequence
+from typing import Any, Literal, TypedDict, final
 
 import numpy as np
 import numpy.typing as npt
@@ -740,6 +740,7 @@ class EphemerisCore:
         max_iter: int = 30,
         integration: tuple[float, float] = (1e-13, 1e-9),
         gm: tuple[float, float, float] | None = None,
+    ) -> dict[str, Any]: ...
 
 __all__ += ["EphemerisAttitudeModel", "eclipse_fraction", "R_SUN_KM", "R_EARTH_KM", "R_MOON_KM", "AU_KM"]
 

@@ -11,8 +11,8 @@ from .attitude3d import (
     periodic_attitude_3d,
 )
 from .attitude_families import AttitudeFamily, attitude_family
-from .ephemeris_attitude import EphemerisAttitude, attitude_to_ephemeris
 from .branches import SrpContinuation, continue_srp, periodic_attitude
+from .ephemeris_attitude import EphemerisAttitude, attitude_to_ephemeris
 from .flexible_periodic import FlexiblePeriodic, FrequencyScan, flexible_periodic, frequency_scan
 from .map3d import attitude_map_3d, find_periodic_attitudes_3d
 from .maps import periodicity_map, zero_contours
