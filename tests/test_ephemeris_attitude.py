@@ -193,8 +193,9 @@ def test_carried_motion_fields_and_deviation(carried):
     """The contract fields (node epochs within the orbit's span, unit quaternions, rates in
     rad/s of the order of the Earth-Moon rotation), the placed motion starting on the CR3BP
     motion (zero deviation at the first node, to 1e-9 deg), and the corrected motion staying
-    near it: within 20 degrees of every body axis over two revolutions (the forcing differs by
-    up to about 25 %, the N = -1 motion is linearly stable in the CR3BP)."""
+    near it: within 45 degrees of every body axis over two revolutions (the forcing differs by up
+    to about 25 % and the N = -1 motion is unstable in the CR3BP; the placed motion propagated
+    alone drifts by about 20 degrees a revolution)."""
     sol, eo, ea = carried
     assert ea.epochs_tdb[0] == eo.epochs_tdb[0] and ea.epochs_tdb[-1] == eo.epochs_tdb[-1]
     assert ea.q.shape == (ea.epochs_tdb.size, 4) and ea.w.shape == (ea.epochs_tdb.size, 3)
@@ -202,7 +203,7 @@ def test_carried_motion_fields_and_deviation(carried):
     # |w| ~ |wz0| theta' with theta' ~ 2.7e-6 rad/s
     assert 0.3 * abs(sol.wz0) * 2.5e-6 < np.median(np.linalg.norm(ea.w, axis=1)) < 3 * abs(sol.wz0) * 3.1e-6
     assert np.max(ea.placed_pointing_error_deg[0]) < 1e-9 and ea.placed_rate_error[0] < 1e-9
-    assert ea.max_pointing_error_deg < 20.0
+    assert ea.max_pointing_error_deg < 45.0
     assert ea.deviation_per_revolution_deg().shape == (2,)
     assert ea.monodromy.shape == (6, 6) and np.all(np.isfinite(ea.multipliers))
 
