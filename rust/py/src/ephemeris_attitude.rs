@@ -161,7 +161,6 @@ impl EphemerisAttitudeModel {
         shooting_dict(py, &s)
     }
 }
-}
 
 /// The sunlit fraction of the solar disc at `r` with the Sun at `sun` and a sphere of
 /// `radius_km` at `body` (any common origin, km).
