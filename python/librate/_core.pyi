@@ -738,7 +738,7 @@ class EphemerisCore:
         scales: tuple[float, float],
         epoch_free: bool = False,
         max_iter: int = 30,
-        integration: tuple[float, float] = (1e-13, 1e-9),
+        integration: tuple[float, float] = ...,
         gm: tuple[float, float, float] | None = None,
     ) -> dict[str, Any]: ...
 
@@ -792,5 +792,5 @@ class EphemerisAttitudeModel:
         w: npt.NDArray[np.float64],
         tol: float = 1e-9,
         max_iter: int = 30,
-        tolerances: tuple[float, float] = (1e-12, 1e-15),
+        tolerances: tuple[float, float] = ...,
     ) -> dict[str, Any]: ...
