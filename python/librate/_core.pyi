@@ -1,5 +1,6 @@
 """Type stubs of the private Rust extension. Use the `librate` package API instead."""
 
+from collections.abc import Sequence
 from typing import Any, Literal, TypedDict, final
 
 import numpy as np
@@ -876,4 +877,57 @@ class EphemerisCore:
         max_iter: int = 30,
         integration: tuple[float, float] = ...,
         gm: tuple[float, float, float] | None = None,
+    ) -> dict[str, Any]: ...
+
+__all__ += ["EphemerisAttitudeModel", "eclipse_fraction", "R_SUN_KM", "R_EARTH_KM", "R_MOON_KM", "AU_KM"]
+
+R_SUN_KM: float
+R_EARTH_KM: float
+R_MOON_KM: float
+AU_KM: float
+
+def eclipse_fraction(r: tuple[float, float, float] | Sequence[float], sun: Sequence[float], body: Sequence[float], radius_km: float) -> float: ...
+@final
+class EphemerisAttitudeModel:
+    def __new__(
+        cls,
+        ephemeris: EphemerisCore,
+        inertia: tuple[float, float, float] | Sequence[float],
+        gravity_gradient: tuple[bool, bool, bool] | Sequence[bool] = ...,
+        facets: list[tuple[float, Sequence[float], Sequence[float], float, float, float]] | None = None,
+        pressure: float = ...,
+        eclipses: bool = True,
+    ) -> EphemerisAttitudeModel: ...
+    def propagate(
+        self,
+        state: npt.NDArray[np.float64],
+        epoch: float,
+        duration_s: float,
+        stm: bool = False,
+        t_eval: npt.NDArray[np.float64] | None = None,
+        rtol: float = 1e-12,
+        atol: float = 1e-15,
+    ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], npt.NDArray[np.float64] | None]: ...
+    def torque(self, epoch: float, state: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]: ...
+    def place(
+        self, epochs: npt.NDArray[np.float64], q: npt.NDArray[np.float64], w: npt.NDArray[np.float64], inverse: bool = False
+    ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]: ...
+    def legs(
+        self,
+        epochs: npt.NDArray[np.float64],
+        orbits: npt.NDArray[np.float64],
+        q: npt.NDArray[np.float64],
+        w: npt.NDArray[np.float64],
+        rtol: float = 1e-12,
+        atol: float = 1e-15,
+    ) -> dict[str, Any]: ...
+    def correct(
+        self,
+        epochs: npt.NDArray[np.float64],
+        orbits: npt.NDArray[np.float64],
+        q: npt.NDArray[np.float64],
+        w: npt.NDArray[np.float64],
+        tol: float = 1e-9,
+        max_iter: int = 30,
+        tolerances: tuple[float, float] = ...,
     ) -> dict[str, Any]: ...

@@ -12,6 +12,7 @@ from .attitude3d import (
 )
 from .attitude_families import AttitudeFamily, attitude_family
 from .branches import SrpContinuation, continue_srp, periodic_attitude
+from .ephemeris_attitude import EphemerisAttitude, attitude_to_ephemeris
 from .flexible_periodic import FlexiblePeriodic, FrequencyScan, flexible_periodic, frequency_scan
 from .map3d import attitude_map_3d, find_periodic_attitudes_3d
 from .maps import periodicity_map, zero_contours
@@ -27,6 +28,8 @@ from .solutions import (
 from .srp_motions import srp_map, sun_pointing_accelerations
 
 __all__ = [
+    "EphemerisAttitude",
+    "attitude_to_ephemeris",
     "AttitudeSolution",
     "AttitudeSolution3D",
     "periodic_attitude_3d",

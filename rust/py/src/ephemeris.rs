@@ -14,7 +14,7 @@ use crate::errors::{invalid, to_py};
 /// The ephemeris (Chebyshev segments evaluated in Rust).
 #[pyclass(module = "librate._core", frozen)]
 pub struct EphemerisCore {
-    inner: Ephemeris,
+    pub(crate) inner: Ephemeris,
 }
 
 #[pymethods]

@@ -22,6 +22,7 @@ mod attitude3d;
 mod build;
 mod convert;
 mod ephemeris;
+mod ephemeris_attitude;
 mod errors;
 mod flexible;
 mod fourier;
@@ -319,6 +320,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(multiple_shooting, m)?)?;
     fourier::register(m)?;
     ephemeris::register(m)?;
+    ephemeris_attitude::register(m)?;
     attitude::register(m)?;
     map::register(m)?;
     flexible::register(m)?;

@@ -67,7 +67,14 @@ pub fn dcm_with<R: Arith>(q: &[R; 4], one: R) -> [[R; 3]; 3] {
 /// qdot = 1/2 Xi(q) (w - A e_Z), with A = A(q) (its third column is A e_Z).
 #[inline(always)]
 pub fn quat_rate<R: Arith>(q: &[R; 4], a: &[[R; 3]; 3], w: &[R; 3]) -> [R; 4] {
-    let wr = [w[0] - a[0][2], w[1] - a[1][2], w[2] - a[2][2]];
+    quat_kinematics(q, &[w[0] - a[0][2], w[1] - a[1][2], w[2] - a[2][2]])
+}
+
+/// qdot = 1/2 Xi(q) wr = 1/2 q (x) (wr, 0): the kinematics for the rate `wr` of the body relative
+/// to q's reference frame, in body axes (the synodic frame: [`quat_rate`]; an inertial frame, as
+/// ICRF in [`crate::ephemeris::attitude`]: wr = w).
+#[inline(always)]
+pub fn quat_kinematics<R: Arith>(q: &[R; 4], wr: &[R; 3]) -> [R; 4] {
     let [q1, q2, q3, q4] = *q;
     [
         (q4 * wr[0] - q3 * wr[1] + q2 * wr[2]).scale(0.5),

@@ -52,17 +52,17 @@ pub fn qmul(p: &Quat, q: &Quat) -> Quat {
     ]
 }
 
-fn conj(q: &Quat) -> Quat {
+pub(crate) fn conj(q: &Quat) -> Quat {
     [-q[0], -q[1], -q[2], q[3]]
 }
 
 /// The 4x4 matrices of p (x) q = L(p) q = R(q) p.
-fn lmat(p: &Quat) -> [[f64; 4]; 4] {
+pub(crate) fn lmat(p: &Quat) -> [[f64; 4]; 4] {
     let [a1, a2, a3, a4] = *p;
     [[a4, -a3, a2, a1], [a3, a4, -a1, a2], [-a2, a1, a4, a3], [-a1, -a2, -a3, a4]]
 }
 
-fn rmat(q: &Quat) -> [[f64; 4]; 4] {
+pub(crate) fn rmat(q: &Quat) -> [[f64; 4]; 4] {
     let [b1, b2, b3, b4] = *q;
     [[b4, b3, -b2, b1], [-b3, b4, b1, b2], [b2, -b1, b4, b3], [-b1, -b2, -b3, b4]]
 }

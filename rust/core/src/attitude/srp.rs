@@ -118,7 +118,8 @@ impl FacetBody {
         self.eval(s_body)
     }
 
-    fn eval<R: Real>(&self, s: &[R; 3]) -> ([R; 3], [R; 3]) {
+    /// Force and torque over any scalar (the ephemeris model scales them by distance and shadow).
+    pub(crate) fn eval<R: Real>(&self, s: &[R; 3]) -> ([R; 3], [R; 3]) {
         let mut f = [R::cst(0.0); 3];
         let mut t = [R::cst(0.0); 3];
         for facet in &self.facets {

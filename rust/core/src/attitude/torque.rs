@@ -76,17 +76,25 @@ pub fn tidal_tensor<R: Real>(mu: f64, pos: &[R; 3], primaries: [bool; 2]) -> [R;
         if !primaries[k] {
             continue;
         }
-        let r = [pos[0] - R::cst(cx), pos[1], pos[2]];
-        let r2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
-        let r5 = r2 * r2 * r2.sqrt();
-        let k3 = R::cst(3.0 * gm) / r5;
-        let kr = [k3 * r[0], k3 * r[1], k3 * r[2]];
-        let terms = [kr[0] * r[0], kr[1] * r[1], kr[2] * r[2], kr[0] * r[1], kr[0] * r[2], kr[1] * r[2]];
+        let terms = tidal_term(gm, &[pos[0] - R::cst(cx), pos[1], pos[2]]);
         for i in 0..6 {
             m[i] = m[i] + terms[i];
         }
     }
     m
+}
+
+/// One attracting point mass's tidal tensor 3 gm / |r|^5 r r' at the position `r` relative to
+/// it, as (xx, yy, zz, xy, xz, yz): the term [`tidal_tensor`] sums over the primaries and the
+/// ephemeris model ([`crate::ephemeris::attitude`]) over Earth, Moon and Sun (gm in the units of
+/// |r|^3 per time unit squared).
+#[inline(always)]
+pub fn tidal_term<R: Real>(gm: f64, r: &[R; 3]) -> [R; 6] {
+    let r2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
+    let r5 = r2 * r2 * r2.sqrt();
+    let k3 = R::cst(3.0 * gm) / r5;
+    let kr = [k3 * r[0], k3 * r[1], k3 * r[2]];
+    [kr[0] * r[0], kr[1] * r[1], kr[2] * r[2], kr[0] * r[1], kr[0] * r[2], kr[1] * r[2]]
 }
 
 /// The gravity-gradient torque in body axes from the synodic tidal tensor `m` ([`tidal_tensor`])

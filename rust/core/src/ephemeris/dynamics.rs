@@ -55,7 +55,21 @@ impl EphemerisDynamics {
     /// Acceleration at (t, r) and, when `grad` is given, its gradient d a / d r.
     #[inline]
     pub fn acceleration(&self, t: f64, r: &[f64; 3], grad: Option<&mut [[f64; 3]; 3]>) -> [f64; 3] {
-        let (earth, sun) = self.bodies.positions(self.epoch0 + t);
+        self.acceleration_among(&self.bodies(t), r, grad)
+    }
+
+    /// Earth and Sun relative to the Moon at t (s from `epoch0`): their positions (km); NaN
+    /// outside the span.
+    #[inline]
+    pub fn bodies(&self, t: f64) -> ([f64; 3], [f64; 3]) {
+        self.bodies.positions(self.epoch0 + t)
+    }
+
+    /// [`Self::acceleration`] with the bodies of [`Self::bodies`] already evaluated (a model that
+    /// needs them too, as the attitude's torques, evaluates the Chebyshev series once).
+    #[inline]
+    pub fn acceleration_among(&self, bodies: &([f64; 3], [f64; 3]), r: &[f64; 3], grad: Option<&mut [[f64; 3]; 3]>) -> [f64; 3] {
+        let (earth, sun) = *bodies;
         let mut a = [0.0; 3];
         let r2 = dot(r, r);
         let rn = r2.sqrt();
