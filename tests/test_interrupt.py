@@ -16,16 +16,20 @@ import pytest
 
 pytestmark = pytest.mark.skipif(sys.platform == "win32", reason="SIGINT to a child process is POSIX")
 
-# A long map: 200 000 trajectories of the planar model over 4 periods of a DRO (minutes
-# uninterrupted on two cores), preceded by a line that says it starts.
+# A long map: 1 000 000 trajectories of the planar model over 4 periods of a DRO (about 20 s
+# uninterrupted on one thread of a release build), preceded by a line that says it starts.
+# Each child first restores Python's SIGINT handler: a child inherits an ignored SIGINT from a
+# parent that ignores it (an earlier test in the same pytest process left it so; CI failed on
+# it), and Python then installs no KeyboardInterrupt handler at start-up.
 CHILD = textwrap.dedent("""
+    import signal; signal.signal(signal.SIGINT, signal.default_int_handler)
     import sys, time
     import numpy as np
     import librate
     from librate.periodicity import orbit_forcing, sweep
     o = librate.correct_dro(librate.System.preset("earth-moon"), 0.85)
     f = orbit_forcing(o)
-    n = 200_000
+    n = 1_000_000
     phi0, wz0, kz = np.zeros(n), np.linspace(-3.0, 3.0, n), np.full(n, 0.5)
     print("start", flush=True)
     t = time.perf_counter()
@@ -57,9 +61,11 @@ def test_ctrl_c_stops_a_long_map_within_a_second():
 
 
 
-# A map over 400 orbits (one at a time, a fraction of a second each), interrupted after 2 s:
+# A map over 2000 orbits (one at a time, a few hundredths of a second each in a release build),
+# interrupted after 2 s:
 # the finished orbits are kept (periodicity_map returns them with attrs["complete"] = 0).
 CHILD_MAP = textwrap.dedent("""
+    import signal; signal.signal(signal.SIGINT, signal.default_int_handler)
     import time, warnings
     import numpy as np
     import xarray  # noqa: F401  (imported before, so that the dataset is assembled at once)
@@ -68,7 +74,7 @@ CHILD_MAP = textwrap.dedent("""
     print("start", flush=True)
     with warnings.catch_warnings(record=True) as w:
         warnings.simplefilter("always")
-        ds = librate.periodicity_map([o] * 400, kz=[0.5], wz0=np.linspace(-3.0, 3.0, 2000), solve=False, threads=1)
+        ds = librate.periodicity_map([o] * 2000, kz=[0.5], wz0=np.linspace(-3.0, 3.0, 2000), solve=False, threads=1)
     rows = int(np.all(np.isfinite(ds["dwz"].values), axis=(1, 2)).sum())
     print("done", int(ds.attrs["complete"]), rows, len(w) and str(w[-1].message), flush=True)
 """)
@@ -90,7 +96,7 @@ def test_ctrl_c_keeps_the_finished_orbits_of_a_map():
             p.wait()
     assert p.returncode == 0 and line.startswith("done"), (p.returncode, line, out, err)
     _, complete, rows, message = line.split(" ", 3)
-    assert complete == "0" and 0 < int(rows) < 400, line
-    assert message.startswith(f"periodicity_map interrupted: {rows} of 400 orbits finished and kept"), line
+    assert complete == "0" and 0 < int(rows) < 2000, line
+    assert message.startswith(f"periodicity_map interrupted: {rows} of 2000 orbits finished and kept"), line
     # the interrupt within 1 s (the test above) plus the assembly of the dataset
     assert delay < 2.0, f"the map returned {delay:.2f} s after SIGINT"
