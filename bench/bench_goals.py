@@ -218,7 +218,7 @@ def map_3d(sz):
     q0, inertia = np.tile([0.0, 0.0, 0.0, 1.0], (n, 1)), np.tile(b3.BODY, (n, 1))
 
     def lib(tol, threads=None):
-        return _core.map_sweep_3d(table, float(T), q0, w0, inertia, rtol=tol, atol=tol, threads=threads)
+        return _core.map_sweep_3d(table, float(T), q0, w0, inertia, lanes=_core.LaneOptions(rtol=tol, atol=tol, threads=threads))
 
     def lib_acc(tol):
         r = lib(tol)
