@@ -19,8 +19,9 @@ pytestmark = pytest.mark.skipif(sys.platform == "win32", reason="SIGINT to a chi
 # A long map: 1 000 000 trajectories of the planar model over 4 periods of a DRO (about 20 s
 # uninterrupted on one thread of a release build), preceded by a line that says it starts.
 # Each child first restores Python's SIGINT handler: a child inherits an ignored SIGINT from a
-# parent that ignores it (an earlier test in the same pytest process left it so; CI failed on
-# it), and Python then installs no KeyboardInterrupt handler at start-up.
+# parent that ignores it (a test run started in the background of a non-interactive shell has
+# SIGINT ignored, as POSIX asks; a CI run failed on it), and Python then installs no
+# KeyboardInterrupt handler at start-up.
 CHILD = textwrap.dedent("""
     import signal; signal.signal(signal.SIGINT, signal.default_int_handler)
     import sys, time
