@@ -29,3 +29,15 @@ def cli(tmp_path, monkeypatch):
         return res
 
     return invoke
+
+
+@pytest.fixture(scope="session")
+def kernel():
+    """The embedded DE440 excerpt opened by jplephem: the independent reader of the ephemeris tests'
+    references (tests/ephemeris_reference.py)."""
+    from jplephem.spk import SPK
+    from librate.ephemeris.spk import embedded_spk_path
+
+    k = SPK.open(str(embedded_spk_path()))
+    yield k
+    k.close()

@@ -10,7 +10,6 @@ import librate
 import numpy as np
 import pytest
 from librate import _core
-from librate.ephemeris.spk import embedded_spk_path
 from scipy.integrate import solve_ivp
 from scipy.spatial.transform import Rotation
 
@@ -20,13 +19,6 @@ DAY = 86400.0
 J2000_JD = 2451545.0
 GM = {399: 398600.435507, 301: 4902.800118, 10: 132712440041.279419}
 EPOCH = "2030-03-01T00:00:00 TDB"
-
-
-@pytest.fixture(scope="module")
-def kernel():
-    k = jplephem_spk.SPK.open(str(embedded_spk_path()))
-    yield k
-    k.close()
 
 
 @pytest.fixture(scope="module")

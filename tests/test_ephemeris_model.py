@@ -7,18 +7,10 @@ import librate
 import numpy as np
 import pytest
 from librate.ephemeris.epochs import tdb_seconds
-from librate.ephemeris.spk import embedded_spk_path
 
 jplephem_spk = pytest.importorskip("jplephem.spk")
 
 from ephemeris_reference import DAY, GM_MOON, ref_propagate, ref_state  # noqa: E402
-
-
-@pytest.fixture(scope="module")
-def kernel():
-    k = jplephem_spk.SPK.open(str(embedded_spk_path()))
-    yield k
-    k.close()
 
 
 @pytest.fixture(scope="module")

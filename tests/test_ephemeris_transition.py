@@ -13,20 +13,12 @@ import librate
 import numpy as np
 import pytest
 from librate.ephemeris.epochs import tdb_seconds
-from librate.ephemeris.spk import embedded_spk_path
 
 jplephem_spk = pytest.importorskip("jplephem.spk")
 from ephemeris_reference import ref_propagate  # noqa: E402
 
 SYNODIC_MONTH_DAYS = 29.530589
 EPOCHS = ["2026-06-01T00:00:00 TDB", "2031-03-15T00:00:00 UTC", "2044-11-20T12:00:00 TDB"]
-
-
-@pytest.fixture(scope="module")
-def kernel():
-    k = jplephem_spk.SPK.open(str(embedded_spk_path()))
-    yield k
-    k.close()
 
 
 @pytest.fixture(scope="module")
