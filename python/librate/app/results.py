@@ -18,14 +18,15 @@ from typing import Any
 
 import numpy as np
 
+from ..results.atomic import clean_orphans, remove_path, replace_path, temporary_sibling
 from ..results.files import is_zarr as _is_zarr
 from ..results.files import open_dataset as _open_dataset
 from ..results.files import verify_dataset, write_dataset
-from ..results.kinds import KINDS, kind_of
+from ..results.kinds import KINDS, Solutions3DResult, kind_of, map3d_schema
 from ..results.lock import writer_lock
-from ..results.store import STORE_ATTRS, store_kind, verify_store
+from ..results.store import STORE_ATTRS, PartStore, store_kind, verify_store
 
-__all__ = ["RESULT_INPUTS", "RESULT_KINDS", "RESULT_STEMS", "ResultExists", "check_output", "describe_result", "open_result", "multipliers_3d", "read_attrs", "result_kind", "run_map_3d_to", "run_map_to", "save_dataset", "save_family", "solution_3d",
+__all__ = ["RESULT_INPUTS", "RESULT_KINDS", "RESULT_STEMS", "ResultExists", "check_output", "describe_result", "open_result", "multipliers_3d", "publish_parts", "read_attrs", "result_kind", "run_map_3d_to", "run_map_to", "save_dataset", "save_family", "solution_3d",
            "solutions_3d_dataset", "solutions_dataset",
            "study_changes", "verify_result"]
 
@@ -412,7 +413,6 @@ def solutions_3d_dataset(family_ds, orbits, period_days, start: dict, attrs: dic
 def multipliers_3d(ds) -> np.ndarray:
     """The complex Floquet multipliers (member, 6) of a saved 3-D solve (``multipliers_real``
     and ``multipliers_imag``)."""
-    from ..results.kinds import Solutions3DResult
 
     return Solutions3DResult.multipliers(ds)
 
@@ -525,9 +525,6 @@ def run_map_3d_to(orbits, store: str | Path, *, body, rates: dict, q0, n_periods
 
     from ..periodicity.map3d import COMPONENTS, map3d_dataset, map3d_grid
     from ..periodicity.maps import orbits_of
-    from ..results.atomic import clean_orphans, remove_path, replace_path, temporary_sibling
-    from ..results.kinds import map3d_schema
-    from ..results.store import PartStore
     from .distribute import ArrivalError, Region, Task, run_tasks
     from .progress import bar as progress_bar
 
@@ -604,17 +601,24 @@ def run_map_3d_to(orbits, store: str | Path, *, body, rates: dict, q0, n_periods
         final.update({"librate_result": "map_3d", **attrs, "title": "librate 3-D attitude map"})
         state0 = np.array([np.asarray(o.state0, dtype=float) for o in olist])
         pstore.finalise({"orbit_state0": (("orbit", "state"), state0, {"units": "LU, LU/TU", "long_name": "orbit initial state"})}, final, complete=True)
-        if parts != store:
-            ds = open_result(parts).load()
-            if store.suffix == ".nc":
-                for k in STORE_ATTRS:
-                    ds.attrs.pop(k, None)
-                save_dataset(ds, store, lock=lock)
-            else:
-                lock.check()
-                replace_path(parts, store)
-            remove_path(parts)
+        publish_parts(parts, store, lock)
         return open_result(store).load(), store
+
+
+def publish_parts(parts: Path, store: Path, lock) -> None:
+    """A finished part store published at ``store``: written as netCDF (without the store's bookkeeping
+    attributes) or, for Zarr, renamed over the old one under the lock; the parts removed after."""
+    if parts == store:
+        return
+    ds = open_result(parts).load()
+    if store.suffix == ".nc":
+        for k in STORE_ATTRS:
+            ds.attrs.pop(k, None)
+        save_dataset(ds, store, lock=lock)
+    else:
+        lock.check()
+        replace_path(parts, store)
+    remove_path(parts)
 
 
 def run_map_to(

@@ -151,13 +151,13 @@ def run_transition_to(orbit, store: str | Path, *, epochs_tdb, revolutions: int,
 
     from ..ephemeris.epochs import iso_tdb
     from ..orbits.periodic import PeriodicOrbit
-    from ..results.atomic import clean_orphans, remove_path, replace_path, temporary_sibling
+    from ..results.atomic import clean_orphans, remove_path, temporary_sibling
     from ..results.kinds import transition_schema
     from ..results.lock import writer_lock
-    from ..results.store import STORE_ATTRS, PartStore, store_kind
+    from ..results.store import PartStore, store_kind
     from .distribute import ArrivalError, Region, Task, run_tasks
     from .progress import bar as progress_bar
-    from .results import check_output, open_result, save_dataset
+    from .results import check_output, open_result, publish_parts
 
     store = Path(store)
     attrs = dict(attrs or {})
@@ -228,16 +228,7 @@ def run_transition_to(orbit, store: str | Path, *, epochs_tdb, revolutions: int,
                   "cr3bp_synodic": (("cr3bp_sample", "component"), _cr3bp_track(orbit),
                                     {"units": "LU, LU/TU", "long_name": "the CR3BP orbit over one period, synodic frame"})}
         pstore.finalise(arrays, final, complete=True)
-        if parts != store:
-            ds = open_result(parts).load()
-            if store.suffix == ".nc":
-                for k in STORE_ATTRS:
-                    ds.attrs.pop(k, None)
-                save_dataset(ds, store, lock=lock)
-            else:
-                lock.check()
-                replace_path(parts, store)
-            remove_path(parts)
+        publish_parts(parts, store, lock)
         return open_result(store).load(), store
 
 
