@@ -30,10 +30,9 @@ __all__ = ["EphemerisOrbit", "to_ephemeris", "ephemeris_sweep", "nodes_per_rev_f
 #: (2030-01-01, 6 or 8 nodes), while 5, 7 or 9 converge in 4-5 steps at every epoch tried.
 MAX_LEG_DAYS = 1.7
 MIN_NODES_PER_REV = 5
-#: A continuous trajectory farther than this fraction of the orbit's size (its largest distance
-#: from the Moon) from the CR3BP orbit is refused: it is another trajectory, not the orbit's
-#: counterpart. (The 9:2 NRHO departs by about 6 % of its size over 10 revolutions, the 70,000 km
-#: DRO by 20 %; the 12-day L2 halo over 10 revolutions leaves in its last one, by 150 %.)
+#: By default a continuous trajectory farther than this fraction of the orbit's size (its largest
+#: distance from the Moon) from the CR3BP orbit is refused: it is another trajectory, not the
+#: orbit's counterpart (``max_departure`` of :func:`to_ephemeris`).
 MAX_DEPARTURE = 0.5
 
 
@@ -124,13 +123,17 @@ def nodes_per_rev_for(orbit: PeriodicOrbit, nodes_per_rev: int | None = None) ->
 
 
 def _guess(orbit: PeriodicOrbit, t0: float, revolutions: int, npr: int, eph: Ephemeris):
-    """CR3BP nodes over the revolutions, placed in the ephemeris at t0 + tau tu_s."""
+    """CR3BP nodes over the revolutions, placed in the ephemeris at t0 + tau tu_s. The orbit is
+    integrated over one period and repeated: integrated over all the revolutions, an unstable
+    orbit's own rounding errors would grow by its stability index each revolution (the 12-day L2
+    halo's guess left the orbit in its tenth)."""
     s = orbit.system
     k = revolutions * npr
     taus = orbit.period * np.arange(k + 1) / npr
-    tr = propagate(s, orbit.state0, (0.0, float(taus[-1])), t_eval=taus, rtol=1e-13, atol=1e-13)
+    one = propagate(s, orbit.state0, (0.0, float(taus[npr])), t_eval=taus[:npr], rtol=1e-13, atol=1e-13).y
+    synodic = np.concatenate([np.tile(one, (revolutions, 1)), orbit.state0[None, :]])
     epochs = t0 + taus * s.tu_s
-    states = np.array([eph.synodic_to_ephemeris(y, float(e), s.mu) for y, e in zip(tr.y, epochs)])
+    states = np.array([eph.synodic_to_ephemeris(y, float(e), s.mu) for y, e in zip(synodic, epochs)])
     return states, epochs
 
 
@@ -166,6 +169,7 @@ def to_ephemeris(
     max_iter: int = 30,
     rtol: float = 1e-13,
     atol: float = 1e-9,
+    max_departure: float = MAX_DEPARTURE,
 ) -> EphemerisOrbit:
     """Carry a CR3BP periodic orbit into the Earth-Moon-Sun ephemeris model at ``epoch``.
 
@@ -199,6 +203,9 @@ def to_ephemeris(
         Newton steps at most.
     rtol, atol : float, default 1e-13 and 1e-9
         Integration tolerances (atol in km and km/s).
+    max_departure : float, default 0.5
+        The largest distance from the CR3BP orbit accepted, as a fraction of the orbit's size
+        (its largest distance from the Moon); a continuous trajectory farther away is refused.
 
     Returns
     -------
@@ -210,8 +217,9 @@ def to_ephemeris(
         An argument out of range, or an epoch span outside the ephemeris (naming the span).
     ConvergenceError
         The multiple shooting stopped before continuity (naming why, the steps and the defects),
-        or the continuous trajectory it found leaves the orbit (farther from it than half the
-        orbit's size: another trajectory, not this orbit's counterpart).
+        or the continuous trajectory it found leaves the orbit (farther from it than
+        ``max_departure`` times the orbit's size: another trajectory, not this orbit's
+        counterpart).
 
     Examples
     --------
@@ -232,6 +240,7 @@ def to_ephemeris(
         as_real(v, name, positive=True)
     as_tolerance(rtol, "rtol")
     as_tolerance(atol, "atol")
+    as_real(max_departure, "max_departure", positive=True)
     max_iter = as_count(max_iter, "max_iter", 1, 1000)
     eph = default_ephemeris(ephemeris)
     t0 = epoch_seconds(epoch)
@@ -254,11 +263,12 @@ def to_ephemeris(
     traj_nodes_t, traj_nodes = d["epochs_tdb"], d["states_km"]
     eo = EphemerisOrbit(orbit, float(traj_nodes_t[0]), revolutions, npr, traj_nodes_t, traj_nodes, int(d["iterations"]), d["defects_km"], d["defects_km_s"],
                         d["history"], math.nan, np.full(revolutions, math.nan), math.nan, eph)
-    return _with_figures(eo)
+    return _with_figures(eo, float(max_departure))
 
 
-def _with_figures(eo: EphemerisOrbit) -> EphemerisOrbit:
-    """The departure from the CR3BP orbit, the perilunes and the drift, from the dense trajectory."""
+def _with_figures(eo: EphemerisOrbit, max_departure: float) -> EphemerisOrbit:
+    """The departure from the CR3BP orbit, the perilunes and the drift, from the dense trajectory;
+    ConvergenceError if it departs by more than ``max_departure`` times the orbit's size."""
     orbit, s = eo.orbit, eo.orbit.system
     traj = eo.sample()
     syn = eo.synodic(traj)[:, :3]
@@ -269,13 +279,13 @@ def _with_figures(eo: EphemerisOrbit) -> EphemerisOrbit:
     dmin = cKDTree(ref).query(syn)[0]
     size = float(np.linalg.norm(ref - [1.0 - s.mu, 0.0, 0.0], axis=1).max())
     worst = int(np.argmax(dmin))
-    if dmin[worst] > MAX_DEPARTURE * size:
+    if dmin[worst] > max_departure * size:
         rev = min(int(np.searchsorted(eo.epochs_tdb, traj.t_tdb[worst], side="right") - 1) // eo.nodes_per_rev, eo.revolutions - 1)
         raise ConvergenceError(
             f"ephemeris transition of the {orbit.family} (period {orbit.period_days:.3f} d) at {eo.epoch_tdb:.1f} TDB s over {eo.revolutions} revolutions: "
             f"the multiple shooting made the trajectory continuous, but it leaves the orbit: in revolution {rev + 1} it passes "
-            f"{dmin[worst] * s.lu_km:,.0f} km from the CR3BP orbit, more than {MAX_DEPARTURE:.0%} of the orbit's size ({size * s.lu_km:,.0f} km "
-            "from the Moon at most); that is not this orbit's ephemeris counterpart. An orbit this unstable holds over fewer revolutions")
+            f"{dmin[worst] * s.lu_km:,.0f} km from the CR3BP orbit, more than {max_departure:.0%} of the orbit's size ({size * s.lu_km:,.0f} km "
+            "from the Moon at most); that is not this orbit's ephemeris counterpart. Fewer revolutions, or more nodes a revolution, may hold")
     starts = eo.synodic()[:: eo.nodes_per_rev, :3]
     departure = np.linalg.norm(starts - orbit.state0[:3], axis=1) * s.lu_km
     drift = float(np.polyfit(np.arange(len(departure)), departure, 1)[0]) if len(departure) > 1 else 0.0
