@@ -109,13 +109,21 @@ def test_a_trajectory_that_leaves_the_orbit_is_refused(orbits):
 
 
 def test_the_sweep_keeps_every_epoch(em):
-    """An epoch sweep returns one result per epoch, in order."""
+    """An epoch sweep returns one result per epoch, in order, the same bits whatever the number
+    of epochs run at once (each epoch is computed alone), and reports its progress by epoch."""
     dro = librate.dro(em, x0=0.9)
-    days = [0.0, 10.0, 20.0]
+    days = [0.0, 10.0, 20.0, 30.0]
     t0 = tdb_seconds("2035-05-01T00:00:00 TDB")
-    out = librate.ephemeris_sweep(dro, [t0 + d * 86400 for d in days], revolutions=1)
+    seen = []
+    out = librate.ephemeris_sweep(dro, [t0 + d * 86400 for d in days], revolutions=1, workers=2, progress=lambda k, n: seen.append((k, n)))
     assert [o.epoch_tdb for o in out] == pytest.approx([t0 + d * 86400 for d in days])
     assert all(isinstance(o, librate.EphemerisOrbit) and o.defects_km.max() < 1e-3 for o in out)
+    assert seen == [(1, 4), (2, 4), (3, 4), (4, 4)]
+    serial = librate.ephemeris_sweep(dro, [t0 + d * 86400 for d in days], revolutions=1, workers=1)
+    for a, b in zip(out, serial):
+        assert np.array_equal(a.states_km, b.states_km) and np.array_equal(a.epochs_tdb, b.epochs_tdb)
+    with pytest.raises(ValueError, match="`workers`"):
+        librate.ephemeris_sweep(dro, [t0], revolutions=1, workers=0)
 
 
 def test_bad_arguments_are_refused_naming_them(em):

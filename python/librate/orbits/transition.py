@@ -9,6 +9,7 @@ dense Newton driver, minimum-norm steps). :func:`ephemeris_sweep` does it at man
 from __future__ import annotations
 
 import math
+import os
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
@@ -17,6 +18,7 @@ import numpy as np
 from .. import _core
 from .._checks import as_count, as_real, as_tolerance
 from .._errors import ConvergenceError
+from .._progress import as_progress
 from ..ephemeris.model import Ephemeris, EphemerisTrajectory, default_ephemeris, epoch_seconds, propagate_ephemeris
 from .periodic import PeriodicOrbit
 from .propagation import propagate
@@ -294,16 +296,53 @@ def _with_figures(eo: EphemerisOrbit, max_departure: float) -> EphemerisOrbit:
                           eo.history, float(dmin.max() * s.lu_km), perilune, drift, eo.ephemeris, departure)
 
 
-def ephemeris_sweep(orbit: PeriodicOrbit, epochs: Sequence, *, revolutions: int, **options) -> list[EphemerisOrbit | ConvergenceError]:
+def ephemeris_sweep(orbit: PeriodicOrbit, epochs: Sequence, *, revolutions: int, workers: int | None = None, progress=None,
+                    **options) -> list[EphemerisOrbit | ConvergenceError]:
     """:func:`to_ephemeris` at each of ``epochs`` (ISO strings or TDB seconds); the transitions that
     do not converge are returned as their :class:`ConvergenceError`, in place (a sweep keeps every
-    finished epoch). ``options`` as for :func:`to_ephemeris`."""
+    finished epoch). ``options`` as for :func:`to_ephemeris`.
+
+    ``workers`` epochs run at once (default: the CPU count, at most 8), each transition's legs on
+    every core too: the Rust multiple shooting releases the GIL, and its serial parts (the
+    linear algebra of each Newton step, the guess and the figures) of one epoch overlap the
+    legs of another. The results do not depend on ``workers``: each epoch is computed alone,
+    deterministically, and returned in the order of ``epochs``. ``progress``: True for a bar on
+    stderr, or ``progress(done, total)`` after each epoch."""
     if isinstance(epochs, (str, bytes)) or not isinstance(epochs, Sequence | np.ndarray):
         raise ValueError(f"invalid argument `epochs`: must be a sequence of epochs, got {type(epochs).__name__}")
-    out: list[EphemerisOrbit | ConvergenceError] = []
-    for e in epochs:
+    epochs = list(epochs)
+    workers = min(8, os.cpu_count() or 1) if workers is None else as_count(workers, "workers", 1, 256)
+    report = as_progress(progress, "ephemeris sweep", "epoch")
+
+    def one(e) -> EphemerisOrbit | ConvergenceError:
         try:
-            out.append(to_ephemeris(orbit, e, revolutions=revolutions, **options))
+            return to_ephemeris(orbit, e, revolutions=revolutions, **options)
         except ConvergenceError as err:
-            out.append(err)
+            return err
+
+    if not epochs:
+        return []
+    first = one(epochs[0])  # bad arguments raise here, before any thread starts
+    out: list[EphemerisOrbit | ConvergenceError] = [first]
+    if report is not None:
+        report(1, len(epochs))
+    if workers == 1 or len(epochs) == 1:
+        for e in epochs[1:]:
+            out.append(one(e))
+            if report is not None:
+                report(len(out), len(epochs))
+        return out
+    from concurrent.futures import ThreadPoolExecutor
+
+    with ThreadPoolExecutor(max_workers=min(workers, len(epochs) - 1), thread_name_prefix="librate-sweep") as pool:
+        futures = [pool.submit(one, e) for e in epochs[1:]]
+        try:
+            for f in futures:
+                out.append(f.result())
+                if report is not None:
+                    report(len(out), len(epochs))
+        except BaseException:
+            for f in futures:
+                f.cancel()
+            raise
     return out
