@@ -82,10 +82,12 @@ def propagation(n_epochs, rounds):
     rhss = [reference_rhs(kernel, t) for t in epochs]
 
     def scipy_run(rtol):
-        return np.array([solve_ivp(f, (0.0, duration), s, method="DOP853", rtol=rtol, atol=1e-3 * rtol).y[:, -1] for f, s in zip(rhss, states)])
+        return np.array([solve_ivp(f, (0.0, duration), s, method="DOP853", rtol=rtol, atol=1e-3 * rtol).y[:, -1]
+                         for f, s in zip(rhss, states)])
 
     def lib_run(rtol):
-        return np.array([librate.propagate_ephemeris(s, t, duration, ephemeris=eph, rtol=rtol, atol=1e-3 * rtol, t_eval=[duration]).states_km[-1]
+        return np.array([librate.propagate_ephemeris(s, t, duration, ephemeris=eph, rtol=rtol, atol=1e-3 * rtol,
+                                                     t_eval=[duration]).states_km[-1]
                          for s, t in zip(states, epochs)])
 
     t0 = time.perf_counter()

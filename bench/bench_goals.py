@@ -81,7 +81,8 @@ def goal(what, ratio, sense, value, **details):
 
 
 def not_measured(what, sense, value):
-    return goal(what, None, sense, value, note="heyoka not installed (pip install heyoka)" if bm.hy is None else "heyoka left out (--no-heyoka)")
+    return goal(what, None, sense, value,
+                note="heyoka not installed (pip install heyoka)" if bm.hy is None else "heyoka left out (--no-heyoka)")
 
 
 def heyoka_configs(make, states, tol, n_threads=(1, 2)):
@@ -268,8 +269,8 @@ def main(argv=None):
     info = librate.build_info()
     cpu = cpu_name()
     load0 = os.getloadavg()
-    print(f"librate {librate.__version__} ({info['profile']} build), heyoka {heyoka.__version__ if heyoka else 'not used' if hy else 'not installed'}, "
-          f"python {platform.python_version()}, {name} sizes")
+    print(f"librate {librate.__version__} ({info['profile']} build), heyoka "
+          f"{heyoka.__version__ if heyoka else 'not used' if hy else 'not installed'}, python {platform.python_version()}, {name} sizes")
     print(f"CPU: {cpu}, {os.cpu_count()} cores, librate SIMD level {info['simd_active']}; load average {load0[0]:.2f}")
     print(f"equal accuracy: each side at the loosest tolerance meeting {TARGET:.0e} (map default rtol {MAP_RTOL:.0e} in c, d)")
     t0 = time.perf_counter()
@@ -280,7 +281,8 @@ def main(argv=None):
         print("\n[b] large map")
         goals["b"] = large_map(sz, std)
     else:
-        print(f"\nheyoka {'left out (--no-heyoka)' if args.no_heyoka else 'is not installed (pip install heyoka)'}: goals a, b and e are not measured")
+        print(f"\nheyoka {'left out (--no-heyoka)' if args.no_heyoka else 'is not installed (pip install heyoka)'}: goals a, b "
+              "and e are not measured")
         goals["a"] = not_measured("the standard map against heyoka's batch mode", ">=", 4)
         goals["b"] = not_measured("the 600k map against heyoka's throughput", ">=", 4)
     print("\n[c, d] solutions and srp_map against the map alone")
@@ -300,7 +302,8 @@ def main(argv=None):
     if args.json:
         with open(args.json, "w") as f:
             json.dump(dict(cpu=cpu, cores=os.cpu_count(), simd=info["simd_active"], build=info, librate=librate.__version__,
-                           heyoka=heyoka.__version__ if heyoka else None, sizes=name, accuracy_target=TARGET, load_average=[load0[0], load1[0]],
+                           heyoka=heyoka.__version__ if heyoka else None, sizes=name, accuracy_target=TARGET,
+                           load_average=[load0[0], load1[0]],
                            goals=goals), f, indent=1)
     return 0
 

@@ -64,7 +64,8 @@ def main():
 
     ref = run("rkf78", 1e-15, False)
     sub = np.linspace(0, wz.size - 1, 40).astype(int)
-    scalar = [librate.propagate_attitude(em, o.state0, (0.0, w), librate.RigidBody.from_kz(0.8), o.period, planar=True, rtol=1e-14, atol=1e-14)
+    scalar = [librate.propagate_attitude(em, o.state0, (0.0, w), librate.RigidBody.from_kz(0.8), o.period,
+                                         planar=True, rtol=1e-14, atol=1e-14)
               for w in wz[sub]]
     chk = max(max(abs(t.phi[-1] - ref.phi_t[i]), abs(t.wz[-1] - ref.wz_t[i])) / max(1.0, abs(t.phi[-1])) for t, i in zip(scalar, sub))
     print(f"reference RKF7(8) lanes at 1e-15 vs the scalar model (orbit integrated, 1e-14) on 40 rates: {chk:.1e}")
@@ -89,7 +90,8 @@ def main():
                 run(m, tol, stm)
                 best[m] = min(best[m], time.process_time() - t0)
         for m, (tol, e, steps) in chosen.items():
-            print(f"{m}: loosest rung meeting {TARGET:.0e}: rtol {tol:.0e} (accuracy {e:.2e}, {steps:.0f} steps), {best[m] * 1e3:.2f} ms CPU on one thread"
+            print(f"{m}: loosest rung meeting {TARGET:.0e}: rtol {tol:.0e} (accuracy {e:.2e}, {steps:.0f} steps), {best[m] * 1e3:.2f} "
+                  "ms CPU on one thread"
                   + (f", {best[m] / best['rkf78']:.2f}x the RKF7(8) time" if "rkf78" in best and m != "rkf78" else ""))
 
 

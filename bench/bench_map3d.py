@@ -82,7 +82,8 @@ def accuracy(q, w, ref):
 def heyoka_system(mu, inertia, fp=float):
     """Spatial CR3BP orbit + rigid-body attitude (quaternion scalar last, body relative to the
     synodic frame; inertial rate in body axes), gravity gradient of both primaries."""
-    x, y, z, vx, vy, vz, q1, q2, q3, q4, wx, wy, wz = hy.make_vars("x", "y", "z", "vx", "vy", "vz", "q1", "q2", "q3", "q4", "wx", "wy", "wz")
+    x, y, z, vx, vy, vz, q1, q2, q3, q4, wx, wy, wz = hy.make_vars("x", "y", "z", "vx", "vy", "vz", "q1", "q2",
+                                                                   "q3", "q4", "wx", "wy", "wz")
     m, omm = fp(mu), fp(1) - fp(mu)
     one, two, half, three = fp(1), fp(2), fp(0.5), fp(3)
     ix, iy, iz = (fp(v) for v in inertia)

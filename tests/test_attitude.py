@@ -136,7 +136,8 @@ def test_roll_pitch_at_l1_against_linearised_equations(em, ix, iy):
     a = Rotation.from_quat(q0).as_matrix().T
     w0 = a[:, 2]
     t = np.linspace(0, 20, 401)
-    tr = librate.propagate_attitude(em, [*l1, 0, 0, 0], (q0, w0), librate.RigidBody(ix, iy, IZ), 20.0, orbit="held", t_eval=t, rtol=1e-13, atol=1e-15)
+    tr = librate.propagate_attitude(em, [*l1, 0, 0, 0], (q0, w0), librate.RigidBody(ix, iy, IZ), 20.0, orbit="held",
+                                    t_eval=t, rtol=1e-13, atol=1e-15)
     ang = tr.euler_angles("123")
     m = robinson_matrix(ix, iy, IZ, h)
     x0 = np.array([phi0, theta0, 0.0, 0.0])
@@ -201,11 +202,16 @@ BAD = [
     ("triangle inequality", lambda em: librate.RigidBody(1.0, 1.0, 3.0), "triangle"),
     ("negative moment", lambda em: librate.RigidBody(-1.0, 1.0, 1.0), "ix"),
     ("kz out of range", lambda em: librate.RigidBody.from_kz(1.2), "kz"),
-    ("non-unit quaternion", lambda em: librate.propagate_attitude(em, [0.8, 0, 0, 0, 0.5, 0], ([0, 0, 0, 2], [0, 0, 1]), librate.RigidBody(1, 2, 2.5), 1.0), "unit"),
-    ("planar needs a planar orbit", lambda em: librate.propagate_attitude(em, [0.8, 0, 0.1, 0, 0.5, 0], (0, 1), librate.RigidBody.from_kz(0.5), 1.0, planar=True), "planar"),
-    ("unknown torque", lambda em: librate.propagate_attitude(em, [0.8, 0, 0, 0, 0.5, 0], (0, 1), librate.RigidBody.from_kz(0.5), 1.0, planar=True, torques=("magnetic",)), "torques"),
-    ("coupling needs mass", lambda em: librate.propagate_attitude(em, [0.8, 0, 0, 0, 0.5, 0], ([0, 0, 0, 1], [0, 0, 1]), librate.RigidBody(1, 2, 2.5), 1.0, orbit="coupled"), "mass"),
-    ("planar attitude pair", lambda em: librate.propagate_attitude(em, [0.8, 0, 0, 0, 0.5, 0], (0, 1, 2), librate.RigidBody.from_kz(0.5), 1.0, planar=True), "attitude"),
+    ("non-unit quaternion", lambda em: librate.propagate_attitude(em, [0.8, 0, 0, 0, 0.5, 0], ([0, 0, 0, 2], [0, 0, 1]),
+                                                                  librate.RigidBody(1, 2, 2.5), 1.0), "unit"),
+    ("planar needs a planar orbit", lambda em: librate.propagate_attitude(em, [0.8, 0, 0.1, 0, 0.5, 0], (0, 1),
+                                                                          librate.RigidBody.from_kz(0.5), 1.0, planar=True), "planar"),
+    ("unknown torque", lambda em: librate.propagate_attitude(em, [0.8, 0, 0, 0, 0.5, 0], (0, 1), librate.RigidBody.from_kz(0.5), 1.0,
+                                                             planar=True, torques=("magnetic",)), "torques"),
+    ("coupling needs mass", lambda em: librate.propagate_attitude(em, [0.8, 0, 0, 0, 0.5, 0], ([0, 0, 0, 1], [0, 0, 1]),
+                                                                  librate.RigidBody(1, 2, 2.5), 1.0, orbit="coupled"), "mass"),
+    ("planar attitude pair", lambda em: librate.propagate_attitude(em, [0.8, 0, 0, 0, 0.5, 0], (0, 1, 2), librate.RigidBody.from_kz(0.5),
+                                                                   1.0, planar=True), "attitude"),
 ]
 
 

@@ -37,7 +37,8 @@ def bracketed_changes(ds) -> list:
     Returns (change, (period before, period after)) pairs."""
     changes = ast.literal_eval(ds.attrs["stability_changes"])
     assert changes
-    on_circle = {round(float(p), 9): int(np.sum(np.abs(np.abs(m) - 1) < 1e-6)) for p, m in zip(ds.period_days.values, ds.multipliers.values)}
+    on_circle = {round(float(p), 9): int(np.sum(np.abs(np.abs(m) - 1) < 1e-6))
+                 for p, m in zip(ds.period_days.values, ds.multipliers.values)}
     out = []
     for c in changes:
         a, b = (round(float(p), 9) for p in c["between"])
@@ -233,7 +234,8 @@ def test_half_period_symmetric_form(em, dro, planar_n_minus_1):
     a = Rotation.from_quat(full.q0).as_matrix().T
     assert abs(a[1, 0]) < 1e-9 and abs(a[1, 2]) < 1e-9 and abs(full.w0[1]) < 1e-9  # the full form's solution is mirror symmetric
     tilt = Rotation.from_quat(full.q0).as_rotvec()[1] + 0.05
-    half = librate.periodic_attitude_3d(h, b2, guess=(Rotation.from_rotvec([0, tilt, 0]).as_quat(), [full.w0[0] + 0.02, 0, full.w0[2] - 0.02]),
+    half = librate.periodic_attitude_3d(h, b2, guess=(Rotation.from_rotvec([0, tilt, 0]).as_quat(),
+                                                      [full.w0[0] + 0.02, 0, full.w0[2] - 0.02]),
                                         symmetric=True)
     assert np.max(np.abs(half.q0 - full.q0)) < 1e-9 and np.max(np.abs(half.w0 - full.w0)) < 1e-9
     assert np.max(np.abs(half.monodromy - full.monodromy)) < 1e-8
@@ -278,7 +280,8 @@ def test_continuation_in_the_inertia_from_the_sphere(em):
 
     h = librate.halo(em, 2, "south", period_days=13.0)
     target = librate.RigidBody(0.8, 0.9, 1.0)
-    ds = attitude_family_3d_inertia(h, (librate.RigidBody(1.0, 1.0, 1.0), target), guess=([0, 0, 0, 1.0], [0, 0, 1 - 2 * math.pi / h.period]),
+    ds = attitude_family_3d_inertia(h, (librate.RigidBody(1.0, 1.0, 1.0), target),
+                                    guess=([0, 0, 0, 1.0], [0, 0, 1 - 2 * math.pi / h.period]),
                                     steps=6)
     assert ds.attrs["end_reason"].startswith("completed") and ds.sizes["member"] == 7
     np.testing.assert_allclose(ds.moments.values[-1], target.moments)
@@ -352,8 +355,10 @@ def test_body_axes_figure(em, tmp_path):
     np.testing.assert_allclose(qx.get_offsets(), tr.orbit[:, :2], atol=1e-12)
     ext = float(np.max(np.ptp(orbit.get_xydata(), axis=0)))
     length = np.hypot(qx.U, qx.V)
-    np.testing.assert_allclose(length, 0.06 * max(ext, float(np.ptp(sol.propagate(t_eval=np.linspace(0, d.period, 400)).orbit[:, 2]))), rtol=1e-9)
-    np.testing.assert_allclose(np.c_[qx.U, qx.V] / length[:, None], tr.dcm()[:, 0, :2] / np.linalg.norm(tr.dcm()[:, 0, :2], axis=1)[:, None], atol=1e-12)
+    np.testing.assert_allclose(length, 0.06 * max(ext, float(np.ptp(sol.propagate(t_eval=np.linspace(0, d.period, 400)).orbit[:, 2]))),
+                               rtol=1e-9)
+    np.testing.assert_allclose(np.c_[qx.U, qx.V] / length[:, None],
+                               tr.dcm()[:, 0, :2] / np.linalg.norm(tr.dcm()[:, 0, :2], axis=1)[:, None], atol=1e-12)
     qz = gid("axis-z")[0]
     assert np.max(np.hypot(qz.U, qz.V)) < 1e-12
     fig.savefig(tmp_path / "axes.png")
@@ -453,7 +458,8 @@ def test_family_followed_through_a_fold_in_the_period(em, dro_family):
     # at the fold a multiplier passes +1 (M - I singular): Q(2) changes sign there too (1e-7)
     changes = ast.literal_eval(ds.attrs["stability_changes"])
     assert any(c["kind"] == "+1" and abs(c["at"] - folds[0]["period_days"]) < 1e-7 for c in changes)
-    nat = librate.attitude_family_3d(dro_family, body, guess=([0, 0, 0, 1.0], [0, 0, _FOLD_START_WZ0]), period_days=periods, method="natural")
+    nat = librate.attitude_family_3d(dro_family, body, guess=([0, 0, 0, 1.0], [0, 0, _FOLD_START_WZ0]),
+                                     period_days=periods, method="natural")
     assert nat.sizes["member"] < periods.size and float(nat.period_days.max()) < folds[0]["period_days"]
 
 

@@ -81,7 +81,8 @@ def test_bad_corrector_arguments(dro1266, kw, name):
                               free=kw.get("free", PHI0), options=options(tol=kw.get("tol", 1e-12)))
 
 
-@pytest.mark.parametrize("kw, name", [(dict(closure="quarter"), "closure"), (dict(free="kz"), "free"), (dict(bordered=("x0", (0, 0, 1, 0.5))), "parameter")])
+@pytest.mark.parametrize("kw, name", [(dict(closure="quarter"), "closure"), (dict(free="kz"), "free"),
+                                      (dict(bordered=("x0", (0, 0, 1, 0.5))), "parameter")])
 def test_variant_names_are_checked_where_they_enter(dro1266, kw, name):
     """The Python layer turns the variants' names into the core's enums, naming the argument."""
     with pytest.raises(ValueError, match=f"invalid argument `{name}`: must be one of"):

@@ -52,7 +52,8 @@ def test_symmetric_correct_returns_an_orbit_record(dro_085):
     the corrector's 1e-12 residual plus the propagation error, 1e-10 allowed)."""
     o = dro_085
     r = _core.symmetric_correct(o.system.mu, [o.x0, 0.0, o.vy0], spatial=False, constraint="fix", values=[0.0, o.x0], t_max=20.0,
-                                newton=_core.NewtonOptions(tol=1e-12, max_iter=25), options=_core.IntegrationOptions(rtol=1e-13, atol=1e-13))
+                                newton=_core.NewtonOptions(tol=1e-12, max_iter=25),
+                                options=_core.IntegrationOptions(rtol=1e-13, atol=1e-13))
     assert isinstance(r, _core.SymmetricOrbit) and isinstance(r.evaluation, _core.ShootingEvaluation)
     e = r.evaluation
     assert r.period == pytest.approx(o.period, rel=1e-10) and e.half_period == pytest.approx(0.5 * r.period, rel=1e-12)

@@ -46,7 +46,8 @@ def fam(em):
 def cluster():
     from distributed import Client, LocalCluster
 
-    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None, scheduler_kwargs=FREE_HTTP_PORT) as c, Client(c) as client:
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None,
+                      scheduler_kwargs=FREE_HTTP_PORT) as c, Client(c) as client:
         yield c, client
 
 
@@ -377,7 +378,8 @@ def test_a_scheduler_gone_for_good_stops_the_run_and_the_same_call_resumes(fam, 
         c.close()
     kept = int(np.sum(zarr.open_group(str(out), mode="r")["done"][:]))
     assert 0 < kept < len(X0)
-    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None, scheduler_kwargs=FREE_HTTP_PORT) as c2, Client(c2) as client2:
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None,
+                      scheduler_kwargs=FREE_HTTP_PORT) as c2, Client(c2) as client2:
         ds = run_map(fam, kz=KZ, wz0=WZ, scheduler=client2, progress=False, out=out, solve=False)
     assert ds.attrs["complete"] == 1
     _same_map(ds, run_map(fam, kz=KZ, wz0=WZ, progress=False, solve=False), ("dwz", "dphi", "phi_T", "status"))
@@ -438,7 +440,8 @@ def test_a_scheduler_restarted_at_its_address_loses_no_finished_part(fam, tmp_pa
                                 stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
 
     def workers():
-        return subprocess.Popen([sys.executable, "-m", "distributed.cli.dask_worker", addr, "--nworkers", "2", "--nthreads", "1", "--no-dashboard"],
+        return subprocess.Popen([sys.executable, "-m", "distributed.cli.dask_worker", addr, "--nworkers", "2",
+                                 "--nthreads", "1", "--no-dashboard"],
                                 stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
 
     procs = [scheduler()]

@@ -243,7 +243,8 @@ def test_srp_torque_with_distance_and_the_moons_shadow(eph, kernel):
     """SRP on a plate and a box face: in sunlight the torque added to the gravity gradient is the
     facet formula with the pressure scaled by (1 AU / r)^2 (1e-10 relative); in the Moon's umbra
     (3,000 km behind its centre on the anti-Sun line) it is zero."""
-    facets = [librate.Facet(4.0, (1.0, 0.0, 0.0), (0.0, 0.5, 0.1), ca=0.2, cs=0.5, cd=0.3), librate.Facet(2.0, (0.0, -1.0, 0.0), (0.3, 0.0, 0.0))]
+    facets = [librate.Facet(4.0, (1.0, 0.0, 0.0), (0.0, 0.5, 0.1), ca=0.2, cs=0.5, cd=0.3),
+              librate.Facet(2.0, (0.0, -1.0, 0.0), (0.3, 0.0, 0.0))]
     spec = [(f.area, tuple(f.normal), tuple(f.center), f.ca, f.cs, f.cd) for f in facets]
     inertia = (800.0, 900.0, 1000.0)
     p0 = librate.Sun().pressure

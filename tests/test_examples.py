@@ -24,7 +24,8 @@ def test_every_example_is_listed():
 @pytest.mark.parametrize("script", sorted(OUTPUTS))
 def test_example_runs(script, tmp_path):
     env = {**os.environ, "MPLBACKEND": "Agg"}
-    res = subprocess.run([sys.executable, str(EXAMPLES / script), str(tmp_path)], capture_output=True, text=True, env=env, timeout=300, cwd=tmp_path)
+    res = subprocess.run([sys.executable, str(EXAMPLES / script), str(tmp_path)], capture_output=True, text=True, env=env,
+                         timeout=300, cwd=tmp_path)
     assert res.returncode == 0, res.stdout + res.stderr
     assert "written:" in res.stdout
     for rel in OUTPUTS[script]:

@@ -151,7 +151,8 @@ BAD = [
     ("L3 Lyapunov", lambda em: librate.lyapunov(em, 3, x0=-1.0), ValueError, "point"),
     ("bad branch", lambda em: librate.halo(em, 2, "east", z0=0.01), ValueError, "branch"),
     ("resonance k = 0", lambda em: librate.dro_family(em, x0=[0.9, 0.8]).resonant(0), ValueError, "k"),
-    ("family that cannot start", lambda em: librate.correct_symmetric(em, (0.5, 0, 0.0), fix="x0", max_iter=3), librate.ConvergenceError, "converge"),
+    ("family that cannot start", lambda em: librate.correct_symmetric(em, (0.5, 0, 0.0), fix="x0", max_iter=3),
+     librate.ConvergenceError, "converge"),
 ]
 
 
@@ -262,7 +263,8 @@ def test_single_orbits_through_a_primary_are_refused(em):
     (1 - mu - 0.985) * 384400 = 1095.54 km and mu * 384400 = 4670.46 km (tolerance 1 km: the
     closest approach is sampled at the integrator's steps)."""
     for x0, k, closest, radius in ((0.985, 2, (1 - em.mu - 0.985) * em.lu_km, em.r2_km), (0.0, 1, em.mu * em.lu_km, em.r1_km)):
-        with pytest.raises(librate.CollisionError, match=rf"{['Earth', 'Moon'][k - 1]}'s radius.*closest approach.*km.*{radius} km") as info:
+        with pytest.raises(librate.CollisionError,
+                           match=rf"{['Earth', 'Moon'][k - 1]}'s radius.*closest approach.*km.*{radius} km") as info:
             librate.correct_dro(em, x0)
         err = info.value
         assert err.primary == k and err.radius_km == radius and err.closest_km == pytest.approx(closest, abs=1.0)

@@ -379,7 +379,8 @@ def test_toml_round_trip_and_presets(tmp_path, station):
     assert path.read_text() == text
     assert librate.FlexibleBody.from_toml(path) == station
     assert librate.FlexibleBody.from_toml(text) == station
-    assert librate.FlexibleBody.from_toml('preset = "sample-station"\nlow_frequency = true\n') == librate.FlexibleBody.sample_station(low_frequency=True)
+    assert librate.FlexibleBody.from_toml('preset = "sample-station"\nlow_frequency = true\n') \
+        == librate.FlexibleBody.sample_station(low_frequency=True)
     custom = librate.FlexibleBody.from_toml("""
         [hub]
         mass = 1000.0
@@ -445,17 +446,29 @@ BAD = [
     ("appendage not an Appendage", lambda: librate.FlexibleBody(HUB, [APP]), "appendages"),
     ("unknown preset", lambda: librate.FlexibleBody.preset("iss"), "sample-station"),
     ("scaled by zero", lambda: librate.FlexibleBody(HUB, [with_()]).scaled(0.0), "frequency_factor"),
-    ("flexible stm", lambda: librate.propagate_attitude(EM, [0.8, 0, 0, 0, 0.5, 0], (0, 1), librate.FlexibleBody(HUB, [with_()]), 1.0, stm=True), "stm"),
-    ("flexible coupled orbit", lambda: librate.propagate_attitude(EM, [0.8, 0, 0, 0, 0.5, 0], (0, 1), librate.FlexibleBody(HUB, [with_()]), 1.0, orbit="coupled"), "orbit"),
-    ("flexible 3-D attitude", lambda: librate.propagate_attitude(EM, [0.8, 0, 0, 0, 0.5, 0], ([0, 0, 0, 1], [0, 0, 1]), librate.FlexibleBody(HUB, [with_()]), 1.0), "attitude"),
-    ("deflection of wrong size", lambda: librate.propagate_attitude(EM, [0.8, 0, 0, 0, 0.5, 0], (0, 1), librate.FlexibleBody(HUB, [with_()]), 1.0, deflection=([0, 0], [0, 0])), "deflection"),
-    ("unknown deflection", lambda: librate.propagate_attitude(EM, [0.8, 0, 0, 0, 0.5, 0], (0, 1), librate.FlexibleBody(HUB, [with_()]), 1.0, deflection="bent"), "deflection"),
-    ("deflection of a rigid body", lambda: librate.propagate_attitude(EM, [0.8, 0, 0, 0, 0.5, 0], (0, 1), librate.RigidBody.from_kz(0.5), 1.0, planar=True, deflection="rest"), "deflection"),
-    ("flexible non-planar orbit", lambda: librate.propagate_attitude(EM, [0.8, 0, 0.1, 0, 0.5, 0], (0, 1), librate.FlexibleBody(HUB, [with_()]), 1.0), "planar"),
-    ("quasi_static of a rigid body", lambda: librate.quasi_static(EM, [0.8, 0, 0, 0, 0.5, 0], (0, 1), librate.RigidBody.from_kz(0.5), 1.0), "FlexibleBody"),
+    ("flexible stm", lambda: librate.propagate_attitude(EM, [0.8, 0, 0, 0, 0.5, 0], (0, 1),
+                                                        librate.FlexibleBody(HUB, [with_()]), 1.0, stm=True), "stm"),
+    ("flexible coupled orbit", lambda: librate.propagate_attitude(EM, [0.8, 0, 0, 0, 0.5, 0], (0, 1), librate.FlexibleBody(HUB, [with_()]),
+                                                                  1.0, orbit="coupled"), "orbit"),
+    ("flexible 3-D attitude", lambda: librate.propagate_attitude(EM, [0.8, 0, 0, 0, 0.5, 0], ([0, 0, 0, 1], [0, 0, 1]),
+                                                                 librate.FlexibleBody(HUB, [with_()]), 1.0), "attitude"),
+    ("deflection of wrong size", lambda: librate.propagate_attitude(EM, [0.8, 0, 0, 0, 0.5, 0], (0, 1),
+                                                                    librate.FlexibleBody(HUB, [with_()]), 1.0,
+                                                                    deflection=([0, 0], [0, 0])), "deflection"),
+    ("unknown deflection", lambda: librate.propagate_attitude(EM, [0.8, 0, 0, 0, 0.5, 0], (0, 1), librate.FlexibleBody(HUB, [with_()]), 1.0,
+                                                              deflection="bent"), "deflection"),
+    ("deflection of a rigid body", lambda: librate.propagate_attitude(EM, [0.8, 0, 0, 0, 0.5, 0], (0, 1), librate.RigidBody.from_kz(0.5),
+                                                                      1.0, planar=True, deflection="rest"), "deflection"),
+    ("flexible non-planar orbit", lambda: librate.propagate_attitude(EM, [0.8, 0, 0.1, 0, 0.5, 0], (0, 1),
+                                                                     librate.FlexibleBody(HUB, [with_()]), 1.0), "planar"),
+    ("quasi_static of a rigid body", lambda: librate.quasi_static(EM, [0.8, 0, 0, 0, 0.5, 0], (0, 1),
+                                                                  librate.RigidBody.from_kz(0.5), 1.0), "FlexibleBody"),
     ("bad TOML", lambda: librate.FlexibleBody.from_toml("hub = [\n"), "TOML"),
-    ("TOML without stiffness", lambda: librate.FlexibleBody.from_toml("[hub]\nmass = 1.0\ninertia = 2.0\n[[appendages]]\nmass = 1.0\nposition = [1.0, 0.0]\ndirection = [0.0, 1.0]\n"), "stiffness"),
-    ("scan with negative factor", lambda: librate.frequency_scan(EM, [0.8, 0, 0, 0, 0.5, 0], (0, 1), librate.FlexibleBody(HUB, [with_()]), 1.0, [-1.0]), "factors"),
+    ("TOML without stiffness", lambda: librate.FlexibleBody.from_toml("[hub]\nmass = 1.0\ninertia = 2.0\n[[appendages]]\n"
+                                                                      "mass = 1.0\nposition = [1.0, 0.0]\ndirection = [0.0, 1.0]\n"),
+     "stiffness"),
+    ("scan with negative factor", lambda: librate.frequency_scan(EM, [0.8, 0, 0, 0, 0.5, 0], (0, 1), librate.FlexibleBody(HUB, [with_()]),
+                                                                 1.0, [-1.0]), "factors"),
 ]
 
 

@@ -71,7 +71,8 @@ def test_circular_orbit_about_the_earth_has_a_r_and_e_0(em):
 
 @pytest.mark.parametrize(
     "elements",
-    [(0.9, 0.3, 0.0, 0.0, 1.1, 2.0), (0.9, 0.3, math.pi, 0.0, 1.1, 2.0), (0.5, 0.72, 0.6, -2.3, 0.8, -1.2), (1.4, 0.05, 2.5, 1.9, -0.4, 0.3)],
+    [(0.9, 0.3, 0.0, 0.0, 1.1, 2.0), (0.9, 0.3, math.pi, 0.0, 1.1, 2.0), (0.5, 0.72, 0.6, -2.3, 0.8, -1.2),
+     (1.4, 0.05, 2.5, 1.9, -0.4, 0.3)],
 )
 def test_elements_recovered_from_a_kepler_state(em, elements):
     """A state built from known elements (textbook perifocal formulas, GM = 1 - mu), placed in

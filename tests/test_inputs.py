@@ -68,7 +68,8 @@ def test_cli_exits_with_the_study_error(tmp_path, monkeypatch):
     from librate.app.cli import main
 
     monkeypatch.chdir(tmp_path)
-    (tmp_path / "s.toml").write_text('[orbits]\nkind = "dro"\nx0 = [0.9, 0.001, 0.5]\n[body]\nkz = 0.8\n[rates]\nwz0 = {start = -1.0, stop = 1.5, num = 20}\n')
+    (tmp_path / "s.toml").write_text('[orbits]\nkind = "dro"\nx0 = [0.9, 0.001, 0.5]\n[body]\nkz = 0.8\n[rates]\n'
+                                     'wz0 = {start = -1.0, stop = 1.5, num = 20}\n')
     r = CliRunner().invoke(main, ["map", "s.toml", "-q"])
     assert r.exit_code != 0 and "orbits.x0" in r.output and "0.001, 0.5" in r.output, r.output
 
@@ -115,7 +116,8 @@ def test_negative_threads_is_a_value_error(em, threads):
         librate.propagate_many(em, [[0.8, 0, 0, 0, 0.5, 0]], 1.0, threads=threads)
 
 
-@pytest.mark.parametrize("kw,name", [({"tol": 0.0}, "tol"), ({"tol": -1e-9}, "tol"), ({"max_iter": 0}, "max_iter"), ({"max_iter": -5}, "max_iter"),
+@pytest.mark.parametrize("kw,name", [({"tol": 0.0}, "tol"), ({"tol": -1e-9}, "tol"), ({"max_iter": 0}, "max_iter"),
+                                     ({"max_iter": -5}, "max_iter"),
                                      ({"tol": float("nan")}, "tol"), ({"max_iter": 2.5}, "max_iter"), ({"t_max": -1.0}, "t_max")])
 def test_tol_and_max_iter_are_checked(em, kw, name):
     """Before: tol <= 0 or max_iter <= 0 gave "did not converge after -5 iterations"."""

@@ -234,8 +234,10 @@ def test_study_names_an_ambiguous_z0():
     way out (select by period), not reported as outside the family."""
     from librate.app.study import Study, StudyError
 
-    st = Study.from_dict({"system": {"preset": "earth-moon-jpl"}, "orbits": {"kind": "halo", "point": 2, "branch": "south", "z0": [-0.2023174456]}})
-    with pytest.raises(StudyError, match=r"orbits\.z0 = \[-0\.2023174456\]: 2 members .* \(periods 10\.26, 10\.53 d\).*orbits\.period_days"):
+    st = Study.from_dict({"system": {"preset": "earth-moon-jpl"},
+                          "orbits": {"kind": "halo", "point": 2, "branch": "south", "z0": [-0.2023174456]}})
+    with pytest.raises(StudyError,
+                       match=r"orbits\.z0 = \[-0\.2023174456\]: 2 members .* \(periods 10\.26, 10\.53 d\).*orbits\.period_days"):
         st.build_orbits()
 
 

@@ -61,13 +61,15 @@ def test_dataset_layout_and_chunking(halo13):
     assert np.all(m["status"].values == 0)
     np.testing.assert_array_equal(m["residual_norm"].values, np.max(np.abs(m["residual"].values), axis=-1))
     # one trajectory against the scalar 3-D model (rtol = atol = 1e-13): the residual to 1e-8
-    tr = librate.propagate_attitude(halo13.system, halo13.state0, ([0, 0, 0, 1.0], [wx[2], 0.01, wz[1]]), bodies[1], halo13.period, rtol=1e-13, atol=1e-13)
+    tr = librate.propagate_attitude(halo13.system, halo13.state0, ([0, 0, 0, 1.0], [wx[2], 0.01, wz[1]]), bodies[1],
+                                    halo13.period, rtol=1e-13, atol=1e-13)
     dw = tr.w[-1] - np.array([wx[2], 0.01, wz[1]])
     assert np.max(np.abs(m["residual"].values[1, 2, 1, 3:] - dw)) < 1e-8
     # chunks and threads
     g = map3d_grid(bodies, wx0=wx, wy0=0.01, wz0=wz)
     flat = m["residual"].values.reshape(-1, 6)
-    parts = [map3d_chunk(halo13, g, a, min(a + 2 * LANES, g.n_cases), tol=1e-10, threads=1).residual for a in range(0, g.n_cases, 2 * LANES)]
+    parts = [map3d_chunk(halo13, g, a, min(a + 2 * LANES, g.n_cases), tol=1e-10, threads=1).residual
+             for a in range(0, g.n_cases, 2 * LANES)]
     np.testing.assert_array_equal(np.concatenate(parts), flat)
     with pytest.raises(ValueError, match="start"):
         map3d_chunk(halo13, g, 3, 10)

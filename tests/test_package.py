@@ -53,8 +53,8 @@ def test_import_librate_leaves_the_application_layer_unloaded():
     import sys
 
     code = ("import sys, librate; heavy = ('librate.app', 'pydantic', 'click', 'tqdm');"
-            "print(sorted({m.split('.')[0] if not m.startswith('librate') else 'librate.app' for m in sys.modules if m.startswith(heavy)}));"
-            "librate.Study; print('librate.app.study' in sys.modules, 'Study' in dir(librate))")
+            "print(sorted({m.split('.')[0] if not m.startswith('librate') else 'librate.app' for m in sys.modules if "
+            "m.startswith(heavy)}));librate.Study; print('librate.app.study' in sys.modules, 'Study' in dir(librate))")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.split("\n")
     assert out[0] == "[]", out
     assert out[1] == "True True"

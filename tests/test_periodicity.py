@@ -245,7 +245,8 @@ def test_a_rate_grid_that_does_not_resolve_the_angle_is_named_not_refined(em):
     wz = np.linspace(-3.0, 2.0, 16)
     # phi(KT) after 200 periods depends on the last bits of the arithmetic (the SIMD level: 7
     # intervals and 667 crossings with AVX2, 8 with the baseline), so the counts are bounded
-    with pytest.warns(RuntimeWarning, match=r"does not resolve phi\(KT\) on the orbit x0 = 0.9 LU \(K = 200 periods\): \d+ interval\(s\) of `wz0`") as rec:
+    with pytest.warns(RuntimeWarning,
+                      match=r"does not resolve phi\(KT\) on the orbit x0 = 0.9 LU \(K = 200 periods\): \d+ interval\(s\) of `wz0`") as rec:
         ds = librate.periodicity_map([o], kz=0.8, wz0=wz, n_periods=200)
     row = ds.phi_T.values[0]
     assert len(candidates(row[0], 0.0, wz, math.pi)) > 300

@@ -915,7 +915,8 @@ def test_solution_legend_prints_integer_n():
     string check on the legend labels (no tolerance)."""
     from librate.plotting import _style
 
-    labels = [h.get_label() for h in _style.solution_legend(np.array([4.0, 13.0, 7.0, 0.0]), np.array(["periodic"] * 4), np.array([True] * 4))]
+    labels = [h.get_label() for h in _style.solution_legend(np.array([4.0, 13.0, 7.0, 0.0]),
+                                                            np.array(["periodic"] * 4), np.array([True] * 4))]
     assert "other $N$ (4 ... 13)" in labels and "$N$ = 0" in labels
     assert not any(".0" in lab for lab in labels)
 

@@ -87,7 +87,8 @@ def test_propagate_invalid(name, data):
     raises_naming(name, lambda: librate.propagate(args["system"], args["state"], args["t_span"], **kw))
 
 
-states6 = st.tuples(st.floats(-1.5, 1.5), st.floats(-1.5, 1.5), st.floats(-0.5, 0.5), st.floats(-2, 2), st.floats(-2, 2), st.floats(-0.5, 0.5))
+states6 = st.tuples(st.floats(-1.5, 1.5), st.floats(-1.5, 1.5), st.floats(-0.5, 0.5), st.floats(-2, 2),
+                    st.floats(-2, 2), st.floats(-0.5, 0.5))
 
 
 @SETTINGS
@@ -190,8 +191,10 @@ def test_rigid_body_valid(a, b, kz):
     raises_naming("kz", lambda: librate.RigidBody.from_kz(kz + 2.0 * math.copysign(1.0, kz or 1.0)))
 
 
-FACET_BAD = {"area": not_positive, "normal": st.one_of(junk, st.just([0.0, 0.0, 0.0]), st.lists(st.floats(-1, 1), min_size=2, max_size=2), non_finite.map(lambda b: [b, 1.0, 0.0])),
-             "center": st.one_of(junk.filter(lambda v: v is not None), st.lists(st.floats(-1, 1), min_size=4, max_size=4), non_finite.map(lambda b: [b, 0.0, 0.0])),
+FACET_BAD = {"area": not_positive, "normal": st.one_of(junk, st.just([0.0, 0.0, 0.0]), st.lists(st.floats(-1, 1), min_size=2, max_size=2),
+                                                       non_finite.map(lambda b: [b, 1.0, 0.0])),
+             "center": st.one_of(junk.filter(lambda v: v is not None), st.lists(st.floats(-1, 1), min_size=4, max_size=4),
+                                 non_finite.map(lambda b: [b, 0.0, 0.0])),
              "ca": st.one_of(not_a_number, st.floats(1.01, 5), st.floats(-5, -0.01)),
              "cs": st.one_of(not_a_number, st.floats(1.01, 5), st.floats(-5, -0.01)),
              "cd": st.one_of(not_a_number, st.floats(1.01, 5), st.floats(-5, -0.01))}
@@ -207,7 +210,8 @@ def test_facet_invalid(name, data):
 
 
 @FEW
-@given(area=st.floats(1e-3, 1e3), n=st.tuples(st.floats(-1, 1), st.floats(-1, 1), st.floats(-1, 1)).filter(lambda v: np.linalg.norm(v) > 1e-3),
+@given(area=st.floats(1e-3, 1e3),
+       n=st.tuples(st.floats(-1, 1), st.floats(-1, 1), st.floats(-1, 1)).filter(lambda v: np.linalg.norm(v) > 1e-3),
        cs=st.floats(0, 0.5), cd=st.floats(0, 0.5))
 def test_facet_and_body_valid(area, n, cs, cd):
     f = librate.Facet(area, n, (0.0, 1.0, 0.0), 1 - cs - cd, cs, cd)
@@ -250,9 +254,11 @@ def test_flat_plate_and_sun_valid(eps, cs, cd, th, p):
 
 # --- periodic orbits -------------------------------------------------------------------------
 
-SYM_BAD = {"guess": bad_state.filter(lambda v: not (isinstance(v, list) and len(v) == 3 and all(isinstance(x, float) and math.isfinite(x) for x in v))),
+SYM_BAD = {"guess": bad_state.filter(lambda v: not (isinstance(v, list) and len(v) == 3
+                                                    and all(isinstance(x, float) and math.isfinite(x) for x in v))),
            "tol": not_positive, "max_iter": not_a_count, "t_max": not_positive, "rtol": not_positive, "atol": not_positive,
-           "fix": st.text(max_size=3).filter(lambda s: s not in ("x0", "z0", "vy0")), "period": not_positive.filter(lambda v: v is not None)}
+           "fix": st.text(max_size=3).filter(lambda s: s not in ("x0", "z0", "vy0")),
+           "period": not_positive.filter(lambda v: v is not None)}
 
 
 @pytest.mark.parametrize("name", sorted(SYM_BAD))
@@ -264,7 +270,8 @@ def test_correct_symmetric_invalid(name, data):
     raises_naming(name, lambda: librate.correct_symmetric(EM, **kw))
 
 
-DRO_BAD = {"x0": st.one_of(not_a_number, st.floats(1.0, 5.0), st.floats(-5.0, -0.02)), "ydot0": st.one_of(not_a_number.filter(lambda v: v is not None)),
+DRO_BAD = {"x0": st.one_of(not_a_number, st.floats(1.0, 5.0), st.floats(-5.0, -0.02)),
+           "ydot0": st.one_of(not_a_number.filter(lambda v: v is not None)),
            "tol": not_positive, "max_iter": not_a_count, "rtol": not_positive, "atol": not_positive}
 
 
@@ -312,10 +319,14 @@ def test_corrected_orbits_agree_with_propagate_on_collisions(x0):
 
 
 LOOKUP_BAD = [
-    ("point", lambda v: librate.lyapunov(EM, v, x0=0.8), st.one_of(st.integers().filter(lambda k: k not in (1, 2)), st.text(max_size=2), st.none(), st.booleans())),
-    ("point", lambda v: librate.halo(EM, v, z0=0.05), st.one_of(st.integers().filter(lambda k: k not in (1, 2)), st.text(max_size=2), st.none())),
-    ("branch", lambda v: librate.halo(EM, 2, v, z0=0.05), st.one_of(st.text(max_size=6).filter(lambda s: s not in ("north", "south")), st.integers())),
-    ("x0", lambda v: librate.dro(EM, x0=v), st.one_of(not_a_number.filter(lambda v: v is not None), st.floats(1.0, 3.0), st.floats(-3.0, -0.02))),
+    ("point", lambda v: librate.lyapunov(EM, v, x0=0.8), st.one_of(st.integers().filter(lambda k: k not in (1, 2)), st.text(max_size=2),
+                                                                   st.none(), st.booleans())),
+    ("point", lambda v: librate.halo(EM, v, z0=0.05), st.one_of(st.integers().filter(lambda k: k not in (1, 2)),
+                                                                st.text(max_size=2), st.none())),
+    ("branch", lambda v: librate.halo(EM, 2, v, z0=0.05),
+     st.one_of(st.text(max_size=6).filter(lambda s: s not in ("north", "south")), st.integers())),
+    ("x0", lambda v: librate.dro(EM, x0=v), st.one_of(not_a_number.filter(lambda v: v is not None), st.floats(1.0, 3.0),
+                                                      st.floats(-3.0, -0.02))),
     ("period_days", lambda v: librate.dro(EM, period_days=v), st.one_of(non_finite, st.floats(-10, -0.1), st.floats(1e4, 1e6))),
     ("z0", lambda v: librate.halo(EM, 2, z0=v), st.one_of(non_finite, st.floats(0.3, 5.0), st.text(max_size=2))),
 ]
@@ -333,11 +344,13 @@ def test_lookups_invalid(case, data):
 # --- attitude ----------------------------------------------------------------------------------
 
 ORBIT = librate.correct_dro(EM, 0.85)
-ATT_BAD = {"orbit_state": bad_state, "attitude": st.one_of(junk, st.lists(st.floats(-1, 1), min_size=3, max_size=3), non_finite.map(lambda b: (b, 1.0))),
+ATT_BAD = {"orbit_state": bad_state, "attitude": st.one_of(junk, st.lists(st.floats(-1, 1), min_size=3, max_size=3),
+                                                           non_finite.map(lambda b: (b, 1.0))),
            "body": st.one_of(junk, st.floats()), "t_span": st.one_of(non_finite, junk.filter(lambda v: v is not None)),
            "torques": st.one_of(st.text(min_size=1, max_size=5), st.lists(st.integers(), min_size=1, max_size=2), st.integers()),
            "orbit": st.text(max_size=5).filter(lambda s: s not in ("integrate", "held", "coupled")), "max_steps": not_a_count,
-           "rtol": not_positive, "srp": st.one_of(st.integers(), st.text(min_size=1, max_size=3)), "sun": st.one_of(st.integers(), st.text(min_size=1, max_size=3))}
+           "rtol": not_positive, "srp": st.one_of(st.integers(), st.text(min_size=1, max_size=3)),
+           "sun": st.one_of(st.integers(), st.text(min_size=1, max_size=3))}
 
 
 @pytest.mark.parametrize("name", sorted(ATT_BAD))
@@ -367,7 +380,8 @@ def test_propagate_attitude_planar_valid(kz, phi, wz, tf, orbit):
        w=st.tuples(st.floats(-2, 2), st.floats(-2, 2), st.floats(-2, 2)), tf=st.floats(0.01, 1.0))
 def test_propagate_attitude_3d_valid(q, w, tf):
     qn = np.asarray(q) / np.linalg.norm(q)
-    tr = finite_or_typed(lambda: librate.propagate_attitude(EM, ORBIT.state0, (qn, w), librate.RigidBody(1.0, 2.0, 2.5), tf, max_steps=20000))
+    tr = finite_or_typed(lambda: librate.propagate_attitude(EM, ORBIT.state0, (qn, w),
+                                                            librate.RigidBody(1.0, 2.0, 2.5), tf, max_steps=20000))
     if tr is not None:
         assert np.all(np.isfinite(tr.q)) and np.all(np.isfinite(tr.w))
 
@@ -378,7 +392,8 @@ def test_messages_name_parameters_with_backticks():
         librate.propagate(EM, STATE, 1.0, rtol=-1.0)
 
 
-GEOMETRY_BAD = {"area_m2": not_positive, "offset_m": not_a_number, "iz_kgm2": not_positive, "sun": st.one_of(st.integers(), st.text(min_size=1, max_size=2))}
+GEOMETRY_BAD = {"area_m2": not_positive, "offset_m": not_a_number, "iz_kgm2": not_positive,
+                "sun": st.one_of(st.integers(), st.text(min_size=1, max_size=2))}
 
 
 @pytest.mark.parametrize("name", sorted(GEOMETRY_BAD))
@@ -460,7 +475,8 @@ def test_sizes_are_refused_with_their_memory_before_allocating():
     (the limit: librate._checks.MAX_ARRAY_BYTES = 2 GiB)."""
     from librate._checks import MAX_ARRAY_BYTES
 
-    with pytest.raises(ValueError, match=r"invalid argument `n_grid`: must be an integer in \[2, [\d,]+\]: 2,147,483,648 would need about 137 GB"):
+    with pytest.raises(ValueError,
+                       match=r"invalid argument `n_grid`: must be an integer in \[2, [\d,]+\]: 2,147,483,648 would need about 137 GB"):
         librate.find_periodic_attitudes(ORBIT, kz=0.8, wz0_range=(0.5, 1.0), n_grid=2**31)
     w = np.linspace(0.0, 1.0, 1000)
     with pytest.raises(ValueError, match=r"invalid arguments `body`, `wx0`, `wy0`, `wz0`: a grid of 1 x 1,000 x 1,000 x 1,000 .* 57 GB"):

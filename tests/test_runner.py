@@ -130,5 +130,6 @@ def test_dask_local_cluster_gives_identical_results(fam, reference):
     """The same map on a Dask LocalCluster of two workers equals the local run bit for bit."""
     from distributed import Client, LocalCluster
 
-    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None, scheduler_kwargs=FREE_HTTP_PORT) as cluster, Client(cluster) as client:
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None,
+                      scheduler_kwargs=FREE_HTTP_PORT) as cluster, Client(cluster) as client:
         _same(run_map(fam, kz=KZ, wz0=WZ, scheduler=client, progress=False), reference)

@@ -148,7 +148,8 @@ def test_bad_srp_parameters(desc, call, text):
 
 def test_srp_needs_a_facet_body(em):
     with pytest.raises(ValueError, match="FacetBody"):
-        librate.propagate_attitude(em, [0.8, 0, 0, 0, 0.5, 0], ([0, 0, 0, 1], [0, 0, 1]), librate.RigidBody(1, 2, 2.5), 1.0, torques=("srp",))
+        librate.propagate_attitude(em, [0.8, 0, 0, 0, 0.5, 0], ([0, 0, 0, 1], [0, 0, 1]),
+                                   librate.RigidBody(1, 2, 2.5), 1.0, torques=("srp",))
 
 
 def test_free_sun_phase_finds_the_symmetric_phases(sun12, gravity_solution):

@@ -164,7 +164,8 @@ def _drive(root: Path, cases, workers: int = 2):
     applied in turn: the second one kills the resume), split over ``workers`` driver processes;
     returns {name: [killed, ...]}."""
     parts = [cases[i::workers] for i in range(workers) if cases[i::workers]]
-    procs = [subprocess.Popen([sys.executable, "-c", DRIVER, str(root), json.dumps(p)], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    procs = [subprocess.Popen([sys.executable, "-c", DRIVER, str(root), json.dumps(p)], stdout=subprocess.PIPE,
+                              stderr=subprocess.PIPE, text=True)
              for p in parts]
     out = {}
     for proc in procs:
@@ -746,7 +747,8 @@ CAMPAIGN = textwrap.dedent("""
             fam.save(os.path.join(d, "family.zarr"))
         elif kind == "solve":
             rows = [(0, s) for s in librate.find_periodic_attitudes(fam[0], kz=0.8, wz0_range=(-1.0, 1.5), n_grid=40)]
-            save_dataset(solutions_dataset(rows, list(fam), [0.8], {{"librate_result": "solutions", "study": "{{}}"}}), os.path.join(d, "solve.zarr"))
+            save_dataset(solutions_dataset(rows, list(fam), [0.8], {{"librate_result": "solutions", "study": "{{}}"}}),
+                         os.path.join(d, "solve.zarr"))
         elif kind == "transition":
             from librate.app.transition import run_transition_to
             run_transition_to(fam[0], os.path.join(d, "transition.zarr"), epochs_tdb=EPOCHS, revolutions=2, nodes_per_rev=4, progress=False)
@@ -802,7 +804,8 @@ FRESH = ("map3d", "transition")
 
 def _campaign(root: Path, cases, workers: int = 2) -> dict:
     parts = [cases[i::workers] for i in range(workers) if cases[i::workers]]
-    procs = [subprocess.Popen([sys.executable, "-c", CAMPAIGN, str(root), json.dumps(p)], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    procs = [subprocess.Popen([sys.executable, "-c", CAMPAIGN, str(root), json.dumps(p)], stdout=subprocess.PIPE,
+                              stderr=subprocess.PIPE, text=True)
              for p in parts]
     out = {}
     for proc in procs:
@@ -963,7 +966,8 @@ def test_random_bit_flips_in_a_family_file_are_never_silent(tmp_path, fam):
             continue
         s, t = g.system, fam.system
         assert (s.mu, s.lu_km, s.tu_s, s.r1_km, s.r2_km, s.name) == (t.mu, t.lu_km, t.tu_s, t.r1_km, t.r2_km, t.name), k
-        assert (g.kind, g.spatial, g.end_reason, g.parameters, g.bifurcations) == (fam.kind, fam.spatial, fam.end_reason, fam.parameters, fam.bifurcations), k
+        assert (g.kind, g.spatial, g.end_reason, g.parameters, g.bifurcations) == (fam.kind, fam.spatial, fam.end_reason,
+                                                                                   fam.parameters, fam.bifurcations), k
         for name in ("state0", "state_half", "period", "jacobi", "eigenvalues", "stability_indices"):
             np.testing.assert_array_equal(getattr(g, name), getattr(fam, name), err_msg=f"flip {k}: {name}")
         outcomes["identical"] += 1

@@ -128,7 +128,8 @@ def test_from_toml_paths_and_syntax_errors(tmp_path):
 # (change to the valid tiny study, purpose, key named, value shown, what is allowed)
 CASES = [
     # unknown keys
-    ({"sytem": {"preset": "earth-moon"}}, None, "sytem", '{preset = "earth-moon"}', "allowed keys in the top level", "did you mean `system`"),
+    ({"sytem": {"preset": "earth-moon"}}, None, "sytem", '{preset = "earth-moon"}', "allowed keys in the top level",
+     "did you mean `system`"),
     ({"body.kzz": 0.8}, None, "body.kzz", "0.8", "allowed keys in [body]: kz, ix, iy, iz, mass_kg, flexible", "did you mean `body.kz`"),
     ({"orbits.x0.step": 0.1}, None, "orbits.x0.step", "0.1", "allowed keys in [orbits.x0]: start, stop, num", None),
     ({"torques.srp": {"eps": 0.01, "colour": "red"}}, None, "torques.srp.colour", '"red"', "allowed keys in [torques.srp]", None),
@@ -164,9 +165,11 @@ CASES = [
     ({"output.figures": ["map", "heat"]}, None, "output.figures[1]", '"heat"', "'family', 'period'", None),
     # inconsistent combinations
     ({"system.mu": 0.01}, None, "system.mu", "0.01", "either system.preset alone", "cannot be combined with system.preset"),
-    ({"system": {"mu": 0.01, "lu_km": 1000.0}}, None, "system.tu_s", None, "a number > 0, the time unit", "needs system.mu, system.lu_km and system.tu_s"),
+    ({"system": {"mu": 0.01, "lu_km": 1000.0}}, None, "system.tu_s", None, "a number > 0, the time unit",
+     "needs system.mu, system.lu_km and system.tu_s"),
     ({"orbits.point": 2}, None, "orbits.point", "2", "for 'lyapunov' and 'halo'", 'does not apply to orbits.kind = "dro"'),
-    ({"orbits.kind": "lyapunov", "orbits.x0": [0.8], "orbits.branch": "north"}, None, "orbits.branch", '"north"', "only with orbits.kind = 'halo'", None),
+    ({"orbits.kind": "lyapunov", "orbits.x0": [0.8], "orbits.branch": "north"}, None, "orbits.branch", '"north"',
+     "only with orbits.kind = 'halo'", None),
     ({"orbits": {"z0": [0.1]}}, None, "orbits.z0", "[0.1]", "only with orbits.kind = 'halo'", None),
     ({"orbits.members": 5}, None, "orbits.members", "5", "at most one of orbits.x0", "cannot be combined with orbits.x0"),
     ({"body.ix": 1.0}, None, "body.ix", "1.0", "either body.kz, or body.ix, body.iy and body.iz", None),
@@ -176,7 +179,8 @@ CASES = [
     ({"torques.srp": {"eps": 0.01, "area_m2": 10.0}}, None, "torques.srp.area_m2", "10.0", "either torques.srp.eps, or", None),
     ({"torques.srp": {"offset_m": 1.0}}, None, "torques.srp.area_m2", None, "a number > 0, the plate's area", "missing"),
     ({"torques.srp": {"eps": 0.01, "cs": 0.7, "cd": 0.5}}, None, "torques.srp.cd", "0.5", "(cs + cd <= 1)", "exceeds 1"),
-    ({"torques.srp": {"area_m2": 10.0, "offset_m": 1.0}}, None, "torques.srp.area_m2", "10.0", "the geometry with body.ix/iy/iz", "needs the body's Iz"),
+    ({"torques.srp": {"area_m2": 10.0, "offset_m": 1.0}}, None, "torques.srp.area_m2", "10.0",
+     "the geometry with body.ix/iy/iz", "needs the body's Iz"),
     ({"rates.phidot0": [0.0, 1.0]}, None, "rates.phidot0", "[0.0, 1.0]", "either rates.wz0 or rates.phidot0", None),
     ({"rates": {}}, None, "rates.wz0", None, "inertial initial rates", "missing"),
     # what a command needs
@@ -185,7 +189,8 @@ CASES = [
     ({"orbits": {"kind": "halo"}}, "map", "orbits.kind", '"halo"', "'dro' or 'lyapunov'", "planar"),
     ({"torques.gravity_gradient": ["earth"]}, "map", "torques.gravity_gradient", '["earth"]', '["earth", "moon"]', "both primaries"),
     ({"torques.srp": {"eps": 0.01}}, "solve", "orbits.sun_resonance", None, "a list of integers k >= 1", "Sun-resonant"),
-    ({"torques.srp": {"eps": 0.01}, "orbits": {"sun_resonance": [2]}, "solver.n_periods": 3}, "map", "solver.n_periods", "3", "a multiple of 2", None),
+    ({"torques.srp": {"eps": 0.01}, "orbits": {"sun_resonance": [2]}, "solver.n_periods": 3}, "map", "solver.n_periods", "3",
+     "a multiple of 2", None),
 ]
 
 

@@ -98,10 +98,12 @@ CASES = [
     # the body: the full inertia, rigid
     ({"body": {"kz": 0.8}}, None, "body.kz", "0.8", "body.ix, body.iy and body.iz in kg m^2", "full inertia"),
     ({"body": {"kz": [0.5, 0.8]}}, "solve", "body.kz", "[0.5, 0.8]", "body.ix, body.iy and body.iz", "not Kz alone"),
-    ({"body": {"flexible": "sample-station"}}, None, "body.flexible", '"sample-station"', "body.ix, body.iy and body.iz", "not modelled in 3-D"),
+    ({"body": {"flexible": "sample-station"}}, None, "body.flexible", '"sample-station"',
+     "body.ix, body.iy and body.iz", "not modelled in 3-D"),
     ({"body": ...}, "solve", "body", None, None, "principal moments"),
     # torques
-    ({"torques.srp": {"eps": 0.01}}, "solve", "torques.srp", '"[torques.srp]"', "no [torques.srp] with attitude.model = '3d'", "not modelled in 3-D"),
+    ({"torques.srp": {"eps": 0.01}}, "solve", "torques.srp", '"[torques.srp]"',
+     "no [torques.srp] with attitude.model = '3d'", "not modelled in 3-D"),
     ({"torques.gravity_gradient": ["moon"]}, None, "torques.gravity_gradient", '["moon"]', '["earth", "moon"]', "both primaries"),
     # [attitude] types and ranges
     ({"attitude.model": "4d"}, None, "attitude.model", '"4d"', "'planar' (the default", None),
@@ -113,13 +115,18 @@ CASES = [
     ({"attitude.start": "given", "attitude.n": ..., "attitude.w0": [0.0, 1.0]}, None, "attitude.w0", "[0.0, 1.0]", "three numbers", None),
     # [attitude] combinations
     ({"attitude.n": ...}, None, "attitude.n", None, "an integer in [-100, 100]", "missing"),
-    ({"attitude.q0": [0.0, 0.0, 0.0, 1.0]}, None, "attitude.q0", "[0.0, 0.0, 0.0, 1.0]", "attitude.start = 'given'", 'attitude.start = "planar"'),
-    ({"attitude.start": "spin", "attitude.w0": [0.0, 0.0, 1.0]}, None, "attitude.w0", "[0.0, 0.0, 1.0]", "attitude.start = 'given'", "spin"),
+    ({"attitude.q0": [0.0, 0.0, 0.0, 1.0]}, None, "attitude.q0", "[0.0, 0.0, 0.0, 1.0]", "attitude.start = 'given'",
+     'attitude.start = "planar"'),
+    ({"attitude.start": "spin", "attitude.w0": [0.0, 0.0, 1.0]}, None, "attitude.w0", "[0.0, 0.0, 1.0]",
+     "attitude.start = 'given'", "spin"),
     ({"attitude.start": "given", "attitude.n": ...}, None, "attitude.w0", None, "three numbers", "missing"),
-    ({"attitude.start": "given", "attitude.w0": [0.0, 0.0, 1.0]}, None, "attitude.n", "-1", "attitude.start = 'planar' or 'spin'", "does not apply"),
-    ({"attitude.start": "spin", "attitude.q0": [0.0, 0.0, 0.0, 2.0]}, None, "attitude.q0", "[0.0, 0.0, 0.0, 2.0]", "a unit quaternion", "|q0| = 2"),
+    ({"attitude.start": "given", "attitude.w0": [0.0, 0.0, 1.0]}, None, "attitude.n", "-1",
+     "attitude.start = 'planar' or 'spin'", "does not apply"),
+    ({"attitude.start": "spin", "attitude.q0": [0.0, 0.0, 0.0, 2.0]}, None, "attitude.q0", "[0.0, 0.0, 0.0, 2.0]",
+     "a unit quaternion", "|q0| = 2"),
     ({"attitude.start": "spin", "attitude.q0": [0.0, 0.0, 0.0, 1.0], "solver.phi0": 0.5}, None, "solver.phi0", "0.5", "not both", None),
-    ({"orbits": {"kind": "halo"}, "attitude.start": "planar"}, None, "attitude.start", '"planar"', "'spin' or 'given' on a halo family", "planar family"),
+    ({"orbits": {"kind": "halo"}, "attitude.start": "planar"}, None, "attitude.start", '"planar"',
+     "'spin' or 'given' on a halo family", "planar family"),
     ({"attitude": {"n": 1}}, None, "attitude.n", "1", "attitude.model = '3d'", "applies only"),
     # what `solve` needs
     ({"rates": ...}, "solve", "rates", None, None, "planar start scans"),
@@ -127,13 +134,16 @@ CASES = [
     # what `map` needs: two grids and one fixed rate
     ({"rates": ...}, "map", "rates", None, None, "two grids and one fixed number"),
     ({"rates.wx0": [0.0, 0.1]}, "map", "rates.wy0", None, "a number (fixed) or a grid", "missing"),
-    ({"rates.wx0": [0.0, 0.1], "rates.wy0": [0.0, 0.1]}, "map", "rates.wz0", '{start = -3.0, stop = 2.0, num = 300}', "exactly one of", "given 0 fixed"),
+    ({"rates.wx0": [0.0, 0.1], "rates.wy0": [0.0, 0.1]}, "map", "rates.wz0", '{start = -3.0, stop = 2.0, num = 300}',
+     "exactly one of", "given 0 fixed"),
     ({"rates.wx0": 0.0, "rates.wy0": 0.0}, "map", "rates.wy0", "0.0", "exactly one of", "given 2 fixed"),
     ({"rates.wx0": [0.1, 0.0], "rates.wy0": 0.0}, "map", "rates.wx0", "[0.1, 0.0]", "strictly increasing", None),
     # the planar model: no 3-D keys
-    ({"attitude": ..., "body": {"kz": 0.8}, "rates.wx0": [0.0, 0.1]}, None, "rates.wx0", "[0.0, 0.1]", "[attitude] model = '3d'", "applies only"),
+    ({"attitude": ..., "body": {"kz": 0.8}, "rates.wx0": [0.0, 0.1]}, None, "rates.wx0", "[0.0, 0.1]",
+     "[attitude] model = '3d'", "applies only"),
     ({"attitude": ..., "body": {"kz": 0.8}, "rates.wz0": 0.5}, None, "rates.wz0", "0.5", "strictly increasing", "at least 2 values"),
-    ({"attitude": ..., "body": {"kz": 0.8}, "orbits": {"kind": "halo"}}, "map", "orbits.kind", '"halo"', "any family with [attitude] model = '3d'", "planar"),
+    ({"attitude": ..., "body": {"kz": 0.8}, "orbits": {"kind": "halo"}}, "map", "orbits.kind", '"halo"',
+     "any family with [attitude] model = '3d'", "planar"),
 ]
 
 
@@ -165,7 +175,8 @@ def test_a_3d_map_takes_exactly_two_grids_and_one_fixed_rate(base, wx0, wy0, wz0
     if fixed == 1:
         assert problems == []
     else:
-        assert len(problems) == 1 and problems[0].startswith("rates.w") and "exactly one of rates.wx0, rates.wy0, rates.wz0" in problems[0], problems
+        assert (len(problems) == 1 and problems[0].startswith("rates.w")
+            and "exactly one of rates.wx0, rates.wy0, rates.wz0" in problems[0]), problems
 
 
 @settings(max_examples=60, deadline=None)
@@ -184,7 +195,8 @@ def test_q0_is_valid_exactly_when_it_is_a_unit_quaternion(q):
 
 
 @settings(max_examples=40, deadline=None)
-@given(st.sampled_from(["planar", "spin", "given"]), st.sampled_from(["dro", "lyapunov", "halo"]), st.booleans(), st.booleans(), st.booleans())
+@given(st.sampled_from(["planar", "spin", "given"]), st.sampled_from(["dro", "lyapunov", "halo"]), st.booleans(),
+       st.booleans(), st.booleans())
 def test_every_start_combination_is_valid_or_names_its_keys(start, kind, with_n, with_q0, with_w0):
     """Property: for any start, family and set of attitude keys, the study is valid exactly when
     the rules of docs/cli.md hold, and every problem names an [attitude] key."""
@@ -299,7 +311,8 @@ def test_solve_a_3d_halo_study_from_the_torque_free_spin(cli, tmp_path):
     check_stored_motions(ds)
     assert json.loads(ds.attrs["study"])["attitude"]["start"] == "spin"
     (change,) = ast.literal_eval(ds.attrs["stability_changes"])
-    assert change["kind"] == "krein" and change["located"] and 11.0 < change["at"] < 12.0 and change["between"] == pytest.approx((12.0, 11.0))
+    assert (change["kind"] == "krein" and change["located"] and 11.0 < change["at"] < 12.0
+            and change["between"] == pytest.approx((12.0, 11.0)))
     assert f"stability change (krein) at T = {change['at']:.10g} d" in res.output
     assert (tmp_path / "librate-out" / "solve_multipliers.png").exists() and not (tmp_path / "librate-out" / "solve_body_axes.png").exists()
 

@@ -29,7 +29,8 @@ def _problems(eph: dict, orbits=None) -> list[str]:
 
 
 @pytest.mark.parametrize("eph, key, allowed", [
-    ({"epoch": "2019-06-01T00:00:00 TDB"}, "ephemeris.epoch = ", "epochs from 2020-01-01T00:00:00.000000 TDB to 2071-01-01T00:00:00.000000 TDB"),
+    ({"epoch": "2019-06-01T00:00:00 TDB"}, "ephemeris.epoch = ",
+     "epochs from 2020-01-01T00:00:00.000000 TDB to 2071-01-01T00:00:00.000000 TDB"),
     ({"epoch": ["2030-01-01T00:00:00 TDB", "2030-13-01T00:00:00 TDB"]}, "ephemeris.epoch[1] = ", "an ISO string with a time scale"),
     ({"epoch": "2030-01-01 noon"}, "ephemeris.epoch = ", "an ISO string with a time scale"),
     ({"epoch": {"start": "2031-01-01T00:00:00 TDB", "stop": "2030-01-01T00:00:00 TDB", "step_days": 1}}, "ephemeris.epoch.stop = ",
@@ -62,7 +63,8 @@ def test_a_transition_needs_its_section_and_one_orbit():
 def test_epochs_of_a_range_a_list_and_mixed_scales():
     """A range runs from start every step_days up to stop (included on a step); UTC is TDB less
     69.184 s in 2030 (37 s of leap seconds + 32.184 s TT - TAI, TDB - TT < 2 ms)."""
-    e = Study.from_dict({"ephemeris": {"epoch": {"start": "2030-01-01T00:00:00 TDB", "stop": "2030-01-21T00:00:00 TDB", "step_days": 10}}}).ephemeris
+    e = Study.from_dict({"ephemeris": {"epoch": {"start": "2030-01-01T00:00:00 TDB", "stop": "2030-01-21T00:00:00 TDB",
+                                                 "step_days": 10}}}).ephemeris
     t = e.epochs_tdb()
     assert t.size == 3 and np.allclose(np.diff(t), 10 * 86400.0, rtol=0, atol=1e-6)
     lst = Study.from_dict({"ephemeris": {"epoch": ["2030-01-01T00:00:00 UTC", float(t[0])]}}).ephemeris.epochs_tdb()
@@ -120,14 +122,16 @@ def test_example_runs_and_every_epoch_is_continuous(example):
         assert 0 < ds["max_departure_km"].values[j] < 1e5 and (ds["perilune_km"].values[j] > 1737.4).all()
     # self-describing: the epochs, frames, constants and the file in the attributes
     a = ds.attrs
-    assert json.loads(a["epochs_iso"]) == ["2030-01-01T00:00:00.000000 TDB", "2030-01-11T00:00:00.000000 TDB", "2030-01-21T00:00:00.000000 TDB"]
+    assert json.loads(a["epochs_iso"]) == ["2030-01-01T00:00:00.000000 TDB", "2030-01-11T00:00:00.000000 TDB",
+                                           "2030-01-21T00:00:00.000000 TDB"]
     assert a["gm_km3_s2"] == [398600.435507, 4902.800118, 132712440041.279419] and "Moon-centred ICRF" in a["frames"]
     assert a["ephemeris_file"].startswith("embedded DE440") and json.loads(a["study"])["ephemeris"]["revolutions"] == 4
     assert a["revolutions"] == 4 and a["librate_result"] == "transition"
     lines = res.output.splitlines()
     assert "3 epoch(s), 3 converged, 4 revolutions" in lines[0]
     assert [ln.split()[0] for ln in lines[2:5]] == ["2030-01-01T00:00:00", "2030-01-11T00:00:00", "2030-01-21T00:00:00"]
-    assert {p.name for p in (d / "librate-out").glob("*.png")} == {"transition_rotating.png", "transition_defects.png", "transition_sweep.png"}
+    assert {p.name for p in (d / "librate-out").glob("*.png")} == {"transition_rotating.png",
+                                                                   "transition_defects.png", "transition_sweep.png"}
 
 
 def test_the_same_run_reuses_a_changed_one_is_refused_by_key(example, tmp_path):
@@ -213,4 +217,5 @@ def test_an_epoch_that_does_not_converge_is_kept_as_such_and_the_sweep_goes_on(t
     (why,) = json.loads(ds.attrs["failures"]).values()
     assert why.startswith("ConvergenceError: ephemeris transition of the dro") and "max iterations" in why
     lines = transition_summary(ds, 1.0)
-    assert "3 epoch(s), 2 converged" in lines[0] and lines[3].endswith("did not converge") and lines[-1].startswith("  epoch 1: ConvergenceError")
+    assert ("3 epoch(s), 2 converged" in lines[0] and lines[3].endswith("did not converge")
+            and lines[-1].startswith("  epoch 1: ConvergenceError"))

@@ -130,7 +130,8 @@ def as_count(value, name: str, minimum: int, maximum: float | None = None) -> in
     MAX_COUNT); not a bool, a float or a string. Else a ValueError naming it and the range."""
     hi = COUNT_LIMITS.get(name, MAX_COUNT) if maximum is None else maximum
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)) or not minimum <= value <= hi:
-        raise ValueError(f"invalid argument `{name}`: must be an integer " + (f">= {minimum}" if hi == math.inf else f"in [{minimum}, {hi:,}]") + f", got {value!r}")
+        raise ValueError(f"invalid argument `{name}`: must be an integer "
+                         + (f">= {minimum}" if hi == math.inf else f"in [{minimum}, {hi:,}]") + f", got {value!r}")
     return int(value)
 
 

@@ -441,7 +441,8 @@ class MultipleShooting:
     def residual(self) -> float: ...
 
 def symmetric_correct(
-    mu: float, p: list[float], *, spatial: bool, constraint: str, values: list[float], t_max: float, newton: NewtonOptions, options: IntegrationOptions
+    mu: float, p: list[float], *, spatial: bool, constraint: str, values: list[float], t_max: float, newton: NewtonOptions,
+    options: IntegrationOptions
 ) -> SymmetricOrbit: ...
 def stability(m: _F64, planar: bool) -> tuple[npt.NDArray[np.complex128], npt.NDArray[np.complex128]]: ...
 def multiple_shooting(
@@ -492,7 +493,8 @@ class OrbitMode:
 @final
 class SrpModel:
     def __new__(
-        cls, facets: list[_FacetTuple], *, sun: tuple[float, float, float] = ..., tu_s: float = 1.0, force: tuple[float, float] | None = None
+        cls, facets: list[_FacetTuple], *, sun: tuple[float, float, float] = ..., tu_s: float = 1.0,
+        force: tuple[float, float] | None = None
     ) -> SrpModel: ...
 
 @final
@@ -505,7 +507,8 @@ class AttitudeModel:
 @final
 class PlanarModel:
     def __new__(
-        cls, mu: float, kz: float, *, primaries: list[bool] = ..., held: bool = False, plate: tuple[float, float, float, float, float] | None = None
+        cls, mu: float, kz: float, *, primaries: list[bool] = ..., held: bool = False,
+        plate: tuple[float, float, float, float, float] | None = None
     ) -> PlanarModel: ...
 
 def attitude_propagate(
@@ -747,7 +750,8 @@ def flexible_correct_periodic(
 ) -> FlexiblePeriodicCorrection: ...
 
 # --- 3-D attitude: equilibria and periodic motions (rust/py/src/attitude3d.rs) ---
-__all__ += ["attitude_equilibrium", "attitude_correct_3d", "attitude_correct_3d_across", "LinearisedEquilibrium", "CorrectionBatch3D", "CorrectionAcross3D"]
+__all__ += ["attitude_equilibrium", "attitude_correct_3d", "attitude_correct_3d_across", "LinearisedEquilibrium",
+            "CorrectionBatch3D", "CorrectionAcross3D"]
 
 @final
 class LinearisedEquilibrium:
@@ -886,7 +890,8 @@ R_EARTH_KM: float
 R_MOON_KM: float
 AU_KM: float
 
-def eclipse_fraction(r: tuple[float, float, float] | Sequence[float], sun: Sequence[float], body: Sequence[float], radius_km: float) -> float: ...
+def eclipse_fraction(r: tuple[float, float, float] | Sequence[float], sun: Sequence[float], body: Sequence[float],
+                     radius_km: float) -> float: ...
 @final
 class EphemerisAttitudeModel:
     def __new__(

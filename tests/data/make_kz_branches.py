@@ -107,7 +107,8 @@ def main():
             rows.append({"orbit": name, "state0": [float(v) for v in o.state0], "period": float(o.period), "n_periods": k, "n": n,
                          "wz0": wz, "fold_after_kz": fold})
             print(name, n, wz, fold, flush=True)
-    doc = {"source": __doc__.strip().splitlines()[0], "mu": MU, "method": "scipy DOP853 rtol=atol=1e-12, angle form, secant half-period shooting",
+    doc = {"source": __doc__.strip().splitlines()[0], "mu": MU,
+           "method": "scipy DOP853 rtol=atol=1e-12, angle form, secant half-period shooting",
            "kz_step": DKZ, "rows": rows}
     Path(__file__).with_name("kz_branches.json").write_text(json.dumps(doc, indent=1))
 

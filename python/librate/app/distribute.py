@@ -113,11 +113,13 @@ def client_of(scheduler):
     try:
         from distributed import Client
     except ImportError:
-        raise ValueError("invalid argument `scheduler`: a Dask scheduler needs dask.distributed (pip install 'dask[distributed]')") from None
+        raise ValueError("invalid argument `scheduler`: a Dask scheduler needs dask.distributed (pip install "
+                         "'dask[distributed]')") from None
     if isinstance(scheduler, Client):
         return scheduler, False
     if not isinstance(scheduler, str) or not scheduler:
-        raise ValueError(f"invalid argument `scheduler`: None, a distributed.Client or a scheduler address (\"tcp://host:port\"), got {scheduler!r}")
+        raise ValueError("invalid argument `scheduler`: None, a distributed.Client or a scheduler address "
+                         f"(\"tcp://host:port\"), got {scheduler!r}")
     return Client(scheduler), True
 
 
@@ -158,8 +160,8 @@ def _wait_connected(client, timeout: float = RECONNECT_S) -> None:
     deadline = time.monotonic() + timeout
     while client.status != "running":
         if client.status in ("closed", "closing") or time.monotonic() > deadline:
-            raise ConnectionError(f"the Dask client lost its scheduler and did not reconnect within {timeout:g} s (status {client.status!r}); "
-                                  "the finished tasks are committed: re-run the same call to resume")
+            raise ConnectionError(f"the Dask client lost its scheduler and did not reconnect within {timeout:g} s (status "
+                                  f"{client.status!r}); the finished tasks are committed: re-run the same call to resume")
         time.sleep(0.1)
 
 
@@ -203,8 +205,9 @@ def _run_on(client, tasks, commit, bar, region, commit_written, attempts) -> Non
                 err = e
         if err is not None:
             if tries[t.key] >= attempts:
-                raise RuntimeError(f"task {t.key} ({t.fn.__name__}) was lost {tries[t.key]} times on the cluster (last: {type(err).__name__}: {err}); "
-                                   "the finished tasks are committed: re-run the same call to resume") from err
+                raise RuntimeError(f"task {t.key} ({t.fn.__name__}) was lost {tries[t.key]} times on the cluster (last: "
+                                   f"{type(err).__name__}: {err}); the finished tasks are committed: re-run "
+                                   "the same call to resume") from err
             _wait_connected(client)
             # a written region that did not check out is computed again and sent back whole
             queue.add(submit(t, direct and not isinstance(err, ArrivalError)))

@@ -118,9 +118,12 @@ def _run_solve_planar(study: PlanarStudy, out: str | Path | None = None, progres
         from ..periodicity.flexible_periodic import flexible_periodic
 
         res = [flexible_periodic(sol, flex, resolve=False) for _, sol in rows]
-        ds["flex_dphi0"] = ("solution", np.array([r.shift[0] for r in res]), {"units": "rad", "long_name": "first-order shift of phi0 from flexibility"})
-        ds["flex_dwz0"] = ("solution", np.array([r.shift[1] for r in res]), {"units": "1/TU", "long_name": "first-order shift of wz0 from flexibility"})
-        ds["flex_max_dphi"] = ("solution", np.array([r.max_dphi for r in res]), {"units": "rad", "long_name": "largest attitude departure over a period"})
+        ds["flex_dphi0"] = ("solution", np.array([r.shift[0] for r in res]),
+                            {"units": "rad", "long_name": "first-order shift of phi0 from flexibility"})
+        ds["flex_dwz0"] = ("solution", np.array([r.shift[1] for r in res]),
+                           {"units": "1/TU", "long_name": "first-order shift of wz0 from flexibility"})
+        ds["flex_max_dphi"] = ("solution", np.array([r.max_dphi for r in res]),
+                               {"units": "rad", "long_name": "largest attitude departure over a period"})
     path = save_dataset(ds, path)
     return ds, path
 
@@ -172,7 +175,8 @@ def _run_solve_3d(study: Study3D, out: str | Path | None = None, progress: Calla
     if not members:
         sel = member_count(study.orbits)
         key, value = (f"orbits.{sel[0]}", sel[1]) if sel else ("orbits.kind", study.orbits.kind)
-        raise StudyError([problem(key, value, "selects no member", "at least 1 member (with 2 or more, the motion is continued along them in order)")])
+        raise StudyError([problem(key, value, "selects no member",
+                                  "at least 1 member (with 2 or more, the motion is continued along them in order)")])
     body = study.build_body()
     k = study.n_periods()
     guess, start = _start_3d(study, members[0], body, k)
@@ -201,7 +205,8 @@ def _start_3d(study: Study3D, orbit, body, n_periods: int):
         found = find_periodic_attitudes(orbit, kz=float(body.kz), wz0_range=(float(wz[0]), float(wz[-1])), phi0=study.solver.phi0,
                                         n_grid=int(wz.size), n_periods=n_periods)
         hits = [x for x in found if x.kind == "periodic" and x.n == n]
-        where = f"on the first member (x0 = {orbit.x0:.6g} LU, T = {orbit.period_days:.6g} d, Kz = {body.kz:.6g}, phi0 = {study.solver.phi0:g})"
+        where = (f"on the first member (x0 = {orbit.x0:.6g} LU, T = {orbit.period_days:.6g} d, Kz = {body.kz:.6g}, "
+                 f"phi0 = {study.solver.phi0:g})")
         if not hits:
             others = ", ".join(f"n = {x.n:g} ({x.kind}) at wz0 = {x.wz0:.6g}" for x in found) or "none"
             raise StudyError([problem("attitude.n", n, f"no planar periodic solution with n = {n} {where} for wz0 in "
@@ -244,7 +249,8 @@ def _run_map_3d(study: Study3D, out: str | Path | None = None, *, scheduler=None
     orbit by orbit, resumable (:func:`librate.app.results.run_map_3d_to`); ``force``: recomputed."""
     from .results import run_map_3d_to
 
-    return run_map_3d_to(study.build_orbits(), _result_path(study, out, "map"), body=study.build_body(), rates=study.rates_3d(), q0=study.q0_3d(),
+    return run_map_3d_to(study.build_orbits(), _result_path(study, out, "map"), body=study.build_body(),
+                         rates=study.rates_3d(), q0=study.q0_3d(),
                          n_periods=study.n_periods(), tol=study.tol, resume=not force, scheduler=scheduler,
                          progress=progress, attrs=study.result_attrs("map_3d", "map"))
 
@@ -309,7 +315,8 @@ def run_transition(study: Study, out: str | Path | None = None, *, scheduler=Non
     if len(orbits) != 1:
         sel = member_count(study.orbits)
         key, value = (f"orbits.{sel[0]}", sel[1]) if sel else ("orbits.kind", study.orbits.kind)
-        raise StudyError([problem(key, value, f"selects {len(orbits)} orbits", "exactly one orbit: a transition carries one orbit into the ephemeris model")])
+        raise StudyError([problem(key, value, f"selects {len(orbits)} orbits",
+                                  "exactly one orbit: a transition carries one orbit into the ephemeris model")])
     orbit = orbits[0]
     e = study.ephemeris
     eph = study.build_ephemeris()
@@ -321,7 +328,8 @@ def run_transition(study: Study, out: str | Path | None = None, *, scheduler=Non
         raw = e.epoch.model_dump() if hasattr(e.epoch, "model_dump") else e.epoch
         raise StudyError([problem("ephemeris.epoch", raw, f"{iso_tdb(float(epochs[bad[0]]))} and its {e.revolutions} revolutions "
                                   f"({duration_s / 86400:.2f} d) leave the ephemeris file's span",
-                                  f"epochs from {iso_tdb(lo)} to {iso_tdb(hi - duration_s)} (the file's span less the revolutions' duration)")])
+                                  f"epochs from {iso_tdb(lo)} to {iso_tdb(hi - duration_s)} (the file's span less the "
+                                  "revolutions' duration)")])
     file = None if e.file is None else str(Path(e.file) if Path(e.file).is_absolute() else (Path(study.base_dir) / e.file).resolve())
     return run_transition_to(orbit, path, epochs_tdb=epochs, revolutions=e.revolutions, nodes_per_rev=e.nodes_per_rev, ephemeris_file=file,
                              resume=not force, scheduler=scheduler, progress=progress, attrs=study.result_attrs("transition", "transition"))

@@ -26,7 +26,9 @@ from ..results.kinds import KINDS, Solutions3DResult, kind_of, map3d_schema
 from ..results.lock import writer_lock
 from ..results.store import STORE_ATTRS, PartStore, store_kind, verify_store
 
-__all__ = ["RESULT_INPUTS", "RESULT_KINDS", "RESULT_STEMS", "ResultExists", "check_output", "describe_result", "open_result", "multipliers_3d", "publish_parts", "read_attrs", "result_kind", "run_map_3d_to", "run_map_to", "save_dataset", "save_family", "solution_3d",
+__all__ = ["RESULT_INPUTS", "RESULT_KINDS", "RESULT_STEMS", "ResultExists", "check_output", "describe_result", "open_result",
+           "multipliers_3d", "publish_parts", "read_attrs", "result_kind", "run_map_3d_to", "run_map_to", "save_dataset",
+           "save_family", "solution_3d",
            "solutions_3d_dataset", "solutions_dataset",
            "study_changes", "verify_result"]
 
@@ -67,8 +69,8 @@ def resolve_result_path(path: str | Path) -> Path:
 
 def study_changes(old: str | dict | None, new: str | dict | None, sections: tuple[str, ...] | None = None) -> list[str]:
     """The study keys that differ between two studies (JSON text or dicts), as
-    ``"body.kz: 0.8 -> 0.5"`` lines in key order (tables flattened: ``rates.wz0.num: 300 -> 50``); only the keys under ``sections`` count (all
-    when None). A missing study (a result saved by the Python API) differs in ``(study)``."""
+    ``"body.kz: 0.8 -> 0.5"`` lines in key order (tables flattened: ``rates.wz0.num: 300 -> 50``); only the keys under ``sections`` count
+    (all when None). A missing study (a result saved by the Python API) differs in ``(study)``."""
     import json
 
     if old is None or new is None:
@@ -129,7 +131,8 @@ def check_output(path: str | Path, kind: str, study: str | None, *, force: bool 
         return "new"
     found = _existing_result(p)
     if found is None:
-        raise FileExistsError(f"{str(p)!r} exists and is not a librate result: refusing to overwrite it; remove it or choose another output folder")
+        raise FileExistsError(f"{str(p)!r} exists and is not a librate result: refusing to overwrite it; remove it or choose "
+                              "another output folder")
     old_kind, attrs = found
     old_study = attrs.get("study")
     changes = []
@@ -277,7 +280,8 @@ def verify_result(path: str | Path) -> tuple[bool, str]:
         ds.close()
     if problems:
         return False, f"{p}: damaged librate result\n" + "\n".join(f"  {q}" for q in problems)
-    note = ", every variable matches its checksum" if checked else " (no checksums stored: written by an older librate; only readability was checked)"
+    note = (", every variable matches its checksum" if checked
+            else " (no checksums stored: written by an older librate; only readability was checked)")
     return True, f"{p}: ok: a librate {kind} result{note}"
 
 
@@ -288,10 +292,12 @@ def _check_target(p: Path) -> None:
     try:
         ds = _open_dataset(p)
     except Exception as err:  # corrupt or foreign
-        raise FileExistsError(f"{str(p)!r} exists and is not a readable librate result ({type(err).__name__}): refusing to overwrite it; remove it or choose another output folder") from None
+        raise FileExistsError(f"{str(p)!r} exists and is not a readable librate result ({type(err).__name__}): refusing to overwrite it; "
+                              "remove it or choose another output folder") from None
     try:
         if result_kind(ds) is None:
-            raise FileExistsError(f"{str(p)!r} exists and is not a librate result: refusing to overwrite it; remove it or choose another output folder")
+            raise FileExistsError(f"{str(p)!r} exists and is not a librate result: refusing to overwrite it; remove it or choose "
+                                  "another output folder")
     finally:
         ds.close()
 
@@ -387,24 +393,29 @@ def solutions_3d_dataset(family_ds, orbits, period_days, start: dict, attrs: dic
     x_axis = Rotation.from_quat(ds["q0"].values).as_matrix()[:, :, 0]
     ds = ds.assign({
         "multipliers_real": (("member", "k"), mult.real, {"long_name": "Floquet multipliers of the 6x6 attitude monodromy, real part"}),
-        "multipliers_imag": (("member", "k"), mult.imag, {"long_name": "Floquet multipliers of the 6x6 attitude monodromy, imaginary part"}),
+        "multipliers_imag": (("member", "k"), mult.imag,
+                             {"long_name": "Floquet multipliers of the 6x6 attitude monodromy, imaginary part"}),
         "orbit_state0": (("member", "state"), np.array([o.state0 for o in members]).reshape(m, 6),
                          {"units": "LU, LU/TU", "long_name": "orbit initial state (x, y, z, vx, vy, vz), synodic frame"}),
         "orbit_period": (dim, np.array([o.period for o in members]), {"units": "TU"}),
         "orbit_jacobi": (dim, np.array([o.jacobi for o in members]), {"long_name": "Jacobi constant"}),
-        "phi0": (dim, np.arctan2(x_axis[:, 1], x_axis[:, 0]), {"units": "rad", "long_name": "angle about Z of the body x axis' projection at t = 0"}),
+        "phi0": (dim, np.arctan2(x_axis[:, 1], x_axis[:, 0]),
+                 {"units": "rad", "long_name": "angle about Z of the body x axis' projection at t = 0"}),
     })
-    ds = ds.assign_coords(member=np.arange(m), state=["x", "y", "z", "vx", "vy", "vz"], quaternion=["x", "y", "z", "w"], axis=["x", "y", "z"])
+    ds = ds.assign_coords(member=np.arange(m), state=["x", "y", "z", "vx", "vy", "vz"],
+                          quaternion=["x", "y", "z", "w"], axis=["x", "y", "z"])
     meta = {"period_days": ("d", "orbit period"), "x0": ("LU", "orbit x at t = 0"), "z0": ("LU", "orbit z at t = 0"),
             "q0": (None, "attitude at t = 0, body relative to the synodic frame, scalar-last quaternion"),
             "w0": ("1/TU", "inertial angular velocity at t = 0 in body axes"),
             "stable": (None, f"every multiplier on the unit circle to {STABILITY_TOL:g}"),
-            "residual": (None, "max(|rotation vector of R(0)' R(KT)| rad, |w(KT) - w0| 1/TU), independent re-propagation at rtol = atol = 1e-14"),
+            "residual": (None, "max(|rotation vector of R(0)' R(KT)| rad, |w(KT) - w0| 1/TU), independent re-propagation "
+                               "at rtol = atol = 1e-14"),
             "turns": (None, "net turns of the body x axis about synodic Z over the K periods (NaN: undefined)")}
     for name, (units, long_name) in meta.items():
         ds[name].attrs.update({"long_name": long_name, **({"units": units} if units else {})})
     sys_ = orbits.system
-    ds.attrs.update({"title": "librate periodic 3-D attitude motions along an orbit family", "mu": sys_.mu, "lu_km": sys_.lu_km, "tu_s": sys_.tu_s,
+    ds.attrs.update({"title": "librate periodic 3-D attitude motions along an orbit family", "mu": sys_.mu,
+                     "lu_km": sys_.lu_km, "tu_s": sys_.tu_s,
                      "system_name": sys_.name, "orbit_family": orbits.kind, "stability_tol": STABILITY_TOL,
                      "members_requested": len(list(period_days)), **start, **(attrs or {})})
     return ds
@@ -450,7 +461,8 @@ def _fingerprint_3d(olist, grid, n_periods: int, tol: float) -> str:
         h.update(np.float64(o.system.mu).tobytes())
     for a in grid.rates:
         h.update(np.asarray(a, dtype=np.float64).tobytes())
-    h.update(json.dumps([[list(b.moments) for b in grid.bodies], [float(v) for v in grid.q0], int(n_periods), float(tol), __version__]).encode())
+    h.update(json.dumps([[list(b.moments) for b in grid.bodies], [float(v) for v in grid.q0], int(n_periods),
+                         float(tol), __version__]).encode())
     return h.hexdigest()
 
 
@@ -548,7 +560,8 @@ def run_map_3d_to(orbits, store: str | Path, *, body, rates: dict, q0, n_periods
         tpl = map3d_dataset(olist[0], grid, np.full((grid.n_cases, 6), np.nan), np.full(grid.n_cases, 255, dtype=np.uint8),
                             n_periods=n_periods, tol=tol)
         coords = {str(k): (tuple(c.dims) if c.ndim != 1 else c.dims[0], np.asarray(c.values), dict(c.attrs)) for k, c in tpl.coords.items()}
-        coords.update({"orbit": ("orbit", np.arange(len(olist)), {}), "x0": ("orbit", np.array([o.state0[0] for o in olist]), {"units": "LU"}),
+        coords.update({"orbit": ("orbit", np.arange(len(olist)), {}),
+                       "x0": ("orbit", np.array([o.state0[0] for o in olist]), {"units": "LU"}),
                        "z0": ("orbit", np.array([o.state0[2] for o in olist]), {"units": "LU"}),
                        "period_days": ("orbit", np.array([o.period_days for o in olist]), {"units": "d"})})
         for k in ("component",):
@@ -576,7 +589,8 @@ def run_map_3d_to(orbits, store: str | Path, *, body, rates: dict, q0, n_periods
                     return
                 mine = pieces.pop(i)
                 got = [mine[a] for a in range(0, grid.n_cases, step)]
-                ds_i = map3d_dataset(olist[i], grid, np.concatenate([g["residual"] for g in got]), np.concatenate([g["status"] for g in got]),
+                ds_i = map3d_dataset(olist[i], grid, np.concatenate([g["residual"] for g in got]),
+                                     np.concatenate([g["status"] for g in got]),
                                      n_periods=n_periods, tol=tol)
                 part = {k: np.asarray(ds_i[k].values) for k in schema.variables}
                 key = i
@@ -592,15 +606,18 @@ def run_map_3d_to(orbits, store: str | Path, *, body, rates: dict, q0, n_periods
 
         with progress_bar(len(olist), "3-D attitude map", "orbit", progress, initial=int(done.sum())) as bar:
             try:
-                run_tasks(todo, commit, scheduler=scheduler, region=None if scheduler is None or step is not None else Region.of(pstore, lock),
+                run_tasks(todo, commit, scheduler=scheduler,
+                          region=None if scheduler is None or step is not None else Region.of(pstore, lock),
                           commit_written=commit_written)
             except KeyboardInterrupt as err:  # the finished orbits are kept
                 raise KeyboardInterrupt(f"3-D map interrupted ({err}); {int(done.sum())} finished orbit(s) kept in {parts}") from None
-        shared = ("mu", "lu_km", "tu_s", "system_name", "n_periods", "tol", "q0", "simd_level", "librate_version")  # the same for every orbit
+        # the same for every orbit
+        shared = ("mu", "lu_km", "tu_s", "system_name", "n_periods", "tol", "q0", "simd_level", "librate_version")
         final = {k: tpl.attrs[k] for k in shared if k in tpl.attrs}
         final.update({"librate_result": "map_3d", **attrs, "title": "librate 3-D attitude map"})
         state0 = np.array([np.asarray(o.state0, dtype=float) for o in olist])
-        pstore.finalise({"orbit_state0": (("orbit", "state"), state0, {"units": "LU, LU/TU", "long_name": "orbit initial state"})}, final, complete=True)
+        pstore.finalise({"orbit_state0": (("orbit", "state"), state0, {"units": "LU, LU/TU", "long_name": "orbit initial state"})},
+                        final, complete=True)
         publish_parts(parts, store, lock)
         return open_result(store).load(), store
 
@@ -675,7 +692,8 @@ def run_map_to(
         if old is None or result_kind(old) != "map":
             if old is not None:
                 old.close()
-            raise FileExistsError(f"{str(store)!r} exists and is not a librate map: refusing to overwrite it; remove it or choose another --out")
+            raise FileExistsError(f"{str(store)!r} exists and is not a librate map: refusing to overwrite it; remove it or "
+                                  "choose another --out")
         same = not study_changes(old.attrs.get("study"), attrs.get("study"), RESULT_INPUTS["map"])
         complete = int(old.attrs.get("complete", 0)) == 1
         if resume and same and complete and not replace:
@@ -684,8 +702,9 @@ def run_map_to(
             return ds, store
         old.close()
         if resume and not same and not replace:
-            raise ResultExists(f"{store} holds a map of another study (changed: {'; '.join(study_changes(old.attrs.get('study'), attrs.get('study')))}): "
-                               "not replaced; pass resume=False (--force) to replace it, or choose another folder")
+            raise ResultExists(f"{store} holds a map of another study (changed: "
+                               f"{'; '.join(study_changes(old.attrs.get('study'), attrs.get('study')))}): not replaced; pass resume=False "
+                               "(--force) to replace it, or choose another folder")
     kw = {} if rtol is None else {"rtol": rtol}
     if atol is not None:
         kw["atol"] = atol

@@ -38,10 +38,13 @@ def common_rules(s: dict[str, Table], given: dict, purpose: str | None) -> list[
         srp = tq.srp  # one rule between [torques.srp] and [body]:
         if srp is not None and srp.eps is None and srp.area_m2 is not None and srp.offset_m is not None \
                 and body is not None and body.iz is None and body.kz is not None:
-            problems.append(problem("torques.srp.area_m2", srp.area_m2, "the plate's geometry needs the body's Iz in kg m^2 (body.ix, body.iy, body.iz); with body.kz alone give torques.srp.eps",
+            problems.append(problem("torques.srp.area_m2", srp.area_m2,
+                                     "the plate's geometry needs the body's Iz in kg m^2 (body.ix, body.iy, body.iz); with body.kz alone "
+                                     "give torques.srp.eps",
                                      "torques.srp.eps with body.kz, or the geometry with body.ix/iy/iz"))
     if rates is not None and rates.wz0 is not None and rates.phidot0 is not None:
-        problems.append(problem("rates.phidot0", grid_raw(rates.phidot0), "cannot be combined with rates.wz0 (phidot0 = wz0 - 1)", "either rates.wz0 or rates.phidot0"))
+        problems.append(problem("rates.phidot0", grid_raw(rates.phidot0), "cannot be combined with rates.wz0 (phidot0 = wz0 - 1)",
+                                "either rates.wz0 or rates.phidot0"))
     if purpose == "transition":
         problems += _needs_transition(s, given)
     return problems
@@ -57,8 +60,10 @@ def planar_rules(s: dict[str, Table], given: dict, purpose: str | None) -> list[
             problems.append(missing("rates.wz0", "missing: give rates.wz0 (inertial) or rates.phidot0 (relative to the synodic frame)"))
         for k in ("wx0", "wy0"):
             if getattr(rates, k) is not None:
-                problems.append(problem(f"rates.{k}", grid_raw(getattr(rates, k)), "applies only to attitude.model = \"3d\" (the planar model has the one rate wz)",
-                                         "rates.wz0 or rates.phidot0 with the planar model; rates.wx0 and rates.wy0 with [attitude] model = '3d'"))
+                problems.append(problem(f"rates.{k}", grid_raw(getattr(rates, k)),
+                                         "applies only to attitude.model = \"3d\" (the planar model has the one rate wz)",
+                                         "rates.wz0 or rates.phidot0 with the planar model; rates.wx0 and rates.wy0 with "
+                                         "[attitude] model = '3d'"))
         for k in ("wz0", "phidot0"):
             if getattr(rates, k) is not None:
                 _check_increasing(f"rates.{k}", getattr(rates, k), problems)
@@ -70,13 +75,16 @@ def planar_rules(s: dict[str, Table], given: dict, purpose: str | None) -> list[
     if "rates" not in given:
         problems.append(missing("rates", f"missing section [rates]: {what} {need} the initial rates (rates.wz0 or rates.phidot0)"))
     if orb is not None and orb.kind == "halo":
-        problems.append(problem("orbits.kind", orb.kind, f"{what} use{'s' if need == 'needs' else ''} the planar attitude model, which needs a planar family",
+        problems.append(problem("orbits.kind", orb.kind,
+                                 f"{what} use{'s' if need == 'needs' else ''} the planar attitude model, which needs a planar family",
                                  "'dro' or 'lyapunov' with the planar model, or any family with [attitude] model = '3d'"))
     if purpose == "map" and body is not None and body.flexible is not None:
         problems.append(problem("body.flexible", body.flexible, "the periodicity-map engine integrates rigid bodies; "
-                                 "`librate solve` reports how flexibility moves each periodic solution", "body.kz or body.ix/iy/iz for a map"))
+                                 "`librate solve` reports how flexibility moves each periodic solution",
+                                 "body.kz or body.ix/iy/iz for a map"))
     if body is not None and body.flexible is not None and tq is not None and tq.srp is not None:
-        problems.append(problem("torques.srp", "[torques.srp]", "the flexible model has no solar radiation pressure yet", "no [torques.srp] with body.flexible"))
+        problems.append(problem("torques.srp", "[torques.srp]", "the flexible model has no solar radiation pressure yet",
+                                "no [torques.srp] with body.flexible"))
     if tq is not None and sorted(tq.gravity_gradient) != ["earth", "moon"]:
         problems.append(problem("torques.gravity_gradient", tq.gravity_gradient,
                                  f"the planar engine behind {what} models the gravity gradient of both primaries", "[\"earth\", \"moon\"]"))
@@ -90,7 +98,9 @@ def planar_rules(s: dict[str, Table], given: dict, purpose: str | None) -> list[
             k = orb.sun_resonance[0]
             sol = s.get("solver")
             if sol is not None and sol.n_periods is not None and sol.n_periods % k:
-                problems.append(problem("solver.n_periods", sol.n_periods, f"with torques.srp on the 1:{k} Sun-resonant orbit the attitude period must cover whole Sun periods",
+                problems.append(problem("solver.n_periods", sol.n_periods,
+                                         f"with torques.srp on the 1:{k} Sun-resonant orbit the attitude period must "
+                                         "cover whole Sun periods",
                                          f"a multiple of {k}"))
     return problems
 
@@ -126,22 +136,28 @@ def _check_3d(att, start: str, s: dict, given: dict) -> list[str]:
     problems: list[str] = []
     orb, body, tq, sol = s.get("orbits"), s.get("body"), s.get("torques"), s.get("solver")
     if start == "planar" and orb is not None and orb.kind == "halo":
-        problems.append(problem("attitude.start", start, "the planar start takes a planar solution, which needs a planar family (orbits.kind = 'dro' or 'lyapunov')",
+        problems.append(problem("attitude.start", start,
+                                 "the planar start takes a planar solution, which needs a planar family "
+                                 "(orbits.kind = 'dro' or 'lyapunov')",
                                  "'spin' or 'given' on a halo family"))
     if att.q0 is not None and sol is not None and "phi0" in (given.get("solver") or {}):
         problems.append(problem("solver.phi0", sol.phi0, "cannot be combined with attitude.q0 (q0 is the whole initial attitude)",
                                  "solver.phi0 (a rotation about Z) or attitude.q0, not both"))
     if body is not None:
         if body.flexible is not None:
-            problems.append(problem("body.flexible", body.flexible, f"flexible bodies are {_NOT_3D}", "body.ix, body.iy and body.iz (kg m^2) with attitude.model = '3d'"))
+            problems.append(problem("body.flexible", body.flexible, f"flexible bodies are {_NOT_3D}",
+                                    "body.ix, body.iy and body.iz (kg m^2) with attitude.model = '3d'"))
         elif body.kz is not None and body.ix is None and body.iy is None and body.iz is None:
-            problems.append(problem("body.kz", grid_raw(body.kz), "the 3-D attitude model needs the full inertia, not Kz alone (Kz fixes only (Iy - Ix) / Iz)",
+            problems.append(problem("body.kz", grid_raw(body.kz),
+                                     "the 3-D attitude model needs the full inertia, not Kz alone (Kz fixes only (Iy - Ix) / Iz)",
                                      "body.ix, body.iy and body.iz in kg m^2 (principal moments, each <= the sum of the other two)"))
     if tq is not None:
         if tq.srp is not None:
-            problems.append(problem("torques.srp", "[torques.srp]", f"solar radiation pressure is {_NOT_3D}", "no [torques.srp] with attitude.model = '3d'"))
+            problems.append(problem("torques.srp", "[torques.srp]", f"solar radiation pressure is {_NOT_3D}",
+                                    "no [torques.srp] with attitude.model = '3d'"))
         if sorted(tq.gravity_gradient) != ["earth", "moon"]:
-            problems.append(problem("torques.gravity_gradient", tq.gravity_gradient, "the 3-D attitude model has the gravity gradient of both primaries",
+            problems.append(problem("torques.gravity_gradient", tq.gravity_gradient,
+                                     "the 3-D attitude model has the gravity gradient of both primaries",
                                      "[\"earth\", \"moon\"]"))
     return problems
 
@@ -170,29 +186,38 @@ def _needs_3d(purpose: str, start: str, s: dict, given: dict) -> list[str]:
     if purpose == "solve":
         if start == "planar":
             if "rates" not in given:
-                problems.append(missing("rates", "missing section [rates]: the planar start scans rates.wz0 (or rates.phidot0) for the planar solution"))
+                problems.append(missing("rates",
+                                        "missing section [rates]: the planar start scans rates.wz0 (or rates.phidot0) "
+                                        "for the planar solution"))
             elif rates is not None:
                 if rates.wz0 is None and rates.phidot0 is None:
-                    problems.append(missing("rates.wz0", "missing: the planar start scans rates.wz0 (or rates.phidot0) for the planar solution"))
+                    problems.append(missing("rates.wz0",
+                                            "missing: the planar start scans rates.wz0 (or rates.phidot0) for the planar solution"))
                 for k in ("wz0", "phidot0"):
                     g = getattr(rates, k)
                     if isinstance(g, (int, float)):
-                        problems.append(problem(f"rates.{k}", g, "the planar start scans a grid of rates for the planar solution, not one value"))
+                        problems.append(problem(f"rates.{k}", g,
+                                                "the planar start scans a grid of rates for the planar solution, not one value"))
         return problems
     if "rates" not in given:
-        problems.append(missing("rates", "missing section [rates]: a 3-D map needs rates.wx0, rates.wy0 and rates.wz0 (or rates.phidot0): two grids and one fixed number"))
+        problems.append(missing("rates",
+                                "missing section [rates]: a 3-D map needs rates.wx0, rates.wy0 and rates.wz0 (or rates.phidot0): two grids "
+                                "and one fixed number"))
         return problems
     if rates is None:
         return problems
     comp = {"wx0": rates.wx0, "wy0": rates.wy0, "wz0": rates.wz0 if rates.wz0 is not None else rates.phidot0}
     for k, v in comp.items():
         if v is None:
-            problems.append(missing(f"rates.{k}", "missing: a 3-D map needs rates.wx0, rates.wy0 and rates.wz0 (or rates.phidot0): two grids and one fixed number"))
+            problems.append(missing(f"rates.{k}",
+                                    "missing: a 3-D map needs rates.wx0, rates.wy0 and rates.wz0 (or rates.phidot0): two grids "
+                                    "and one fixed number"))
     fixed = [k for k, v in comp.items() if isinstance(v, (int, float))]
     if all(v is not None for v in comp.values()) and len(fixed) != 1:
         key = fixed[-1] if fixed else "wz0"
         name = key if key != "wz0" or rates.wz0 is not None else "phidot0"
-        problems.append(problem(f"rates.{name}", grid_raw(getattr(rates, name)), f"a 3-D map has grids over two rate components and one fixed number; "
+        problems.append(problem(f"rates.{name}", grid_raw(getattr(rates, name)),
+                                 f"a 3-D map has grids over two rate components and one fixed number; "
                                  f"given {len(fixed)} fixed ({', '.join('rates.' + f for f in fixed) or 'none'})",
                                  "exactly one of rates.wx0, rates.wy0, rates.wz0 (or rates.phidot0) a number, the other two grids"))
     return problems
@@ -210,6 +235,7 @@ def _needs_transition(s: dict, given: dict) -> list[str]:
             problems.append(missing("orbits.x0", "missing: a transition carries one orbit into the ephemeris model: select it "
                                                  "(e.g. orbits.x0 = [0.8], orbits.period_days = [6.56], orbits.members = 1)"))
         elif sel[2] != 1:
-            problems.append(problem(f"orbits.{sel[0]}", sel[1], f"selects {sel[2]} orbits; a transition carries one orbit into the ephemeris model "
+            problems.append(problem(f"orbits.{sel[0]}", sel[1],
+                                    f"selects {sel[2]} orbits; a transition carries one orbit into the ephemeris model "
                                     "(its epochs are ephemeris.epoch)", "exactly one value"))
     return problems

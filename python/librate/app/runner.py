@@ -168,7 +168,8 @@ def run_map(
         return ds
 
 
-def _run(olist, family, kzs, wz, coords, fp, args, out, resume, scheduler, progress, solve, attrs, *, phi0, n_periods, srp, rtol, atol, lock=None):
+def _run(olist, family, kzs, wz, coords, fp, args, out, resume, scheduler, progress, solve, attrs, *, phi0, n_periods,
+         srp, rtol, atol, lock=None):
     no, nk, nw = len(olist), kzs.size, wz.size
     if out is not None:
         store, damaged = PartStore.open(Path(out), map_schema(no, nk, nw, coords), fp, resume=resume, attrs=attrs, lock=lock)

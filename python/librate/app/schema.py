@@ -93,11 +93,14 @@ Grid = Annotated[
 ]
 KzValue = Annotated[float, Field(ge=-1, le=1)]
 KzGrid = Annotated[
-    Annotated[KzValue, Tag("number")] | Annotated[list[KzValue], Field(min_length=1, max_length=MAX_GRID), Tag("list")] | Annotated[Range, Tag("range")],
-    Discriminator(_number_grid_tag, custom_error_type="grid", custom_error_message="must be a number, a list of numbers or a table {start, stop, num}"),
+    Annotated[KzValue, Tag("number")] | Annotated[list[KzValue], Field(min_length=1, max_length=MAX_GRID), Tag("list")]
+    | Annotated[Range, Tag("range")],
+    Discriminator(_number_grid_tag, custom_error_type="grid",
+                  custom_error_message="must be a number, a list of numbers or a table {start, stop, num}"),
 ]
 RateGrid = Annotated[
-    Annotated[float, Tag("number")] | Annotated[list[float], Field(min_length=1, max_length=MAX_GRID), Tag("list")] | Annotated[Range, Tag("range")],
+    Annotated[float, Tag("number")] | Annotated[list[float], Field(min_length=1, max_length=MAX_GRID), Tag("list")]
+    | Annotated[Range, Tag("range")],
     Discriminator(_number_grid_tag, custom_error_type="grid", custom_error_message=_RATE_MSG),
 ]
 _TAGS = {"list", "range", "number", "planar", "3d"}
@@ -110,7 +113,8 @@ class SystemSection(Table):
     mu: float | None = Field(None, gt=0, le=0.5, description="a number in (0, 0.5], the mass ratio m2 / (m1 + m2)")
     lu_km: float | None = Field(None, gt=0, description="a number > 0, the length unit (distance between the primaries) in km")
     tu_s: float | None = Field(None, gt=0, description="a number > 0, the time unit (1 / mean motion) in s")
-    radii_km: list[Annotated[float, Field(ge=0)]] | None = Field(None, min_length=2, max_length=2, description="two numbers >= 0, the primaries' radii in km")
+    radii_km: list[Annotated[float, Field(ge=0)]] | None = Field(None, min_length=2, max_length=2,
+                                                                 description="two numbers >= 0, the primaries' radii in km")
     name: str | None = Field(None, description="a string")
 
     def mass_ratio(self) -> float | None:
@@ -134,12 +138,16 @@ class SystemSection(Table):
             if sysc.preset not in System.presets():
                 problems.append(problem("system.preset", sysc.preset, "unknown preset"))
             for k in custom:
-                problems.append(problem(f"system.{k}", getattr(sysc, k), "cannot be combined with system.preset (a preset fixes the constants)",
-                                         "either system.preset alone, or system.mu, system.lu_km and system.tu_s (and optionally system.radii_km)"))
+                problems.append(problem(f"system.{k}", getattr(sysc, k),
+                                         "cannot be combined with system.preset (a preset fixes the constants)",
+                                         "either system.preset alone, or system.mu, system.lu_km and system.tu_s (and "
+                                         "optionally system.radii_km)"))
         elif custom:
             for k in ("mu", "lu_km", "tu_s"):
                 if getattr(sysc, k) is None:
-                    problems.append(missing(f"system.{k}", f"missing: a custom system (given {', '.join('system.' + c for c in custom)}) needs system.mu, system.lu_km and system.tu_s"))
+                    problems.append(missing(f"system.{k}",
+                                            f"missing: a custom system (given {', '.join('system.' + c for c in custom)}) needs system.mu, "
+                                            "system.lu_km and system.tu_s"))
         return _rules_found(self, problems)
 
 
@@ -152,10 +160,15 @@ class OrbitsSection(Table):
     x0: Grid | None = Field(None, description="a list of x0 values (LU) or a table {start, stop, num}")
     z0: Grid | None = Field(None, description="a list of z0 values (LU) or a table {start, stop, num}, for halo families")
     period_days: Grid | None = Field(None, description="a list of periods (days) or a table {start, stop, num}")
-    resonance: list[Annotated[int, Field(ge=1, le=100)]] | None = Field(None, min_length=1, max_length=100, description="a list of integers k >= 1 (synodic 1:k members, T = 2 pi / k)")
-    sun_resonance: list[Annotated[int, Field(ge=1, le=100)]] | None = Field(None, min_length=1, max_length=100, description="a list of integers k >= 1 (Sun-resonant members, T = Ts / k)")
+    resonance: list[Annotated[int, Field(ge=1, le=100)]] | None = Field(None, min_length=1, max_length=100,
+                                                                        description="a list of integers k >= 1 (synodic 1:k "
+                                                                                    "members, T = 2 pi / k)")
+    sun_resonance: list[Annotated[int, Field(ge=1, le=100)]] | None = Field(None, min_length=1, max_length=100,
+                                                                            description="a list of integers k >= 1 (Sun-resonant "
+                                                                                        "members, T = Ts / k)")
     members: int | None = Field(None, ge=1, le=10_000, description="an integer >= 1: that many members evenly spread along the family")
-    max_members: int | None = Field(None, ge=2, le=5_000, description="an integer in [2, 5000], the continuation's length (lyapunov and halo)")
+    max_members: int | None = Field(None, ge=2, le=5_000,
+                                    description="an integer in [2, 5000], the continuation's length (lyapunov and halo)")
 
     @model_validator(mode="after")
     def _rules(self, info: ValidationInfo) -> OrbitsSection:
@@ -170,20 +183,24 @@ class OrbitsSection(Table):
                     problems.append(problem(f"orbits.{k}", getattr(orb, k), "does not apply to orbits.kind = \"dro\"",
                                              "orbits.point and orbits.max_members for 'lyapunov' and 'halo', orbits.branch for 'halo'"))
         if orb.kind == "lyapunov" and orb.branch is not None:
-            problems.append(problem("orbits.branch", orb.branch, "does not apply to orbits.kind = \"lyapunov\" (planar)", "orbits.branch only with orbits.kind = 'halo'"))
+            problems.append(problem("orbits.branch", orb.branch, "does not apply to orbits.kind = \"lyapunov\" (planar)",
+                                    "orbits.branch only with orbits.kind = 'halo'"))
         if orb.kind != "halo" and orb.z0 is not None:
-            problems.append(problem("orbits.z0", grid_raw(orb.z0), f"does not apply to orbits.kind = \"{orb.kind}\" (planar: z0 = 0)", "orbits.z0 only with orbits.kind = 'halo'"))
+            problems.append(problem("orbits.z0", grid_raw(orb.z0), f"does not apply to orbits.kind = \"{orb.kind}\" (planar: z0 = 0)",
+                                    "orbits.z0 only with orbits.kind = 'halo'"))
         sel = [k for k in ("x0", "z0", "period_days", "resonance", "sun_resonance", "members") if getattr(orb, k) is not None]
         if len(sel) > 1:
             for k in sel[1:]:
-                problems.append(problem(f"orbits.{k}", grid_raw(getattr(orb, k)), f"cannot be combined with orbits.{sel[0]}: choose the members one way",
+                problems.append(problem(f"orbits.{k}", grid_raw(getattr(orb, k)),
+                                         f"cannot be combined with orbits.{sel[0]}: choose the members one way",
                                          "at most one of orbits.x0, z0, period_days, resonance, sun_resonance, members"))
         for k in ("x0", "z0", "period_days"):
             v = grid_values(getattr(orb, k))
             if v is None:
                 continue
             if k == "x0" and mu is not None and orb.kind == "dro" and (np.any(v <= -mu) or np.any(v >= 1 - mu)):
-                problems.append(problem("orbits.x0", grid_raw(orb.x0), f"DROs start between the primaries, -mu < x0 < 1 - mu = ({-mu:.6g}, {1 - mu:.6g})",
+                problems.append(problem("orbits.x0", grid_raw(orb.x0),
+                                         f"DROs start between the primaries, -mu < x0 < 1 - mu = ({-mu:.6g}, {1 - mu:.6g})",
                                          "values in (-mu, 1 - mu)"))
             if k == "period_days" and np.any(v <= 0):
                 problems.append(problem("orbits.period_days", grid_raw(orb.period_days), "periods must be > 0 days"))
@@ -231,12 +248,16 @@ class BodySection(Table):
         elif moments and len(moments) < 3:
             for k in ("ix", "iy", "iz"):
                 if k not in moments:
-                    problems.append(missing(f"body.{k}", f"missing: the inertia needs all three of body.ix, body.iy, body.iz (given: {', '.join('body.' + m for m in moments)})"))
+                    problems.append(missing(f"body.{k}",
+                                            "missing: the inertia needs all three of body.ix, body.iy, body.iz (given: "
+                                            f"{', '.join('body.' + m for m in moments)})"))
         elif len(moments) == 3:
             ix, iy, iz = moments["ix"], moments["iy"], moments["iz"]
             for k, a, b, c in (("ix", ix, iy, iz), ("iy", iy, ix, iz), ("iz", iz, ix, iy)):
                 if a > b + c:
-                    problems.append(problem(f"body.{k}", a, f"violates the triangle inequality: {k} must not exceed the sum of the other two moments ({b + c:g} kg m^2)",
+                    problems.append(problem(f"body.{k}", a,
+                                             f"violates the triangle inequality: {k} must not exceed the sum of the other two "
+                                             f"moments ({b + c:g} kg m^2)",
                                              "principal moments with each <= the sum of the other two"))
                     break
         if isinstance(body.kz, Range):
@@ -277,23 +298,28 @@ class SrpSection(Table):
         geo = [k for k in ("area_m2", "offset_m") if getattr(srp, k) is not None]
         if srp.eps is not None and geo:
             for k in geo:
-                problems.append(problem(f"torques.srp.{k}", getattr(srp, k), "cannot be combined with torques.srp.eps (eps follows from the geometry)",
+                problems.append(problem(f"torques.srp.{k}", getattr(srp, k),
+                                         "cannot be combined with torques.srp.eps (eps follows from the geometry)",
                                          "either torques.srp.eps, or torques.srp.area_m2 and torques.srp.offset_m"))
         elif srp.eps is None and len(geo) < 2:
             absent = [k for k in ("area_m2", "offset_m") if k not in geo] if geo else ["eps"]
             for k in absent:
-                problems.append(missing(f"torques.srp.{k}", "missing: the plate needs torques.srp.eps, or torques.srp.area_m2 and torques.srp.offset_m"))
+                problems.append(missing(f"torques.srp.{k}",
+                                        "missing: the plate needs torques.srp.eps, or torques.srp.area_m2 and torques.srp.offset_m"))
         if srp.cs + srp.cd > 1 + 1e-12:
-            problems.append(problem("torques.srp.cd", srp.cd, f"cs + cd = {srp.cs + srp.cd:g} exceeds 1 (the absorbed fraction is 1 - cs - cd)"))
+            problems.append(problem("torques.srp.cd", srp.cd,
+                                    f"cs + cd = {srp.cs + srp.cd:g} exceeds 1 (the absorbed fraction is 1 - cs - cd)"))
         if srp.pressure is not None and srp.eps is not None:
-            problems.append(problem("torques.srp.pressure", srp.pressure, "only used with the geometry (area_m2, offset_m); eps already includes it"))
+            problems.append(problem("torques.srp.pressure", srp.pressure,
+                                    "only used with the geometry (area_m2, offset_m); eps already includes it"))
         return _rules_found(self, problems)
 
 
 class TorquesSection(Table):
     """[torques]: gravity gradient of the primaries, and solar radiation pressure."""
 
-    gravity_gradient: list[Literal["earth", "moon"]] = Field(default_factory=lambda: ["earth", "moon"], description="a list of primaries among 'earth' and 'moon'")
+    gravity_gradient: list[Literal["earth", "moon"]] = Field(default_factory=lambda: ["earth", "moon"],
+                                                             description="a list of primaries among 'earth' and 'moon'")
     srp: SrpSection | None = None
 
     @model_validator(mode="after")
@@ -309,21 +335,44 @@ class RatesSection(Table):
     """[rates]: the initial rates, inertial wz0 or relative phidot0 = wz0 - 1 (1/TU); for a 3-D
     map also wx0 and wy0 (inertial, body axes): two grids and one fixed number."""
 
-    wz0: RateGrid | None = Field(None, description="a list of inertial initial rates (1/TU), strictly increasing, or a table {start, stop, num} with start < stop, num >= 2")
-    phidot0: RateGrid | None = Field(None, description="a list of initial rates relative to the synodic frame (1/TU), strictly increasing, or a table {start, stop, num} with start < stop, num >= 2")
-    wx0: RateGrid | None = Field(None, description="for attitude.model = '3d' maps: a number (fixed) or a grid of inertial initial rates about body x (1/TU): a strictly increasing list or a table {start, stop, num} with start < stop, num >= 2")
-    wy0: RateGrid | None = Field(None, description="for attitude.model = '3d' maps: a number (fixed) or a grid of inertial initial rates about body y (1/TU): a strictly increasing list or a table {start, stop, num} with start < stop, num >= 2")
+    wz0: RateGrid | None = Field(None,
+                                 description="a list of inertial initial rates (1/TU), strictly increasing, or a table {start, stop, num} "
+                                             "with start < stop, num >= 2")
+    phidot0: RateGrid | None = Field(None,
+                                     description="a list of initial rates relative to the synodic frame (1/TU), strictly increasing, or a "
+                                                 "table {start, stop, num} with start < stop, num >= 2")
+    wx0: RateGrid | None = Field(None,
+                                 description="for attitude.model = '3d' maps: a number (fixed) or a grid of inertial initial rates about "
+                                             "body x (1/TU): a strictly increasing list or a table {start, stop, num} with "
+                                             "start < stop, num >= 2")
+    wy0: RateGrid | None = Field(None,
+                                 description="for attitude.model = '3d' maps: a number (fixed) or a grid of inertial initial rates about "
+                                             "body y (1/TU): a strictly increasing list or a table {start, stop, num} with "
+                                             "start < stop, num >= 2")
 
 
 class AttitudeSection(Table):
     """[attitude]: the attitude model ("planar" or "3d") and how a 3-D solve starts."""
 
-    model: Literal["planar", "3d"] = Field("planar", description="'planar' (the default: the planar model, phi and wz) or '3d' (the 3-D rigid body, quaternion and three rates)")
-    start: Literal["planar", "spin", "given"] | None = Field(None, description="'planar' (the planar N-family solution on the first member, planar families), 'spin' (the torque-free spin wz0 = 1 + 2 pi n / (K T) about synodic Z) or 'given' (attitude.q0 and attitude.w0), with attitude.model = '3d'")
-    n: int | None = Field(None, ge=-100, le=100, description="an integer in [-100, 100], net turns about synodic Z per attitude period, with attitude.start = 'planar' or 'spin'")
-    q0: list[float] | None = Field(None, min_length=4, max_length=4, description="four numbers, a unit quaternion (scalar last): the body relative to the synodic frame at t = 0, with attitude.start = 'given' or 'spin'")
-    w0: list[float] | None = Field(None, min_length=3, max_length=3, description="three numbers, the inertial rate in body axes (1/TU), with attitude.start = 'given'")
-    tol: float | None = Field(None, ge=1e-14, le=1e-6, description="a number in [1e-14, 1e-6], the 3-D corrector's tolerance on the closure (default 1e-12; 1e-10 for NRHOs)")
+    model: Literal["planar", "3d"] = Field("planar",
+                                           description="'planar' (the default: the planar model, phi and wz) or '3d' (the 3-D rigid body, "
+                                                       "quaternion and three rates)")
+    start: Literal["planar", "spin", "given"] | None = Field(None,
+                                                             description="'planar' (the planar N-family solution on the first member, "
+                                                                         "planar families), 'spin' (the torque-free spin "
+                                                                         "wz0 = 1 + 2 pi n / (K T) about synodic Z) or 'given' "
+                                                                         "(attitude.q0 and attitude.w0), with attitude.model = '3d'")
+    n: int | None = Field(None, ge=-100, le=100,
+                          description="an integer in [-100, 100], net turns about synodic Z per attitude period, "
+                                      "with attitude.start = 'planar' or 'spin'")
+    q0: list[float] | None = Field(None, min_length=4, max_length=4,
+                                   description="four numbers, a unit quaternion (scalar last): the body relative to the synodic frame "
+                                               "at t = 0, with attitude.start = 'given' or 'spin'")
+    w0: list[float] | None = Field(None, min_length=3, max_length=3,
+                                   description="three numbers, the inertial rate in body axes (1/TU), with attitude.start = 'given'")
+    tol: float | None = Field(None, ge=1e-14, le=1e-6,
+                              description="a number in [1e-14, 1e-6], the 3-D corrector's tolerance on the closure "
+                                          "(default 1e-12; 1e-10 for NRHOs)")
 
     @classmethod
     def model_validate(cls, obj: Any, **kwargs: Any) -> AttitudeSection:
@@ -346,7 +395,8 @@ class PlanarAttitude(AttitudeSection):
     def _rules(self) -> PlanarAttitude:
         """The 3-D keys do not apply to the planar model."""
         return _rules_found(self, [problem(f"attitude.{k}", getattr(self, k), "applies only to attitude.model = \"3d\"",
-                                           "attitude.model = '3d' with it, or leave it out") for k in _3D_KEYS if getattr(self, k) is not None])
+                                           "attitude.model = '3d' with it, or leave it out") for k in _3D_KEYS
+                                   if getattr(self, k) is not None])
 
 
 class Attitude3D(AttitudeSection):
@@ -372,18 +422,24 @@ class Attitude3D(AttitudeSection):
         if start == "planar":
             for k in ("q0", "w0"):
                 if getattr(self, k) is not None:
-                    problems.append(problem(f"attitude.{k}", getattr(self, k), "cannot be combined with attitude.start = \"planar\" (the start is the planar solution: "
-                                             "phi0 = solver.phi0 about Z, wz0 from the rates.wz0 scan)", "attitude.q0 and attitude.w0 with attitude.start = 'given'"))
+                    problems.append(problem(f"attitude.{k}", getattr(self, k),
+                                             "cannot be combined with attitude.start = \"planar\" (the start is the planar solution: "
+                                             "phi0 = solver.phi0 about Z, wz0 from the rates.wz0 scan)",
+                                             "attitude.q0 and attitude.w0 with attitude.start = 'given'"))
         elif start == "spin" and self.w0 is not None:
-            problems.append(problem("attitude.w0", self.w0, "cannot be combined with attitude.start = \"spin\" (the spin is w = (1 + 2 pi n / (K T)) e_Z)",
+            problems.append(problem("attitude.w0", self.w0,
+                                     "cannot be combined with attitude.start = \"spin\" (the spin is w = (1 + 2 pi n / (K T)) e_Z)",
                                      "attitude.w0 with attitude.start = 'given'"))
         if start in ("planar", "spin") and self.n is None:
             problems.append(missing("attitude.n", f"missing: attitude.start = \"{start}\" needs the net turns n per attitude period"))
         if start == "given":
             if self.w0 is None:
-                problems.append(missing("attitude.w0", "missing: attitude.start = \"given\" starts from attitude.w0 (and attitude.q0, default the identity)"))
+                problems.append(missing("attitude.w0",
+                                        "missing: attitude.start = \"given\" starts from attitude.w0 (and attitude.q0, "
+                                        "default the identity)"))
             if self.n is not None:
-                problems.append(problem("attitude.n", self.n, "does not apply to attitude.start = \"given\" (the start is attitude.q0, attitude.w0)",
+                problems.append(problem("attitude.n", self.n,
+                                         "does not apply to attitude.start = \"given\" (the start is attitude.q0, attitude.w0)",
                                          "attitude.n with attitude.start = 'planar' or 'spin'"))
         if self.q0 is not None and abs(math.hypot(*self.q0) - 1) > 1e-6:  # finite: the schema refuses inf and nan
             problems.append(problem("attitude.q0", self.q0, f"must be a unit quaternion (|q0| = {math.hypot(*self.q0):.6g})"))
@@ -398,7 +454,8 @@ def _model_tag(v: Any) -> str | None:
 
 
 _ATTITUDE = TypeAdapter(Annotated[Annotated[PlanarAttitude, Tag("planar")] | Annotated[Attitude3D, Tag("3d")],
-                                  Discriminator(_model_tag, custom_error_type="attitude_model", custom_error_message="must be 'planar' or '3d'")])
+                                  Discriminator(_model_tag, custom_error_type="attitude_model",
+                                                custom_error_message="must be 'planar' or '3d'")])
 
 
 
@@ -453,7 +510,8 @@ class EphemerisSection(Table):
 
     epoch: Epochs = Field(description="an epoch (" + _EPOCH_TEXT + "), a list of them, or a table {start, stop, step_days} "
                           f"(at most {MAX_EPOCHS} epochs), within the ephemeris file's span")
-    revolutions: int = Field(10, ge=1, le=100, description="an integer in [1, 100], the orbit's revolutions carried into the ephemeris model")
+    revolutions: int = Field(10, ge=1, le=100,
+                             description="an integer in [1, 100], the orbit's revolutions carried into the ephemeris model")
     nodes_per_rev: int | None = Field(None, ge=2, le=100, description="an integer in [2, 100], the multiple-shooting nodes per revolution "
                                       "(default: the transition's own choice for the orbit)")
     file: str | None = Field(None, min_length=1, description="the path of a JPL SPK file with type-2 segments of the Sun, the Earth-Moon "
@@ -526,7 +584,8 @@ class OutputSection(Table):
 
     folder: str = Field("librate-out", min_length=1, description="a non-empty path (relative paths are taken from the study file's folder)")
     format: Literal["zarr", "netcdf"] = Field("zarr", description="'zarr' or 'netcdf'")
-    figures: list[Literal["family", "period", "stability", "map", "residuals", "solutions", "multipliers", "body_axes", "transition", "defects", "sweep"]] | None = Field(None, description=FIGURES_TEXT)
+    figures: list[Literal["family", "period", "stability", "map", "residuals", "solutions", "multipliers", "body_axes", "transition",
+                          "defects", "sweep"]] | None = Field(None, description=FIGURES_TEXT)
 
 
 SECTIONS: dict[str, type[Table]] = {

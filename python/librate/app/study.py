@@ -18,8 +18,8 @@ torque-free spin about the synodic Z axis (``start = "spin"``) or from a given (
 
 The ``build_*`` helpers turn a valid study into librate objects (:class:`~librate.System`, the
 :class:`~librate.OrbitFamily` or a list of :class:`~librate.PeriodicOrbit`, the Kz values, the
-:class:`~librate.FlatPlate` plate, the array of inertial initial rates); the jobs that the ``librate family``, ``librate solve`` and ``librate map`` commands run are in
-:mod:`librate.app.jobs`.
+:class:`~librate.FlatPlate` plate, the array of inertial initial rates); the jobs that the ``librate family``, ``librate solve`` and
+``librate map`` commands run are in :mod:`librate.app.jobs`.
 
 Units: rates in 1/TU (nondimensional: the synodic frame turns at rate 1), angles in rad, the
 inertia in kg m^2, areas in m^2, lengths in m, the solar pressure in N/m^2, periods in days.
@@ -75,7 +75,8 @@ else:  # pragma: no cover - Python 3.10
     import tomli as tomllib
 
 # ATTITUDE_TOL, grid_raw, member_count and problem: the jobs (librate.app.jobs) read them from here.
-__all__ = ["ATTITUDE_TOL", "EXAMPLE_STUDY", "FIGURES", "PURPOSES", "PlanarStudy", "Study", "Study3D", "StudyError", "grid_raw", "member_count", "problem"]
+__all__ = ["ATTITUDE_TOL", "EXAMPLE_STUDY", "FIGURES", "PURPOSES", "PlanarStudy", "Study", "Study3D", "StudyError", "grid_raw",
+           "member_count", "problem"]
 
 # --- the study -----------------------------------------------------------------------------------
 class Study(Header):
@@ -132,7 +133,8 @@ class Study(Header):
                     typed[key] = [problem(key, value, "must be a string")]
             elif key in SECTIONS:
                 if not isinstance(value, dict):
-                    typed[key] = [problem(key, value, f"must be a table [{key}]", f"a table [{key}] with keys {', '.join(SECTIONS[key].model_fields)}")]
+                    typed[key] = [problem(key, value, f"must be a table [{key}]",
+                                          f"a table [{key}] with keys {', '.join(SECTIONS[key].model_fields)}")]
                     continue
                 try:
                     sections[key] = SECTIONS[key].model_validate(value, context=context)
@@ -140,7 +142,8 @@ class Study(Header):
                     ruled[key] = []
                     typed[key] = pydantic_problems(key, err, ruled[key])
                     if not typed[key]:  # the types are right, its own rules failed: the rules between sections still see it
-                        found = [e["ctx"]["error"] for e in err.errors() if e["loc"] == () and isinstance((e.get("ctx") or {}).get("error"), SectionProblems)]
+                        found = [e["ctx"]["error"] for e in err.errors() if e["loc"] == ()
+                                 and isinstance((e.get("ctx") or {}).get("error"), SectionProblems)]
                         if found:
                             sections[key] = found[0].section
                 if key == "system" and key in sections:
@@ -264,9 +267,10 @@ class Study(Header):
                 if not missing:
                     raise
                 raise StudyError([problem("orbits.x0", grid_raw(o.x0),
-                                           f"no DRO reached at x0 = {', '.join(f'{v:g}' for v in missing)} (the continuation ended: {err.end_reason}); "
-                                           f"{len(err.found)} of the requested members were found",
-                                           "x0 values on the DRO family, between the Moon and the DRO that grazes the Earth (about 0.985 to 0.005)")]) from None
+                                           f"no DRO reached at x0 = {', '.join(f'{v:g}' for v in missing)} (the continuation "
+                                           f"ended: {err.end_reason}); {len(err.found)} of the requested members were found",
+                                           "x0 values on the DRO family, between the Moon and the DRO that grazes the Earth "
+                                           "(about 0.985 to 0.005)")]) from None
         kw = {"progress": progress} if o.max_members is None else {"max_members": o.max_members, "progress": progress}
         if o.kind == "lyapunov":
             return lyapunov_family(system, o.point or 1, **kw)
@@ -286,7 +290,8 @@ class Study(Header):
             return fam  # dro_family(x0=...) computed exactly these members
         for key, find in (("x0", lambda v: fam.member(x0=float(v))), ("z0", lambda v: fam.member(z0=float(v))),
                           ("period_days", lambda v: fam.member(period_days=float(v))),
-                          ("resonance", lambda k: fam.resonant(int(k), "synodic")), ("sun_resonance", lambda k: fam.resonant(int(k), "sun"))):
+                          ("resonance", lambda k: fam.resonant(int(k), "synodic")),
+                          ("sun_resonance", lambda k: fam.resonant(int(k), "sun"))):
             sel = getattr(o, key)
             if sel is None:
                 continue
@@ -299,14 +304,16 @@ class Study(Header):
                     cands = getattr(err, "candidates", None)
                     if cands:
                         days = ", ".join(f"{fam.system.period_days(c['period']):.4g}" for c in cands)
-                        raise StudyError([problem(f"orbits.{key}", grid_raw(sel), f"{len(cands)} members of the {fam.kind} family have {key} = {float(v):g} "
+                        raise StudyError([problem(f"orbits.{key}", grid_raw(sel),
+                                                   f"{len(cands)} members of the {fam.kind} family have {key} = {float(v):g} "
                                                    f"(periods {days} d)",
                                                    "a value that one member has, or select by orbits.period_days")]) from None
                     span = {"x0": fam.x0, "z0": fam.z0, "period_days": fam.period_days,
                             "resonance": 2 * math.pi / fam.period, "sun_resonance": _sun_period() / fam.period}[key]
                     what = {"x0": "x0 (LU)", "z0": "z0 (LU)", "period_days": "periods (days)", "resonance": "k = 2 pi / T",
                             "sun_resonance": "k = Ts / T"}[key]
-                    raise StudyError([problem(f"orbits.{key}", grid_raw(sel), f"no member at {float(v):g} on the {fam.kind} family ({len(fam)} members)",
+                    raise StudyError([problem(f"orbits.{key}", grid_raw(sel),
+                                               f"no member at {float(v):g} on the {fam.kind} family ({len(fam)} members)",
                                                f"{what} from {np.min(span):.6g} to {np.max(span):.6g}")]) from None
             return out
         return fam

@@ -34,9 +34,9 @@ PER_LEG = 8
 #: Samples of the stored CR3BP orbit over one period (the rotating-frame figure).
 CR3BP_SAMPLES = 400
 #: What the frames of the stored states are (the result's ``frames`` attribute).
-FRAMES = ("states_km: Moon-centred ICRF (km, km/s), TDB; synodic, track_synodic, cr3bp_synodic: the instantaneous Earth-Moon rotating frame "
-          "(x Earth -> Moon, z along the Earth-Moon angular momentum, y = z x x; origin the Earth-Moon barycentre), nondimensional with the "
-          "instantaneous Earth-Moon distance and rotation rate (Ephemeris.ephemeris_to_synodic)")
+FRAMES = ("states_km: Moon-centred ICRF (km, km/s), TDB; synodic, track_synodic, cr3bp_synodic: the instantaneous "
+          "Earth-Moon rotating frame (x Earth -> Moon, z along the Earth-Moon angular momentum, y = z x x; origin the Earth-Moon "
+          "barycentre), nondimensional with the instantaneous Earth-Moon distance and rotation rate (Ephemeris.ephemeris_to_synodic)")
 
 _EPHEMERIS: dict[str | None, Any] = {}
 
@@ -139,7 +139,8 @@ def _cr3bp_track(orbit) -> np.ndarray:
     return np.asarray(propagate(orbit.system, orbit.state0, orbit.period, t_eval=t, rtol=1e-12, atol=1e-12).y, dtype=float)
 
 
-def run_transition_to(orbit, store: str | Path, *, epochs_tdb, revolutions: int, nodes_per_rev: int | None = None, ephemeris_file: str | None = None,
+def run_transition_to(orbit, store: str | Path, *, epochs_tdb, revolutions: int, nodes_per_rev: int | None = None,
+                      ephemeris_file: str | None = None,
                       resume: bool = True, scheduler=None, progress: bool | None = None, attrs: dict[str, Any] | None = None):
     """The transitions of ``orbit`` (a :class:`~librate.PeriodicOrbit`) at every epoch of
     ``epochs_tdb`` (TDB s past J2000) over ``revolutions``, written to ``store`` (a ``.zarr`` part
@@ -189,7 +190,8 @@ def run_transition_to(orbit, store: str | Path, *, epochs_tdb, revolutions: int,
                           + "; ".join(f"epoch {i}: {why}" for i, why in sorted(damaged.items())), RuntimeWarning, stacklevel=2)
         done = pstore.done_flags(damaged)
         failures = dict(json.loads(pstore.g.attrs.get("failures", "{}")))
-        todo = [Task(j, _transition_epoch, (orbit, float(epochs[j]), int(revolutions), npr, eph_path, sizes)) for j in range(epochs.size) if not done[j]]
+        todo = [Task(j, _transition_epoch, (orbit, float(epochs[j]), int(revolutions), npr, eph_path, sizes))
+                for j in range(epochs.size) if not done[j]]
 
         def commit(j, part):
             if "reason" in part:
@@ -206,7 +208,8 @@ def run_transition_to(orbit, store: str | Path, *, epochs_tdb, revolutions: int,
 
         with progress_bar(epochs.size, "ephemeris transitions", "epoch", progress, initial=int(done.sum())) as bar:
             try:
-                run_tasks(todo, commit, scheduler=scheduler, region=None if scheduler is None else Region.of(pstore, lock), commit_written=commit_written)
+                run_tasks(todo, commit, scheduler=scheduler, region=None if scheduler is None else Region.of(pstore, lock),
+                          commit_written=commit_written)
             except KeyboardInterrupt as err:  # the finished epochs are kept
                 raise KeyboardInterrupt(f"transition interrupted ({err}); {int(done.sum())} finished epoch(s) kept in {parts}") from None
         # a failure written by a worker's region carries no reason back: its status says it
@@ -218,13 +221,16 @@ def run_transition_to(orbit, store: str | Path, *, epochs_tdb, revolutions: int,
         system = orbit.system
         final = {**attrs, "librate_result": "transition", "title": "librate orbit transition into the ephemeris model",
                  "mu": float(system.mu), "lu_km": float(system.lu_km), "tu_s": float(system.tu_s), "system_name": str(system.name),
-                 "orbit_family": str(getattr(orbit, "family", "")), "orbit_period": float(orbit.period), "orbit_period_days": float(orbit.period_days),
+                 "orbit_family": str(getattr(orbit, "family", "")), "orbit_period": float(orbit.period),
+                 "orbit_period_days": float(orbit.period_days),
                  "revolutions": int(revolutions), "nodes_per_rev": int(npr), "samples_per_leg": PER_LEG,
                  "epochs_iso": json.dumps([iso_tdb(float(t)) for t in epochs]), "frames": FRAMES, "time_scale": "TDB",
-                 "ephemeris_file": eph_name, "ephemeris_digest": eph_digest, "ephemeris_span_tdb": [float(v) for v in _ephemeris(eph_path).span],
+                 "ephemeris_file": eph_name, "ephemeris_digest": eph_digest,
+                 "ephemeris_span_tdb": [float(v) for v in _ephemeris(eph_path).span],
                  "gm_km3_s2": [float(_core.GM_EARTH), float(_core.GM_MOON), float(_core.GM_SUN)], "gm_bodies": "earth moon sun (DE440)",
                  "failures": json.dumps(failures, sort_keys=True)}
-        arrays = {"orbit_state0": (("component",), np.asarray(orbit.state0, dtype=float), {"units": "LU, LU/TU", "long_name": "CR3BP orbit initial state"}),
+        arrays = {"orbit_state0": (("component",), np.asarray(orbit.state0, dtype=float),
+                                   {"units": "LU, LU/TU", "long_name": "CR3BP orbit initial state"}),
                   "cr3bp_synodic": (("cr3bp_sample", "component"), _cr3bp_track(orbit),
                                     {"units": "LU, LU/TU", "long_name": "the CR3BP orbit over one period, synodic frame"})}
         pstore.finalise(arrays, final, complete=True)
@@ -241,7 +247,8 @@ def transition_summary(ds, elapsed: float) -> list[str]:
     out = [f"{ds.attrs.get('orbit_family') or 'orbit'} (T = {float(ds.attrs['orbit_period_days']):.4f} d) into the ephemeris model "
            f"({ds.attrs.get('ephemeris_file')}): {n} epoch(s), {int(ok.sum())} converged, {ds.attrs['revolutions']} revolutions, "
            f"{ds.attrs['nodes_per_rev']} nodes per revolution ({elapsed:.2f} s)",
-           f"{'epoch (TDB)':<27} {'iter':>4} {'max defect [m]':>14} {'[km/s]':>9} {'max departure [km]':>18} {'perilune [km]':>23} {'drift [km/rev]':>14}"]
+           f"{'epoch (TDB)':<27} {'iter':>4} {'max defect [m]':>14} {'[km/s]':>9} {'max departure [km]':>18} {'perilune [km]':>23} "
+           f"{'drift [km/rev]':>14}"]
     for j in range(n):
         label = epochs[j][:19] if j < len(epochs) else f"{float(ds['epoch'].values[j]):.1f} s"
         if not ok[j]:

@@ -30,7 +30,8 @@ def torque_names(torques) -> tuple[str, ...]:
     try:
         names = tuple(names)
     except TypeError:
-        raise ValueError(f"invalid argument `torques`: must be a torque name or a list of names from {', '.join(TORQUES)}, got {torques!r}") from None
+        raise ValueError("invalid argument `torques`: must be a torque name or a list of names from "
+                         f"{', '.join(TORQUES)}, got {torques!r}") from None
     for n in names:
         if not isinstance(n, str) or n not in TORQUES:
             raise ValueError(f"invalid argument `torques`: unknown torque {n!r}; known: {', '.join(TORQUES)}")
@@ -102,7 +103,8 @@ class RigidBody:
                     raise ValueError(f"invalid argument `{name}`: principal moments violate the triangle inequality: {name} = {a} "
                                      f"exceeds the sum of the other two ({b + c}); a zero moment is a thin rod (the other two equal)")
         m = self.mass_kg
-        if m is not None and (isinstance(m, bool) or not isinstance(m, (int, float, np.integer, np.floating)) or not (math.isfinite(m) and m > 0)):
+        if m is not None and (isinstance(m, bool) or not isinstance(m, (int, float, np.integer, np.floating))
+                              or not (math.isfinite(m) and m > 0)):
             raise ValueError(f"invalid argument `mass_kg`: must be a finite number > 0, got {m!r}")
 
     @classmethod
@@ -155,7 +157,8 @@ def quaternion_from_euler(angles: Sequence[float], sequence: str = "123") -> np.
 
     seq = EULER_SEQUENCES.get(sequence, sequence) if isinstance(sequence, str) else None
     if seq is None or len(seq) != 3 or not (set(seq) <= set("xyz") or set(seq) <= set("XYZ")) or seq[0] == seq[1] or seq[1] == seq[2]:
-        raise ValueError(f"invalid argument `sequence`: must be '123', '321', '313' or three axes (scipy's 'XYZ', 'zxz', ...), got {sequence!r}")
+        raise ValueError("invalid argument `sequence`: must be '123', '321', '313' or three axes (scipy's 'XYZ', 'zxz', "
+                         f"...), got {sequence!r}")
     a = as_float_array(angles, "angles")
     if a.shape[-1:] != (3,) or a.ndim > 2 or not np.all(np.isfinite(a)):
         raise ValueError(f"invalid argument `angles`: must be 3 finite angles (rad) or an (n, 3) array of them, got {angles!r}")

@@ -28,8 +28,8 @@ hub's centre sits where it balances them, h = -sum_j m_j b_j / m0.
   ``traj.flex``);
 - :func:`quasi_static`: high structural frequencies, the closed form q_j = L_j / k_j along the
   rigid solution (L_j the transverse load) and the first-order attitude perturbation;
-- :func:`librate.periodicity.flexible_periodic` (in the periodicity layer): what flexibility does to a periodic orbit-attitude solution (drift
-  and first-order shift in closed form; re-solved with the full model at low frequencies);
+- :func:`librate.periodicity.flexible_periodic` (in the periodicity layer): what flexibility does to a periodic orbit-attitude solution
+  (drift and first-order shift in closed form; re-solved with the full model at low frequencies);
 - :func:`librate.periodicity.frequency_scan`: the coupled response against the structural frequency (resonances).
 
 Two precisions on the model (docs/physics.md, flexible spacecraft). Omega_j = sqrt(k_j / m_j) is the *clamped-hub* frequency:
@@ -212,7 +212,8 @@ def _hub(hub) -> RigidBody:
     try:
         m, j0 = hub
     except (TypeError, ValueError):
-        raise ValueError(f"invalid argument `hub`: must be a librate.RigidBody with mass_kg, or a pair (mass_kg, J0), got {hub!r}") from None
+        raise ValueError("invalid argument `hub`: must be a librate.RigidBody with mass_kg, or a pair "
+                         f"(mass_kg, J0), got {hub!r}") from None
     j0 = _positive("hub", j0)
     return RigidBody(0.5 * j0, 0.5 * j0, j0, mass_kg=_positive("hub", m))
 
@@ -447,11 +448,13 @@ class FlexibleBody:
                 if "stiffness" in a:
                     apps.append(Appendage(a["mass"], a["position"], a["direction"], a["stiffness"], a.get("damping", 0.0), **kw))
                 elif "frequency_hz" in a:
-                    apps.append(Appendage.from_frequency(a["mass"], a["position"], a["direction"], a["frequency_hz"], a.get("damping_ratio", 0.0), **kw))
+                    apps.append(Appendage.from_frequency(a["mass"], a["position"], a["direction"], a["frequency_hz"],
+                                                         a.get("damping_ratio", 0.0), **kw))
                 else:
                     raise ValueError(f"invalid argument `appendages`: appendage {j} needs `stiffness` (N/m) or `frequency_hz`")
         except (KeyError, TypeError) as exc:
-            raise ValueError(f"invalid argument `data`: a flexible body needs hub.mass, hub.inertia and appendages with mass, position, direction ({exc!r})") from None
+            raise ValueError("invalid argument `data`: a flexible body needs hub.mass, hub.inertia and appendages with mass, "
+                             f"position, direction ({exc!r})") from None
         return cls(hub_body, apps, data.get("name", "custom"))
 
     def to_toml(self, path=None) -> str:
@@ -570,7 +573,8 @@ def initial_deflection(deflection, sys_, body, primaries, held, s, phi0, wz0):
     except (TypeError, ValueError):
         raise ValueError(f"invalid argument `deflection`: must be None/'rest', 'quasi-static' or (q0, qdot0), got {deflection!r}") from None
     if q0.shape != (n,) or qd0.shape != (n,) or not (np.all(np.isfinite(q0)) and np.all(np.isfinite(qd0))):
-        raise ValueError(f"invalid argument `deflection`: q0 (m) and qdot0 (m/TU) need {n} finite values each, got shapes {q0.shape}, {qd0.shape}")
+        raise ValueError(f"invalid argument `deflection`: q0 (m) and qdot0 (m/TU) need {n} finite values each, got shapes "
+                         f"{q0.shape}, {qd0.shape}")
     return q0.tolist(), qd0.tolist()
 
 

@@ -222,7 +222,8 @@ def propagate_attitude(
         raise ValueError(f"invalid argument `body`: must be a librate.RigidBody or librate.FlexibleBody, got {body!r}")
     names = torque_names(torques)
     if srp is not None and not (planar and isinstance(srp, FlatPlate)):
-        raise ValueError("invalid argument `srp`: a librate.FlatPlate, for planar runs (3-D runs use a FacetBody with torques including 'srp')")
+        raise ValueError("invalid argument `srp`: a librate.FlatPlate, for planar runs (3-D runs use a FacetBody with "
+                         "torques including 'srp')")
     if planar and "srp" in names:
         raise ValueError("invalid argument `torques`: planar runs take the SRP plate through srp=FlatPlate(...)")
     if not planar and ("srp" in names or srp_force) and not isinstance(body, FacetBody):
@@ -237,7 +238,8 @@ def propagate_attitude(
     if sun is not None and (planar or isinstance(body, FlexibleBody)):
         raise ValueError("invalid argument `sun`: planar runs take the Sun from the plate, srp=FlatPlate(..., sun=Sun(...))")
     if sun is not None and not isinstance(body, FacetBody):
-        raise ValueError("invalid argument `sun`: only a librate.FacetBody feels the Sun (solar radiation pressure); a plain RigidBody does not")
+        raise ValueError("invalid argument `sun`: only a librate.FacetBody feels the Sun (solar radiation pressure); a "
+                         "plain RigidBody does not")
     if orbit not in ("integrate", "held", "coupled"):
         raise ValueError(f"invalid argument `orbit`: must be 'integrate', 'held' or 'coupled', got {orbit!r}")
     opts = integration_options(rtol, atol, h0, h_min, h_max, max_steps, safety, fixed_step)
@@ -287,7 +289,8 @@ def propagate_attitude(
     model = _core.AttitudeModel(sys_.mu, list(body.moments), list(names), orbit=_ORBIT_MODES[orbit], inertia_nd=inertia_nd, srp=srp_model)
     r = _core.attitude_propagate(model, state0, (t0, tf), options=opts, stm=bool(stm), t_eval=te)
     st = r.states
-    return AttitudeTrajectory(sys_, body, names, False, r.t, st[:, :6], st[:, 6:10], st[:, 10:], None, None, r.stm, Stats.from_core(r.stats))
+    return AttitudeTrajectory(sys_, body, names, False, r.t, st[:, :6], st[:, 6:10], st[:, 10:], None, None, r.stm,
+                              Stats.from_core(r.stats))
 
 
 def _pair(attitude) -> tuple[float, float]:
@@ -306,9 +309,11 @@ def _quaternion_and_rate(attitude) -> tuple[np.ndarray, np.ndarray]:
         q = np.asarray(q, dtype=np.float64).ravel()
         w = np.asarray(w, dtype=np.float64).ravel()
     except (TypeError, ValueError):
-        raise ValueError(f"invalid argument `attitude`: 3-D runs take (q, w), q of 4 (scalar last) and w of 3 components, got {attitude!r}") from None
+        raise ValueError("invalid argument `attitude`: 3-D runs take (q, w), q of 4 (scalar last) and w of 3 "
+                         f"components, got {attitude!r}") from None
     if q.shape != (4,) or w.shape != (3,) or not (np.all(np.isfinite(q)) and np.all(np.isfinite(w))):
-        raise ValueError(f"invalid argument `attitude`: q must have 4 finite components (scalar last) and w 3, got shapes {q.shape}, {w.shape}")
+        raise ValueError("invalid argument `attitude`: q must have 4 finite components (scalar last) and w 3, got shapes "
+                         f"{q.shape}, {w.shape}")
     n = np.linalg.norm(q)
     if abs(n - 1) > 1e-6:
         raise ValueError(f"invalid argument `attitude`: q must be a unit quaternion, |q| = {n}")

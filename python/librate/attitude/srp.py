@@ -180,7 +180,8 @@ class FacetBody(RigidBody):
     def two_sided_panel(cls, area, *, normal=(1.0, 0.0, 0.0), center=(0.0, 0.0, 0.0), ca=1.0, cs=0.0, cd=0.0, inertia, mass_kg=None):
         """A two-sided panel: two facets with opposite normals at the same centre of pressure."""
         n = np.asarray(normal, dtype=float)
-        return cls(*inertia, mass_kg=mass_kg, facets=(Facet(area, tuple(n), center, ca, cs, cd), Facet(area, tuple(-n), center, ca, cs, cd)))
+        return cls(*inertia, mass_kg=mass_kg, facets=(Facet(area, tuple(n), center, ca, cs, cd),
+                                                      Facet(area, tuple(-n), center, ca, cs, cd)))
 
     @classmethod
     def box_with_arrays(cls, bus_size=(4.0, 4.0, 6.0), *, array_area=50.0, array_offset=8.0, bus_coefficients=(0.6, 0.2, 0.2),
@@ -262,7 +263,8 @@ class FlatPlate:
         return 1.0 - self.cs - self.cd
 
     @classmethod
-    def from_geometry(cls, system, *, area_m2: float, offset_m: float, iz_kgm2: float, cs: float = 0.0, cd: float = 0.0, sun: Sun | None = None):
+    def from_geometry(cls, system, *, area_m2: float, offset_m: float, iz_kgm2: float, cs: float = 0.0, cd: float = 0.0,
+                      sun: Sun | None = None):
         """eps = P A d TU^2 / Iz from the plate's area, offset and the body's Iz (SI units)."""
         sun = Sun() if sun is None else sun
         if not isinstance(sun, Sun):

@@ -103,7 +103,8 @@ class Ephemeris:
         (the Rust corrector; :func:`librate.to_ephemeris` is the user's entry): ``tol`` (km, km/s)
         per leg, ``scales`` (km, s) of the unknowns, ``integration`` (rtol, atol). A dict of
         states_km, epochs_tdb, iterations, reason, defects_km, defects_km_s, history."""
-        return self._core.transition(np.ascontiguousarray(states_km, dtype=float), np.ascontiguousarray(epochs_tdb, dtype=float).ravel(), tol, scales,
+        return self._core.transition(np.ascontiguousarray(states_km, dtype=float),
+                                     np.ascontiguousarray(epochs_tdb, dtype=float).ravel(), tol, scales,
                                      epoch_free, max_iter, integration)
 
 
@@ -120,7 +121,8 @@ def default_ephemeris(ephemeris: Ephemeris | None = None) -> Ephemeris:
 
 
 def propagate_ephemeris(
-    state_km, epoch, duration_s: float, *, ephemeris: Ephemeris | None = None, stm: bool = False, t_eval=None, rtol: float = 1e-13, atol: float = 1e-9
+    state_km, epoch, duration_s: float, *, ephemeris: Ephemeris | None = None, stm: bool = False, t_eval=None,
+    rtol: float = 1e-13, atol: float = 1e-9
 ) -> EphemerisTrajectory:
     """Propagate a Moon-centred ICRF state (km, km/s) from ``epoch`` for ``duration_s`` seconds
     under Earth, Moon and Sun point masses (DE440 GM values). ``t_eval``: offsets from the epoch
@@ -128,7 +130,8 @@ def propagate_ephemeris(
     e = default_ephemeris(ephemeris)
     t0 = epoch_seconds(epoch)
     te = None if t_eval is None else np.ascontiguousarray(t_eval, dtype=float).ravel()
-    t, y, phi = e._core.propagate(np.ascontiguousarray(state_km, dtype=float).ravel(), t0, float(duration_s), bool(stm), te, float(rtol), float(atol))
+    t, y, phi = e._core.propagate(np.ascontiguousarray(state_km, dtype=float).ravel(), t0, float(duration_s), bool(stm), te,
+                                  float(rtol), float(atol))
     return EphemerisTrajectory(t, y, phi)
 
 

@@ -87,7 +87,8 @@ def correct_dro(
     sys_ = resolve_system(system)
     mu = sys_.mu
     collision_mode(collision)
-    if not (isinstance(x0, (int, float, np.integer, np.floating)) and not isinstance(x0, (bool, np.bool_)) and math.isfinite(x0) and -mu < x0 < 1.0 - mu):
+    if not (isinstance(x0, (int, float, np.integer, np.floating)) and not isinstance(x0, (bool, np.bool_))
+            and math.isfinite(x0) and -mu < x0 < 1.0 - mu):
         raise ValueError(f"invalid argument `x0`: a DRO starts between the primaries, -mu < x0 < 1 - mu = ({-mu}, {1 - mu}), got {x0!r}")
     x0 = float(x0)
     if ydot0 is not None:
@@ -118,7 +119,8 @@ def _correct_dro_at(sys_, x0, ydot0, tol, max_iter, rtol, atol) -> PeriodicOrbit
     if ydot0 is None:
         d = 1.0 - sys_.mu - x0
         ydot0 = math.sqrt(sys_.mu / d) + d
-    return correct_symmetric(sys_, (x0, 0.0, ydot0), fix="x0", family="dro", tol=tol, max_iter=max_iter, rtol=rtol, atol=atol, collision=None)
+    return correct_symmetric(sys_, (x0, 0.0, ydot0), fix="x0", family="dro", tol=tol, max_iter=max_iter, rtol=rtol,
+                             atol=atol, collision=None)
 
 
 #: The default DRO family's members: x0 from 0.985 near the Moon to 0.005 near the Earth, every 0.005.

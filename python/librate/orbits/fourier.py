@@ -35,7 +35,8 @@ def _coefficients(value, name: str) -> np.ndarray:
     if arr.ndim == 1 and arr.size == 0:
         arr = arr.reshape(0, 3)
     if arr.ndim != 2 or arr.shape[1] != 3:
-        raise ValueError(f"invalid argument `{name}`: must have shape (N, 3) = one row (x, y, z) per harmonic n = 1..N, got shape {arr.shape}")
+        raise ValueError(f"invalid argument `{name}`: must have shape (N, 3) = one row (x, y, z) per harmonic n = 1..N, "
+                         f"got shape {arr.shape}")
     if not np.all(np.isfinite(arr)):
         raise ValueError(f"invalid argument `{name}`: must be finite")
     return arr

@@ -342,7 +342,8 @@ def jpl_document(system: System, kind: str, parameters: dict, state0: np.ndarray
     }
     data = [[*(_s(float(v)) for v in state0[i]), float(jacobi[i]), _s(float(period[i])), float(stability[i])] for i in range(len(period))]
     doc = {
-        "signature": {"source": f"librate {version} OrbitFamily.to_jpl (format of the NASA/JPL Three-Body Periodic Orbits API)", "version": "1.0"},
+        "signature": {"source": f"librate {version} OrbitFamily.to_jpl (format of the NASA/JPL Three-Body "
+                                "Periodic Orbits API)", "version": "1.0"},
         "system": block,
         "family": family,
         "libration_point": point,

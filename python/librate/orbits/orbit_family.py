@@ -131,7 +131,8 @@ class OrbitFamily:
         half = np.array([np.full(6, np.nan) if m._evaluation is None else m._evaluation.crossing for m in members])
         missing = np.flatnonzero(np.isnan(half[:, 0]))
         if missing.size:  # members not from the symmetric corrector: their half-period states
-            half[missing] = propagate_many(system, state0[missing], 0.5 * period[missing], rtol=SHOOT_RTOL, atol=SHOOT_ATOL, collision="point").y
+            half[missing] = propagate_many(system, state0[missing], 0.5 * period[missing], rtol=SHOOT_RTOL,
+                                           atol=SHOOT_ATOL, collision="point").y
         batch = propagate_many(system, state0, period, stm=True, rtol=SHOOT_RTOL, atol=SHOOT_ATOL, on_error="mask", collision="point")
         eig = np.full((len(members), 6), np.nan + 0j)
         nu = np.full((len(members), 2), np.nan + 0j)
@@ -267,7 +268,8 @@ class OrbitFamily:
         for i in range(len(d) - 1):
             if d[i] == 0 or d[i] * d[i + 1] < 0:
                 w = 0.0 if d[i] == 0 else d[i] / (d[i] - d[i + 1])
-                cands.append((float(self.period[i] + w * (self.period[i + 1] - self.period[i])), self.state0[i] + w * (self.state0[i + 1] - self.state0[i]), i))
+                cands.append((float(self.period[i] + w * (self.period[i + 1] - self.period[i])),
+                              self.state0[i] + w * (self.state0[i + 1] - self.state0[i]), i))
         if len(d) and d[-1] == 0:
             cands.append((float(self.period[-1]), self.state0[-1], len(d) - 1))
         if not cands:
@@ -344,8 +346,8 @@ class OrbitFamily:
         base = 2 * math.pi if kind == "synodic" else SUN_SYNODIC_PERIOD
         lo, hi = float(np.min(self.period)), float(np.max(self.period))
         if not lo <= base / k <= hi:
-            raise ValueError(f"invalid argument `k`: the 1:{k} {kind} resonant period {base / k:.6g} TU is outside the {self.kind} family's "
-                             f"range [{lo:.6g}, {hi:.6g}], got {k!r}")
+            raise ValueError(f"invalid argument `k`: the 1:{k} {kind} resonant period {base / k:.6g} TU is outside the "
+                             f"{self.kind} family's range [{lo:.6g}, {hi:.6g}], got {k!r}")
         return self.member(period=base / k)
 
     # --- the JPL catalog format ---------------------------------------------------------------
@@ -414,7 +416,8 @@ class OrbitFamily:
         p = Path(path)
         if p.suffix.lower() != ".json":
             raise ValueError(f"invalid argument `path`: must end in .json, got {str(path)!r}")
-        doc = jpl_document(self.system, self.kind, self.parameters, self.state0, self.jacobi, self.period, jpl_stability(self.eigenvalues), __version__)
+        doc = jpl_document(self.system, self.kind, self.parameters, self.state0, self.jacobi, self.period,
+                           jpl_stability(self.eigenvalues), __version__)
         from ..results.atomic import atomic_write_text
 
         atomic_write_text(p, json.dumps(doc))
@@ -430,13 +433,15 @@ class OrbitFamily:
         ds = xr.Dataset(
             {
                 "state0": (("member", "component"), self.state0, {"units": "LU, LU/TU", "long_name": "initial state on the x-z plane"}),
-                "state_half": (("member", "component"), self.state_half, {"units": "LU, LU/TU", "long_name": "state at the half-period crossing"}),
+                "state_half": (("member", "component"), self.state_half,
+                               {"units": "LU, LU/TU", "long_name": "state at the half-period crossing"}),
                 "period": ("member", self.period, {"units": "TU"}),
                 "period_days": ("member", self.period_days, {"units": "d"}),
                 "jacobi": ("member", self.jacobi, {"units": "LU^2/TU^2", "long_name": "Jacobi constant"}),
                 "eigenvalues_real": (("member", "eig"), self.eigenvalues.real),
                 "eigenvalues_imag": (("member", "eig"), self.eigenvalues.imag),
-                "stability_real": (("member", "pair"), self.stability_indices.real, {"long_name": "stability index (lambda + 1/lambda)/2, real part"}),
+                "stability_real": (("member", "pair"), self.stability_indices.real,
+                                   {"long_name": "stability index (lambda + 1/lambda)/2, real part"}),
                 "stability_imag": (("member", "pair"), self.stability_indices.imag),
             },
             coords={"member": np.arange(len(self)), "component": comp, "pair": [0, 1], "eig": np.arange(6)},
@@ -544,8 +549,10 @@ class OrbitFamily:
             kind = a.get("librate_result")
             if kind is not None and kind != "family":
                 raise ValueError(f"{not_family}: it is a librate {kind} result")
-            need_vars = ("state0", "state_half", "period", "jacobi", "eigenvalues_real", "eigenvalues_imag", "stability_real", "stability_imag")
-            need_attrs = ("mu", "lu_km", "tu_s", "r1_km", "r2_km", "system_name", "kind", "spatial", "end_reason", "bifurcations", "parameters")
+            need_vars = ("state0", "state_half", "period", "jacobi", "eigenvalues_real", "eigenvalues_imag",
+                         "stability_real", "stability_imag")
+            need_attrs = ("mu", "lu_km", "tu_s", "r1_km", "r2_km", "system_name", "kind", "spatial", "end_reason",
+                          "bifurcations", "parameters")
             miss = [v for v in need_vars if v not in ds.variables] + [f"attribute {k}" for k in need_attrs if k not in a]
             if miss:
                 raise ValueError(f"{not_family}: missing {', '.join(miss)}")
@@ -560,7 +567,8 @@ class OrbitFamily:
                 with quiet_zarr():
                     values = {v: np.asarray(ds[v].values) for v in ds.variables}
             except Exception as err:  # noqa: BLE001 - a garbled chunk: named, never a decompressor traceback
-                raise ValueError(f"{name!r} is a damaged librate family file: a variable cannot be read ({type(err).__name__}: {err})") from None
+                raise ValueError(f"{name!r} is a damaged librate family file: a variable cannot be read "
+                                 f"({type(err).__name__}: {err})") from None
             if isinstance(a.get(CHECKSUM_ATTR), str):
                 problems, _ = check_dataset(ds, values)
                 bad = [q.split()[1] for q in problems if q.startswith("variable ") and q.endswith("does not match its checksum")]
@@ -569,13 +577,15 @@ class OrbitFamily:
                 if problems:
                     raise ValueError(f"{name!r} is a damaged librate family file: {'; '.join(problems)}")
             n = values["period"].shape[0] if values["period"].ndim == 1 else -1
-            shapes = {"state0": (n, 6), "state_half": (n, 6), "period": (n,), "jacobi": (n,), "eigenvalues_real": (n, 6), "eigenvalues_imag": (n, 6),
+            shapes = {"state0": (n, 6), "state_half": (n, 6), "period": (n,), "jacobi": (n,), "eigenvalues_real": (n, 6),
+                      "eigenvalues_imag": (n, 6),
                       "stability_real": (n, 2), "stability_imag": (n, 2)}
             wrong = [f"{v} {values[v].shape} (expected {s})" for v, s in shapes.items() if values[v].shape != s]
             if wrong:
                 raise ValueError(f"{not_family}: inconsistent shapes: {'; '.join(wrong)}")
             try:
-                system = System(mu=float(a["mu"]), lu_km=float(a["lu_km"]), tu_s=float(a["tu_s"]), r1_km=float(a["r1_km"]), r2_km=float(a["r2_km"]),
+                system = System(mu=float(a["mu"]), lu_km=float(a["lu_km"]), tu_s=float(a["tu_s"]), r1_km=float(a["r1_km"]),
+                                r2_km=float(a["r2_km"]),
                                 name=str(a["system_name"]))
                 spatial = bool(int(a["spatial"]))
                 bif = ast.literal_eval(str(a["bifurcations"]))
@@ -585,8 +595,8 @@ class OrbitFamily:
             convention = a.get(STATE0_ATTR)
             if spatial and convention is None and params.get("branch") not in ("north", "south"):
                 raise ValueError(f"{name!r} holds a spatial family written by an older librate, with state0 at the crossing continued from "
-                                 "its first member; without a halo branch (parameters['branch'] = 'north' or 'south') it cannot be converted "
-                                 "to the branch-hemisphere convention: recompute the family and save it again")
+                                 "its first member; without a halo branch (parameters['branch'] = 'north' or 'south') it "
+                                 "cannot be converted to the branch-hemisphere convention: recompute the family and save it again")
             fam = cls(
                 system, str(a["kind"]), spatial,
                 values["state0"].copy(), values["state_half"].copy(), values["period"].copy(), values["jacobi"].copy(),

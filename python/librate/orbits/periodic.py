@@ -14,7 +14,8 @@ from .._display import html_summary, short_repr
 from .._errors import CollisionError
 from .system import System, resolve_system
 
-__all__ = ["PeriodicOrbit", "Geometry", "geometry", "primary_passes", "inside_primary_index", "collision_mode", "check_outside_primaries", "correct_symmetric", "correct_periodic", "real_if_real", "INDEX_TESTS", "index_tests", "symmetric_monodromy"]
+__all__ = ["PeriodicOrbit", "Geometry", "geometry", "primary_passes", "inside_primary_index", "collision_mode", "check_outside_primaries",
+           "correct_symmetric", "correct_periodic", "real_if_real", "INDEX_TESTS", "index_tests", "symmetric_monodromy"]
 
 _VARS = {"x0": 0, "z0": 1, "vy0": 2}
 # Tolerances of the shooting propagations: the 8th-order solution at 1e-13 puts the
@@ -109,7 +110,8 @@ class PeriodicOrbit:
         if "stability_indices" in self.__dict__:  # already computed: shown, never computed for display
             fit.append(("stability_indices", self.__dict__["stability_indices"], ""))
         return html_summary(f"librate.PeriodicOrbit ({self.family}, {self.period_days:.4g} d)", self._rows(),
-                            {"initial state": [("state0", self.state0, "LU, LU/TU")], "correction": fit, "system": [("system", repr(self.system), "")]})
+                            {"initial state": [("state0", self.state0, "LU, LU/TU")], "correction": fit,
+                             "system": [("system", repr(self.system), "")]})
 
     @property
     def x0(self) -> float:
@@ -223,7 +225,8 @@ def inside_primary_index(status) -> np.ndarray:
 def collision_mode(collision) -> str | None:
     """``collision`` checked: "radius", "point" or None (ValueError naming it otherwise)."""
     if collision is not None and (not isinstance(collision, str) or collision not in ("radius", "point")):
-        raise ValueError(f"invalid argument `collision`: must be 'radius' (the system's radii), 'point' (point masses) or None, got {collision!r}")
+        raise ValueError("invalid argument `collision`: must be 'radius' (the system's radii), 'point' (point masses) or "
+                         f"None, got {collision!r}")
     return collision
 
 
@@ -397,7 +400,8 @@ def correct_symmetric(
         values = [float(value)]
     r = _core.symmetric_correct(
         sys_.mu, [float(v) for v in g], spatial=bool(spatial), constraint=kind, values=values, t_max=float(t_max),
-        newton=_core.NewtonOptions(tol=float(tol), max_iter=int(max_iter)), options=_core.IntegrationOptions(rtol=float(rtol), atol=float(atol)),
+        newton=_core.NewtonOptions(tol=float(tol), max_iter=int(max_iter)),
+        options=_core.IntegrationOptions(rtol=float(rtol), atol=float(atol)),
     )
     return check_outside_primaries(orbit_from_core(sys_, r, family), collision)
 
@@ -419,8 +423,9 @@ def _check_jacobi_reachable(system: System, patches: np.ndarray, target: float) 
     i = int(np.argmin(reach))
     if target > reach[i]:
         raise ValueError(f"invalid argument `jacobi`: {target:.10g} is out of reach of the guess: at patch {i} (r = "
-                         f"{', '.join(f'{v:.6g}' for v in patches[i, :3])} LU) no state has a Jacobi constant above 2U(r) = {reach[i]:.10g} "
-                         f"(C = 2U - |v|^2), so the member wanted does not pass there; the guess has C = {float(system.jacobi(patches[0])):.10g}. "
+                         f"{', '.join(f'{v:.6g}' for v in patches[i, :3])} LU) no state has a Jacobi constant above "
+                         f"2U(r) = {reach[i]:.10g} (C = 2U - |v|^2), so the member wanted does not pass there; "
+                         f"the guess has C = {float(system.jacobi(patches[0])):.10g}. "
                          "Give a guess on that member, or reach it by continuation (small steps in `jacobi`)")
 
 
@@ -511,4 +516,5 @@ def correct_periodic(
     r = _core.multiple_shooting(sys_.mu, patches, float(period), condition=cond, value=value,
                                 newton=_core.NewtonOptions(tol=float(tol), max_iter=int(max_iter)),
                                 options=_core.IntegrationOptions(rtol=float(rtol), atol=float(atol)))
-    return check_outside_primaries(PeriodicOrbit(sys_, r.patches[0].copy(), r.period, r.jacobi, family, r.iterations, r.residual), collision)
+    return check_outside_primaries(PeriodicOrbit(sys_, r.patches[0].copy(), r.period, r.jacobi, family,
+                                                 r.iterations, r.residual), collision)

@@ -174,7 +174,8 @@ def collision_radii(system: System, collision) -> tuple[float, float] | None:
     if collision is None:
         return None
     if not isinstance(collision, str) or collision not in ("radius", "point"):
-        raise ValueError(f"invalid argument `collision`: must be 'radius' (the system's radii), 'point' (point masses) or None, got {collision!r}")
+        raise ValueError("invalid argument `collision`: must be 'radius' (the system's radii), 'point' (point masses) or "
+                         f"None, got {collision!r}")
     if collision == "point":
         return (0.0, 0.0)
     return (system.r1_km / system.lu_km, system.r2_km / system.lu_km)
@@ -302,7 +303,8 @@ def tolerance_options(rtol: float, atol: float) -> _core.IntegrationOptions:
     return _tolerance_options(float(rtol), float(atol))
 
 
-def integrate(system: System, state: np.ndarray, t0: float, tf: float, options: _core.IntegrationOptions, radii: tuple[float, float] | None, *,
+def integrate(system: System, state: np.ndarray, t0: float, tf: float, options: _core.IntegrationOptions,
+              radii: tuple[float, float] | None, *,
               stm: bool = False, t_eval: np.ndarray | None = None, events: Sequence[Event] = ()) -> Trajectory:
     """The one call of the core's propagator behind :func:`propagate`, on arguments already
     checked where they entered (a System, a (6,) float state, ``options`` from
@@ -434,7 +436,8 @@ def propagate_many(
     result = BatchResult(y=r.y, stm=r.stm, ok=r.ok, errors=errors, stats=r.stats, status=status)
     if result.errors and on_error == "raise":
         index, err = next(iter(result.errors.items()))
-        err.add_note(f"in member {index} of propagate_many ({len(result.errors)} of {arr.shape[0]} members failed)") if hasattr(err, "add_note") else None
+        err.add_note(f"in member {index} of propagate_many ({len(result.errors)} of "
+                     f"{arr.shape[0]} members failed)") if hasattr(err, "add_note") else None
         err.batch_result = result
         raise err
     return result

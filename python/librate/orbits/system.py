@@ -167,7 +167,8 @@ def resolve_system(system) -> System:
         if system not in System.presets():
             raise ValueError(f"invalid argument `system`: unknown system preset {system!r}; known presets: {', '.join(System.presets())}")
         return System.preset(system)
-    raise ValueError(f"invalid argument `system`: must be a librate.System or a preset name ({', '.join(System.presets())}), got {system!r}")
+    raise ValueError("invalid argument `system`: must be a librate.System or a preset name "
+                     f"({', '.join(System.presets())}), got {system!r}")
 
 
 def check_system(system) -> System:

@@ -54,6 +54,8 @@ from .periodic_attitude3d import (
     verified_solution_3d,
 )
 
-__all__ = ["AttitudeSolution3D", "periodic_attitude_3d", "is_mirror_symmetric", "out_of_plane_stability", "out_of_plane_family", "attitude_family_3d",
-           "attitude_family_3d_inertia", "OrbitFamilyBranch3D", "FamilyMember3D", "rotvec_jacobian", "InertiaBranch3D", "STABILITY_TOL", "VERIFY_RTOL", "floquet_tests",
+__all__ = ["AttitudeSolution3D", "periodic_attitude_3d", "is_mirror_symmetric", "out_of_plane_stability",
+           "out_of_plane_family", "attitude_family_3d",
+           "attitude_family_3d_inertia", "OrbitFamilyBranch3D", "FamilyMember3D", "rotvec_jacobian", "InertiaBranch3D", "STABILITY_TOL",
+           "VERIFY_RTOL", "floquet_tests",
            "SOLVE_RTOL", "verified_solution_3d"]

@@ -78,7 +78,8 @@ class OrbitFamilyBranch:
         if not b.converged[0]:
             raise CorrectionFailed(f"orbit-family branch: {b.reason[0]}")
         g = b.jacobian[0, 0]
-        return Point(np.array([b.parameter[0], b.wz0[0]]), {"g_p": float(g[2]), "g_wz": float(g[1]), "trace": float(np.trace(b.monodromy[0]))},
+        return Point(np.array([b.parameter[0], b.wz0[0]]), {"g_p": float(g[2]), "g_wz": float(g[1]),
+                                                            "trace": float(np.trace(b.monodromy[0]))},
                      int(b.iterations[0]))
 
     # the tangent and the tests are those of the Kz branch (x = (parameter, wz0) in both)

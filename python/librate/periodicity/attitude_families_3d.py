@@ -18,7 +18,8 @@ from ..attitude.body import RigidBody
 from ..orbits.periodic import PeriodicOrbit
 from .periodic_attitude3d import SOLVE_RTOL, STABILITY_TOL, AttitudeSolution3D, periodic_attitude_3d, verified_solution_3d
 
-__all__ = ["attitude_family_3d", "attitude_family_3d_inertia", "OrbitFamilyBranch3D", "FamilyMember3D", "InertiaBranch3D", "rotvec_jacobian",
+__all__ = ["attitude_family_3d", "attitude_family_3d_inertia", "OrbitFamilyBranch3D", "FamilyMember3D",
+           "InertiaBranch3D", "rotvec_jacobian",
            "floquet_tests", "FLOQUET_TESTS"]
 
 
@@ -82,15 +83,18 @@ class OrbitFamilyBranch3D:
         b_chart = float(c.b) - float(a[1:4] @ rv)
         cases = _core.AttitudeCases3D(Rotation.from_rotvec(rv).as_quat()[None, :], np.asarray(guess[None, 4:7], dtype=float),
                                       period=np.array([float(ref.period)]), a=a_chart[None, :], b=np.array([b_chart]))
-        options = _core.CorrectorOptions3D(_core.NewtonOptions(tol=float(self.tol), max_iter=int(self.max_iter)), rtol=SOLVE_RTOL, atol=SOLVE_RTOL)
-        r = _core.attitude_correct_3d_across(self.orbits.system.mu, list(self.body.moments), [float(v) for v in ref.state0], float(ref.period),
+        options = _core.CorrectorOptions3D(_core.NewtonOptions(tol=float(self.tol), max_iter=int(self.max_iter)),
+                                           rtol=SOLVE_RTOL, atol=SOLVE_RTOL)
+        r = _core.attitude_correct_3d_across(self.orbits.system.mu, list(self.body.moments),
+                                             [float(v) for v in ref.state0], float(ref.period),
                                              self.n_periods, cases, options=options)
         if r.reason[0] != "converged":
-            raise CorrectionFailed(f"3-D attitude across the orbit family: {r.reason[0].replace('_', ' ')} after {int(r.iterations[0])} steps, "
-                                   f"residual {float(r.residual_norm[0]):.2e}")
+            raise CorrectionFailed(f"3-D attitude across the orbit family: {r.reason[0].replace('_', ' ')} after "
+                                   f"{int(r.iterations[0])} steps, residual {float(r.residual_norm[0]):.2e}")
         state0 = np.asarray(r.orbit0[0])
         orbit = PeriodicOrbit(self.orbits.system, state0, float(r.period[0]), float(self.orbits.system.jacobi(state0)), ref.family)
-        s = verified_solution_3d(orbit, self.body, self.n_periods, np.asarray(r.q0[0]), np.asarray(r.w0[0]), np.asarray(r.monodromy[0]), int(r.iterations[0]))
+        s = verified_solution_3d(orbit, self.body, self.n_periods, np.asarray(r.q0[0]), np.asarray(r.w0[0]),
+                                 np.asarray(r.monodromy[0]), int(r.iterations[0]))
         if not s.residual <= 1e-9:
             raise CorrectionFailed(f"re-propagation residual {s.residual:.2e} above 1e-9")
         x = np.concatenate([[orbit.period_days], Rotation.from_quat(s.q0).as_rotvec(), s.w0])
@@ -200,7 +204,8 @@ def attitude_family_3d(orbits, body: RigidBody, *, guess, period_days, n_periods
     if targets.size == 1:
         br, members = None, [first]
     elif method == "natural":
-        br = natural(problem, first, targets[1:], rules=StepRules(ds=abs(targets[1] - targets[0]), ds_min=ds_min), name="period_days", stop=report)
+        br = natural(problem, first, targets[1:], rules=StepRules(ds=abs(targets[1] - targets[0]), ds_min=ds_min),
+                     name="period_days", stop=report)
         members = [first] + br.points
     else:
         if not (np.all(np.diff(targets) > 0) or np.all(np.diff(targets) < 0)):
@@ -219,7 +224,8 @@ def attitude_family_3d(orbits, body: RigidBody, *, guess, period_days, n_periods
         on_target = np.any(np.abs(targets - last.x[0]) <= 1e-12)
         if len(br.points) > 1 and on_target and not any(m is last for m in members):
             members.append(last)  # the branch ended landing exactly on a requested period (a bound)
-        folds = [{"period_days": float(f.parameter), "located": bool(f.located), "w0": [float(v) for v in f.point.x[4:7]]} for f in br.folds]
+        folds = [{"period_days": float(f.parameter), "located": bool(f.located),
+                  "w0": [float(v) for v in f.point.x[4:7]]} for f in br.folds]
         # requested periods the branch crossed whose correction there was rejected (it left the
         # jump guard: landed too far from the interpolation between the two branch points)
         ps = [float(q.x[0]) for q in br.points]
@@ -304,7 +310,8 @@ class InertiaBranch3D:
         if not (c.a[0] == 1 and not np.any(c.a[1:])) or not (0 <= c.b <= 1):
             raise CorrectionFailed("the inertia path is continued in s in [0, 1] only (natural parameter)")
         q = Rotation.from_rotvec(np.asarray(guess[1:4], dtype=float)).as_quat()
-        sol = periodic_attitude_3d(self.orbit, self.body(float(c.b)), guess=(q, np.asarray(guess[4:7], dtype=float)), n_periods=self.n_periods,
+        sol = periodic_attitude_3d(self.orbit, self.body(float(c.b)), guess=(q, np.asarray(guess[4:7], dtype=float)),
+                                   n_periods=self.n_periods,
                                    tol=self.tol)
         if not sol.residual <= 1e-9:
             raise CorrectionFailed(f"re-propagation residual {sol.residual:.2e} above 1e-9")

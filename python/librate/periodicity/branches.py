@@ -1,5 +1,5 @@
-"""Solution branches (thesis sec. 3.3, ch. 4; docs/physics.md: periodic attitude motions, solar radiation pressure): periodic attitude motions
-continued by the shared driver (:mod:`librate.solving.continuation`) with the Rust corrector
+"""Solution branches (thesis sec. 3.3, ch. 4; docs/physics.md: periodic attitude motions, solar radiation pressure): periodic attitude
+motions continued by the shared driver (:mod:`librate.solving.continuation`) with the Rust corrector
 freeing one parameter: Kz for one orbit (:class:`KzBranch`), the flat-plate amplitude eps
 (:class:`EpsBranch`, :func:`continue_srp`). :func:`periodic_attitude` returns, by default, the
 member of the N family continued in Kz from Kz = 0.
@@ -43,7 +43,8 @@ from .solutions import (
     verified,
 )
 
-__all__ = ["periodic_attitude", "KzBranch", "kz_branch", "EpsBranch", "SrpContinuation", "continue_srp", "eps_branch", "eps_branches", "branch_solutions",
+__all__ = ["periodic_attitude", "KzBranch", "kz_branch", "EpsBranch", "SrpContinuation", "continue_srp", "eps_branch",
+           "eps_branches", "branch_solutions",
            "branch_fold"]
 
 
@@ -52,8 +53,9 @@ def _plate(srp, theta):
 
 
 def _failure(what: str, batch, i: int = 0, tol: float = 1e-12) -> ConvergenceError:
-    return ConvergenceError(f"{what}: the corrector stopped ({batch.reason[i].replace('_', ' ')}) after {int(batch.iterations[i])} Newton steps "
-                            f"at wz0 = {float(batch.wz0[i]):.10g}, residual {float(batch.residual_norm[i]):.3e} (tolerance {tol:.1e})")
+    return ConvergenceError(f"{what}: the corrector stopped ({batch.reason[i].replace('_', ' ')}) after "
+                            f"{int(batch.iterations[i])} Newton steps at wz0 = {float(batch.wz0[i]):.10g}, residual "
+                            f"{float(batch.residual_norm[i]):.3e} (tolerance {tol:.1e})")
 
 
 def periodic_attitude(
@@ -170,7 +172,8 @@ def periodic_attitude(
         raise ValueError("invalid argument `method`: with free='theta_sun0' the full-period closure is used; leave method='auto'")
     symmetric = is_symmetric(orbit, phi0)
     if method == "half" and not (symmetric and (srp is None or srp.eps == 0.0)):
-        raise ValueError("invalid argument `method`: 'half' needs an x-symmetric orbit started on the x axis, phi0 a multiple of pi/2 and no SRP")
+        raise ValueError("invalid argument `method`: 'half' needs an x-symmetric orbit started on the x axis, phi0 a "
+                         "multiple of pi/2 and no SRP")
     what = f"periodic attitude (N = {per_period(n_total, n_periods)}, {kind}, Kz = {kz})"
     T = n_periods * orbit.period
     gravity = srp is None or srp.eps == 0.0
@@ -187,7 +190,8 @@ def periodic_attitude(
             return _direct(orbit, kz, n_total, kind, base.phi0, base.wz0, n_periods, srp, "full", "sun_phase", tol, max_iter, what)
         c = continue_srp(base, srp)
         if not c.reached:
-            raise ConvergenceError(f"{what}: the branch continued in eps from the gravity-only solution stops before eps = {srp.eps}: {c.end_reason}")
+            raise ConvergenceError(f"{what}: the branch continued in eps from the gravity-only solution stops "
+                                   f"before eps = {srp.eps}: {c.end_reason}")
         return c.solutions[-1]
     if free == "theta_sun0":
         return _direct(orbit, kz, n_total, kind, phi0, wz0, n_periods, srp, "full", "sun_phase", tol, max_iter, what)
@@ -220,13 +224,15 @@ class KzBranch:
 
     def correct(self, guess, c):
         a_k, a_w = c.a
-        b = correct(self.orbit, kz=float(np.clip(guess[0], -1.0, 1.0)), n_total=self.n_total, kind=self.kind, phi0=self.phi0, wz0=float(guess[1]),
+        b = correct(self.orbit, kz=float(np.clip(guess[0], -1.0, 1.0)), n_total=self.n_total, kind=self.kind,
+                    phi0=self.phi0, wz0=float(guess[1]),
                     n_periods=self.n_periods, closure="half", tol=self.tol, max_iter=min(self.max_iter, STEP_MAX_ITER),
                     max_halvings=STEP_MAX_HALVINGS, bordered=("kz", (0.0, a_w, a_k, c.b)))
         if not b.converged[0]:
             raise CorrectionFailed(f"Kz branch: {b.reason[0]}")
         g = b.jacobian[0, 0]
-        return Point(np.array([b.parameter[0], b.wz0[0]]), {"g_p": float(g[2]), "g_wz": float(g[1]), "trace": float(np.trace(b.monodromy[0])),
+        return Point(np.array([b.parameter[0], b.wz0[0]]), {"g_p": float(g[2]), "g_wz": float(g[1]),
+                                                            "trace": float(np.trace(b.monodromy[0])),
                                                             "iterations": int(b.iterations[0])}, int(b.iterations[0]))
 
     def tangent(self, pt):

@@ -170,10 +170,13 @@ def _cr3bp_reference(solution) -> tuple[RigidBody, np.ndarray, np.ndarray, int]:
             raise ValueError("invalid argument `solution`: a planar solution with the flat-plate SRP model; pass a gravity-gradient "
                              "solution (the ephemeris model's SRP acts on the facets of a librate.FacetBody given as `body`)")
         if solution.kind != "periodic":
-            raise ValueError("invalid argument `solution`: a half-turn solution repeats the attitude only up to a half turn; pass a periodic one")
+            raise ValueError("invalid argument `solution`: a half-turn solution repeats the attitude only up to a half "
+                             "turn; pass a periodic one")
         h = 0.5 * solution.phi0
-        return RigidBody.from_kz(solution.kz), np.array([0.0, 0.0, math.sin(h), math.cos(h)]), np.array([0.0, 0.0, solution.wz0]), int(solution.n_periods)
-    raise ValueError(f"invalid argument `solution`: must be a librate.AttitudeSolution or AttitudeSolution3D, got {type(solution).__name__}")
+        return (RigidBody.from_kz(solution.kz), np.array([0.0, 0.0, math.sin(h), math.cos(h)]), np.array([0.0, 0.0, solution.wz0]),
+                int(solution.n_periods))
+    raise ValueError("invalid argument `solution`: must be a librate.AttitudeSolution or AttitudeSolution3D, got "
+                     f"{type(solution).__name__}")
 
 
 def _check_body(body, ref: RigidBody) -> RigidBody:
@@ -298,7 +301,8 @@ def attitude_to_ephemeris(solution, ephemeris_orbit, *, correct: bool = True, bo
         if not hasattr(eo, name):
             raise ValueError(f"invalid argument `ephemeris_orbit`: must be a librate.EphemerisOrbit (no `{name}`)")
     if abs(eo.orbit.period - solution.orbit.period) > 1e-9 * solution.orbit.period:
-        raise ValueError(f"invalid argument `ephemeris_orbit`: its orbit's period {eo.orbit.period} differs from the solution's {solution.orbit.period}")
+        raise ValueError(f"invalid argument `ephemeris_orbit`: its orbit's period {eo.orbit.period} differs from the solution's "
+                         f"{solution.orbit.period}")
     srp = isinstance(use_body, FacetBody)
     facets = [(f.area, tuple(f.normal), tuple(f.center), f.ca, f.cs, f.cd) for f in use_body.facets] if srp else None
     eph = eo.ephemeris if eo.ephemeris is not None else Ephemeris()
@@ -311,8 +315,8 @@ def attitude_to_ephemeris(solution, ephemeris_orbit, *, correct: bool = True, bo
         out = model.correct(epochs, orbits, q_g, w_g, tol=tol, max_iter=max_iter, tolerances=(float(rtol), float(atol)))
         if not out["converged"]:
             d = np.asarray(out["defects"])
-            raise ConvergenceError(f"attitude_to_ephemeris: the multiple-shooting corrector stopped ({out['reason']}) after {out['iterations']} "
-                                   f"iterations; largest defect {np.max(np.abs(d[:, :3])):.3e} rad, tolerance {tol}")
+            raise ConvergenceError(f"attitude_to_ephemeris: the multiple-shooting corrector stopped ({out['reason']}) after "
+                                   f"{out['iterations']} iterations; largest defect {np.max(np.abs(d[:, :3])):.3e} rad, tolerance {tol}")
     else:
         out = model.legs(epochs, orbits, q_g, w_g, rtol=float(rtol), atol=float(atol))
     q, w, d = np.asarray(out["q"]), np.asarray(out["w"]), np.asarray(out["defects"])
@@ -329,7 +333,8 @@ def attitude_to_ephemeris(solution, ephemeris_orbit, *, correct: bool = True, bo
     for i in range(epochs.size - 1):
         sel = np.flatnonzero(leg == i)
         y0 = np.concatenate([orbits[i], q[i], w[i]])
-        _, ys, _ = model.propagate(y0, epochs[i], epochs[i + 1] - epochs[i], t_eval=np.ascontiguousarray(t_s[sel] - epochs[i]), rtol=rtol, atol=atol)
+        _, ys, _ = model.propagate(y0, epochs[i], epochs[i + 1] - epochs[i],
+                                   t_eval=np.ascontiguousarray(t_s[sel] - epochs[i]), rtol=rtol, atol=atol)
         qs[sel], ws[sel] = ys[:, 6:10], ys[:, 10:]
     err, rate = _deviation(model, t_s, qs, ws, q_rs, w_rs)
     y0 = np.concatenate([orbits[0], q_g[0], w_g[0]])

@@ -345,4 +345,5 @@ def frequency_scan(
         rows.append((b.frequencies_nd(sys_), np.max(np.abs(tr.flex.q), axis=0), np.max(np.abs(qs.q), axis=0),
                      float(np.max(np.abs(tr.phi - qs.phi))), float(np.max(np.abs(tr.wz - qs.wz))), float(np.max(e["structural"]))))
     cols = list(zip(*rows))
-    return FrequencyScan(fs, np.array(cols[0]), np.array(cols[1]), np.array(cols[2]), np.array(cols[3]), np.array(cols[4]), np.array(cols[5]))
+    return FrequencyScan(fs, np.array(cols[0]), np.array(cols[1]), np.array(cols[2]), np.array(cols[3]),
+                         np.array(cols[4]), np.array(cols[5]))

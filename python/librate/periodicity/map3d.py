@@ -69,7 +69,8 @@ class Map3DGrid:
 
     def _repr_html_(self) -> str:
         bodies = [(f"body {i}", f"ix={fmt(b.ix)}, iy={fmt(b.iy)}, iz={fmt(b.iz)}", "") for i, b in enumerate(self.bodies)]
-        return html_summary(f"librate.Map3DGrid ({self.n_cases} cases)", self._rows(), {"bodies": bodies, "initial attitude": [("q0", self.q0, "scalar last")]})
+        return html_summary(f"librate.Map3DGrid ({self.n_cases} cases)", self._rows(),
+                            {"bodies": bodies, "initial attitude": [("q0", self.q0, "scalar last")]})
 
     @property
     def dims(self) -> tuple[str, ...]:
@@ -102,7 +103,8 @@ def _bodies(body) -> tuple[tuple[RigidBody, ...], bool]:
         raise ValueError("invalid argument `body`: an empty list of bodies")
     for b in lst:
         if not isinstance(b, RigidBody) or b.is_rod:
-            raise ValueError(f"invalid argument `body`: must be a librate.RigidBody with every principal moment > 0 (or a list of them), got {b!r}")
+            raise ValueError("invalid argument `body`: must be a librate.RigidBody with every principal moment > 0 (or a "
+                             f"list of them), got {b!r}")
     return tuple(lst), isinstance(body, (list, tuple))
 
 
@@ -111,7 +113,8 @@ def _rate(v, name: str) -> tuple[np.ndarray, bool]:
         raise ValueError(f"invalid argument `{name}`: must be a finite number or a strictly increasing 1-D array (rad/TU), got {v!r}")
     a = as_float_array(v, name)
     if a.ndim > 1 or a.size == 0 or not np.all(np.isfinite(a)) or (a.ndim == 1 and np.any(np.diff(a) <= 0)):
-        raise ValueError(f"invalid argument `{name}`: must be a finite number or a non-empty, finite, strictly increasing 1-D array (rad/TU), got {v!r}")
+        raise ValueError(f"invalid argument `{name}`: must be a finite number or a non-empty, finite, strictly increasing 1-D "
+                         f"array (rad/TU), got {v!r}")
     return np.atleast_1d(a).astype(float), a.ndim == 1
 
 
@@ -166,7 +169,8 @@ def map3d_chunk(orbit: PeriodicOrbit, grid: Map3DGrid, start: int, stop: int, *,
     n_periods, tol = _check(orbit, n_periods, tol)
     start, stop = as_count(start, "start", 0), as_count(stop, "stop", 0)
     if start % LANES or not start <= stop <= grid.n_cases:
-        raise ValueError(f"invalid argument `start`: need a multiple of {LANES} with start <= stop <= {grid.n_cases}, got ({start}, {stop})")
+        raise ValueError(f"invalid argument `start`: need a multiple of {LANES} with start <= stop <= {grid.n_cases}, "
+                         f"got ({start}, {stop})")
     inertia, w0 = grid.cases(start, stop)
     q = np.ascontiguousarray(np.broadcast_to(grid.q0, (stop - start, 4)))
     lanes = _core.LaneOptions(rtol=tol, atol=tol, threads=threads)
@@ -187,7 +191,8 @@ def map3d_dataset(orbit: PeriodicOrbit, grid: Map3DGrid, residual: np.ndarray, s
         norm = np.max(np.abs(res), axis=-1)
     coords: dict = {"component": ("component", list(COMPONENTS))}
     for name, a, d in zip(_RATES, grid.rates, grid.rate_dims):
-        coords[name] = ((name,), a, {"units": "1/TU", "long_name": f"initial inertial rate, body {name[1]}"}) if d else ((), float(a[0]), {"units": "1/TU"})
+        coords[name] = (((name,), a, {"units": "1/TU", "long_name": f"initial inertial rate, body {name[1]}"}) if d
+                        else ((), float(a[0]), {"units": "1/TU"}))
     m = np.array([b.moments for b in grid.bodies])
     ratios = {"ix_iz": m[:, 0] / m[:, 2], "iy_iz": m[:, 1] / m[:, 2], "kz": (m[:, 1] - m[:, 0]) / m[:, 2]}
     for name, v in ratios.items():
@@ -201,8 +206,10 @@ def map3d_dataset(orbit: PeriodicOrbit, grid: Map3DGrid, residual: np.ndarray, s
          "status": (dims, st, dict(MAP_3D_VARIABLES["status"]))},
         coords=coords,
         attrs={"title": "librate 3-D attitude map", "mu": s.mu, "lu_km": s.lu_km, "tu_s": s.tu_s, "system_name": s.name,
-               "orbit_state0": [float(v) for v in orbit.state0], "orbit_period": float(orbit.period), "orbit_period_days": float(orbit.period_days),
-               "n_periods": int(n_periods), "tol": float(tol), "q0": [float(v) for v in grid.q0], "simd_level": _core.build_info()["simd_active"],
+               "orbit_state0": [float(v) for v in orbit.state0], "orbit_period": float(orbit.period),
+               "orbit_period_days": float(orbit.period_days),
+               "n_periods": int(n_periods), "tol": float(tol), "q0": [float(v) for v in grid.q0],
+               "simd_level": _core.build_info()["simd_active"],
                "complete": int(complete), "librate_version": __version__},
     )
 
@@ -340,12 +347,14 @@ def find_periodic_attitudes_3d(orbit: PeriodicOrbit, body: RigidBody, dataset, *
     m = np.array(body.moments)
     ratios = (m[0] / m[2], m[1] / m[2])
     if "body" in ds.dims:
-        hit = np.flatnonzero(np.isclose(ds["ix_iz"].values, ratios[0], rtol=0, atol=1e-12) & np.isclose(ds["iy_iz"].values, ratios[1], rtol=0, atol=1e-12))
+        hit = np.flatnonzero(np.isclose(ds["ix_iz"].values, ratios[0], rtol=0, atol=1e-12)
+                             & np.isclose(ds["iy_iz"].values, ratios[1], rtol=0, atol=1e-12))
         if hit.size == 0:
             raise ValueError(f"invalid argument `body`: its inertia ratios {ratios} are not among the map's bodies")
         ds = ds.isel(body=int(hit[0]))
     elif abs(float(ds["ix_iz"]) - ratios[0]) > 1e-12 or abs(float(ds["iy_iz"]) - ratios[1]) > 1e-12:
-        raise ValueError(f"invalid argument `body`: its inertia ratios {ratios} are not the map's ({float(ds['ix_iz'])}, {float(ds['iy_iz'])})")
+        raise ValueError(f"invalid argument `body`: its inertia ratios {ratios} are not the map's ({float(ds['ix_iz'])}, "
+                         f"{float(ds['iy_iz'])})")
     dims = [d for d in _RATES if d in ds["residual_norm"].dims]
     norm = ds["residual_norm"].transpose(*dims).values if dims else np.atleast_1d(ds["residual_norm"].values)
     filled = np.where(np.isfinite(norm), norm, np.inf)

@@ -49,7 +49,8 @@ def orbits_of(orbits) -> tuple[list[PeriodicOrbit], OrbitFamily | None]:
     try:
         lst = list(orbits)
     except TypeError:
-        raise ValueError(f"invalid argument `orbits`: must be an OrbitFamily, a PeriodicOrbit or a list of them, got {type(orbits).__name__}") from None
+        raise ValueError("invalid argument `orbits`: must be an OrbitFamily, a PeriodicOrbit or a list of them, got "
+                         f"{type(orbits).__name__}") from None
     if not lst or not all(isinstance(o, PeriodicOrbit) for o in lst):
         raise ValueError("invalid argument `orbits`: must be a non-empty list of librate.PeriodicOrbit")
     return lst, None
@@ -144,7 +145,8 @@ def periodicity_map(
             raise ValueError("invalid argument `srp`: an empty list of plates")
         plates = [check_srp(p) for p in srp]
         maps = [periodicity_map(olist if family is None else family, kz=kz, wz0=wz0, phi0=phi0, n_periods=n_periods, solve=solve,
-                                progress=progress, rtol=rtol, atol=atol, chunk=chunk, threads=threads, srp=p, method=method) for p in plates]
+                                progress=progress, rtol=rtol, atol=atol, chunk=chunk, threads=threads, srp=p,
+                                method=method) for p in plates]
         return _stack_srp(maps, plates)
     srp = check_srp(srp)
     kzs, wz = map_grid(kz, wz0, n_periods)
@@ -170,7 +172,8 @@ def periodicity_map(
                 complete = False
                 warnings.warn(f"periodicity_map: orbit {i} (x0 = {o.x0:.10g}) skipped, its row left uncomputed: {err}", stacklevel=2)
                 continue
-            r = sweep(forcing, n_periods * o.period, phi0, wz_grid, kz_grid, rtol=rtol, atol=atol, chunk=chunk, threads=threads, srp=srp, method=method)
+            r = sweep(forcing, n_periods * o.period, phi0, wz_grid, kz_grid, rtol=rtol, atol=atol, chunk=chunk,
+                      threads=threads, srp=srp, method=method)
             dwz[i], dphi[i], phi_t[i] = (r[k].reshape(nk, nw) for k in ("dwz", "dphi", "phi_t"))
             status[i] = r["status"].reshape(nk, nw)
             if solve:
@@ -323,7 +326,8 @@ def row_candidates(kzs, phi0, wz, phi_t_rows) -> tuple[list, list[float], int]:
     return cands, kk, unresolved
 
 
-def solutions_from_rows(orbit, kzs, phi0, wz, phi_t_rows, n_periods, srp=None, progress: Callable[[int, int], None] | None = None) -> list[AttitudeSolution]:
+def solutions_from_rows(orbit, kzs, phi0, wz, phi_t_rows, n_periods, srp=None,
+                        progress: Callable[[int, int], None] | None = None) -> list[AttitudeSolution]:
     """The solutions of one orbit's rows (one per Kz): the candidates where phi(KT) - phi0 crosses
     a multiple of pi (:func:`row_candidates`), refined in ONE call of the Rust corrector (the
     half-period form where the orbit and phi0 are symmetric and there is no SRP, else the
@@ -340,7 +344,8 @@ def solutions_from_rows(orbit, kzs, phi0, wz, phi_t_rows, n_periods, srp=None, p
     size = max(REFINE_BATCH_MIN, REFINE_BATCH_PERIODS // max(int(n_periods), 1))
     sols: list[AttitudeSolution] = []
     for a in range(0, len(cands), size):
-        sols += refine(orbit, np.array(kk[a:a + size]), phi0, cands[a:a + size], n_periods=n_periods, srp=srp, closure="half" if symmetric else "full",
+        sols += refine(orbit, np.array(kk[a:a + size]), phi0, cands[a:a + size], n_periods=n_periods, srp=srp,
+                       closure="half" if symmetric else "full",
                        window=(float(wz[0]), float(wz[-1])), quick=symmetric)
         if progress is not None:
             progress(min(a + size, len(cands)), len(cands))

@@ -90,7 +90,8 @@ class AttitudeSolution3D:
                                  ("monodromy", self.monodromy, "")],
                    "correction": [("residual_rotation", self.residual_rotation, "rad"), ("residual_rate", self.residual_rate, "rad/TU"),
                                   ("iterations", self.iterations, "")],
-                   "orbit and body": [("orbit", repr(self.orbit), ""), ("body", f"{type(b).__name__}(ix={fmt(b.ix)}, iy={fmt(b.iy)}, iz={fmt(b.iz)})", "")]}
+                   "orbit and body": [("orbit", repr(self.orbit), ""),
+                                      ("body", f"{type(b).__name__}(ix={fmt(b.ix)}, iy={fmt(b.iy)}, iz={fmt(b.iz)})", "")]}
         title = f"librate.AttitudeSolution3D over {self.n_periods} period(s) ({'stable' if self.stable else 'unstable'})"
         return html_summary(title, self._rows(), details)
 
@@ -139,12 +140,15 @@ class AttitudeSolution3D:
 def _guess(guess, n_periods: int) -> tuple[np.ndarray, np.ndarray]:
     if isinstance(guess, AttitudeSolution):
         if guess.srp is not None:
-            raise ValueError("invalid argument `guess`: a planar solution with solar radiation pressure; the 3-D corrector has the gravity gradient only")
+            raise ValueError("invalid argument `guess`: a planar solution with solar radiation pressure; the 3-D corrector has the "
+                             "gravity gradient only")
         if guess.n_periods != n_periods:
-            raise ValueError(f"invalid argument `n_periods`: the planar guess closes over {guess.n_periods} periods, got n_periods = {n_periods}")
+            raise ValueError(f"invalid argument `n_periods`: the planar guess closes over {guess.n_periods} periods, got "
+                             f"n_periods = {n_periods}")
         if guess.kind != "periodic":
             # a half turn about z is a different attitude (R(T) = R(0) Rz(pi)): not a 3-D periodic motion
-            raise ValueError("invalid argument `guess`: a half-turn planar solution repeats the attitude only up to a half turn; pass a periodic one")
+            raise ValueError("invalid argument `guess`: a half-turn planar solution repeats the attitude only up to a half "
+                             "turn; pass a periodic one")
         h = 0.5 * guess.phi0
         return np.array([0.0, 0.0, math.sin(h), math.cos(h)]), np.array([0.0, 0.0, guess.wz0])
     try:
@@ -218,16 +222,18 @@ def periodic_attitude_3d(orbit: PeriodicOrbit, body: RigidBody, *, guess, n_peri
         w = w.copy()
         w[1] = 0.0  # symmetric to 1e-12: exactly so
     T = n_periods * float(orbit.period)
-    options = _core.CorrectorOptions3D(_core.NewtonOptions(tol=float(tol), max_iter=int(max_iter)), rtol=SOLVE_RTOL, atol=SOLVE_RTOL, half=bool(half))
+    options = _core.CorrectorOptions3D(_core.NewtonOptions(tol=float(tol), max_iter=int(max_iter)), rtol=SOLVE_RTOL,
+                                       atol=SOLVE_RTOL, half=bool(half))
     r = _core.attitude_correct_3d(orbit.system.mu, list(body.moments), [float(v) for v in orbit.state0], T,
                                   _core.AttitudeCases3D(q[None, :], w[None, :]), options=options)
     if r.reason[0] != "converged":
-        raise ConvergenceError(f"periodic 3-D attitude: the corrector stopped ({r.reason[0].replace('_', ' ')}) after {int(r.iterations[0])} "
-                               f"Newton steps, residual {float(r.residual_norm[0]):.3e} (tolerance {tol:.1e})")
+        raise ConvergenceError(f"periodic 3-D attitude: the corrector stopped ({r.reason[0].replace('_', ' ')}) after "
+                               f"{int(r.iterations[0])} Newton steps, residual {float(r.residual_norm[0]):.3e} (tolerance {tol:.1e})")
     return verified_solution_3d(orbit, body, n_periods, r.q0[0], r.w0[0], r.monodromy[0], int(r.iterations[0]))
 
 
-def verified_solution_3d(orbit: PeriodicOrbit, body: RigidBody, n_periods: int, q0, w0, monodromy, iterations: int = 0) -> AttitudeSolution3D:
+def verified_solution_3d(orbit: PeriodicOrbit, body: RigidBody, n_periods: int, q0, w0, monodromy,
+                         iterations: int = 0) -> AttitudeSolution3D:
     """A corrected motion (q0, w0) with the corrector's ``monodromy``, re-propagated
     independently with the scalar 3-D model at rtol = atol = :data:`VERIFY_RTOL` (its residual
     and turns), as an :class:`AttitudeSolution3D`."""

@@ -30,7 +30,8 @@ from ..attitude.srp import FlatPlate
 from ..orbits.periodic import PeriodicOrbit
 
 __all__ = ["AttitudeSolution", "find_periodic_attitudes", "orbit_forcing", "clear_forcing_cache", "sweep", "candidates",
-           "check_orbit", "check_kz", "check_kinds", "KINDS", "check_srp", "is_symmetric", "MAP_RTOL", "MAP_ATOL", "correct", "verified", "refine", "refine_groups",
+           "check_orbit", "check_kz", "check_kinds", "KINDS", "check_srp", "is_symmetric", "MAP_RTOL", "MAP_ATOL", "correct", "verified",
+           "refine", "refine_groups",
            "turns_of", "n_total_of", "per_period", "turns_array", "SOLVE_RTOL", "SOLVE_ATOL", "STEP_MAX_ITER", "MAP_METHOD",
            "STEP_MAX_HALVINGS"]
 
@@ -94,8 +95,8 @@ def sweep(forcing, t_final, phi0, wz0, kz, *, stm=False, rtol=MAP_RTOL, atol=MAP
           method=MAP_METHOD):
     """The engine over broadcast (phi0, wz0, kz[, eps]) arrays; ``srp`` a FlatPlate (its eps
     overridden per case by ``eps`` when given); ``method`` "rkf78" (Runge-Kutta-Fehlberg 7(8),
-    the default), "dp87" (Prince and Dormand's RK8(7)13M on the same states) or "rkn86" (Runge-Kutta-Nyström 8(6) on phi'' = wzdot(t, phi); its embedded
-    error estimate is of sixth order, so the same accuracy comes at a looser rtol: see
+    the default), "dp87" (Prince and Dormand's RK8(7)13M on the same states) or "rkn86" (Runge-Kutta-Nyström 8(6) on phi'' = wzdot(t, phi);
+    its embedded error estimate is of sixth order, so the same accuracy comes at a looser rtol: see
     bench/bench_lanes.py)."""
     chunk = as_count(chunk, "chunk", 1)
     threads = as_threads(threads)
@@ -104,7 +105,8 @@ def sweep(forcing, t_final, phi0, wz0, kz, *, stm=False, rtol=MAP_RTOL, atol=MAP
     flat = lambda a: np.ascontiguousarray(np.broadcast_to(np.asarray(a, dtype=np.float64), n)).ravel()  # noqa: E731
     p, w, k = flat(phi0), flat(wz0), flat(kz)
     plates = None if srp is None else plates_of(flat(srp.eps if eps is None else eps), flat(srp.cs), flat(srp.cd), flat(srp.sun.theta0))
-    lanes = _core.LaneOptions(rtol=float(rtol), atol=float(atol), max_steps=200_000, method=lane_method(method), chunk=int(chunk), threads=threads)
+    lanes = _core.LaneOptions(rtol=float(rtol), atol=float(atol), max_steps=200_000, method=lane_method(method),
+                              chunk=int(chunk), threads=threads)
     return _core.map_sweep(forcing, float(t_final), _core.PlanarCases(p, w, k, plates=plates), lanes=lanes, stm=bool(stm))
 
 
@@ -301,7 +303,8 @@ def correct(orbit: PeriodicOrbit, *, kz, n_total, kind, phi0, wz0, n_periods: in
     ``closure`` "half" (symmetric, over K T / 2) or "full" (over K T); ``free`` "phi0" or
     "sun_phase"; ``bordered``: (parameter "kz" or "eps", condition (a_angle, a_wz0, a_parameter,
     b), or one such row per candidate) for the continuation driver. Returns the core's CorrectionBatch."""
-    cols = np.broadcast_arrays(np.asarray(kz, dtype=float), np.asarray(n_total, dtype=float), np.asarray(kind), np.asarray(phi0, dtype=float),
+    cols = np.broadcast_arrays(np.asarray(kz, dtype=float), np.asarray(n_total, dtype=float), np.asarray(kind),
+                               np.asarray(phi0, dtype=float),
                                np.asarray(wz0, dtype=float), np.asarray(0.0 if eps is None else eps, dtype=float),
                                np.asarray(0.0 if theta_sun0 is None else theta_sun0, dtype=float))
     k, nt, kd, p, w, e, th = (np.ascontiguousarray(c).ravel() for c in cols)
@@ -334,7 +337,8 @@ def verified(orbit: PeriodicOrbit, *, kz, n_total, kind, phi0, wz0, n_periods: i
     FlatPlate (or None) per solution."""
     kz, n_total, phi0, wz0, kind = (np.ascontiguousarray(np.atleast_1d(v).ravel())
                                     for v in np.broadcast_arrays(np.asarray(kz, dtype=float), np.asarray(n_total, dtype=float),
-                                                                 np.asarray(phi0, dtype=float), np.asarray(wz0, dtype=float), np.asarray(kind)))
+                                                                 np.asarray(phi0, dtype=float),
+                                                                 np.asarray(wz0, dtype=float), np.asarray(kind)))
     m = kz.size
     if m == 0:
         return []
@@ -421,7 +425,8 @@ def refine_groups(orbit, kz, phi0, cands, *, n_periods, srp, closure, window, ki
     conv = sorted(np.flatnonzero(b.converged & (b.wz0 >= lo) & (b.wz0 <= hi)), key=lambda i: (order[grp[i]], kzs[i], b.wz0[i]))
     ok: list[int] = []  # one per solution: candidates that converged onto the same one are verified once
     for i in conv:
-        if not any(grp[j] == grp[i] and kzs[j] == kzs[i] and n_total[j] == n_total[i] and kind[j] == kind[i] and abs(b.wz0[j] - b.wz0[i]) < 1e-8
+        if not any(grp[j] == grp[i] and kzs[j] == kzs[i] and n_total[j] == n_total[i] and kind[j] == kind[i]
+                   and abs(b.wz0[j] - b.wz0[i]) < 1e-8
                    for j in ok):
             ok.append(int(i))
     sols = verified(orbit, kz=kzs[ok], n_total=n_total[ok], kind=kind[ok], phi0=b.phi0[ok], wz0=b.wz0[ok], n_periods=n_periods,

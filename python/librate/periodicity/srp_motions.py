@@ -188,7 +188,8 @@ def srp_map(
                 owners = [(start, p) for (start, _, _, _), br in zip(jobs, brs) for p in br.marked]
                 checked = pool.submit(verified, orbit, kz=kz, n_total=[s_.n_total for s_, _ in owners], kind=[s_.kind for s_, _ in owners],
                                       phi0=[p.x[1] for _, p in owners], wz0=[p.x[2] for _, p in owners], n_periods=n_periods,
-                                      plates=[plate.with_eps(float(p.x[0])) for _, p in owners], iterations=[p.iterations for _, p in owners],
+                                      plates=[plate.with_eps(float(p.x[0])) for _, p in owners],
+                                      iterations=[p.iterations for _, p in owners],
                                       threads=1)
                 runs.append((jobs, lead, brs, checked))
 
@@ -196,7 +197,8 @@ def srp_map(
                 """The motions the runs so far have at eps = e_end (their lead and marked points)."""
                 out = [s_ for jobs, lead, _, _ in runs for first in lead for e, s_ in first if e == e_end]
                 return out + [Known(start.n_total, start.kind, float(p.x[2]), float(p.x[1]))
-                              for jobs, _, brs, _ in runs for (start, _, _, _), br in zip(jobs, brs) for p in br.marked if float(p.x[0]) == e_end]
+                              for jobs, _, brs, _ in runs for (start, _, _, _), br in zip(jobs, brs)
+                              for p in br.marked if float(p.x[0]) == e_end]
 
             def record(jobs, lead, brs, checked):
                 """The branches of one run, recorded in order, each after its ``lead`` solutions
@@ -236,7 +238,8 @@ def srp_map(
             for e_end, inward in ends:
                 known = found_at(e_end)
                 # phi0 is free: scan from four initial attitudes (one sweep, one corrector call)
-                found = find_periodic_attitudes(orbit, kz=kz, wz0_range=window, phi0=[phi0 + s_ for s_ in (0.0, 0.5 * math.pi, math.pi, -0.5 * math.pi)],
+                found = find_periodic_attitudes(orbit, kz=kz, wz0_range=window,
+                                                phi0=[phi0 + s_ for s_ in (0.0, 0.5 * math.pi, math.pi, -0.5 * math.pi)],
                                                 kinds=kinds, n_periods=n_periods, srp=plate.with_eps(e_end))
                 jobs, lead = [], []
                 for s1 in sorted(found, key=lambda x: x.wz0):
@@ -266,7 +269,8 @@ def srp_map(
             "sol_phi0": ("solution", sol_arr(lambda b, e, s: math.remainder(s.phi0, 2 * math.pi)), {"units": "rad",
                          "long_name": "phi0 wrapped to [-pi, pi]"}),
             "sol_n": ("solution", turns_array(s.n for b, e, s in sols), {"long_name": "net body turns per orbit period"}),
-            "sol_n_total": ("solution", sol_arr(lambda b, e, s: s.n_total, np.int64), {"long_name": "net body turns over the n_periods periods"}),
+            "sol_n_total": ("solution", sol_arr(lambda b, e, s: s.n_total, np.int64),
+                            {"long_name": "net body turns over the n_periods periods"}),
             "sol_kind": ("solution", sol_arr(lambda b, e, s: s.kind, "<U9")),
             "sol_trace": ("solution", sol_arr(lambda b, e, s: s.trace)),
             "sol_stable": ("solution", sol_arr(lambda b, e, s: s.stable, bool)),
@@ -276,7 +280,8 @@ def srp_map(
             "path_wz0": ("path", np.array([p[2] for p in path], dtype=float), {"units": "1/TU"}),
             "path_phi0": ("path", np.array([math.remainder(p[3], 2 * math.pi) for p in path], dtype=float), {"units": "rad"}),
             "path_trace": ("path", np.array([p[4] for p in path], dtype=float)),
-            "branch_n": ("branch", np.array([x[0] / n_periods for x in branches], dtype=float), {"long_name": "net body turns per orbit period"}),
+            "branch_n": ("branch", np.array([x[0] / n_periods for x in branches], dtype=float),
+                         {"long_name": "net body turns per orbit period"}),
             "branch_n_total": ("branch", np.array([x[0] for x in branches], dtype=np.int64)),
             "branch_kind": ("branch", np.array([x[1] for x in branches], dtype="<U9")),
             "branch_origin": ("branch", np.array([x[2] for x in branches], dtype="<U7")),
@@ -377,7 +382,8 @@ def sun_pointing_accelerations(system, body_or_plate, t, *, orbit: PeriodicOrbit
         if not isinstance(sun_, Sun):
             raise ValueError(f"invalid argument `sun`: must be a librate.Sun, got {sun!r}")
     else:
-        raise ValueError(f"invalid argument `body_or_plate`: must be a librate.FlatPlate or a librate.FacetBody, got {type(body_or_plate).__name__}")
+        raise ValueError("invalid argument `body_or_plate`: must be a librate.FlatPlate or a librate.FacetBody, got "
+                         f"{type(body_or_plate).__name__}")
     t = as_float_array(t, "t")
     if not np.all(np.isfinite(t)):
         raise ValueError("invalid argument `t`: times must be finite")

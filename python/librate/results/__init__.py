@@ -16,6 +16,8 @@ from .kinds import KINDS, kind_of
 from .lock import StoreBusyError, writer_lock
 from .store import PartStore, StoreReport, verify_store
 
-__all__ = ["CHECKSUM_ATTR", "KINDS", "META_ATTR", "PartStore", "StoreBusyError", "StoreReport", "array_digest", "atomic_path", "atomic_write_text",
-           "clean_orphans", "dataset_checksums", "kind_of", "open_dataset", "replace_path", "verify_dataset", "verify_store", "write_dataset",
+__all__ = ["CHECKSUM_ATTR", "KINDS", "META_ATTR", "PartStore", "StoreBusyError", "StoreReport", "array_digest",
+           "atomic_path", "atomic_write_text",
+           "clean_orphans", "dataset_checksums", "kind_of", "open_dataset", "replace_path", "verify_dataset",
+           "verify_store", "write_dataset",
            "writer_lock"]

@@ -22,7 +22,8 @@ import shutil
 from collections.abc import Callable, Iterator
 from pathlib import Path
 
-__all__ = ["atomic_path", "atomic_write_bytes", "atomic_write_text", "clean_orphans", "fsync_tree", "pid_alive", "remove_path", "replace_path",
+__all__ = ["atomic_path", "atomic_write_bytes", "atomic_write_text", "clean_orphans", "fsync_tree", "pid_alive",
+           "remove_path", "replace_path",
            "temporary_sibling"]
 
 _TMP = re.compile(r"^\.(?P<name>.+)\.(?P<what>tmp|old|creating)-(?P<pid>\d+)$")

@@ -10,7 +10,8 @@ import json
 
 import numpy as np
 
-__all__ = ["CHECKSUM_ATTR", "META_ATTR", "array_digest", "attrs_digest", "check_dataset", "dataset_checksums", "dataset_meta", "meta_digest",
+__all__ = ["CHECKSUM_ATTR", "META_ATTR", "array_digest", "attrs_digest", "check_dataset", "dataset_checksums",
+           "dataset_meta", "meta_digest",
            "plain", "value_digest"]
 
 #: The attribute of a saved Dataset holding the digests of its variables' values (JSON).

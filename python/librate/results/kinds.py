@@ -13,7 +13,8 @@ import numpy as np
 
 from .store import StoreSchema, Var
 
-__all__ = ["FIGURE_FILES", "FamilyResult", "KINDS", "Map3DResult", "MAP_3D_VARIABLES", "MAP_VARIABLES", "MapResult", "ResultKind", "Solutions3DResult",
+__all__ = ["FIGURE_FILES", "FamilyResult", "KINDS", "Map3DResult", "MAP_3D_VARIABLES", "MAP_VARIABLES", "MapResult",
+           "ResultKind", "Solutions3DResult",
            "SolutionsResult", "TRANSITION_VARIABLES", "TransitionResult", "kind_of", "map3d_schema", "map_schema", "transition_schema"]
 
 #: The per-orbit variables of a planar map: units and long names (periodicity_map, run_map and
@@ -59,14 +60,15 @@ TRANSITION_VARIABLES = {
     "drift_km_per_rev": ("f8", (), {"units": "km", "long_name": "drift of the ephemeris trajectory from the CR3BP orbit per revolution"}),
     "node_epochs_tdb": ("f8", ("node",), {"units": "s", "long_name": "node epochs, TDB seconds past J2000"}),
     "states_km": ("f8", ("node", "component"), {"units": "km, km/s", "long_name": "node states, Moon-centred ICRF"}),
-    "synodic": ("f8", ("node", "component"), {"units": "LU, LU/TU", "long_name": "node states in the instantaneous Earth-Moon rotating frame, "
-                                              "nondimensional (barycentre origin, the CR3BP's synodic frame)"}),
+    "synodic": ("f8", ("node", "component"),
+                {"units": "LU, LU/TU", "long_name": "node states in the instantaneous Earth-Moon rotating frame, "
+                                                    "nondimensional (barycentre origin, the CR3BP's synodic frame)"}),
     "defects_km": ("f8", ("leg",), {"units": "km", "long_name": "position defect at the end of each leg, re-propagated from its node"}),
     "defects_km_s": ("f8", ("leg",), {"units": "km/s", "long_name": "velocity defect at the end of each leg, re-propagated from its node"}),
     "perilune_km": ("f8", ("revolution",), {"units": "km", "long_name": "closest approach to the Moon's centre in each revolution"}),
     "track_t_tdb": ("f8", ("sample",), {"units": "s", "long_name": "epochs of the sampled ephemeris trajectory, TDB seconds past J2000"}),
-    "track_synodic": ("f8", ("sample", "component"), {"units": "LU, LU/TU", "long_name": "the sampled ephemeris trajectory in the rotating frame, "
-                                                      "nondimensional"}),
+    "track_synodic": ("f8", ("sample", "component"),
+                      {"units": "LU, LU/TU", "long_name": "the sampled ephemeris trajectory in the rotating frame, nondimensional"}),
 }
 
 
@@ -169,7 +171,8 @@ class FamilyResult(ResultKind):
 
     @classmethod
     def recognise(cls, ds) -> bool:
-        return ds.attrs.get("librate_result") == "family" or ("librate_result" not in ds.attrs and "state0" in ds.variables and "kind" in ds.attrs)
+        return ds.attrs.get("librate_result") == "family" or ("librate_result" not in ds.attrs and "state0" in ds.variables
+                                                              and "kind" in ds.attrs)
 
 
 class SolutionsResult(ResultKind):
@@ -331,7 +334,8 @@ class TransitionResult(ResultKind):
         ds = self.dataset
         n = ds.sizes.get("epoch", 0)
         conv = int((np.asarray(ds["status"].values) == 0).sum()) if "status" in ds.variables else 0
-        return f"a librate transition: {n} epoch(s), {conv} converged, {ds.attrs.get('revolutions', '?')} revolutions, librate {ds.attrs.get('librate_version', '?')}"
+        return (f"a librate transition: {n} epoch(s), {conv} converged, {ds.attrs.get('revolutions', '?')} revolutions, "
+                f"librate {ds.attrs.get('librate_version', '?')}")
 
     @classmethod
     def recognise(cls, ds) -> bool:
@@ -339,7 +343,8 @@ class TransitionResult(ResultKind):
 
 
 #: The classes by kind, in the order they are recognised.
-KINDS: dict[str, type[ResultKind]] = {c.kind: c for c in (FamilyResult, SolutionsResult, Solutions3DResult, MapResult, Map3DResult, TransitionResult)}
+KINDS: dict[str, type[ResultKind]] = {c.kind: c for c in (FamilyResult, SolutionsResult, Solutions3DResult, MapResult,
+                                                          Map3DResult, TransitionResult)}
 
 
 def kind_of(ds) -> type[ResultKind] | None:

@@ -108,7 +108,8 @@ def open_group(path: Path, kind: str, mode: str = "r"):
 
 
 def _what(kind: str) -> str:
-    return {"periodicity_map": "map store", "map_3d": "3-D map store", "ephemeris_transition": "transition store"}.get(kind, f"{kind} store")
+    return {"periodicity_map": "map store", "map_3d": "3-D map store",
+            "ephemeris_transition": "transition store"}.get(kind, f"{kind} store")
 
 
 def _array_meta(g, name: str) -> str:
@@ -155,7 +156,8 @@ class PartStore:
         if g.attrs.get("fingerprint") != fingerprint:
             raise ValueError(f"invalid argument `out`: {path} holds a map of different inputs (fingerprint mismatch); use another folder")
         if not resume:
-            raise ValueError(f"invalid argument `out`: {path} already holds this map; pass resume=True to continue it or choose another folder")
+            raise ValueError(f"invalid argument `out`: {path} already holds this map; pass resume=True to continue it or "
+                             "choose another folder")
         bad = []
         want = {**{k: (schema.shape(k), np.dtype(v.dtype)) for k, v in schema.variables.items()},
                 "done": ((schema.n_parts,), np.dtype(bool)), "row_checksum": ((schema.n_parts, len(schema.variables)), np.dtype("u8"))}
@@ -202,7 +204,8 @@ class PartStore:
         g = zarr.open_group(str(tmp), mode="w", zarr_format=2)
         store = cls(g, tmp, schema, fingerprint, lock)
         for name, v in schema.variables.items():
-            g.create_array(name, shape=schema.shape(name), chunks=(1, *v.shape), dtype=v.dtype, fill_value=v.fill, attributes=store._var_attrs(name))
+            g.create_array(name, shape=schema.shape(name), chunks=(1, *v.shape), dtype=v.dtype, fill_value=v.fill,
+                           attributes=store._var_attrs(name))
         n, nv = schema.n_parts, len(schema.variables)
         g.create_array("done", shape=(n,), chunks=(1,), dtype="bool", fill_value=False, attributes={"_ARRAY_DIMENSIONS": [schema.part_dim]})
         g.create_array("row_checksum", shape=(n, nv), chunks=(1, nv), dtype="u8", fill_value=None,
@@ -240,7 +243,8 @@ class PartStore:
     def _write_coords(self, coords: dict) -> None:
         for name, (dim, values, attrs) in coords.items():
             # no fill value: xarray would read a fill value of 0 as "missing" (orbit 0, Kz = 0)
-            a = self.g.create_array(name, shape=values.shape, chunks=tuple(max(1, n) for n in values.shape), dtype=values.dtype, fill_value=None, overwrite=True,
+            a = self.g.create_array(name, shape=values.shape, chunks=tuple(max(1, n) for n in values.shape), dtype=values.dtype,
+                                    fill_value=None, overwrite=True,
                                     attributes={"_ARRAY_DIMENSIONS": [dim] if values.ndim == 1 else list(dim), **attrs})
             a[...] = values
 
@@ -325,7 +329,8 @@ class PartStore:
             if values.size:
                 a[...] = values
             sums[name] = array_digest(values)
-        final = {k: v for k, v in attrs.items() if isinstance(v, (int, float, str)) or (isinstance(v, list) and all(isinstance(x, (int, float)) for x in v))}
+        final = {k: v for k, v in attrs.items()
+                 if isinstance(v, (int, float, str)) or (isinstance(v, list) and all(isinstance(x, (int, float)) for x in v))}
         final.update(self._base_attrs(None))
         final.update({"complete": int(complete), "extra_checksums": sums})
         if self.lock is not None:
@@ -484,7 +489,8 @@ def verify_store(path, names: list[str] | None = None) -> StoreReport:
             continue
         if got != digest:
             rep.problems.append(f"array {name}: its dtype, shape or attributes do not match their checksum (e.g. an added scale_factor)")
-    known = set(names) | {"done", ck} | set(attrs.get("coord_checksums") or {}) | set(attrs.get("extra_checksums") or attrs.get("sol_checksums") or {})
+    known = (set(names) | {"done", ck} | set(attrs.get("coord_checksums") or {})
+             | set(attrs.get("extra_checksums") or attrs.get("sol_checksums") or {}))
     if rep.complete:
         for name in sorted(set(g.array_keys()) - known):
             rep.problems.append(f"array {name} is not one the store was written with (a damaged name?)")
@@ -503,7 +509,8 @@ def verify_store(path, names: list[str] | None = None) -> StoreReport:
                 with quiet_zarr():
                     got = array_digest(np.asarray(g[name][...]))
             except Exception as err:  # noqa: BLE001
-                rep.problems.append(f"{label} {name}: array {name} is {'missing' if isinstance(err, KeyError) else 'unreadable'} ({short(err)})")
+                rep.problems.append(f"{label} {name}: array {name} is "
+                                    f"{'missing' if isinstance(err, KeyError) else 'unreadable'} ({short(err)})")
                 continue
             if got != want:
                 rep.problems.append(f"{label} {name} does not match its checksum")

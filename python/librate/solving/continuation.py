@@ -343,7 +343,8 @@ def arclength_steps(
                     return (yield from finish())
                 ds *= 0.5
                 if ds < rules.ds_min:
-                    branch.end_reason = f"step floor: could not land on {name} = {edge[0]:.12g} from {base.x[k]:.12g} (step below {rules.ds_min:g})"
+                    branch.end_reason = (f"step floor: could not land on {name} = {edge[0]:.12g} from {base.x[k]:.12g} "
+                                         f"(step below {rules.ds_min:g})")
                     return (yield from finish())
                 continue
             new = yield from at(base, t, ds, _bend(points, t, sx, last_ds, ds) if rules.predictor == "quadratic" else None)
@@ -368,7 +369,8 @@ def arclength_steps(
             branch.rejected_jumps += status == "jump"
             ds *= 0.5
             if ds < rules.ds_min:
-                branch.end_reason = f"step floor: arclength step below {rules.ds_min:g} at {name} = {base.x[k]:.12g} after {len(points)} points"
+                branch.end_reason = (f"step floor: arclength step below {rules.ds_min:g} at {name} = {base.x[k]:.12g} "
+                                     f"after {len(points)} points")
                 return (yield from finish())
         assert t_new is not None and new is not None
         # the points inside this step (locating a fold or a sign change) start on the quadratic
@@ -380,12 +382,14 @@ def arclength_steps(
 
         # a fold: the parameter component of the tangent changes sign
         if t[k] * t_new[k] < 0:
-            fold = (yield from locate_fold(problem, base, t, ds, new, t_new, within, fold_tol)) if locate else Fold(float(new.x[k]), new, False, abs(new.x[k] - base.x[k]))
+            fold = ((yield from locate_fold(problem, base, t, ds, new, t_new, within, fold_tol)) if locate
+                    else Fold(float(new.x[k]), new, False, abs(new.x[k] - base.x[k])))
             branch.folds.append(fold)
             if stop_at_fold:
                 if fold.located:
                     points.append(fold.point)  # the branch ends on its turning point
-                branch.end_reason = f"fold at {name} = {fold.parameter:.12g}" + ("" if fold.located else f" (not located: within {fold.tolerance:.2g})")
+                branch.end_reason = (f"fold at {name} = {fold.parameter:.12g}"
+                                     + ("" if fold.located else f" (not located: within {fold.tolerance:.2g})"))
                 return (yield from finish())
         tests_new = test_values(problem, new)
         for test, u, v, w in sign_changes(tests_prev, tests_new):

@@ -147,7 +147,8 @@ class StepRules:
             if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
                 raise ValueError(f"invalid argument `{name}`: must be a finite number > 0, got {v!r}")
         if not self.ds_min <= self.ds_max:
-            raise ValueError(f"invalid arguments `ds_min`, `ds_max`: ds_min must not exceed ds_max, got ds_min = {self.ds_min}, ds_max = {self.ds_max}")
+            raise ValueError(f"invalid arguments `ds_min`, `ds_max`: ds_min must not exceed ds_max, got ds_min = {self.ds_min}, "
+                             f"ds_max = {self.ds_max}")
         if self.growth < 1:
             raise ValueError(f"invalid argument `growth`: must be >= 1, got {self.growth}")
 
