@@ -35,7 +35,8 @@ def _legs_meet(kernel, eo, tol_km=1e-3, tol_km_s=1e-8):
     """Largest position and velocity mismatch of the re-propagated legs."""
     worst = [0.0, 0.0]
     for i in range(len(eo.epochs_tdb) - 1):
-        end = ref_propagate(kernel, eo.states_km[i], float(eo.epochs_tdb[i]), float(eo.epochs_tdb[i + 1] - eo.epochs_tdb[i]), rtol=1e-12, atol=1e-9)
+        end = ref_propagate(kernel, eo.states_km[i], float(eo.epochs_tdb[i]),
+                            float(eo.epochs_tdb[i + 1] - eo.epochs_tdb[i]), rtol=1e-12, atol=1e-9)
         worst[0] = max(worst[0], float(np.linalg.norm(end[:3] - eo.states_km[i + 1, :3])))
         worst[1] = max(worst[1], float(np.linalg.norm(end[3:] - eo.states_km[i + 1, 3:])))
     return worst
@@ -100,7 +101,8 @@ def test_a_trajectory_that_leaves_the_orbit_is_refused(orbits):
     the size) the transition refuses it with a ConvergenceError naming the revolution and the
     distance, not a result under the orbit's name; with the default (50 %) it is returned."""
     dro = orbits["dro70k"]
-    with pytest.raises(librate.ConvergenceError, match=r"leaves the orbit: in revolution [1-3] it passes [\d,]+ km from the CR3BP orbit, more than 5%"):
+    with pytest.raises(librate.ConvergenceError,
+                       match=r"leaves the orbit: in revolution [1-3] it passes [\d,]+ km from the CR3BP orbit, more than 5%"):
         librate.to_ephemeris(dro, "2031-03-15T00:00:00 UTC", revolutions=3, max_departure=0.05)
     eo = librate.to_ephemeris(dro, "2031-03-15T00:00:00 UTC", revolutions=3)
     assert 0.05 * 95300 < eo.max_departure_km < 0.5 * 95300, eo.max_departure_km

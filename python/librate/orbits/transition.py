@@ -95,7 +95,8 @@ class EphemerisOrbit:
         Moon-centred ICRF ``states_km``), the node epochs included once."""
         ts, ys = [], []
         for i in range(len(self.epochs_tdb) - 1):
-            tr = propagate_ephemeris(self.states_km[i], float(self.epochs_tdb[i]), float(self.epochs_tdb[i + 1] - self.epochs_tdb[i]), ephemeris=self.ephemeris)
+            tr = propagate_ephemeris(self.states_km[i], float(self.epochs_tdb[i]), float(self.epochs_tdb[i + 1] - self.epochs_tdb[i]),
+                                     ephemeris=self.ephemeris)
             ts.append(tr.t_tdb[:-1])
             ys.append(tr.states_km[:-1])
         ts.append(self.epochs_tdb[-1:])
@@ -112,7 +113,8 @@ class EphemerisOrbit:
     def __repr__(self) -> str:
         return (f"EphemerisOrbit({self.orbit.family}, epoch_tdb={self.epoch_tdb:.1f}, revolutions={self.revolutions}, "
                 f"nodes={len(self.epochs_tdb)}, iterations={self.iterations}, defect={float(self.defects_km.max()) * 1e3:.2e} m, "
-                f"max_departure={self.max_departure_km:.1f} km, perilune={float(self.perilune_km.min()):.0f}..{float(self.perilune_km.max()):.0f} km)")
+                f"max_departure={self.max_departure_km:.1f} km, "
+                f"perilune={float(self.perilune_km.min()):.0f}..{float(self.perilune_km.max()):.0f} km)")
 
 
 def nodes_per_rev_for(orbit: PeriodicOrbit, nodes_per_rev: int | None = None) -> int:
@@ -235,7 +237,8 @@ def to_ephemeris(
         raise ValueError(f"invalid argument `orbit`: must be a librate.PeriodicOrbit, got {type(orbit).__name__}")
     mu_em = _core.GM_MOON / (_core.GM_EARTH + _core.GM_MOON)
     if not math.isclose(orbit.system.mu, mu_em, rel_tol=1e-3):
-        raise ValueError(f"invalid argument `orbit`: the ephemeris model is the Earth-Moon-Sun one (mu = {mu_em:.9f}), got an orbit with mu = {orbit.system.mu!r}")
+        raise ValueError(f"invalid argument `orbit`: the ephemeris model is the Earth-Moon-Sun one (mu = {mu_em:.9f}), got an orbit with "
+                         f"mu = {orbit.system.mu!r}")
     revolutions = as_count(revolutions, "revolutions", 1, 1000)
     npr = nodes_per_rev_for(orbit, nodes_per_rev)
     for name, v in (("tol_km", tol_km), ("tol_km_s", tol_km_s)):
@@ -249,21 +252,24 @@ def to_ephemeris(
     span = eph.span
     t_end = t0 + revolutions * orbit.period * orbit.system.tu_s
     if not (span[0] <= t0 and t_end <= span[1]):
-        raise ValueError(f"invalid argument `epoch`: the {revolutions} revolutions from {t0:.1f} to {t_end:.1f} TDB s past J2000 leave the ephemeris span "
-                         f"[{span[0]:.1f}, {span[1]:.1f}] TDB s")
+        raise ValueError(f"invalid argument `epoch`: the {revolutions} revolutions from {t0:.1f} to {t_end:.1f} TDB s past J2000 "
+                         f"leave the ephemeris span [{span[0]:.1f}, {span[1]:.1f}] TDB s")
     states, epochs = _guess(orbit, t0, revolutions, npr, eph)
     s = orbit.system
     d = eph.transition(states, epochs, tol=(float(tol_km), float(tol_km_s)), scales=(s.lu_km, s.tu_s), epoch_free=bool(epoch_free),
                             max_iter=max_iter, integration=(float(rtol), float(atol)))
     if d["reason"] != "converged":
         worst = int(np.argmax(d["defects_km"]))
-        err = ConvergenceError(f"ephemeris transition of the {orbit.family} (period {orbit.period_days:.3f} d) at {t0:.1f} TDB s, {revolutions} revolutions, "
-                               f"{npr} nodes a revolution: the multiple shooting stopped ({d['reason'].replace('_', ' ')}) after {d['iterations']} Newton steps; "
-                               f"largest defects {float(d['defects_km'].max()):.3e} km (leg {worst}) and {float(d['defects_km_s'].max()):.3e} km/s, "
-                               f"asked {tol_km:.1e} km and {tol_km_s:.1e} km/s. More nodes a revolution (an odd nodes_per_rev: no node on the perilune) or fewer revolutions may help")
+        err = ConvergenceError(f"ephemeris transition of the {orbit.family} (period {orbit.period_days:.3f} d) at {t0:.1f} TDB s, "
+                               f"{revolutions} revolutions, {npr} nodes a revolution: the multiple shooting stopped "
+                               f"({d['reason'].replace('_', ' ')}) after {d['iterations']} Newton steps; largest defects "
+                               f"{float(d['defects_km'].max()):.3e} km (leg {worst}) and {float(d['defects_km_s'].max()):.3e} km/s, asked "
+                               f"{tol_km:.1e} km and {tol_km_s:.1e} km/s. More nodes a revolution (an odd nodes_per_rev: no node on the "
+                               "perilune) or fewer revolutions may help")
         raise err
     traj_nodes_t, traj_nodes = d["epochs_tdb"], d["states_km"]
-    eo = EphemerisOrbit(orbit, float(traj_nodes_t[0]), revolutions, npr, traj_nodes_t, traj_nodes, int(d["iterations"]), d["defects_km"], d["defects_km_s"],
+    eo = EphemerisOrbit(orbit, float(traj_nodes_t[0]), revolutions, npr, traj_nodes_t, traj_nodes, int(d["iterations"]),
+                        d["defects_km"], d["defects_km_s"],
                         d["history"], math.nan, np.full(revolutions, math.nan), math.nan, eph)
     return _with_figures(eo, float(max_departure))
 
@@ -284,15 +290,17 @@ def _with_figures(eo: EphemerisOrbit, max_departure: float) -> EphemerisOrbit:
     if dmin[worst] > max_departure * size:
         rev = min(int(np.searchsorted(eo.epochs_tdb, traj.t_tdb[worst], side="right") - 1) // eo.nodes_per_rev, eo.revolutions - 1)
         raise ConvergenceError(
-            f"ephemeris transition of the {orbit.family} (period {orbit.period_days:.3f} d) at {eo.epoch_tdb:.1f} TDB s over {eo.revolutions} revolutions: "
-            f"the multiple shooting made the trajectory continuous, but it leaves the orbit: in revolution {rev + 1} it passes "
-            f"{dmin[worst] * s.lu_km:,.0f} km from the CR3BP orbit, more than {max_departure:.0%} of the orbit's size ({size * s.lu_km:,.0f} km "
-            "from the Moon at most); that is not this orbit's ephemeris counterpart. Fewer revolutions, or more nodes a revolution, may hold")
+            f"ephemeris transition of the {orbit.family} (period {orbit.period_days:.3f} d) at {eo.epoch_tdb:.1f} TDB s over "
+            f"{eo.revolutions} revolutions: the multiple shooting made the trajectory continuous, but it leaves the orbit: in revolution "
+            f"{rev + 1} it passes {dmin[worst] * s.lu_km:,.0f} km from the CR3BP orbit, more than {max_departure:.0%} of the orbit's size "
+            f"({size * s.lu_km:,.0f} km from the Moon at most); that is not this orbit's ephemeris counterpart. Fewer revolutions, or more "
+            "nodes a revolution, may hold")
     starts = eo.synodic()[:: eo.nodes_per_rev, :3]
     departure = np.linalg.norm(starts - orbit.state0[:3], axis=1) * s.lu_km
     drift = float(np.polyfit(np.arange(len(departure)), departure, 1)[0]) if len(departure) > 1 else 0.0
     perilune = _perilunes(traj, eo.epochs_tdb, eo.revolutions, eo.nodes_per_rev)
-    return EphemerisOrbit(orbit, eo.epoch_tdb, eo.revolutions, eo.nodes_per_rev, eo.epochs_tdb, eo.states_km, eo.iterations, eo.defects_km, eo.defects_km_s,
+    return EphemerisOrbit(orbit, eo.epoch_tdb, eo.revolutions, eo.nodes_per_rev, eo.epochs_tdb, eo.states_km, eo.iterations,
+                          eo.defects_km, eo.defects_km_s,
                           eo.history, float(dmin.max() * s.lu_km), perilune, drift, eo.ephemeris, departure)
 
 
