@@ -389,7 +389,8 @@ def test_a_failed_attitude_correction_keeps_the_orbit_and_says_why(tmp_path, mon
     ({"rates": None}, "rates: missing section [rates]", "rates.wz0"),
     ({"torques": {"srp": {"eps": 0.1}}}, "torques.srp = ", "no [torques.srp] with ephemeris.attitude_n"),
     ({"body": {"kz": [0.5, 0.8]}}, "body.kz = [0.5, 0.8]", "one number in [-1, 1]"),
-    ({"ephemeris": {"epoch": 9e8, "attitude_n": [0, 0]}}, "ephemeris.attitude_n = [0, 0]: an N is listed twice", "at most 8 distinct integers"),
+    ({"ephemeris": {"epoch": 9e8, "attitude_n": [0, 0]}}, "ephemeris.attitude_n = [0, 0]: an N is listed twice",
+     "at most 8 distinct integers"),
     ({"ephemeris": {"epoch": 9e8, "attitude_n": []}}, "ephemeris.attitude_n = []", "at most 8 distinct integers"),
 ])
 def test_bad_attitude_input_names_the_key_and_the_allowed_range(change, key, allowed):
