@@ -443,3 +443,23 @@ def test_a_killed_attitude_run_resumes_to_the_same_arrays(tmp_path, monkeypatch)
     assert ds["attitude_status"].values.tolist() == [[0], [0]]
     for v in ref.data_vars:
         np.testing.assert_array_equal(ds[v].values, ref[v].values, err_msg=v)
+
+
+def test_a_3d_study_carries_the_3d_motion_and_agrees_with_the_planar_one(attitude_run, tmp_path):
+    """[attitude] model = "3d" with the moments of Kz = 0.8 (100, 900, 1000 kg m^2) and the planar
+    start: the 3-D motion corrected from the N = 0 planar solution (periodic_attitude_3d, as the
+    3-D solve starts) is the planar motion (an in-plane solution of the 3-D model), so its
+    ephemeris counterpart has the planar run's pointing error, to 1e-9 deg (the 3-D corrector's
+    closure tolerance is 1e-12)."""
+    from librate.app.jobs import run_transition
+
+    d, _ = attitude_run
+    planar = librate.open_result(d / "out" / "transition.zarr")
+    raw = {**ATTITUDE_STUDY, "body": {"ix": 100.0, "iy": 900.0, "iz": 1000.0}, "attitude": {"model": "3d", "start": "planar", "n": 0}}
+    ds, _ = run_transition(Study.from_dict(raw, purpose="transition", base_dir=tmp_path))
+    assert ds.attrs["attitude_model"] == "3d" and ds.attrs["attitude_body_moments"] == [100.0, 900.0, 1000.0]
+    assert ds["attitude_status"].values.tolist() == [[0]] and ds["attitude_q0"].dims == ("attitude", "quaternion")
+    np.testing.assert_allclose(ds["attitude_w0"].values[0], [0.0, 0.0, planar["attitude_wz0"].values[0]], rtol=0, atol=1e-10)
+    np.testing.assert_allclose(ds["attitude_pointing_deg"].values, planar["attitude_pointing_deg"].values, rtol=0, atol=1e-9)
+    with pytest.raises(StudyError, match=r"ephemeris.attitude_n = \[0\]: with attitude.start = \"given\" the 3-D motion has no N"):
+        Study.from_dict({**raw, "attitude": {"model": "3d", "start": "given", "w0": [0.0, 0.0, 1.0]}}, purpose="transition")
