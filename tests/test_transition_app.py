@@ -463,3 +463,16 @@ def test_a_3d_study_carries_the_3d_motion_and_agrees_with_the_planar_one(attitud
     np.testing.assert_allclose(ds["attitude_pointing_deg"].values, planar["attitude_pointing_deg"].values, rtol=0, atol=1e-9)
     with pytest.raises(StudyError, match=r"ephemeris.attitude_n = \[0\]: with attitude.start = \"given\" the 3-D motion has no N"):
         Study.from_dict({**raw, "attitude": {"model": "3d", "start": "given", "w0": [0.0, 0.0, 1.0]}}, purpose="transition")
+
+
+def test_an_epoch_whose_orbit_fails_marks_its_attitude_not_computed(tmp_path, monkeypatch):
+    from librate.app.jobs import run_transition
+    from librate.orbits import transition
+
+    real = transition.to_ephemeris
+    monkeypatch.setattr(transition, "to_ephemeris", lambda orbit, epoch, **kw: real(orbit, epoch, **kw, max_iter=1))
+    st = Study.from_dict({**ATTITUDE_STUDY, "ephemeris": {**ATTITUDE_STUDY["ephemeris"], "revolutions": 1}}, purpose="transition",
+                         base_dir=tmp_path)
+    ds, path = run_transition(st)
+    assert verify_result(path)[0] and ds["status"].values.tolist() == [1] and ds["attitude_status"].values.tolist() == [[2]]
+    assert np.isnan(ds["attitude_pointing_deg"].values).all() and json.loads(ds.attrs["attitude_failures"]) == {}
