@@ -297,7 +297,9 @@ def run_transition(study: Study, out: str | Path | None = None, *, scheduler=Non
     StudyError names ``ephemeris.epoch`` and the allowed range). ``scheduler``: None (this
     process), a Dask ``distributed.Client`` or its address: each epoch is one task, checksummed
     on arrival; the result equals the local one bit for bit. A result of the same inputs is
-    resumed or reused; one of other inputs is refused unless ``force`` (``say`` names it)."""
+    resumed or reused; one of other inputs is refused unless ``force`` (``say`` names it).
+    With ``ephemeris.attitude_n`` every epoch also carries the CR3BP attitude solutions of
+    :func:`_transition_attitudes` (found before any epoch is computed)."""
     from ..ephemeris.epochs import iso_tdb
     from .results import check_output
     from .transition import run_transition_to
