@@ -537,6 +537,14 @@ def transition(study, out_dir, quiet, scheduler, resume, sets) -> None:
       transition_rotating.png   the orbit in the rotating frame in both models (first epoch)
       transition_defects.png    the node defects of every epoch
       transition_sweep.png      departure and perilune range against the epoch (2+ epochs)
+      transition_attitude.png   with ephemeris.attitude_n: attitude angles against time in both
+                   models (first epoch, first solution)
+      transition_pointing.png   with ephemeris.attitude_n: the pointing error of each body axis
+
+    With ephemeris.attitude_n = [N, ...] the CR3BP periodic attitude solutions with those N
+    (found on the orbit as `librate solve` finds them, from [body], [rates] and [solver]) are
+    carried along the ephemeris orbit at each epoch and corrected by multiple shooting; the
+    table then adds per solution the largest pointing error and the corrected motion's defects.
     """
     st = _load_study(study, "transition", _overrides(sets))
     _check_writable(st.output_dir(out_dir), "--out" if out_dir else "output.folder")
@@ -550,7 +558,8 @@ def transition(study, out_dir, quiet, scheduler, resume, sets) -> None:
 
         _lines(transition_summary(ds, time.perf_counter() - t0))
     click.echo(f"written: {path}")
-    _figures(ds, path, _wanted(st, ("transition", "defects", "sweep")), quiet)
+    att = ("attitude", "pointing") if st.ephemeris.attitude_n else ()
+    _figures(ds, path, _wanted(st, ("transition", "defects", "sweep", *att)), quiet)
 
 
 @main.command(context_settings=_CONTEXT, short_help="Re-draw the figures of any saved result, without recomputing.")
@@ -577,7 +586,8 @@ def plot(result_path, quiet) -> None:
       a 3-D map  STEM_residual_norm.png (log10 of the residual max-norm over the two rate
                  grids, the first three orbits)
       a transition  STEM_rotating.png (the orbit in the rotating frame in both models),
-                 STEM_defects.png (node defects), STEM_sweep.png (against the epoch)
+                 STEM_defects.png (node defects), STEM_sweep.png (against the epoch),
+                 STEM_attitude.png and STEM_pointing.png (with attitude solutions)
     """
     from .results import open_result, resolve_result_path
 

@@ -191,12 +191,13 @@ def _run_solve_3d(study: Study3D, out: str | Path | None = None, progress: Calla
     path = save_dataset(ds, path)
     return ds, path
 
-def _start_3d(study: Study3D, orbit, body, n_periods: int):
-    """The guess of the first member's 3-D motion and its description (attributes)."""
+def _start_3d(study: Study3D, orbit, body, n_periods: int, n: int | None = None, key_n: str = "attitude.n"):
+    """The guess of the first member's 3-D motion and its description (attributes); ``n``: the
+    start's net turns (default ``attitude.n``; ``key_n`` the study key a missing solution names)."""
     from scipy.spatial.transform import Rotation
 
     start = study.attitude_start()
-    n = study.attitude.n
+    n = study.attitude.n if n is None else n
     if start == "planar":
         from ..periodicity.solutions import find_periodic_attitudes
 
@@ -209,14 +210,14 @@ def _start_3d(study: Study3D, orbit, body, n_periods: int):
                  f"phi0 = {study.solver.phi0:g})")
         if not hits:
             others = ", ".join(f"n = {x.n:g} ({x.kind}) at wz0 = {x.wz0:.6g}" for x in found) or "none"
-            raise StudyError([problem("attitude.n", n, f"no planar periodic solution with n = {n} {where} for wz0 in "
+            raise StudyError([problem(key_n, n, f"no planar periodic solution with n = {n} {where} for wz0 in "
                                        f"[{wz[0]:g}, {wz[-1]:g}]; found: {others}",
                                        "the n of a planar periodic solution in the window, or widen " + key)])
         if len(hits) > 1:
             raise StudyError([problem(key, grid_raw(getattr(study.rates, key.split(".")[1])),
                                        f"{len(hits)} planar periodic solutions with n = {n} {where}: wz0 = "
                                        + ", ".join(f"{x.wz0:.6g}" for x in hits) + "; narrow the window to one of them",
-                                       "a rate window holding exactly one planar solution with n = attitude.n")])
+                                       f"a rate window holding exactly one planar solution with n = {key_n}")])
         sol = hits[0]
         return sol, {"start": "planar", "start_n": int(n), "start_planar_wz0": float(sol.wz0), "start_planar_phi0": float(sol.phi0),
                      "start_planar_trace": float(sol.trace), "start_planar_stable": int(bool(sol.stable)),
@@ -302,7 +303,9 @@ def run_transition(study: Study, out: str | Path | None = None, *, scheduler=Non
     StudyError names ``ephemeris.epoch`` and the allowed range). ``scheduler``: None (this
     process), a Dask ``distributed.Client`` or its address: each epoch is one task, checksummed
     on arrival; the result equals the local one bit for bit. A result of the same inputs is
-    resumed or reused; one of other inputs is refused unless ``force`` (``say`` names it)."""
+    resumed or reused; one of other inputs is refused unless ``force`` (``say`` names it).
+    With ``ephemeris.attitude_n`` every epoch also carries the CR3BP attitude solutions of
+    :func:`_transition_attitudes` (found before any epoch is computed)."""
     from ..ephemeris.epochs import iso_tdb
     from .results import check_output
     from .transition import run_transition_to
@@ -331,8 +334,51 @@ def run_transition(study: Study, out: str | Path | None = None, *, scheduler=Non
                                   f"epochs from {iso_tdb(lo)} to {iso_tdb(hi - duration_s)} (the file's span less the "
                                   "revolutions' duration)")])
     file = None if e.file is None else str(Path(e.file) if Path(e.file).is_absolute() else (Path(study.base_dir) / e.file).resolve())
+    attitudes = _transition_attitudes(study, orbit)
     return run_transition_to(orbit, path, epochs_tdb=epochs, revolutions=e.revolutions, nodes_per_rev=e.nodes_per_rev, ephemeris_file=file,
-                             resume=not force, scheduler=scheduler, progress=progress, attrs=study.result_attrs("transition", "transition"))
+                             resume=not force, scheduler=scheduler, progress=progress, attrs=study.result_attrs("transition", "transition"),
+                             attitudes=attitudes)
+
+
+def _transition_attitudes(study: Study, orbit) -> list:
+    """The CR3BP periodic attitude solutions ``ephemeris.attitude_n`` asks for on ``orbit``, found
+    as ``librate solve`` finds them: for each N the periodic solution with N turns of lowest wz0
+    in the planar scan (:func:`_solve_one` on the study's Kz, rate window, phi0 and periods), or,
+    in a 3-D study, the 3-D motion started as :func:`_start_3d` starts it with n = N and corrected
+    by :func:`librate.periodic_attitude_3d`. A StudyError names an N with no solution."""
+    wanted = study.ephemeris.attitude_n
+    if not wanted:
+        return []
+    k = study.n_periods()
+    if isinstance(study, Study3D):
+        from .._errors import ConvergenceError
+        from ..periodicity.periodic_attitude3d import periodic_attitude_3d
+
+        body, out = study.build_body(), []
+        for n in wanted:
+            guess, start = _start_3d(study, orbit, body, k, n=n, key_n="ephemeris.attitude_n")
+            try:
+                out.append(periodic_attitude_3d(orbit, body, guess=guess, n_periods=k, tol=study.tol))
+            except ConvergenceError as err:
+                raise StudyError([problem("ephemeris.attitude_n", wanted, f"the 3-D motion with n = {n} ({start['start_description']}) "
+                                          f"did not converge: {str(err).splitlines()[0]}")]) from None
+        return out
+    wz = study.wz0_values()
+    kz = float(study.kz_values()[0])
+    window = (float(wz[0]), float(wz[-1]))
+    found = [_solution_of(orbit, None, d) for d in _solve_one(orbit, kz, window, study.solver.phi0, int(wz.size), k, None)]
+    out = []
+    for n in wanted:
+        hits = [x for x in found if x.kind == "periodic" and x.n == n]
+        if not hits:
+            others = ", ".join(f"N = {x.n:g} ({x.kind}) at wz0 = {x.wz0:.6g}" for x in found) or "none"
+            key = "rates.wz0" if study.rates.wz0 is not None else "rates.phidot0"
+            raise StudyError([problem("ephemeris.attitude_n", wanted, f"no periodic solution with N = {n} on the orbit "
+                                      f"(x0 = {orbit.x0:.6g} LU, Kz = {kz:g}, phi0 = {study.solver.phi0:g}) for wz0 in "
+                                      f"[{wz[0]:g}, {wz[-1]:g}]; found: {others}",
+                                      f"the N of periodic solutions in the window, or widen {key}")])
+        out.append(hits[0])
+    return out
 
 
 def _family_of(fam, orbits):

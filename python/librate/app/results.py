@@ -139,7 +139,7 @@ def check_output(path: str | Path, kind: str, study: str | None, *, force: bool 
     if old_kind != kind:
         changes.append(f"(result): a {old_kind or 'result of unknown kind'} -> a {kind}")
     else:
-        changes += study_changes(old_study, study, RESULT_INPUTS.get(kind))
+        changes += study_changes(old_study, study, _inputs(kind, old_study, study))
         if old_study is not None and study is not None:
             from .._core import __version__
 
@@ -154,6 +154,21 @@ def check_output(path: str | Path, kind: str, study: str | None, *, force: bool 
         return "resume"
     raise ResultExists(f"{p} holds a {old_kind or 'result'} of other inputs (changed: {'; '.join(changes)}): "
                        "not replaced; run again with --force to replace it, or choose another --out", changes)
+
+
+def _inputs(kind: str, *studies) -> tuple[str, ...] | None:
+    """The study sections a result of ``kind`` depends on for either of ``studies`` (JSON text,
+    dicts or None; :meth:`librate.results.kinds.ResultKind.inputs_of`), None for an unknown kind."""
+    import json
+
+    cls = KINDS.get(kind)
+    if cls is None:
+        return None
+    out: tuple[str, ...] = ()
+    for st in studies:
+        for k in cls.inputs_of(json.loads(st) if isinstance(st, str) else st):
+            out += (k,) if k not in out else ()
+    return out
 
 
 def _existing_result(p: Path) -> tuple[str | None, dict] | None:

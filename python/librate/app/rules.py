@@ -238,4 +238,46 @@ def _needs_transition(s: dict, given: dict) -> list[str]:
             problems.append(problem(f"orbits.{sel[0]}", sel[1],
                                     f"selects {sel[2]} orbits; a transition carries one orbit into the ephemeris model "
                                     "(its epochs are ephemeris.epoch)", "exactly one value"))
+    eph = s.get("ephemeris")
+    if eph is not None and eph.attitude_n is not None:
+        problems += _needs_transition_attitude(s, given)
+    return problems
+
+
+def _needs_transition_attitude(s: dict, given: dict) -> list[str]:
+    """What ``ephemeris.attitude_n`` needs: the CR3BP solutions found as ``librate solve`` finds
+    them (the body, the rate scan), in a model the ephemeris attitude has (gravity gradient of a
+    rigid body; no flat-plate SRP, no flexible body)."""
+    from .schema import Attitude3D
+
+    problems: list[str] = []
+    n = s["ephemeris"].attitude_n
+    body, rates, tq, orb, att = s.get("body"), s.get("rates"), s.get("torques"), s.get("orbits"), s.get("attitude")
+    is_3d = isinstance(att, Attitude3D)
+    start = start_of(att, orb) if is_3d else "planar"
+    why = "ephemeris.attitude_n carries the CR3BP periodic attitude solutions that `librate solve` finds"
+    if "body" not in given:
+        problems.append(missing("body", f"missing section [body]: {why} for the body (body.kz, or body.ix/iy/iz)"))
+    elif body is not None and not is_3d:
+        if body.flexible is not None:
+            problems.append(problem("body.flexible", body.flexible, "the ephemeris attitude model is a rigid body",
+                                    "body.kz or body.ix/iy/iz"))
+        elif body.kz is not None and grid_values(body.kz).size != 1:
+            problems.append(problem("body.kz", grid_raw(body.kz), f"{why} for one body: one Kz", "one number in [-1, 1]"))
+    if start == "planar" and "rates" not in given:
+        problems.append(missing("rates", f"missing section [rates]: {why} by scanning rates.wz0 (or rates.phidot0)"))
+    elif start == "planar" and rates is not None and rates.wz0 is None and rates.phidot0 is None:
+        problems.append(missing("rates.wz0", f"missing: {why} by scanning rates.wz0 (or rates.phidot0)"))
+    if is_3d and start == "given":
+        problems.append(problem("ephemeris.attitude_n", n, "with attitude.start = \"given\" the 3-D motion has no N",
+                                "ephemeris.attitude_n with attitude.start = 'planar' or 'spin' (each N the start's n)"))
+    if not is_3d and orb is not None and orb.kind == "halo":
+        problems.append(problem("orbits.kind", orb.kind, "the planar attitude solutions need a planar family",
+                                "'dro' or 'lyapunov' with the planar model, or any family with [attitude] model = '3d'"))
+    if tq is not None and tq.srp is not None:
+        problems.append(problem("torques.srp", "[torques.srp]", "the ephemeris attitude model has no flat-plate SRP (its SRP acts on the "
+                                "facets of a librate.FacetBody, in the Python API)", "no [torques.srp] with ephemeris.attitude_n"))
+    if tq is not None and sorted(tq.gravity_gradient) != ["earth", "moon"]:
+        problems.append(problem("torques.gravity_gradient", tq.gravity_gradient, "the CR3BP solutions have the gravity gradient of both "
+                                "primaries (the ephemeris model adds the Sun's)", "[\"earth\", \"moon\"]"))
     return problems

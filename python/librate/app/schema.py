@@ -17,8 +17,10 @@ from pydantic import BaseModel, ConfigDict, Discriminator, Field, Tag, TypeAdapt
 
 #: What a study can be checked for (the commands that run it).
 PURPOSES = ("family", "solve", "map", "transition")
-#: Figure names accepted in ``output.figures`` ("multipliers" and "body_axes": 3-D solves).
-FIGURES = ("family", "period", "stability", "map", "residuals", "solutions", "multipliers", "body_axes", "transition", "defects", "sweep")
+#: Figure names accepted in ``output.figures`` ("multipliers" and "body_axes": 3-D solves; "attitude" and "pointing":
+#: transitions with ephemeris.attitude_n).
+FIGURES = ("family", "period", "stability", "map", "residuals", "solutions", "multipliers", "body_axes", "transition", "defects", "sweep",
+           "attitude", "pointing")
 #: What output.figures accepts (its field's description).
 FIGURES_TEXT = "a list of figure names among " + ", ".join(repr(f) for f in FIGURES)
 
@@ -93,14 +95,14 @@ Grid = Annotated[
 ]
 KzValue = Annotated[float, Field(ge=-1, le=1)]
 KzGrid = Annotated[
-    Annotated[KzValue, Tag("number")] | Annotated[list[KzValue], Field(min_length=1, max_length=MAX_GRID), Tag("list")]
-    | Annotated[Range, Tag("range")],
+    Annotated[KzValue, Tag("number")] | Annotated[list[KzValue], Field(min_length=1, max_length=MAX_GRID),
+                                                  Tag("list")] | Annotated[Range, Tag("range")],
     Discriminator(_number_grid_tag, custom_error_type="grid",
                   custom_error_message="must be a number, a list of numbers or a table {start, stop, num}"),
 ]
 RateGrid = Annotated[
-    Annotated[float, Tag("number")] | Annotated[list[float], Field(min_length=1, max_length=MAX_GRID), Tag("list")]
-    | Annotated[Range, Tag("range")],
+    Annotated[float, Tag("number")] | Annotated[list[float], Field(min_length=1, max_length=MAX_GRID),
+                                                Tag("list")] | Annotated[Range, Tag("range")],
     Discriminator(_number_grid_tag, custom_error_type="grid", custom_error_message=_RATE_MSG),
 ]
 _TAGS = {"list", "range", "number", "planar", "3d"}
@@ -359,20 +361,20 @@ class AttitudeSection(Table):
                                                        "quaternion and three rates)")
     start: Literal["planar", "spin", "given"] | None = Field(None,
                                                              description="'planar' (the planar N-family solution on the first member, "
-                                                                         "planar families), 'spin' (the torque-free spin "
-                                                                         "wz0 = 1 + 2 pi n / (K T) about synodic Z) or 'given' "
-                                                                         "(attitude.q0 and attitude.w0), with attitude.model = '3d'")
+                                                                         "planar families), 'spin' (the torque-free spin wz0 = 1 + 2 pi n "
+                                                                         "/ (K T) about synodic Z) or 'given' (attitude.q0 and "
+                                                                         "attitude.w0), with attitude.model = '3d'")
     n: int | None = Field(None, ge=-100, le=100,
-                          description="an integer in [-100, 100], net turns about synodic Z per attitude period, "
-                                      "with attitude.start = 'planar' or 'spin'")
+                          description="an integer in [-100, 100], net turns about synodic Z per attitude period, with attitude.start "
+                                      "= 'planar' or 'spin'")
     q0: list[float] | None = Field(None, min_length=4, max_length=4,
-                                   description="four numbers, a unit quaternion (scalar last): the body relative to the synodic frame "
-                                               "at t = 0, with attitude.start = 'given' or 'spin'")
+                                   description="four numbers, a unit quaternion (scalar last): the body relative to the synodic frame at t "
+                                               "= 0, with attitude.start = 'given' or 'spin'")
     w0: list[float] | None = Field(None, min_length=3, max_length=3,
                                    description="three numbers, the inertial rate in body axes (1/TU), with attitude.start = 'given'")
     tol: float | None = Field(None, ge=1e-14, le=1e-6,
-                              description="a number in [1e-14, 1e-6], the 3-D corrector's tolerance on the closure "
-                                          "(default 1e-12; 1e-10 for NRHOs)")
+                              description="a number in [1e-14, 1e-6], the 3-D corrector's tolerance on the closure (default "
+                                          "1e-12; 1e-10 for NRHOs)")
 
     @classmethod
     def model_validate(cls, obj: Any, **kwargs: Any) -> AttitudeSection:
@@ -463,6 +465,8 @@ _ATTITUDE = TypeAdapter(Annotated[Annotated[PlanarAttitude, Tag("planar")] | Ann
 # --- [ephemeris] ----------------------------------------------------------------------------------
 #: The most epochs of one [ephemeris] section (a list, or a range's count).
 MAX_EPOCHS = 10_000
+#: The most attitude solutions one transition carries (``ephemeris.attitude_n``).
+MAX_ATTITUDES = 8
 _EPOCH_TEXT = "an ISO string with a time scale ('2030-01-01T00:00:00 TDB', or UTC, TT) or TDB seconds past J2000"
 EpochValue = Annotated[float | int | str, Field(description=_EPOCH_TEXT)]
 
@@ -517,6 +521,11 @@ class EphemerisSection(Table):
     file: str | None = Field(None, min_length=1, description="the path of a JPL SPK file with type-2 segments of the Sun, the Earth-Moon "
                              "barycentre, the Moon and the Earth (relative paths from the study file's folder); default the embedded DE440 "
                              "excerpt, 2020-2070")
+    attitude_n: list[Annotated[int, Field(ge=-100, le=100)]] | None = Field(
+        None, min_length=1, max_length=MAX_ATTITUDES,
+        description=f"a list of at most {MAX_ATTITUDES} distinct integers N in [-100, 100]: for each N, the first periodic attitude "
+        "solution with N net turns that `librate solve` finds on the orbit ([body], [rates], [solver]; with attitude.model = '3d', "
+        "the 3-D motion started with attitude.n = N) is carried along the ephemeris orbit at every epoch and corrected")
 
     def epochs_tdb(self) -> np.ndarray:
         """The epochs in TDB seconds past J2000, (n,) (a range: start + k step, up to stop)."""
@@ -558,6 +567,8 @@ class EphemerisSection(Table):
                 problems.append(problem("ephemeris.epoch.step_days", e.step_days,
                                         f"gives {int((t1 - t0) / (e.step_days * 86400.0)) + 1} epochs from start to stop",
                                         f"a step giving at most {MAX_EPOCHS} epochs"))
+        if self.attitude_n is not None and len(set(self.attitude_n)) != len(self.attitude_n):
+            problems.append(problem("ephemeris.attitude_n", self.attitude_n, "an N is listed twice"))
         if not bad and self.file is None:
             lo, hi = _embedded_span()
             t = self.epochs_tdb()
@@ -584,8 +595,7 @@ class OutputSection(Table):
 
     folder: str = Field("librate-out", min_length=1, description="a non-empty path (relative paths are taken from the study file's folder)")
     format: Literal["zarr", "netcdf"] = Field("zarr", description="'zarr' or 'netcdf'")
-    figures: list[Literal["family", "period", "stability", "map", "residuals", "solutions", "multipliers", "body_axes", "transition",
-                          "defects", "sweep"]] | None = Field(None, description=FIGURES_TEXT)
+    figures: list[Literal[FIGURES]] | None = Field(None, description=FIGURES_TEXT)
 
 
 SECTIONS: dict[str, type[Table]] = {

@@ -12,6 +12,13 @@ equal the local run's bit for bit (the transitions are deterministic).
 
 An epoch whose multiple shooting does not converge is kept with ``status = 1`` (its arrays NaN,
 its reason in the ``failures`` attribute) and the sweep goes on.
+
+With ``attitudes`` (CR3BP periodic attitude solutions on the orbit), each epoch's task also
+carries every solution along the epoch's ephemeris orbit (:func:`librate.attitude_to_ephemeris`,
+corrected) and adds its nodes, defects and deviation figures to the epoch's part (dimensions
+``attitude`` and ``attitude_sample``). A correction that does not converge keeps the orbit and
+marks that solution ``attitude_status = 1`` (its reason in ``attitude_failures``, keyed
+"epoch/solution").
 """
 
 from __future__ import annotations
@@ -25,7 +32,8 @@ import numpy as np
 
 from ..orbits.transition import nodes_per_rev_for
 
-__all__ = ["COMPONENTS", "CR3BP_SAMPLES", "PER_LEG", "run_transition_to", "transition_sizes", "transition_summary"]
+__all__ = ["ANGLES", "ATTITUDE_PER_LEG", "COMPONENTS", "CR3BP_SAMPLES", "PER_LEG", "run_transition_to", "transition_sizes",
+           "transition_summary"]
 
 #: The state components (position, then velocity).
 COMPONENTS = ("x", "y", "z", "vx", "vy", "vz")
@@ -33,6 +41,10 @@ COMPONENTS = ("x", "y", "z", "vx", "vy", "vz")
 PER_LEG = 8
 #: Samples of the stored CR3BP orbit over one period (the rotating-frame figure).
 CR3BP_SAMPLES = 400
+#: Samples per leg of the stored attitude deviation figures (attitude_to_ephemeris's samples_per_leg).
+ATTITUDE_PER_LEG = 8
+#: The attitude angles stored (EphemerisAttitude.angles_deg), and the components of a quaternion and of a body vector.
+ANGLES, QUATERNION, AXES = ("roll", "pitch", "yaw"), ("x", "y", "z", "w"), ("x", "y", "z")
 #: What the frames of the stored states are (the result's ``frames`` attribute).
 FRAMES = ("states_km: Moon-centred ICRF (km, km/s), TDB; synodic, track_synodic, cr3bp_synodic: the instantaneous "
           "Earth-Moon rotating frame (x Earth -> Moon, z along the Earth-Moon angular momentum, y = z x x; origin the Earth-Moon "
@@ -50,25 +62,63 @@ def _ephemeris(path: str | None):
     return _EPHEMERIS[path]
 
 
-def transition_sizes(revolutions: int, nodes_per_rev: int) -> dict[str, int]:
-    """The lengths of an epoch's dimensions: node, leg, revolution, sample, component."""
+def transition_sizes(revolutions: int, nodes_per_rev: int, attitudes: int = 0) -> dict[str, int]:
+    """The lengths of an epoch's dimensions: node, leg, revolution, sample, component; with
+    ``attitudes`` solutions also attitude, attitude_sample, quaternion, axis and angle."""
     nodes = revolutions * nodes_per_rev + 1
-    return {"node": nodes, "leg": nodes - 1, "revolution": revolutions, "sample": (nodes - 1) * PER_LEG + 1, "component": 6}
-
-
-def _failed(sizes: dict) -> dict:
-    from ..results.kinds import TRANSITION_VARIABLES
-
-    out = {}
-    for k, (dtype, dims, _) in TRANSITION_VARIABLES.items():
-        shape = tuple(sizes[d] for d in dims)
-        out[k] = np.full(shape, np.nan) if dtype == "f8" else np.full(shape, 1 if k == "status" else -1, dtype=dtype)
+    out = {"node": nodes, "leg": nodes - 1, "revolution": revolutions, "sample": (nodes - 1) * PER_LEG + 1, "component": 6}
+    if attitudes:
+        out.update({"attitude": int(attitudes), "attitude_sample": (nodes - 1) * ATTITUDE_PER_LEG + 1, "quaternion": 4, "axis": 3,
+                    "angle": 3})
     return out
 
 
-def _transition_epoch(orbit, epoch_tdb: float, revolutions: int, nodes_per_rev: int, path: str | None, sizes: dict) -> dict:
+def _failed(sizes: dict, names=None, status: int = 1) -> dict:
+    """NaN arrays (counts -1, flags ``status``) of the variables ``names`` (default all)."""
+    from ..results.kinds import transition_variables
+
+    out = {}
+    for k, (dtype, dims, _) in transition_variables("attitude" in sizes).items():
+        if names is not None and k not in names:
+            continue
+        shape = tuple(sizes[d] for d in dims)
+        out[k] = np.full(shape, np.nan) if dtype == "f8" else np.full(shape, status if dtype == "u1" else -1, dtype=dtype)
+    return out
+
+
+def _attitude_parts(r, attitudes, sizes: dict) -> tuple[dict, dict]:
+    """Every solution of ``attitudes`` carried along the EphemerisOrbit ``r`` and corrected
+    (:func:`librate.attitude_to_ephemeris`): the epoch's attitude arrays, and the reason of each
+    solution whose correction did not converge ({index: reason})."""
+    from .._errors import ConvergenceError
+    from ..periodicity.ephemeris_attitude import attitude_to_ephemeris
+    from ..results.kinds import TRANSITION_ATTITUDE_VARIABLES
+
+    out = _failed(sizes, TRANSITION_ATTITUDE_VARIABLES)
+    reasons = {}
+    for k, sol in enumerate(attitudes):
+        try:
+            a = attitude_to_ephemeris(sol, r, correct=True, samples_per_leg=ATTITUDE_PER_LEG)
+        except ConvergenceError as err:
+            out["attitude_status"][k] = 1
+            reasons[k] = f"{type(err).__name__}: {str(err).splitlines()[0] if str(err) else ''}"
+            continue
+        cr3bp, eph = a.angles_deg()
+        row = {"attitude_status": 0, "attitude_iterations": a.iterations, "attitude_q": a.q, "attitude_w": a.w,
+               "attitude_defect_rad": a.defect_rad, "attitude_defect_rate": a.defect_rate, "attitude_growth": a.growth,
+               "attitude_max_pointing_deg": a.max_pointing_error_deg, "attitude_placed_max_pointing_deg": a.placed_max_pointing_error_deg,
+               "attitude_pointing_deg": a.pointing_error_deg, "attitude_placed_pointing_deg": a.placed_pointing_error_deg,
+               "attitude_rate_error": a.rate_error, "attitude_angles_deg": eph, "attitude_cr3bp_angles_deg": cr3bp}
+        for name, v in row.items():
+            out[name][k] = v
+        out["attitude_t_tdb"] = np.asarray(a.t_tdb, dtype=float)  # the same for every solution (NaN when none was corrected)
+    return out, reasons
+
+
+def _transition_epoch(orbit, epoch_tdb: float, revolutions: int, nodes_per_rev: int, path: str | None, sizes: dict, attitudes=()) -> dict:
     """One epoch's transition (a task, picklable for Dask): its per-epoch arrays, or status 1
-    and NaN arrays with ``reason`` when the multiple shooting did not converge."""
+    and NaN arrays with ``reason`` when the multiple shooting did not converge (its attitudes
+    then status 2); with ``attitudes``, their arrays and ``attitude_reasons`` ({index: reason})."""
     from .._errors import ConvergenceError
     from ..orbits.transition import to_ephemeris
 
@@ -76,7 +126,10 @@ def _transition_epoch(orbit, epoch_tdb: float, revolutions: int, nodes_per_rev: 
     try:
         r = to_ephemeris(orbit, epoch_tdb, revolutions=revolutions, nodes_per_rev=nodes_per_rev, ephemeris=eph)
     except ConvergenceError as err:
-        return {**_failed(sizes), "reason": f"{type(err).__name__}: {str(err).splitlines()[0] if str(err) else ''}"}
+        from ..results.kinds import TRANSITION_ATTITUDE_VARIABLES, TRANSITION_VARIABLES
+
+        failed = {**_failed(sizes, TRANSITION_VARIABLES), **(_failed(sizes, TRANSITION_ATTITUDE_VARIABLES, status=2) if attitudes else {})}
+        return {**failed, "reason": f"{type(err).__name__}: {str(err).splitlines()[0] if str(err) else ''}"}
     t_track, x_track = _sampled(r, eph)
     mu = orbit.system.mu
     track = np.array([eph.ephemeris_to_synodic(x, float(t), mu) for t, x in zip(t_track, x_track)])
@@ -85,9 +138,14 @@ def _transition_epoch(orbit, epoch_tdb: float, revolutions: int, nodes_per_rev: 
            "states_km": np.asarray(r.states_km, dtype=float), "synodic": np.asarray(r.synodic(), dtype=float),
            "defects_km": np.asarray(r.defects_km, dtype=float), "defects_km_s": np.asarray(r.defects_km_s, dtype=float),
            "perilune_km": np.asarray(r.perilune_km, dtype=float), "track_t_tdb": t_track, "track_synodic": track}
-    from ..results.kinds import TRANSITION_VARIABLES
+    if attitudes:
+        parts, reasons = _attitude_parts(r, attitudes, sizes)
+        out.update(parts)
+        if reasons:
+            out["attitude_reasons"] = reasons
+    from ..results.kinds import transition_variables
 
-    for k, (_, dims, _) in TRANSITION_VARIABLES.items():
+    for k, (_, dims, _) in transition_variables(bool(attitudes)).items():
         want = tuple(sizes[d] for d in dims)
         if np.shape(out[k]) != want:
             raise ValueError(f"the transition at {epoch_tdb!r} s TDB gave {k} of shape {np.shape(out[k])}, the store holds {want}")
@@ -109,14 +167,54 @@ def _sampled(r, eph) -> tuple[np.ndarray, np.ndarray]:
     return np.concatenate([*ts, t[-1:]]), np.concatenate([*xs, x[-1:]])
 
 
-def _fingerprint(orbit, epochs, revolutions: int, nodes_per_rev: int, eph_digest: str) -> str:
+def _fingerprint(orbit, epochs, revolutions: int, nodes_per_rev: int, eph_digest: str, attitudes=()) -> str:
+    """The digest of every input (a transition without attitudes: as before they were added,
+    so its old stores resume)."""
     from .._core import __version__
 
     h = hashlib.sha256()
     for a in (orbit.state0, [orbit.period, orbit.system.mu, orbit.system.lu_km, orbit.system.tu_s], epochs):
         h.update(np.asarray(a, dtype=np.float64).tobytes())
     h.update(json.dumps([int(revolutions), int(nodes_per_rev), eph_digest, PER_LEG, __version__]).encode())
+    for sol in attitudes:
+        h.update(json.dumps([type(sol).__name__, ATTITUDE_PER_LEG, *_attitude_inputs(sol)]).encode())
     return h.hexdigest()
+
+
+def _attitude_inputs(sol) -> list:
+    """What defines a CR3BP attitude solution (its body, start and periods), as plain numbers."""
+    if hasattr(sol, "wz0"):  # planar
+        return [float(sol.kz), float(sol.phi0), float(sol.wz0), int(sol.n_periods), float(sol.n), str(sol.kind)]
+    return [*map(float, sol.body.moments), *map(float, sol.q0), *map(float, sol.w0), int(sol.n_periods)]
+
+
+def _body_moments(sol) -> tuple:
+    """The principal moments of a solution's body (a planar one: normalised from its Kz)."""
+    from ..attitude.body import RigidBody
+
+    return tuple(sol.body.moments) if hasattr(sol, "body") else tuple(RigidBody.from_kz(float(sol.kz)).moments)
+
+
+def _attitude_table(attitudes, attitude_n) -> dict:
+    """The arrays over ``attitude`` written at the end: N, the periods, stability and start of each solution."""
+    planar = [hasattr(s_, "wz0") for s_ in attitudes]
+    out = {"attitude_n": (("attitude",), np.asarray(attitude_n, dtype=np.int64), {"long_name": "N: net turns per attitude period"}),
+           "attitude_n_periods": (("attitude",), np.array([int(s_.n_periods) for s_ in attitudes], dtype=np.int64),
+                                  {"long_name": "orbit periods per attitude period of the CR3BP solution"}),
+           "attitude_stable": (("attitude",), np.array([int(bool(s_.stable)) for s_ in attitudes], dtype=np.int64),
+                               {"long_name": "the CR3BP solution is linearly stable (1) or not (0)"})}
+    if all(planar):
+        out["attitude_wz0"] = (("attitude",), np.array([s_.wz0 for s_ in attitudes]),
+                               {"units": "1/TU", "long_name": "CR3BP initial inertial rate"})
+        out["attitude_phi0"] = (("attitude",), np.array([s_.phi0 for s_ in attitudes]),
+                                {"units": "rad", "long_name": "CR3BP initial angle"})
+        out["attitude_kz"] = (("attitude",), np.array([s_.kz for s_ in attitudes]), {"long_name": "Kz = (Iy - Ix) / Iz"})
+    else:
+        out["attitude_q0"] = (("attitude", "quaternion"), np.array([s_.q0 for s_ in attitudes], dtype=float),
+                              {"long_name": "CR3BP initial attitude, body relative to the synodic frame, scalar last"})
+        out["attitude_w0"] = (("attitude", "axis"), np.array([s_.w0 for s_ in attitudes], dtype=float),
+                              {"units": "1/TU", "long_name": "CR3BP initial inertial rate, body axes"})
+    return out
 
 
 def _file_digest(path: str | None) -> tuple[str, str]:
@@ -141,13 +239,18 @@ def _cr3bp_track(orbit) -> np.ndarray:
 
 def run_transition_to(orbit, store: str | Path, *, epochs_tdb, revolutions: int, nodes_per_rev: int | None = None,
                       ephemeris_file: str | None = None,
-                      resume: bool = True, scheduler=None, progress: bool | None = None, attrs: dict[str, Any] | None = None):
+                      resume: bool = True, scheduler=None, progress: bool | None = None, attrs: dict[str, Any] | None = None,
+                      attitudes=(), attitude_n=None):
     """The transitions of ``orbit`` (a :class:`~librate.PeriodicOrbit`) at every epoch of
     ``epochs_tdb`` (TDB s past J2000) over ``revolutions``, written to ``store`` (a ``.zarr`` part
     store, or a ``.nc`` file exported whole at the end from ``<store>.parts``). See the module
     docstring for resuming, faults and ``scheduler``. An existing ``store`` of the same inputs is
     resumed or reused; of others it is refused unless ``resume`` is False (then the new result is
-    computed aside and replaces the old one once complete). Returns ``(dataset, store_path)``."""
+    computed aside and replaces the old one once complete). ``attitudes``: CR3BP periodic
+    attitude solutions on ``orbit`` (:class:`~librate.AttitudeSolution` or
+    :class:`~librate.AttitudeSolution3D`, gravity gradient) carried at every epoch, ``attitude_n``
+    their N (default each planar solution's ``n``). Returns ``(dataset, store_path)``."""
+    import dataclasses
     import warnings
 
     from ..ephemeris.epochs import iso_tdb
@@ -165,9 +268,14 @@ def run_transition_to(orbit, store: str | Path, *, epochs_tdb, revolutions: int,
     # the orbit's public fields only: what a corrector keeps for itself does not pickle (Dask)
     orbit = PeriodicOrbit(orbit.system, np.asarray(orbit.state0, dtype=float), float(orbit.period), float(orbit.jacobi), orbit.family,
                           orbit.iterations, orbit.residual)
+    attitudes = [dataclasses.replace(s_, orbit=orbit) for s_ in attitudes]  # on the picklable orbit
+    if attitude_n is None:
+        attitude_n = [int(getattr(s_, "n", 0)) for s_ in attitudes]
+    if len(attitude_n) != len(attitudes):
+        raise ValueError(f"invalid argument `attitude_n`: one N per solution of `attitudes` ({len(attitudes)}), got {len(attitude_n)}")
     epochs = np.atleast_1d(np.asarray(epochs_tdb, dtype=float))
     npr = nodes_per_rev_for(orbit, nodes_per_rev)
-    sizes = transition_sizes(int(revolutions), npr)
+    sizes = transition_sizes(int(revolutions), npr, len(attitudes))
     eph_path = None if ephemeris_file is None else str(ephemeris_file)
     eph_name, eph_digest = _file_digest(eph_path)
     state = check_output(store, "transition", attrs.get("study"), force=not resume)
@@ -183,19 +291,28 @@ def run_transition_to(orbit, store: str | Path, *, epochs_tdb, revolutions: int,
         coords = {"epoch": ("epoch", epochs, {"units": "s", "long_name": "epoch of the first node, TDB seconds past J2000"}),
                   **{d: (d, np.arange(sizes[d]), {}) for d in ("node", "leg", "revolution", "sample")},
                   "component": ("component", np.array(COMPONENTS), {})}
+        if attitudes:
+            coords.update({d: (d, np.arange(sizes[d]), {}) for d in ("attitude", "attitude_sample")})
+            coords.update({"quaternion": ("quaternion", np.array(QUATERNION), {}), "axis": ("axis", np.array(AXES), {}),
+                           "angle": ("angle", np.array(ANGLES), {})})
         schema = transition_schema(epochs.size, sizes, coords)
-        pstore, damaged = PartStore.open(parts, schema, _fingerprint(orbit, epochs, revolutions, npr, eph_digest), attrs=attrs, lock=lock)
+        pstore, damaged = PartStore.open(parts, schema, _fingerprint(orbit, epochs, revolutions, npr, eph_digest, attitudes), attrs=attrs,
+                                         lock=lock)
         if damaged:
             warnings.warn(f"{parts}: {len(damaged)} damaged epoch(s) are recomputed: "
                           + "; ".join(f"epoch {i}: {why}" for i, why in sorted(damaged.items())), RuntimeWarning, stacklevel=2)
         done = pstore.done_flags(damaged)
         failures = dict(json.loads(pstore.g.attrs.get("failures", "{}")))
-        todo = [Task(j, _transition_epoch, (orbit, float(epochs[j]), int(revolutions), npr, eph_path, sizes))
+        att_failures = dict(json.loads(pstore.g.attrs.get("attitude_failures", "{}")))
+        extra = (tuple(attitudes),) if attitudes else ()
+        todo = [Task(j, _transition_epoch, (orbit, float(epochs[j]), int(revolutions), npr, eph_path, sizes, *extra))
                 for j in range(epochs.size) if not done[j]]
 
         def commit(j, part):
             if "reason" in part:
                 failures[str(j)] = part["reason"]
+            for k, why in part.get("attitude_reasons", {}).items():
+                att_failures[f"{j}/{k}"] = why
             pstore.write_part(j, part)
             done[j] = True
             bar.update(1)
@@ -216,6 +333,11 @@ def run_transition_to(orbit, store: str | Path, *, epochs_tdb, revolutions: int,
         status = pstore.read("status")
         failures = {k: v for k, v in failures.items() if status[int(k)] == 1}
         failures.update({str(j): "did not converge" for j in np.flatnonzero(status == 1) if str(j) not in failures})
+        if attitudes:
+            a_status = pstore.read("attitude_status")
+            att_failures = {k: v for k, v in att_failures.items() if a_status[tuple(map(int, k.split("/")))] == 1}
+            att_failures.update({f"{j}/{k}": "did not converge" for j, k in zip(*np.nonzero(a_status == 1))
+                                 if f"{j}/{k}" not in att_failures})
         from .. import _core
 
         system = orbit.system
@@ -229,10 +351,18 @@ def run_transition_to(orbit, store: str | Path, *, epochs_tdb, revolutions: int,
                  "ephemeris_span_tdb": [float(v) for v in _ephemeris(eph_path).span],
                  "gm_km3_s2": [float(_core.GM_EARTH), float(_core.GM_MOON), float(_core.GM_SUN)], "gm_bodies": "earth moon sun (DE440)",
                  "failures": json.dumps(failures, sort_keys=True)}
+        if attitudes:
+            final.update({"attitude_failures": json.dumps(att_failures, sort_keys=True), "attitude_samples_per_leg": ATTITUDE_PER_LEG,
+                          "attitude_model": "3d" if not hasattr(attitudes[0], "wz0") else "planar",
+                          "attitude_body_moments": [float(v) for v in _body_moments(attitudes[0])],
+                          "attitude_frames": "attitude_q: body -> Moon-centred ICRF, scalar last, attitude_w: inertial, body axes (rad/s); "
+                                             "angles and pointing errors relative to the instantaneous rotating frame"})
         arrays = {"orbit_state0": (("component",), np.asarray(orbit.state0, dtype=float),
                                    {"units": "LU, LU/TU", "long_name": "CR3BP orbit initial state"}),
                   "cr3bp_synodic": (("cr3bp_sample", "component"), _cr3bp_track(orbit),
                                     {"units": "LU, LU/TU", "long_name": "the CR3BP orbit over one period, synodic frame"})}
+        if attitudes:
+            arrays.update(_attitude_table(attitudes, attitude_n))
         pstore.finalise(arrays, final, complete=True)
         publish_parts(parts, store, lock)
         return open_result(store).load(), store
@@ -260,4 +390,34 @@ def transition_summary(ds, elapsed: float) -> list[str]:
                    f"{np.min(per):>10.1f} .. {np.max(per):<10.1f} {float(ds['drift_km_per_rev'].values[j]):>14.2f}")
     for j, why in sorted(json.loads(ds.attrs.get("failures", "{}")).items(), key=lambda kv: int(kv[0])):
         out.append(f"  epoch {j}: {why}")
+    if "attitude_status" in ds.variables:
+        out += _attitude_summary(ds)
+    return out
+
+
+def _attitude_summary(ds) -> list[str]:
+    """Per attitude solution: at how many epochs it was corrected, the largest pointing error
+    (corrected, and placed without correction), the corrected motion's largest defects and the
+    largest span growth; then the failed corrections."""
+    status = np.asarray(ds["attitude_status"].values)
+    out = [f"attitude in the ephemeris model ({ds.sizes['attitude']} CR3BP solution(s), {ds.attrs.get('attitude_model', 'planar')}):"]
+    for k in range(ds.sizes["attitude"]):
+        ok = status[:, k] == 0
+        n = int(ds["attitude_n"].values[k])
+        rate = f", wz0 = {float(ds['attitude_wz0'].values[k]):.6g} 1/TU" if "attitude_wz0" in ds.variables else ""
+        head = f"  N = {n}{rate} ({'stable' if int(ds['attitude_stable'].values[k]) else 'unstable'} in the CR3BP): "
+        if not ok.any():
+            out.append(head + f"corrected at no epoch of {ok.size}")
+            continue
+        names = ("attitude_max_pointing_deg", "attitude_placed_max_pointing_deg", "attitude_defect_rad", "attitude_defect_rate",
+                 "attitude_growth")
+        big = {name: np.max(np.asarray(ds[name].values)[ok, k]) for name in names}
+        out.append(head + f"corrected at {int(ok.sum())}/{ok.size} epochs; largest pointing error "
+                   f"{big['attitude_max_pointing_deg']:.3g} deg "
+                   f"(placed, uncorrected: {big['attitude_placed_max_pointing_deg']:.3g} deg); largest defects "
+                   f"{big['attitude_defect_rad']:.1e} rad, {big['attitude_defect_rate']:.1e} in rate; "
+                   f"span growth up to {big['attitude_growth']:.3g}")
+    for key, why in sorted(json.loads(ds.attrs.get("attitude_failures", "{}")).items(), key=lambda kv: tuple(map(int, kv[0].split("/")))):
+        j, k = map(int, key.split("/"))
+        out.append(f"  epoch {j}, N = {int(ds['attitude_n'].values[k])}: {why}")
     return out

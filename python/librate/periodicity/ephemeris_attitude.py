@@ -90,6 +90,10 @@ class EphemerisAttitude:
         |w - w_ref| / |w_ref|, w_ref the CR3BP rate placed at the epoch.
     placed_pointing_error_deg, placed_rate_error : numpy.ndarray
         The same for the placed motion propagated from the first node without correction.
+    q_rotating, q_rotating_cr3bp : numpy.ndarray, shape (m, 4)
+        At the sample epochs, scalar last: this motion taken back into the instantaneous
+        rotating frame, and the CR3BP motion (relative to the synodic frame) at the same CR3BP
+        times (the two attitudes the pointing error compares; :meth:`angles_deg`).
     gravity_gradient : (bool, bool, bool)
         The gradients of the Earth, the Moon and the Sun.
     srp : bool
@@ -121,6 +125,8 @@ class EphemerisAttitude:
     placed_rate_error: np.ndarray = field(repr=False)
     gravity_gradient: tuple = (True, True, True)
     srp: bool = False
+    q_rotating: np.ndarray | None = field(default=None, repr=False)
+    q_rotating_cr3bp: np.ndarray | None = field(default=None, repr=False)
 
     @property
     def max_defect_rad(self) -> float:
@@ -149,6 +155,21 @@ class EphemerisAttitude:
         err = (self.placed_pointing_error_deg if placed else self.pointing_error_deg).max(axis=1)
         n = int(self.revolution.max()) + 1
         return np.array([err[self.revolution == k].max() for k in range(n)])
+
+    def angles_deg(self) -> tuple[np.ndarray, np.ndarray]:
+        """The attitude angles at the sample epochs in both models, (m, 3) each, degrees:
+        (CR3BP motion, this motion). Roll, pitch and yaw are the Euler angles of the body
+        relative to the rotating frame, R = Rz(yaw) Ry(pitch) Rx(roll) (scipy's "ZYX"), with roll
+        and yaw unwrapped along time (a turning motion's yaw runs on past 180 degrees); in the
+        planar model yaw is phi and roll = pitch = 0."""
+        from scipy.spatial.transform import Rotation
+
+        def rpy(q) -> np.ndarray:
+            ypr = Rotation.from_quat(np.asarray(q, dtype=float)).as_euler("ZYX")
+            ypr[:, [0, 2]] = np.unwrap(ypr[:, [0, 2]], axis=0)
+            return np.degrees(ypr[:, ::-1])
+
+        return rpy(self.q_rotating_cr3bp), rpy(self.q_rotating)
 
     @property
     def multipliers(self) -> np.ndarray:
@@ -221,8 +242,9 @@ def _reference_at(solution, body, q0, w0, k_periods, taus) -> tuple[np.ndarray, 
     return np.ascontiguousarray(tr.q[inverse]), np.ascontiguousarray(tr.w[inverse])
 
 
-def _deviation(model, epochs, q, w, q_ref, w_ref) -> tuple[np.ndarray, np.ndarray]:
-    """Pointing error of each body axis (deg) and relative rate error against the CR3BP motion."""
+def _deviation(model, epochs, q, w, q_ref, w_ref) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Pointing error of each body axis (deg) and relative rate error against the CR3BP motion,
+    and the motion in the rotating frame (q, scalar last)."""
     from scipy.spatial.transform import Rotation
 
     q_s, _ = model.place(epochs, np.ascontiguousarray(q), np.ascontiguousarray(w), inverse=True)
@@ -232,7 +254,7 @@ def _deviation(model, epochs, q, w, q_ref, w_ref) -> tuple[np.ndarray, np.ndarra
     chord = np.linalg.norm(a - b, axis=1)  # |x_a - x_b| per body axis (column); angle 2 asin(chord / 2)
     err = np.degrees(2.0 * np.arcsin(np.clip(0.5 * chord, 0.0, 1.0)))
     rate = np.linalg.norm(w - w_placed, axis=1) / np.linalg.norm(w_placed, axis=1)
-    return err, rate
+    return err, rate, np.asarray(q_s)
 
 
 def _samples(epochs: np.ndarray, per_leg: int) -> np.ndarray:
@@ -336,13 +358,13 @@ def attitude_to_ephemeris(solution, ephemeris_orbit, *, correct: bool = True, bo
         _, ys, _ = model.propagate(y0, epochs[i], epochs[i + 1] - epochs[i],
                                    t_eval=np.ascontiguousarray(t_s[sel] - epochs[i]), rtol=rtol, atol=atol)
         qs[sel], ws[sel] = ys[:, 6:10], ys[:, 10:]
-    err, rate = _deviation(model, t_s, qs, ws, q_rs, w_rs)
+    err, rate, q_rot = _deviation(model, t_s, qs, ws, q_rs, w_rs)
     y0 = np.concatenate([orbits[0], q_g[0], w_g[0]])
     _, yp, _ = model.propagate(y0, epochs[0], epochs[-1] - epochs[0], t_eval=np.ascontiguousarray(t_s - epochs[0]), rtol=rtol, atol=atol)
-    perr, prate = _deviation(model, t_s, yp[:, 6:10], yp[:, 10:], q_rs, w_rs)
+    perr, prate, _ = _deviation(model, t_s, yp[:, 6:10], yp[:, 10:], q_rs, w_rs)
     revolution = np.minimum(np.floor(tau_s / eo.orbit.period + 1e-9), max(eo.revolutions - 1, 0)).astype(int)
     return EphemerisAttitude(solution=solution, ephemeris_orbit=eo, body=use_body, epochs_tdb=epochs, q=q, w=w, orbit_states_km=orbits,
                              corrected=bool(correct), iterations=int(out["iterations"]), reason=str(out["reason"]), defect_rad=defect_rad,
                              defect_rate=defect_rate, monodromy=np.asarray(out["monodromy"]), t_tdb=t_s, revolution=revolution,
                              pointing_error_deg=err, rate_error=rate, placed_pointing_error_deg=perr, placed_rate_error=prate,
-                             gravity_gradient=gg, srp=srp)
+                             gravity_gradient=gg, srp=srp, q_rotating=q_rot, q_rotating_cr3bp=np.asarray(q_rs))

@@ -15,7 +15,8 @@ from .store import StoreSchema, Var
 
 __all__ = ["FIGURE_FILES", "FamilyResult", "KINDS", "Map3DResult", "MAP_3D_VARIABLES", "MAP_VARIABLES", "MapResult",
            "ResultKind", "Solutions3DResult",
-           "SolutionsResult", "TRANSITION_VARIABLES", "TransitionResult", "kind_of", "map3d_schema", "map_schema", "transition_schema"]
+           "SolutionsResult", "TRANSITION_ATTITUDE_VARIABLES", "TRANSITION_VARIABLES", "TransitionResult", "kind_of", "map3d_schema",
+           "map_schema", "transition_schema", "transition_variables"]
 
 #: The per-orbit variables of a planar map: units and long names (periodicity_map, run_map and
 #: the store all take them from here).
@@ -60,25 +61,67 @@ TRANSITION_VARIABLES = {
     "drift_km_per_rev": ("f8", (), {"units": "km", "long_name": "drift of the ephemeris trajectory from the CR3BP orbit per revolution"}),
     "node_epochs_tdb": ("f8", ("node",), {"units": "s", "long_name": "node epochs, TDB seconds past J2000"}),
     "states_km": ("f8", ("node", "component"), {"units": "km, km/s", "long_name": "node states, Moon-centred ICRF"}),
-    "synodic": ("f8", ("node", "component"),
-                {"units": "LU, LU/TU", "long_name": "node states in the instantaneous Earth-Moon rotating frame, "
-                                                    "nondimensional (barycentre origin, the CR3BP's synodic frame)"}),
+    "synodic": ("f8", ("node", "component"), {"units": "LU, LU/TU",
+                                              "long_name": "node states in the instantaneous Earth-Moon rotating frame, "
+                                              "nondimensional (barycentre origin, the CR3BP's synodic frame)"}),
     "defects_km": ("f8", ("leg",), {"units": "km", "long_name": "position defect at the end of each leg, re-propagated from its node"}),
     "defects_km_s": ("f8", ("leg",), {"units": "km/s", "long_name": "velocity defect at the end of each leg, re-propagated from its node"}),
     "perilune_km": ("f8", ("revolution",), {"units": "km", "long_name": "closest approach to the Moon's centre in each revolution"}),
     "track_t_tdb": ("f8", ("sample",), {"units": "s", "long_name": "epochs of the sampled ephemeris trajectory, TDB seconds past J2000"}),
-    "track_synodic": ("f8", ("sample", "component"),
-                      {"units": "LU, LU/TU", "long_name": "the sampled ephemeris trajectory in the rotating frame, nondimensional"}),
+    "track_synodic": ("f8", ("sample", "component"), {"units": "LU, LU/TU",
+                                                      "long_name": "the sampled ephemeris trajectory in the rotating frame, "
+                                                      "nondimensional"}),
 }
+
+
+#: The per-epoch attitude variables of a transition with ``ephemeris.attitude_n`` (dimension
+#: ``attitude``: the CR3BP solutions carried; ``attitude_sample``: the epochs of the deviation
+#: figures), as :data:`TRANSITION_VARIABLES`. ``attitude_status``: 0 corrected, 1 not corrected.
+TRANSITION_ATTITUDE_VARIABLES = {
+    "attitude_status": ("u1", ("attitude",), {
+        "flag_values": "0 corrected, 1 the correction did not converge (ConvergenceError), 2 not computed (the epoch's orbit did not "
+                       "converge), 255 not computed"}),
+    "attitude_iterations": ("i8", ("attitude",), {"long_name": "Newton iterations of the attitude multiple shooting (-1: not corrected)"}),
+    "attitude_q": ("f8", ("attitude", "node", "quaternion"), {
+        "units": "1", "long_name": "corrected attitude at the node epochs, body -> ICRF (v_icrf = R(q) v_body), scalar last"}),
+    "attitude_w": ("f8", ("attitude", "node", "axis"), {
+        "units": "rad/s", "long_name": "inertial angular velocity at the node epochs, body axes"}),
+    "attitude_defect_rad": ("f8", ("attitude", "leg"), {
+        "units": "rad", "long_name": "attitude defect at the end of each leg (rotation angle), re-propagated from its node"}),
+    "attitude_defect_rate": ("f8", ("attitude", "leg"), {"units": "1", "long_name": "rate defect |dw| / |w| at the end of each leg"}),
+    "attitude_growth": ("f8", ("attitude",), {"units": "1", "long_name": "largest |eigenvalue| of the attitude monodromy over the span"}),
+    "attitude_max_pointing_deg": ("f8", ("attitude",), {
+        "units": "deg", "long_name": "largest pointing error of the corrected motion, any body axis"}),
+    "attitude_placed_max_pointing_deg": ("f8", ("attitude",), {
+        "units": "deg", "long_name": "largest pointing error of the placed motion propagated from the first node without correction"}),
+    "attitude_t_tdb": ("f8", ("attitude_sample",), {"units": "s", "long_name": "epochs of the attitude samples, TDB seconds past J2000"}),
+    "attitude_pointing_deg": ("f8", ("attitude", "attitude_sample", "axis"), {
+        "units": "deg", "long_name": "angle between each body axis of the corrected motion and of the CR3BP motion (rotating frame)"}),
+    "attitude_placed_pointing_deg": ("f8", ("attitude", "attitude_sample", "axis"), {
+        "units": "deg", "long_name": "the same for the placed motion, uncorrected"}),
+    "attitude_rate_error": ("f8", ("attitude", "attitude_sample"), {
+        "units": "1", "long_name": "|w - w_ref| / |w_ref|, w_ref the CR3BP rate placed at the epoch"}),
+    "attitude_angles_deg": ("f8", ("attitude", "attitude_sample", "angle"), {
+        "units": "deg", "long_name": "roll, pitch, yaw of the corrected motion relative to the rotating frame (ZYX Euler, unwrapped)"}),
+    "attitude_cr3bp_angles_deg": ("f8", ("attitude", "attitude_sample", "angle"), {
+        "units": "deg", "long_name": "roll, pitch, yaw of the CR3BP motion relative to the synodic frame, at the same samples"}),
+}
+
+
+def transition_variables(attitude: bool) -> dict:
+    """The per-epoch variables of a transition: :data:`TRANSITION_VARIABLES`, and with
+    ``attitude`` :data:`TRANSITION_ATTITUDE_VARIABLES`."""
+    return {**TRANSITION_VARIABLES, **(TRANSITION_ATTITUDE_VARIABLES if attitude else {})}
 
 
 def transition_schema(n_epochs: int, sizes: dict, coords: dict) -> StoreSchema:
     """The part store of ``librate transition``: one part per epoch; ``sizes`` the lengths of
-    node, leg, revolution, sample and component."""
+    node, leg, revolution, sample and component (and, with attitude, of attitude,
+    attitude_sample, quaternion, axis and angle)."""
     v = {}
-    for k, (dtype, dims, attrs) in TRANSITION_VARIABLES.items():
+    for k, (dtype, dims, attrs) in transition_variables("attitude" in sizes).items():
         # no fill value for the counts: xarray would read one (-1: not converged) as missing
-        fill = 255 if k == "status" else (None if dtype == "i8" else np.nan)
+        fill = 255 if dtype == "u1" else (None if dtype == "i8" else np.nan)
         v[k] = Var(dtype, tuple(sizes[d] for d in dims), dims, fill, dict(attrs))
     return StoreSchema("ephemeris_transition", "epoch", n_epochs, v, coords)
 
@@ -86,7 +129,7 @@ def transition_schema(n_epochs: int, sizes: dict, coords: dict) -> StoreSchema:
 #: The file suffix of each figure: a result STEM.zarr gets STEM_<suffix>.png beside it.
 FIGURE_FILES = {"family": "orbits", "period": "period", "stability": "stability", "map": "contours", "residuals": "residuals",
                 "solutions": "solutions", "multipliers": "multipliers", "body_axes": "body_axes",
-                "transition": "rotating", "defects": "defects", "sweep": "sweep"}
+                "transition": "rotating", "defects": "defects", "sweep": "sweep", "attitude": "attitude", "pointing": "pointing"}
 
 #: A figure to draw: (its file suffix, a function that draws it and returns the Figure).
 Figure = tuple[str, Callable]
@@ -120,6 +163,12 @@ class ResultKind:
     @classmethod
     def recognise(cls, ds) -> bool:
         return ds.attrs.get("librate_result") == cls.kind
+
+    @classmethod
+    def inputs_of(cls, study: dict | None) -> tuple[str, ...]:
+        """The study sections this result depends on for ``study`` (a study as plain data, or
+        None): :attr:`inputs`."""
+        return cls.inputs
 
     @classmethod
     def from_dataset(cls, ds):
@@ -293,20 +342,34 @@ class TransitionResult(ResultKind):
 
     kind = "transition"
     inputs = ("system", "orbits", "ephemeris")
-    figure_names = ("transition", "defects", "sweep")
+    figure_names = ("transition", "defects", "sweep", "attitude", "pointing")
+    #: What the attitude solutions of ``ephemeris.attitude_n`` depend on besides :attr:`inputs`.
+    attitude_inputs = ("body", "torques", "rates", "attitude", "solver")
     dtypes = {"status": "uint8", "iterations": "int64"}
     dims = ("epoch",)
 
     @classmethod
+    def inputs_of(cls, study: dict | None) -> tuple[str, ...]:
+        """[system], [orbits] and [ephemeris]; with ``ephemeris.attitude_n`` also the sections
+        its CR3BP attitude solutions are found from."""
+        att = ((study or {}).get("ephemeris") or {}).get("attitude_n")
+        return cls.inputs + (cls.attitude_inputs if att else ())
+
+    @classmethod
     def figures(cls, result, names=None, skip=None, **data) -> list[Figure]:
         """The orbit in the rotating frame in both models (the first converged epoch), the node
-        defects of every epoch, and (two epochs or more) the sweep's departure and perilune
-        range against the epoch."""
+        defects of every epoch, (two epochs or more) the sweep's departure and perilune range
+        against the epoch, and, with attitude solutions, the attitude angles in both models and
+        the pointing error of each body axis (the first epoch where the first solution was
+        corrected)."""
         lp = _plotting()
         ok = np.flatnonzero(np.asarray(result["status"].values) == 0)
         out: list[Figure] = []
         for name in cls.figure_names if names is None else names:
             if name not in cls.figure_names:
+                continue
+            if name in ("attitude", "pointing"):
+                out += cls._attitude_figure(result, name, skip, lp)
                 continue
             if ok.size == 0:
                 if skip is not None:
@@ -329,6 +392,36 @@ class TransitionResult(ResultKind):
                     result["epoch"].values[ok], result["max_departure_km"].values[ok], result["perilune_km"].values[ok],
                     result["iterations"].values[ok])))
         return out
+
+    @staticmethod
+    def _attitude_figure(result, name: str, skip, lp) -> list[Figure]:
+        """The attitude angles or the pointing error of the first solution at the first epoch
+        where it was corrected."""
+        if "attitude_status" not in result.variables:
+            why = "the transition carries no attitude (ephemeris.attitude_n)"
+        else:
+            good = np.flatnonzero(np.asarray(result["attitude_status"].values)[:, 0] == 0)
+            why = "the first attitude solution was corrected at no epoch"
+        if "attitude_status" not in result.variables or good.size == 0:
+            if skip is not None:
+                skip(FIGURE_FILES[name], why)
+            return []
+        j = int(good[0])
+        t_days = (result["attitude_t_tdb"].values[j] - result["attitude_t_tdb"].values[j][0]) / 86400.0
+        n = int(result["attitude_n"].values[0])
+        title = f"N = {n} solution, {_epochs_iso(result)[j][:19]} TDB"
+        if name == "attitude":
+            def draw():
+                fig = lp.plot_ephemeris_attitude(t_days, result["attitude_cr3bp_angles_deg"].values[j, 0],
+                                                 result["attitude_angles_deg"].values[j, 0])
+                fig.suptitle(f"attitude relative to the rotating frame, {title}")
+                return fig
+        else:
+            def draw():
+                fig = lp.plot_pointing_error(t_days, result["attitude_pointing_deg"].values[j, 0])
+                fig.axes[0].set_title(f"corrected ephemeris attitude against the CR3BP motion, {title}", fontsize=9)
+                return fig
+        return [(FIGURE_FILES[name], draw)]
 
     def summary(self) -> str:
         ds = self.dataset
