@@ -223,7 +223,7 @@ def test_3d_map_survives_a_killed_worker_bit_identically(cluster, fam, tmp_path,
     """Per orbit (8 orbits of 80 cases: "auto" keeps one task each, written by the workers) and
     per chunk of 16 cases (5 tasks an orbit, gathered, each orbit committed whole): both equal
     the local map, computed one orbit at a time, bit for bit."""
-    from librate.app.results import run_map_3d_to
+    from librate.app.map3d_runs import run_map_3d_to
     from librate.results.store import verify_store
 
     _, client = cluster
@@ -242,7 +242,7 @@ def test_3d_map_survives_a_killed_worker_bit_identically(cluster, fam, tmp_path,
 def test_3d_map_chunks_locally_give_the_same_bits(fam, tmp_path):
     """A count of cases per task applies locally too (rounded up to the 8 lanes: 20 -> 24);
     reference: the map of one task per orbit (exact equality)."""
-    from librate.app.results import run_map_3d_to
+    from librate.app.map3d_runs import run_map_3d_to
 
     kw = dict(body=BODY, rates=RATES_3D, q0=[0.0, 0.0, 0.0, 1.0], tol=1e-10, progress=False)
     a, _ = run_map_3d_to(list(fam)[:2], tmp_path / "a.zarr", chunk_cases=20, **kw)

@@ -58,3 +58,13 @@ def test_import_librate_leaves_the_application_layer_unloaded():
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.split("\n")
     assert out[0] == "[]", out
     assert out[1] == "True True"
+
+
+def test_no_module_is_over_700_lines():
+    """Issue 20's rule for a package a newcomer can read: no Python module of librate is over 700
+    lines (the largest, app/schema.py, holds 687)."""
+    from pathlib import Path
+
+    root = Path(librate.__file__).parent
+    long = {str(p.relative_to(root)): n for p in root.rglob("*.py") if (n := len(p.read_text(encoding="utf-8").splitlines())) > 700}
+    assert not long, long

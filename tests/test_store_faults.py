@@ -421,7 +421,8 @@ def test_plot_refuses_a_damaged_store_by_name(tmp_path, good_store):
 # Issue 24: every result kind (family, solutions, map, map_3d) through librate.results. Each test
 # below fails on main 126a94a (the defect it names) and passes with the one writer and store.
 
-from librate.app.results import run_map_3d_to, run_map_to, save_dataset, verify_result  # noqa: E402
+from librate.app.map3d_runs import run_map_3d_to  # noqa: E402
+from librate.app.results import run_map_to, save_dataset, verify_result  # noqa: E402
 from librate.results import atomic  # noqa: E402
 
 BODY = librate.RigidBody(1.0, 1.02, 1.04)
@@ -650,7 +651,7 @@ def test_3d_maps_are_locked_and_keep_their_dtypes(tmp_path, fam, map3d_ref):
     with writer_lock(out):
         script = textwrap.dedent(f"""
             import numpy as np, librate
-            from librate.app.results import run_map_3d_to
+            from librate.app.map3d_runs import run_map_3d_to
             fam = librate.dro_family(librate.System.preset("earth-moon"), x0={X0!r})
             run_map_3d_to(fam, {str(out)!r}, body=librate.RigidBody(1.0, 1.02, 1.04), rates={{"wx0": np.linspace(-0.05, 0.05, 5),
                           "wy0": 0.0, "wz0": np.linspace(1.1, 1.4, 8)}}, q0=[0, 0, 0, 1.0], tol=1e-10, progress=False)
@@ -730,7 +731,8 @@ CAMPAIGN = textwrap.dedent("""
     import json, os, signal, sys, threading
     import numpy as np
     import librate, xarray, zarr  # noqa: F401 - imported once, before the forks
-    from librate.app.results import run_map_3d_to, run_map_to, save_dataset, solutions_dataset
+    from librate.app.map3d_runs import run_map_3d_to
+    from librate.app.results import run_map_to, save_dataset, solutions_dataset
     from librate.results import atomic
 
     xarray.Dataset({{"a": ("x", [1.0])}}).merge(xarray.Dataset({{"b": ("x", [2.0])}}))

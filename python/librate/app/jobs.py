@@ -247,8 +247,8 @@ def run_map(study: Study, out: str | Path | None = None, *, scheduler=None, prog
 def _run_map_3d(study: Study3D, out: str | Path | None = None, *, scheduler=None, progress: bool | None = None, force: bool = False,
                 say: Callable[[str], None] | None = None):
     """The six 3-D closure residuals over (orbit, two rate grids) into ``map.zarr`` (or ``.nc``),
-    orbit by orbit, resumable (:func:`librate.app.results.run_map_3d_to`); ``force``: recomputed."""
-    from .results import run_map_3d_to
+    orbit by orbit, resumable (:func:`librate.app.map3d_runs.run_map_3d_to`); ``force``: recomputed."""
+    from .map3d_runs import run_map_3d_to
 
     return run_map_3d_to(study.build_orbits(), _result_path(study, out, "map"), body=study.build_body(),
                          rates=study.rates_3d(), q0=study.q0_3d(),

@@ -5,7 +5,6 @@ what is allowed)."""
 
 from __future__ import annotations
 
-import difflib
 import json
 import math
 import re
@@ -13,7 +12,7 @@ import warnings
 from typing import Annotated, Any, Literal
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Discriminator, Field, Tag, TypeAdapter, ValidationError, ValidationInfo, model_validator
+from pydantic import BaseModel, ConfigDict, Discriminator, Field, Tag, TypeAdapter, ValidationInfo, model_validator
 
 #: What a study can be checked for (the commands that run it).
 PURPOSES = ("family", "solve", "map", "transition")
@@ -41,7 +40,7 @@ class StudyError(ValueError):
 # --- schema ------------------------------------------------------------------------------------
 class SectionProblems(ValueError):
     """What a section's rules (its model's validator) found, one line per problem naming its
-    key; :func:`pydantic_problems` lists them after the type problems. ``section``: the section
+    key; :func:`librate.app.schema_problems.pydantic_problems` lists them after the type problems. ``section``: the section
     as validated (its types are right), for the rules between sections."""
 
     def __init__(self, problems: list[str], section: BaseModel):
@@ -105,7 +104,7 @@ RateGrid = Annotated[
                                                 Tag("list")] | Annotated[Range, Tag("range")],
     Discriminator(_number_grid_tag, custom_error_type="grid", custom_error_message=_RATE_MSG),
 ]
-_TAGS = {"list", "range", "number", "planar", "3d"}
+GRID_TAGS = {"list", "range", "number", "planar", "3d"}
 
 
 class SystemSection(Table):
@@ -653,69 +652,6 @@ def problem(key: str, value: Any, message: str, allowed: str | None = None) -> s
 def missing(key: str, message: str) -> str:
     allowed = _allowed(key)
     return f"{key}: {message}" + (f"; allowed: {allowed}" if allowed else "")
-
-
-def _dotted(prefix: str, loc: tuple) -> str:
-    key = prefix
-    for part in loc:
-        if isinstance(part, int):
-            key += f"[{part}]"
-        elif part in _TAGS:
-            continue
-        else:
-            key = f"{key}.{part}" if key else str(part)
-    return key
-
-
-def _keys_of(parent: str) -> list[str] | None:
-    base = re.sub(r"\[\d+\]", "", parent)
-    if base == "":
-        return list(TOP_KEYS)
-    if base in TABLES:
-        return list(TABLES[base].model_fields)
-    last = base.rsplit(".", 1)[-1]
-    if last in ("x0", "z0", "period_days", "wz0", "phidot0", "wx0", "wy0", "kz"):
-        return list(Range.model_fields)
-    return None
-
-
-def unknown_key(key: str, value: Any) -> str:
-    parent, _, name = key.rpartition(".")
-    keys = _keys_of(parent) or []
-    where = f"[{parent}]" if parent else "the top level"
-    hint = difflib.get_close_matches(name, keys, n=1)
-    text = f"{key} = {show_value(value)}: unknown key; allowed keys in {where}: {', '.join(keys)}"
-    return text + (f" (did you mean `{(parent + '.') if parent else ''}{hint[0]}`?)" if hint else "")
-
-
-def pydantic_problems(prefix: str, err: ValidationError, rules: list[str] | None = None) -> list[str]:
-    """The problems of a section's validation, one line each naming the key: the type problems
-    (returned), and what its rules found (:class:`SectionProblems`; added to ``rules`` when
-    given, else returned after the type problems)."""
-    out: list[str] = []
-    found: list[str] = []
-    for e in err.errors():
-        key = _dotted(prefix, e["loc"])
-        if isinstance((e.get("ctx") or {}).get("error"), SectionProblems):
-            found += e["ctx"]["error"].problems
-        elif e["type"] == "attitude_model":  # the discriminator of [attitude]: its model
-            value = e["input"].get("model") if isinstance(e["input"], dict) else e["input"]
-            out.append(problem(f"{key}.model", value, e["msg"]))
-        elif e["type"] == "extra_forbidden":
-            out.append(unknown_key(key, e["input"]))
-        elif e["type"] == "missing":
-            out.append(missing(key, "missing (required)"))
-        else:
-            msg = e["msg"]
-            msg = msg[0].lower() + msg[1:]
-            msg = msg.removeprefix("value error, ")
-            if e["type"] == "model_type":
-                msg = "must be a table"
-            out.append(problem(key, e["input"], msg))
-    if rules is None:
-        return out + found
-    rules += found
-    return out
 
 
 # --- checks beyond the types -------------------------------------------------------------------

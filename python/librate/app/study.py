@@ -65,9 +65,8 @@ from .schema import (
     grid_size,
     grid_values,
     problem,
-    pydantic_problems,
-    unknown_key,
 )
+from .schema_problems import pydantic_problems, unknown_key
 
 if sys.version_info >= (3, 11):
     import tomllib
