@@ -30,13 +30,7 @@ def test_the_named_api_is_found():
     assert len(NAMED) >= 40 and {"propagate", "periodicity_map", "System", "OrbitFamily"} <= set(NAMED)
 
 
-# the modules being split on main (orbits/families.py, periodicity/attitude3d.py) get theirs after the split
-PENDING = {"AttitudeSolution3D", "OrbitFamily", "attitude_family_3d", "attitude_family_3d_inertia", "correct_dro", "dro", "dro_family",
-           "halo", "halo_family", "lyapunov", "lyapunov_family", "out_of_plane_stability", "periodic_attitude_3d"}
-
-
-@pytest.mark.parametrize("name", [pytest.param(n, marks=pytest.mark.xfail(strict=True, reason="pending the split")) if n in PENDING else n
-                                  for n in NAMED])
+@pytest.mark.parametrize("name", NAMED)
 def test_named_api_has_numpydoc_sections(name):
     obj = getattr(librate, name)
     have = sections(obj)

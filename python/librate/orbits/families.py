@@ -66,23 +66,74 @@ def correct_dro(
     atol: float = SHOOT_ATOL,
     collision: str | None = "radius",
 ) -> PeriodicOrbit:
-    """Correct the distant retrograde orbit through (x0, 0, 0) with ydot0 > 0 (docs/physics.md, periodic orbits).
+    """Correct the distant retrograde orbit (DRO) through (x0, 0, 0) with ydot0 > 0.
 
-    Single shooting on the half period (thesis eq. 19): integrate with the STM to the next
-    y = 0 crossing, located in time, and drive xdot there to zero by correcting ydot0 with x0
-    fixed. ``x0`` must lie between the primaries (-mu < x0 < 1 - mu). Without ``ydot0`` the
-    guess is a retrograde circle about the Moon seen in the rotating frame, sqrt(mu/d) + d with
-    d = 1 - mu - x0, where it is good (d <= 0.2); farther from the Moon the family is continued
-    (guarded natural continuation) from x0 = 0.95 to ``x0``.
+    The method is single shooting on the half period (thesis eq. 19; docs/physics.md, periodic
+    orbits). The trajectory is integrated with its STM to the next y = 0 crossing, located in
+    time, and ydot0 is corrected (x0 held fixed) until xdot vanishes there. Without ``ydot0``
+    the guess is the retrograde circle about the Moon as it appears in the rotating frame,
+    ydot0 = sqrt(mu/d) + d with d = 1 - mu - x0. That guess is good close to the Moon
+    (d <= 0.2); farther out, the family is instead continued (guarded natural continuation)
+    from x0 = 0.95 to ``x0``.
 
-    The result is always a DRO: it winds once clockwise about the Moon and not about the Earth
-    (winding numbers (0, -1)); a correction that lands on another orbit (e.g. one about the
-    Earth, from a poor ``ydot0``) raises :class:`librate.ConvergenceError` naming what it found.
+    The orbit returned is always a DRO: it winds once clockwise about the Moon and not about
+    the Earth (winding numbers (0, -1)). A correction that lands on some other orbit (e.g. one
+    about the Earth, from a poor ``ydot0``) raises :class:`librate.ConvergenceError` naming
+    what it found.
 
-    ``collision`` as in :func:`librate.correct_symmetric`: by default a DRO that passes within a
-    primary's radius (in the Earth-Moon system the Moon's for x0 near 0.985, the Earth's for
-    x0 near 0) raises :class:`librate.CollisionError` naming the primary, the closest approach
-    and the radius; ``None`` returns the point-mass orbit anyway.
+    Parameters
+    ----------
+    system : System or str
+        The system, or a preset name ("earth-moon", "earth-moon-jpl").
+    x0 : float
+        The x-axis crossing, between the primaries: -mu < x0 < 1 - mu (finite, not a bool).
+    ydot0 : float, optional
+        The guess of the velocity at x0 (LU/TU), a finite number > 0. By default the circle
+        guess near the Moon (d <= 0.2), the family continued from x0 = 0.95 farther out.
+    tol : float, default 1e-12
+        Newton tolerance, in [1e-15, 1e-3].
+    max_iter : int, default 30
+        Newton iterations at most, in [1, 10,000].
+    rtol, atol : float, default 1e-13
+        Integration tolerances, rtol in [1e-15, 1e-3] and atol in [1e-18, 1e-3].
+    collision : {"radius", "point", None}, default "radius"
+        As in :func:`librate.correct_symmetric`. With "radius", a DRO that passes within a
+        primary's radius raises :class:`librate.CollisionError`: in the Earth-Moon system the
+        Moon's for x0 near 0.985, the Earth's for x0 near 0. "point" counts only the singular
+        points; ``None`` returns the point-mass orbit anyway. (When the family is continued
+        from x0 = 0.95, ``tol``, ``max_iter``, ``rtol`` and ``atol`` apply to that first
+        member; the continuation's own corrections keep their defaults.)
+
+    Returns
+    -------
+    PeriodicOrbit
+        The corrected DRO (family "dro").
+
+    Raises
+    ------
+    ValueError
+        An argument out of range (``x0`` outside the primaries, ``ydot0`` not > 0, a tolerance
+        or count outside its range, an unknown system or collision mode), naming it.
+    ConvergenceError
+        Newton did not converge; the family continued from x0 = 0.95 did not reach ``x0``; or
+        the correction converged to an orbit that is not a DRO (its ydot0, period and winding
+        numbers named).
+    CollisionError
+        The DRO passes within a primary's radius (with ``collision`` "radius" or "point"),
+        naming the primary, the closest approach and the radius.
+
+    Examples
+    --------
+    >>> import librate
+    >>> orbit = librate.correct_dro("earth-moon", 0.9)
+    >>> orbit.family, round(orbit.period_days, 3)
+    ('dro', 5.545)
+    >>> librate.correct_dro("earth-moon", 0.985)
+    Traceback (most recent call last):
+        ...
+    librate.CollisionError: the corrected dro orbit (x0 = 0.985, ...) passes within the Moon's radius (primary 2): ...
+    >>> librate.correct_dro("earth-moon", 0.985, collision=None).family
+    'dro'
     """
     sys_ = resolve_system(system)
     mu = sys_.mu
@@ -129,26 +180,65 @@ DRO_DEFAULT_X0 = np.round(np.arange(0.985, 0.0049, -0.005), 10)
 
 def dro_family(system: System | str = "earth-moon", x0=None, *, check_geometry: bool = True, allow_partial: bool = False,
                progress=None) -> OrbitFamily:
-    """The planar DRO family by natural-parameter continuation in x0 (thesis eq. 20-22).
+    """The planar DRO family, by natural-parameter continuation in x0 (thesis eq. 20-22).
 
-    ``x0``: the members wanted (any order along the family; default the whole family from
-    0.985 near the Moon to 0.005 near the Earth, every 0.005, :data:`DRO_DEFAULT_X0`). Each
-    step is guarded against silent jumps (Jacobi constant and period continuity, winding
-    numbers about both primaries) and halved when needed; the run ends cleanly, with
-    ``end_reason``, at a collision with the Earth's surface or a step floor, keeping every
-    member found. Members that pass within a primary's radius (near the Moon, x0 = 0.985 in
-    the Earth-Moon system) are kept and flagged (:attr:`OrbitFamily.inside_primary`).
+    Every continuation step is guarded against silent jumps (continuity of the Jacobi constant
+    and of the period, the winding numbers about both primaries) and is halved when a guard
+    trips. The run ends cleanly, with its ``end_reason``, when an orbit reaches the Earth's
+    surface or the step reaches its floor, and every member found up to there is kept.
+    Members that pass within a primary's radius (in the Earth-Moon system, near the Moon at
+    x0 = 0.985) are kept too, flagged in :attr:`OrbitFamily.inside_primary`.
 
-    Requested members are reached the default way: the continuation starts at x0 = 0.985 (or
-    the largest requested x0 above it) and walks the default members down to the smallest
-    requested x0, with every requested x0 inserted as a target and corrected exactly there; the
-    family holds the requested members only, in the requested order. So every member the
-    default family reaches is reachable on request. When ``x0`` is given, every requested
-    member must be reached: otherwise :class:`librate.LibrateError` lists the missing x0 values
-    and why the continuation ended (attributes ``missing``, ``found`` and ``end_reason``),
-    unless ``allow_partial=True``, which returns the members found
-    (``parameters["missing_x0"]`` lists the others). ``progress(done, total)`` is called as the
-    requested members are reached (total: their number).
+    Requested members are reached the way the default family is. The continuation starts at
+    x0 = 0.985 (or at the largest requested x0, if above that) and walks down the default
+    members to the smallest requested x0; each requested x0 is inserted among the targets and
+    corrected exactly there. The family then holds only the requested members, in the
+    requested order. Any member the default family reaches can thus be requested.
+
+    Parameters
+    ----------
+    system : System or str, default "earth-moon"
+        The system, or a preset name.
+    x0 : float or array_like, optional
+        The members wanted, in any order along the family, each finite and between the
+        primaries (-mu < x0 < 1 - mu); at least one. By default the whole family, from 0.985
+        near the Moon to 0.005 near the Earth every 0.005 (:data:`DRO_DEFAULT_X0`).
+    check_geometry : bool, default True
+        Guard the steps with the winding numbers about both primaries too (False: the Jacobi
+        constant and period continuity only).
+    allow_partial : bool, default False
+        With ``x0`` given, return the members found when some were not reached
+        (``parameters["missing_x0"]`` lists the others) instead of raising.
+    progress : bool or callable, optional
+        True for a bar on stderr, or ``progress(done, total)``, called as the requested members
+        are reached (total: their number).
+
+    Returns
+    -------
+    OrbitFamily
+        The family (kind "dro", planar), with ``end_reason``, the bifurcations between its
+        members and ``parameters["rejected_jumps"]`` (the steps the guards refused).
+
+    Raises
+    ------
+    ValueError
+        An argument out of range (an ``x0`` empty, not finite or outside the primaries, a bad
+        ``progress``), naming it.
+    LibrateError
+        With ``x0`` given and ``allow_partial`` False, some requested member was not reached:
+        the message lists the missing x0 values and why the continuation ended (attributes
+        ``missing``, ``found`` and ``end_reason``).
+    ConvergenceError
+        The first member (at the largest x0) could not be corrected.
+
+    Examples
+    --------
+    >>> import librate
+    >>> fam = librate.dro_family("earth-moon", x0=[0.95, 0.9, 0.85])
+    >>> len(fam), fam.period_days.round(3).tolist()
+    (3, [1.724, 5.545, 9.977])
+    >>> fam.end_reason
+    'completed: reached the last requested value'
     """
     sys_ = resolve_system(system)
     mu = sys_.mu
@@ -218,11 +308,55 @@ def _one_target(kw: dict) -> tuple[str, float]:
 
 def dro(system: System | str = "earth-moon", *, x0: float | None = None, period: float | None = None,
         period_days: float | None = None, jacobi: float | None = None, which: int | None = None) -> PeriodicOrbit:
-    """One corrected DRO, chosen by x0, period (TU or days) or Jacobi constant.
+    """One corrected DRO, chosen by its x0, period (TU or days) or Jacobi constant.
 
-    Near the Moon (x0 >= 0.8) x0 is corrected directly; otherwise the member is found on the
-    whole family (computed once per system and cached); ``which`` as in
-    :meth:`OrbitFamily.member`, for a value that several members have."""
+    Near the Moon (x0 >= 0.8) an ``x0`` is corrected directly (:func:`correct_dro`). Any other
+    value is looked up on the whole default family (:func:`dro_family`, computed once per
+    system and cached) by :meth:`OrbitFamily.member`. Exactly one of ``x0``, ``period``,
+    ``period_days`` and ``jacobi`` is given.
+
+    Parameters
+    ----------
+    system : System or str, default "earth-moon"
+        The system, or a preset name.
+    x0 : float, optional
+        The x-axis crossing, finite and between the primaries (-mu < x0 < 1 - mu); below 0.8,
+        within the default family's range (0.985 to 0.005).
+    period : float, optional
+        The period (TU), within the default family's range.
+    period_days : float, optional
+        The period in days, within the default family's range.
+    jacobi : float, optional
+        The Jacobi constant, within the default family's range.
+    which : int, optional
+        As in :meth:`OrbitFamily.member`: for a value that several members have, the index of
+        the one wanted among them (ordered by period). Not used for an ``x0`` >= 0.8.
+
+    Returns
+    -------
+    PeriodicOrbit
+        The corrected DRO (family "dro").
+
+    Raises
+    ------
+    ValueError
+        Not exactly one of the four given, a value not a finite number or outside the family's
+        range, an ambiguous value without ``which`` (the candidates listed with their periods)
+        or a ``which`` out of range.
+    ConvergenceError
+        The correction did not converge.
+    CollisionError
+        The DRO passes within a primary's radius (e.g. the Moon's at x0 near 0.985).
+
+    Examples
+    --------
+    >>> import librate
+    >>> orbit = librate.dro(period_days=12.66)
+    >>> round(orbit.x0, 5)
+    0.82017
+    >>> round(librate.dro(x0=0.9).period_days, 3)
+    5.545
+    """
     sys_ = resolve_system(system)
     name, value = _one_target(dict(x0=x0, period=period, period_days=period_days, jacobi=jacobi))
     value = as_real(value, name)
@@ -257,10 +391,53 @@ def _lyapunov_start(sys_: System, point: int, amplitude: float) -> PeriodicOrbit
 
 def lyapunov_family(system: System | str = "earth-moon", point: int = 1, *, max_members: int = 150,
                     ds_max: float = 0.02, check_geometry: bool = True, progress=None) -> OrbitFamily:
-    """Planar Lyapunov family at L1 or L2 by pseudo-arclength continuation from a small
-    orbit (x0 = L - 0.002, on the side of L toward the larger primary), growing in amplitude.
-    Ends at a collision with the Moon's surface, a step floor or ``max_members``. ``progress(done,
-    total)`` after each member (total: max_members until the end)."""
+    """The planar Lyapunov family at L1 or L2, by pseudo-arclength continuation.
+
+    The family starts from a small orbit, x0 = L - 0.002 (on the side of the libration point L
+    toward the larger primary), corrected from the linearisation at L, and grows in amplitude.
+    The run ends when an orbit passes within a primary's radius (a collision with the Moon's
+    or the Earth's surface), when the step reaches its floor, or at ``max_members``.
+
+    Parameters
+    ----------
+    system : System or str, default "earth-moon"
+        The system, or a preset name.
+    point : {1, 2}, default 1
+        The libration point, L1 or L2.
+    max_members : int, default 150
+        Members at most, in [2, 100,000].
+    ds_max : float, default 0.02
+        The largest continuation step in (x0, z0, vy0) (LU, LU/TU), in [1e-5, 0.5].
+    check_geometry : bool, default True
+        Guard the steps with the winding numbers about both primaries too (False: the Jacobi
+        constant and period continuity only).
+    progress : bool or callable, optional
+        True for a bar on stderr, or ``progress(done, total)`` after each member (total:
+        ``max_members`` until the end, then the number found).
+
+    Returns
+    -------
+    OrbitFamily
+        The family (kind "lyapunov-L1" or "lyapunov-L2", planar; ``parameters["point"]``),
+        with its ``end_reason`` and bifurcations.
+
+    Raises
+    ------
+    ValueError
+        An argument out of range, naming it.
+    ConvergenceError
+        The small starting orbit could not be corrected.
+
+    Examples
+    --------
+    >>> import librate
+    >>> fam = librate.lyapunov_family("earth-moon", 1, max_members=10)
+    >>> len(fam), fam.kind, fam.end_reason
+    (10, 'lyapunov-L1', 'completed: max_points = 10 reached')
+    >>> l1 = fam.system.lagrange_points()[0, 0]
+    >>> round(float(fam.x0[0] - l1), 6)
+    -0.002
+    """
     sys_ = resolve_system(system)
     point = _check_point(point)
     max_members, ds_max = as_count(max_members, "max_members", 2), as_between(ds_max, "ds_max", 1e-5, 0.5)
@@ -281,8 +458,53 @@ def _cached_lyapunov(system: System, point: int) -> OrbitFamily:
 def lyapunov(system: System | str = "earth-moon", point: int = 1, *, x0: float | None = None,
              period: float | None = None, period_days: float | None = None, jacobi: float | None = None,
              which: int | None = None) -> PeriodicOrbit:
-    """One planar Lyapunov orbit at L1/L2, by x0, period (TU or days) or Jacobi constant
-    (``which`` as in :meth:`OrbitFamily.member`, for a value that several members have)."""
+    """One planar Lyapunov orbit at L1 or L2, chosen by its x0, period (TU or days) or Jacobi constant.
+
+    The orbit is looked up on the family (:func:`lyapunov_family` with its defaults, computed
+    once per system and point and cached) by :meth:`OrbitFamily.member`. Exactly one of
+    ``x0``, ``period``, ``period_days`` and ``jacobi`` is given.
+
+    Parameters
+    ----------
+    system : System or str, default "earth-moon"
+        The system, or a preset name.
+    point : {1, 2}, default 1
+        The libration point, L1 or L2.
+    x0 : float, optional
+        The x-axis crossing, within the family's range.
+    period : float, optional
+        The period (TU), within the family's range.
+    period_days : float, optional
+        The period in days, within the family's range.
+    jacobi : float, optional
+        The Jacobi constant, within the family's range.
+    which : int, optional
+        As in :meth:`OrbitFamily.member`: for a value that several members have, the index of
+        the one wanted among them (ordered by period).
+
+    Returns
+    -------
+    PeriodicOrbit
+        The corrected orbit (family "lyapunov-L1" or "lyapunov-L2").
+
+    Raises
+    ------
+    ValueError
+        Not exactly one of the four given, a bad ``point``, a value not a finite number or
+        outside the family's range, an ambiguous value without ``which`` (the candidates listed
+        with their periods) or a ``which`` out of range.
+    ConvergenceError
+        The correction did not converge.
+    CollisionError
+        The orbit passes within a primary's radius.
+
+    Examples
+    --------
+    >>> import librate
+    >>> orbit = librate.lyapunov("earth-moon", 1, x0=0.8)
+    >>> orbit.family, round(orbit.period_days, 3)
+    ('lyapunov-L1', 14.431)
+    """
     sys_ = resolve_system(system)
     name, value = _one_target(dict(x0=x0, period=period, period_days=period_days, jacobi=jacobi))
     return _cached_lyapunov(sys_, _check_point(point)).member(**{name: value}, which=which)
@@ -290,18 +512,66 @@ def lyapunov(system: System | str = "earth-moon", point: int = 1, *, x0: float |
 
 def halo_family(system: System | str = "earth-moon", point: int = 2, branch: str = "south", *, max_members: int = 400,
                 ds_max: float = 0.02, check_geometry: bool = True, progress=None) -> OrbitFamily:
-    """Halo family at L1/L2, started at its bifurcation from the planar Lyapunov family (where
-    the out-of-plane stability index crosses +1) and continued by pseudo-arclength in
-    (x0, z0, vy0) into the near-rectilinear halo orbits (NRHOs), until the orbit reaches the
-    Moon's surface, a step floor or ``max_members``.
+    """The halo family at L1 or L2, from its bifurcation off the planar Lyapunov family into the NRHOs.
 
-    ``branch`` follows the usual convention (and the JPL catalog's): a southern halo has its
+    The family starts where it branches off the planar Lyapunov family (:func:`lyapunov`'s
+    cached family), at the bifurcation where the out-of-plane stability index crosses +1: the
+    planar orbit there is corrected, lifted to z0 = 0.002 and corrected in 3-D. It is then
+    continued by pseudo-arclength in (x0, z0, vy0) into the near-rectilinear halo orbits
+    (NRHOs), until an orbit reaches a primary's surface (the Moon's), the step reaches its
+    floor, or at ``max_members``.
+
+    The branches follow the usual convention, the JPL catalog's too: a southern halo has its
     largest excursion from the x-y plane (apolune, for L2) below it, z < 0; a northern one
-    above. The two are mirror images under z -> -z, so one is computed and mirrored. ``state0``
-    is each member's x-z-plane crossing in the branch's hemisphere (the one with the smaller z
-    for south, the larger for north), as the JPL catalog lists them; ``state_half`` the other
-    one. Neither x0 nor z0 is monotonic along the family; the period is, for L2. ``progress(done,
-    total)`` after each member (total: max_members until the end).
+    above it. The two are mirror images of each other under z -> -z, so one is computed and
+    mirrored. Each member's ``state0`` is its x-z-plane crossing in the branch's hemisphere
+    (the one of smaller z for south, larger z for north), as the JPL catalog lists them;
+    ``state_half`` is the other crossing. Neither x0 nor z0 is monotonic along the family; the
+    period is, for L2.
+
+    Parameters
+    ----------
+    system : System or str, default "earth-moon"
+        The system, or a preset name.
+    point : {1, 2}, default 2
+        The libration point, L1 or L2.
+    branch : {"south", "north"}, default "south"
+        The branch.
+    max_members : int, default 400
+        Members at most, in [2, 100,000].
+    ds_max : float, default 0.02
+        The largest continuation step in (x0, z0, vy0) (LU, LU/TU), in [1e-5, 0.5].
+    check_geometry : bool, default True
+        Guard the steps with the winding numbers of planar members too (False: the Jacobi
+        constant and period continuity only).
+    progress : bool or callable, optional
+        True for a bar on stderr, or ``progress(done, total)`` after each member (total:
+        ``max_members`` until the end, then the number found).
+
+    Returns
+    -------
+    OrbitFamily
+        The family (kind "halo-L1-south", "halo-L2-north", ..., spatial), with its
+        ``end_reason``, its bifurcations and ``parameters`` "point", "branch" and
+        "bifurcation_x0" (the Lyapunov orbit it starts from).
+
+    Raises
+    ------
+    ValueError
+        An argument out of range (``point``, ``branch``, a count or step), naming it.
+    LibrateError
+        No halo bifurcation (out-of-plane index through +1) on the Lyapunov family.
+    ConvergenceError
+        The orbit at the bifurcation, or the first halo, could not be corrected.
+
+    Examples
+    --------
+    >>> import librate
+    >>> fam = librate.halo_family("earth-moon", 2, "south", max_members=10)
+    >>> len(fam), fam.kind, bool((fam.z0 < 0).all())
+    (10, 'halo-L2-south', True)
+    >>> round(fam.parameters["bifurcation_x0"], 4)
+    1.1204
     """
     sys_ = resolve_system(system)
     point = _check_point(point)
@@ -344,13 +614,67 @@ def _cached_halo(system: System, point: int, branch: str) -> OrbitFamily:
 def halo(system: System | str = "earth-moon", point: int = 2, branch: str = "south", *, x0: float | None = None,
          z0: float | None = None, period: float | None = None, period_days: float | None = None,
          jacobi: float | None = None, which: int | None = None) -> PeriodicOrbit:
-    """One halo orbit at L1/L2 (north or south branch) by x0, z0, period (TU or days) or Jacobi
-    constant, found on the family (computed once per system and cached).
+    """One halo orbit at L1 or L2, north or south, chosen by its x0, z0, period (TU or days) or Jacobi constant.
 
-    ``x0`` and ``z0`` are those of ``state0``, the x-z-plane crossing in the branch's
-    hemisphere (the JPL catalog's). When several members have the value, ``ValueError`` lists
-    them with their periods; ``which`` (an index, ordered by period) picks one
-    (:meth:`OrbitFamily.member`)."""
+    The orbit is looked up on the family (:func:`halo_family` with its defaults, computed once
+    per system, point and branch and cached) by :meth:`OrbitFamily.member`. ``x0`` and ``z0``
+    are those of ``state0``, the x-z-plane crossing in the branch's hemisphere (the JPL
+    catalog's). Exactly one of ``x0``, ``z0``, ``period``, ``period_days`` and ``jacobi`` is
+    given. Several members can have the value (x0, z0 and the Jacobi constant are not
+    monotonic along the family): then ``ValueError`` lists them with their periods, and
+    ``which`` picks one.
+
+    Parameters
+    ----------
+    system : System or str, default "earth-moon"
+        The system, or a preset name.
+    point : {1, 2}, default 2
+        The libration point, L1 or L2.
+    branch : {"south", "north"}, default "south"
+        The branch.
+    x0, z0 : float, optional
+        The components of ``state0``, within the family's range.
+    period : float, optional
+        The period (TU), within the family's range.
+    period_days : float, optional
+        The period in days, within the family's range.
+    jacobi : float, optional
+        The Jacobi constant, within the family's range.
+    which : int, optional
+        For a value that several members have, the index of the one wanted among them (ordered
+        by period); with one candidate, omitted or 0.
+
+    Returns
+    -------
+    PeriodicOrbit
+        The corrected halo (family "halo-L2-south", ...).
+
+    Raises
+    ------
+    ValueError
+        Not exactly one of the five given, a bad ``point`` or ``branch``, a value not a finite
+        number or outside the family's range, an ambiguous value without ``which`` or a
+        ``which`` out of range.
+    ConvergenceError
+        The correction did not converge.
+    CollisionError
+        The orbit passes within a primary's radius.
+    LibrateError
+        The family could not be started (no halo bifurcation on the Lyapunov family).
+
+    Examples
+    --------
+    >>> import librate
+    >>> orbit = librate.halo("earth-moon", 2, "south", period_days=8.0)
+    >>> round(orbit.z0, 4)
+    -0.195
+    >>> librate.halo(jacobi=3.05)
+    Traceback (most recent call last):
+        ...
+    ValueError: ambiguous `jacobi` = 3.05: 2 members of the halo-L2-south family have it ...
+    >>> round(librate.halo(jacobi=3.05, which=1).period_days, 3)
+    13.317
+    """
     sys_ = resolve_system(system)
     point = _check_point(point)
     check_branch(branch)

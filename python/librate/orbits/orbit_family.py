@@ -66,19 +66,86 @@ def _bifurcation_record(b) -> dict:
 
 @dataclass
 class OrbitFamily:
-    """Members of one family of x-z-symmetric periodic orbits.
+    """The members of one family of x-z-symmetric periodic orbits, with their stability.
 
-    Arrays over members: ``state0`` (n, 6) initial states on the x-z plane, ``state_half`` (n, 6)
-    the states at the half-period crossing (the other symmetric point of the same orbit),
-    ``period`` (TU), ``jacobi``, ``eigenvalues`` (n, 6) complex, ``stability_indices`` (n, 2)
-    ([in-plane, out-of-plane] for planar families; float when every index is real, complex
-    only when some member has a complex pair). ``end_reason`` says why the continuation
-    stopped; ``bifurcations`` lists the members where an index crosses +1 or -1.
+    Made by :func:`librate.dro_family`, :func:`librate.lyapunov_family`,
+    :func:`librate.halo_family`, :meth:`from_jpl` and :meth:`load`. The arrays run over the n
+    members, in order along the family; ``len(fam)`` is n, ``fam[i]`` the i-th member as a
+    :class:`PeriodicOrbit`, and iterating gives every member. :meth:`member` finds the member
+    of a given x0, z0, period or Jacobi constant, :meth:`resonant` a resonant one;
+    :meth:`save`, :meth:`load`, :meth:`to_dataset`, :meth:`from_jpl` and :meth:`to_jpl` are
+    its files.
 
-    For spatial families ``state0`` is the crossing in the branch's hemisphere (z < 0 for a
-    southern halo, z > 0 for a northern one), the JPL catalog's convention; ``x0`` and ``z0``
-    refer to it. A family read by :meth:`from_jpl` keeps the catalog's crossing and carries
-    ``import_report``, the per-row record of the import (not saved by :meth:`save`).
+    In spatial families ``state0`` is each member's crossing in the branch's hemisphere (z < 0
+    for a southern halo, z > 0 for a northern one), the JPL catalog's convention, and ``x0``
+    and ``z0`` are its components. A family read by :meth:`from_jpl` keeps the catalog's
+    crossing instead.
+
+    Parameters
+    ----------
+    system : System
+        The system.
+    kind : str
+        The family's name ("dro", "lyapunov-L1", "halo-L2-south", ...).
+    spatial : bool
+        Whether the members are 3-D (halos, NRHOs) rather than planar.
+    state0 : numpy.ndarray, shape (n, 6)
+        The initial states, on the x-z plane.
+    state_half : numpy.ndarray, shape (n, 6)
+        The states at the half-period crossing: the other symmetric point of the same orbit.
+    period : numpy.ndarray, shape (n,)
+        The periods (TU).
+    jacobi : numpy.ndarray, shape (n,)
+        The Jacobi constants.
+    eigenvalues : numpy.ndarray, shape (n, 6), complex
+        The eigenvalues of each member's monodromy (NaN where its propagation failed).
+    stability_indices : numpy.ndarray, shape (n, 2)
+        The stability indices nu of each member: [in-plane, out-of-plane] for planar families,
+        [index 1, index 2] for spatial ones. Float when every index is real; complex only when
+        some member has a complex pair.
+    end_reason : str, default ""
+        Why the continuation stopped.
+    bifurcations : list of dict, default []
+        The places between members where a stability index crosses +1 or -1, each a dict:
+        "member" (the member before it), "index", "type", "level" (+1 or -1), "x0" and "z0" (at
+        the crossing of ``state0``), "x0_half" and "z0_half" (at the other crossing), "located"
+        (located by the continuation driver, or else interpolated linearly between members).
+    parameters : dict, default {}
+        How the family was made: e.g. "point", "branch", "bifurcation_x0", "rejected_jumps",
+        "missing_x0", or the catalog's "jpl_family", "jpl_libration_point", "jpl_branch",
+        "jpl_signature" for an import.
+    import_report : xarray.Dataset, optional
+        Only for a family read by :meth:`from_jpl`: the per-row record of the import. It is
+        not saved by :meth:`save`.
+
+    Attributes
+    ----------
+    x0, z0 : numpy.ndarray, shape (n,)
+        The components x and z of ``state0``.
+    period_days : numpy.ndarray, shape (n,)
+        The periods in days.
+    stable : numpy.ndarray, shape (n,), bool
+        The linearly stable members: both indices real with |nu| <= 1 (to 1e-9).
+    inside_primary : numpy.ndarray, shape (n,), int8
+        For each member, 1 or 2 when the orbit passes within that primary's radius over its
+        period, 0 when it stays outside both, -1 when its propagation failed; computed on first
+        use (see the property).
+    closest_km : numpy.ndarray, shape (n, 2)
+        Each member's closest approach to the larger and the smaller primary's centre (km);
+        computed on first use.
+    outside_primaries : numpy.ndarray, shape (n,), bool
+        The members that stay outside both primaries' radii (``inside_primary == 0``).
+
+    Examples
+    --------
+    >>> import librate
+    >>> fam = librate.dro_family("earth-moon", x0=[0.95, 0.9, 0.85])
+    >>> len(fam), fam.x0.tolist(), fam.stable.tolist()
+    (3, [0.95, 0.9, 0.85], [True, True, True])
+    >>> fam[1].family, round(fam[1].period_days, 3)
+    ('dro', 5.545)
+    >>> round(fam.member(x0=0.875).period_days, 4)
+    7.7226
     """
 
     system: System

@@ -119,47 +119,98 @@ class OrbitFamilyBranch3D:
 
 def attitude_family_3d(orbits, body: RigidBody, *, guess, period_days, n_periods: int = 1, tol: float = 1e-12, ds_min: float = 1e-4,
                        progress=None, method: str = "arclength", max_points: int = 400):
-    """A periodic 3-D attitude motion of ``body`` continued along the orbit family ``orbits``
-    (e.g. the L2 southern halos into the NRHOs) through the orbit periods ``period_days`` (days,
-    in order) from ``guess`` ((q0, w0) or a planar solution) at the first period. ``tol``: the
-    corrector's tolerance (NRHOs pass within a few thousand km of the Moon, where the tidal torque
-    is some 1e4 times the Earth's at the Moon's distance; their attitude closure is reached to
-    ~1e-11, so pass tol=1e-10 there). Every member is re-propagated independently to 1e-9.
-    ``progress``: True for a bar on stderr, or ``progress(done, total)``, called with the number
-    of requested periods reached so far.
-    One period gives the one-member family of that orbit (no continuation).
+    """A periodic 3-D attitude motion of ``body`` continued along the orbit family ``orbits``, in the orbit period.
 
-    ``method``: "arclength" (the default) follows the family by pseudo-arclength continuation
-    (:func:`librate.solving.continuation.arclength`, at most ``max_points`` points) on the
-    bordered corrector (:class:`OrbitFamilyBranch3D`: the orbit period is an unknown, each Newton
-    point on its own family member), through folds, until it leaves the requested periods' range;
-    the members are the solutions corrected exactly at the requested periods each time the
-    branch crosses one (after a fold a period can have two or more members, in branch order).
-    "natural" steps in the period (:func:`librate.solving.continuation.natural`) and stops at a
-    fold (the step collapses there).
+    The motion is corrected from ``guess`` on the member of the first period and followed
+    through the requested periods ``period_days`` in order, e.g. along the L2 southern halos
+    into the NRHOs. Every member is re-propagated independently, to 1e-9. A single period gives
+    the one-member family of that orbit (no continuation).
 
-    Returns an xarray Dataset along ``member`` (attribute ``parameter`` = "period_days"):
+    ``method`` chooses the continuation. "arclength" (the default) follows the family by
+    pseudo-arclength continuation (:func:`librate.solving.continuation.arclength`) on the
+    bordered corrector (:class:`OrbitFamilyBranch3D`: the orbit period is an unknown, and each
+    Newton point lies on its own family member), through folds, until the branch leaves the
+    range of the requested periods. Its members are the solutions corrected exactly at a
+    requested period each time the branch crosses one, so after a fold a period can have two
+    or more members, in branch order. "natural" steps in the period
+    (:func:`librate.solving.continuation.natural`) and stops at a fold, where its step
+    collapses. A correction that fails later in the run ends it, with its ``end_reason``.
 
-    - ``period_days``, ``x0``, ``z0``;
-    - ``q0`` and ``w0``;
-    - the six ``multipliers`` (complex), ``stable`` and ``residual`` (from the re-propagation);
-    - ``turns``, NaN where it is undefined.
+    Parameters
+    ----------
+    orbits : OrbitFamily
+        The orbit family.
+    body : RigidBody
+        The body, every principal moment > 0 (as :func:`periodic_attitude_3d` checks).
+    guess : AttitudeSolution or (q0, w0)
+        The guess at the first period, as in :func:`periodic_attitude_3d`.
+    period_days : float or array_like
+        The orbit periods wanted (days), finite, at least one, each within the family's range;
+        for "arclength", strictly monotonic.
+    n_periods : int, default 1
+        K, the orbit periods per attitude period, in [1, 1000].
+    tol : float, default 1e-12
+        The corrector's tolerance, in [1e-15, 1e-3]. NRHOs pass within a few thousand km of the
+        Moon, where the tidal torque is some 1e4 times the Earth's at the Moon's distance:
+        their attitude closure reaches only ~1e-11, so pass tol=1e-10 there.
+    ds_min : float, default 1e-4
+        The smallest continuation step (in x = (period in days, rotation vector of q0, w0)),
+        a finite number > 0; with "natural", at most 0.05.
+    progress : bool or callable, optional
+        True for a bar on stderr, or ``progress(done, total)``, called with the number of
+        requested periods reached so far.
+    method : {"arclength", "natural"}, default "arclength"
+        The continuation.
+    max_points : int, default 400
+        The most branch points of the "arclength" continuation, in [2, 100,000].
 
-    Attributes:
+    Returns
+    -------
+    xarray.Dataset
+        Along ``member`` (attribute ``parameter`` = "period_days"): ``period_days``, ``x0``,
+        ``z0``; ``q0`` and ``w0``; the six ``multipliers`` (complex), ``stable`` and
+        ``residual`` (from the re-propagation); ``turns``, NaN where it is undefined.
 
-    - ``stability_changes``: where a pair of multipliers passes +1 or -1 ("+1", "-1") or two
-      pairs collide ("krein": on the unit circle, or two real pairs meeting off it), located by
-      the continuation driver on the test functions :func:`floquet_tests` to 1e-8 in the
-      parameter (``at``, ``located``), with the two members around it (``between``; the second None
-      when natural continuation stalled past the last member; with arclength, where no two
-      consecutive members bracket it, the two branch points around it and ``members`` False) and their
-      counts of multipliers on the unit circle (``on_unit_circle``).
-    - ``folds`` (arclength): the turning points of the family in the period, located to 1e-8
-      (``period_days``, ``located``, the ``w0`` there).
-    - ``unmarked_periods`` (arclength): requested periods the branch crossed where no member
-      was kept (the correction there landed further from the interpolation between the two
-      branch points than the driver's jump guard allows); normally empty.
-    - ``end_reason``: why the continuation stopped.
+        The attributes: ``stability_changes``, where a pair of multipliers passes +1 or -1
+        ("+1", "-1") or two pairs collide ("krein": on the unit circle, or two real pairs
+        meeting off it). They are located by the continuation driver on the test functions
+        :func:`floquet_tests`, to 1e-8 in the parameter (``at``, ``located``), each with the two
+        members around it (``between``: the second None when natural continuation stalled past
+        the last member; with arclength, where no two consecutive members bracket it, the two
+        branch points around it, and ``members`` False) and their counts of multipliers on the
+        unit circle (``on_unit_circle``). ``folds`` (arclength): the family's turning points in
+        the period, located to 1e-8 (``period_days``, ``located``, the ``w0`` there).
+        ``unmarked_periods`` (arclength): requested periods the branch crossed where no member
+        was kept, because the correction there landed farther from the interpolation between
+        the two branch points than the driver's jump guard allows; normally empty.
+        ``end_reason``: why the continuation stopped. Also ``body_moments``, ``n_periods``,
+        ``system`` and ``method``.
+
+    Raises
+    ------
+    ValueError
+        A bad argument, naming it: ``orbits`` not an :class:`OrbitFamily`, an unknown
+        ``method``, ``period_days`` empty, not finite, outside the family's range or (for
+        "arclength") not strictly monotonic, a count, tolerance or step out of range, or a bad
+        ``body`` or ``guess``.
+    ConvergenceError
+        The first solution could not be corrected, or the bordered corrector did not reproduce
+        it (or the first period's orbit could not be corrected).
+    CollisionError
+        The first period's orbit passes within a primary's radius.
+
+    Examples
+    --------
+    >>> import librate, math
+    >>> halos = librate.halo_family("earth-moon", 2, "south")
+    >>> h = halos.member(period_days=14.0)
+    >>> body = librate.RigidBody(0.8, 0.9, 1.0)
+    >>> s = librate.periodic_attitude_3d(h, body, guess=([0, 0, 0, 1.0], [0, 0, 1 - 2 * math.pi / h.period]))
+    >>> ds = librate.attitude_family_3d(halos, body, guess=(s.q0, s.w0), period_days=[14.0, 13.5, 13.0])
+    >>> ds.period_days.values.round(6).tolist(), bool(ds.residual.max() < 1e-9)
+    ([14.0, 13.5, 13.0], True)
+    >>> ds.attrs["end_reason"]
+    'completed: parameter range end: period_days = 13'
     """
 
     from ..orbits.families import OrbitFamily
@@ -326,14 +377,59 @@ class InertiaBranch3D:
 
 def attitude_family_3d_inertia(orbit: PeriodicOrbit, bodies, *, guess, steps: int = 20, n_periods: int = 1, tol: float = 1e-12,
                                ds_min: float = 1e-5):
-    """A periodic 3-D attitude motion along ``orbit`` continued in the inertia, from
-    ``bodies[0]`` to ``bodies[1]`` along I(s) = (1 - s) I_a + s I_b (``steps`` equal steps in
-    s), by natural-parameter continuation (:func:`librate.solving.continuation.natural`) from
-    ``guess`` ((q0, w0) or a planar solution) for the first body.
+    """A periodic 3-D attitude motion along ``orbit`` continued in the inertia, from one body to another.
 
-    A common start is the torque-free sphere: with equal moments, the spin
-    (1 + 2 pi N / T) e_Z is periodic at any attitude. The Dataset is that of
-    :func:`attitude_family_3d`, along ``s``, with the ``moments`` (member, axis) of each body.
+    The moments follow the straight path I(s) = (1 - s) I_a + s I_b from ``bodies[0]`` (s = 0)
+    to ``bodies[1]`` (s = 1) in ``steps`` equal steps of s, by natural-parameter continuation
+    (:func:`librate.solving.continuation.natural`), from ``guess`` for the first body. A
+    common start is the torque-free sphere: with equal moments, the spin (1 + 2 pi N / T) e_Z
+    is periodic at any attitude. A correction that fails later in the run ends it, with its
+    ``end_reason``.
+
+    Parameters
+    ----------
+    orbit : PeriodicOrbit
+        The orbit.
+    bodies : (RigidBody, RigidBody)
+        The first and the last body, each with every principal moment > 0.
+    guess : AttitudeSolution or (q0, w0)
+        The guess for the first body, as in :func:`periodic_attitude_3d`.
+    steps : int, default 20
+        Equal steps in s, in [1, 100,000].
+    n_periods : int, default 1
+        K, the orbit periods per attitude period, in [1, 1000].
+    tol : float, default 1e-12
+        The corrector's tolerance, in [1e-15, 1e-3].
+    ds_min : float, default 1e-5
+        The smallest step in s after halvings, a finite number > 0 and at most 0.05.
+
+    Returns
+    -------
+    xarray.Dataset
+        That of :func:`attitude_family_3d`, along ``s`` (attribute ``parameter`` = "s"), with
+        the ``moments`` (member, axis) of each member's body; attributes ``orbit_period_days``,
+        ``n_periods``, ``system``, ``end_reason`` and ``stability_changes``.
+
+    Raises
+    ------
+    ValueError
+        A bad argument, naming it: ``orbit`` not a :class:`PeriodicOrbit`, ``bodies`` not two
+        :class:`RigidBody` with every moment > 0, a count, tolerance or step out of range, or a
+        bad ``guess``.
+    ConvergenceError
+        The first body's motion could not be corrected.
+
+    Examples
+    --------
+    >>> import librate, math
+    >>> h = librate.halo("earth-moon", 2, "south", period_days=13.0)
+    >>> bodies = (librate.RigidBody(1.0, 1.0, 1.0), librate.RigidBody(0.8, 0.9, 1.0))
+    >>> spin = ([0, 0, 0, 1.0], [0, 0, 1 - 2 * math.pi / h.period])
+    >>> ds = librate.attitude_family_3d_inertia(h, bodies, guess=spin, steps=3)
+    >>> ds.s.values.round(4).tolist(), ds.moments.values[-1].tolist()
+    ([0.0, 0.3333, 0.6667, 1.0], [0.8, 0.9, 1.0])
+    >>> ds.attrs["end_reason"]
+    'completed: reached the last requested value'
     """
     from ..solving.continuation import Point, StepRules, natural
 

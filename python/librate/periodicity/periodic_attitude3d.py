@@ -42,26 +42,67 @@ def _rotvec(q_from, q_to) -> np.ndarray:
 
 @dataclass(frozen=True)
 class AttitudeSolution3D:
-    """A periodic 3-D attitude motion along ``orbit`` over K = ``n_periods`` orbit periods.
+    """A periodic 3-D attitude motion along ``orbit``, over K = ``n_periods`` orbit periods.
 
-    Fields:
+    Made by :func:`periodic_attitude_3d`, :func:`out_of_plane_stability` and the 3-D families.
+    The residuals and turns come from an independent re-propagation of the corrected motion:
+    the scalar 3-D model without STM at rtol = atol = 1e-14 (:data:`VERIFY_RTOL`), with scipy's
+    rotation algebra rather than the corrector's. ``propagate(n_periods=None, **kwargs)``
+    integrates the motion again (default over its own K periods, rtol = atol = 1e-13).
 
-    - ``q0``: scalar last, the body relative to the synodic frame.
-    - ``w0``: the inertial rate in body axes (rad/TU).
-    - ``monodromy``: the 6x6 d(theta, w)(KT)/d(theta, w)(0) (theta a small rotation in body axes).
-    - ``multipliers``: its six eigenvalues.
-    - ``stable``: every multiplier on the unit circle to :data:`STABILITY_TOL`.
-    - ``residual``: max(|rotation vector of R(0)' R(KT)|, |w(KT) - w0|), from an independent
-      re-propagation. It uses the scalar 3-D model without STM, rtol = atol = 1e-14, and scipy's
-      rotation algebra rather than the corrector's; the components are in ``residual_rotation``
-      and ``residual_rate``.
-    - ``turns``: net turns of the body x axis about the synodic Z axis over the K periods (its
-      projection on the synodic XY plane, unwrapped). None where that projection passes within
-      1e-3 of zero, because the count is then undefined.
-    - ``planar``: True for a motion in the plane (planar orbit, q0 a rotation about Z and w0
-      along z, to 1e-10). For those, ``in_plane_multipliers`` are from the (theta_z, w_z) block
-      and ``out_of_plane_multipliers`` from the roll/yaw block (theta_x, theta_y, w_x, w_y);
-      otherwise both are None.
+    Parameters
+    ----------
+    orbit : PeriodicOrbit
+        The orbit.
+    body : RigidBody
+        The body.
+    n_periods : int
+        K, the orbit periods per attitude period.
+    q0 : numpy.ndarray, shape (4,)
+        The initial attitude, a unit quaternion (scalar last): the body relative to the synodic
+        frame.
+    w0 : numpy.ndarray, shape (3,)
+        The initial inertial angular rate in body axes (rad/TU).
+    monodromy : numpy.ndarray, shape (6, 6)
+        d(theta, w)(KT) / d(theta, w)(0), theta a small rotation in body axes.
+    residual_rotation : float, default nan
+        |rotation vector of R(0)' R(KT)| after the K periods (rad), from the re-propagation.
+    residual_rate : float, default nan
+        |w(KT) - w0| after the K periods (rad/TU), from the re-propagation.
+    turns : float or None, default None
+        The net turns of the body x axis about the synodic Z axis over the K periods (of its
+        projection on the synodic XY plane, unwrapped). None where that projection passes
+        within 1e-3 of zero: the count is then undefined.
+    iterations : int, default 0
+        The corrector's Newton steps.
+
+    Attributes
+    ----------
+    residual : float
+        max(``residual_rotation``, ``residual_rate``).
+    multipliers : numpy.ndarray, shape (6,), complex
+        The monodromy's six eigenvalues.
+    stable : bool
+        Every multiplier on the unit circle, to :data:`STABILITY_TOL`.
+    planar : bool
+        A motion in the plane: a planar orbit, q0 a rotation about Z and w0 along z (to 1e-10).
+    in_plane_multipliers : numpy.ndarray or None
+        For a planar motion the multipliers of the (theta_z, w_z) block of the monodromy;
+        otherwise None.
+    out_of_plane_multipliers : numpy.ndarray or None
+        For a planar motion the multipliers of the roll/yaw block (theta_x, theta_y, w_x,
+        w_y); otherwise None.
+    phi0 : float
+        The angle about Z of the body x axis from the synodic X axis at t = 0 (rad).
+
+    Examples
+    --------
+    >>> import librate
+    >>> orbit = librate.dro(period_days=12.66)
+    >>> planar = librate.periodic_attitude(orbit, kz=0.8, n=-1)
+    >>> s = librate.periodic_attitude_3d(orbit, librate.RigidBody.from_kz(0.8), guess=planar)
+    >>> s.planar, round(s.turns, 6), bool(s.residual < 1e-9), s.stable
+    (True, -1.0, True, False)
     """
 
     orbit: PeriodicOrbit
@@ -189,20 +230,66 @@ def is_mirror_symmetric(orbit: PeriodicOrbit, q0, w0) -> bool:
 
 def periodic_attitude_3d(orbit: PeriodicOrbit, body: RigidBody, *, guess, n_periods: int = 1, tol: float = 1e-12,
                          max_iter: int = 40, symmetric: bool = False) -> AttitudeSolution3D:
-    """The periodic 3-D attitude motion of ``body`` along ``orbit`` (planar or spatial) over
-    ``n_periods`` revolutions, corrected from ``guess``.
+    """The periodic 3-D attitude motion of ``body`` along ``orbit``, corrected from ``guess``.
 
-    ``guess`` is either a planar :class:`~librate.AttitudeSolution` (its phi0 about Z and wz0)
-    or a pair ``(q0, w0)`` (scalar-last quaternion, inertial rate in body axes). The corrector
-    stops when the residual max-norm is <= ``tol``. The solution is then re-propagated
-    independently, at a tighter tolerance, and ``residual`` reports that check. Raises
-    :class:`librate.ConvergenceError` when the corrector stops without converging.
+    The orbit may be planar or spatial; the motion closes over ``n_periods`` revolutions. The
+    corrector (Newton, in Rust) stops once the max-norm of the closure residual is <= ``tol``.
+    The solution is then re-propagated independently at a tighter tolerance, and its
+    ``residual`` reports that check.
 
-    ``symmetric`` selects the formulation. True uses the half-period form: the orbit and the
-    guess must be mirror symmetric (:func:`is_mirror_symmetric`), and the solution then is
-    too, with three unknowns and three equations at KT/2. It is cheaper, but from a poor guess
-    its Newton basin can be smaller than the full form's. False (the default) uses the full
-    period, with six unknowns. The monodromy is always the full-period one.
+    ``symmetric`` chooses the formulation. The full-period form (the default) has six
+    unknowns. The half-period form needs the orbit and the guess to be mirror symmetric
+    (:func:`is_mirror_symmetric`), and the solution then is too: three unknowns and three
+    equations at KT/2. It is cheaper, but from a poor guess its Newton basin can be smaller
+    than the full form's. The monodromy is the full-period one either way.
+
+    Parameters
+    ----------
+    orbit : PeriodicOrbit
+        The orbit.
+    body : RigidBody
+        The body: a :class:`RigidBody` with every principal moment > 0 (not a rod).
+    guess : AttitudeSolution or (q0, w0)
+        A planar periodic :class:`~librate.AttitudeSolution` over the same ``n_periods``,
+        without SRP (its phi0 about Z and its wz0), or a pair of a unit quaternion q0 (4
+        numbers, scalar last, |q0| = 1 to 1e-6) and an inertial rate w0 in body axes (3
+        numbers, rad/TU), all finite.
+    n_periods : int, default 1
+        K, the orbit periods per attitude period, in [1, 1000].
+    tol : float, default 1e-12
+        The corrector's tolerance on the residual's max-norm, in [1e-15, 1e-3].
+    max_iter : int, default 40
+        Newton steps at most, in [1, 10,000].
+    symmetric : bool, default False
+        Use the mirror-symmetric half-period form (True) rather than the full period.
+
+    Returns
+    -------
+    AttitudeSolution3D
+        The verified solution.
+
+    Raises
+    ------
+    ValueError
+        A bad argument, naming it: an orbit that is not a :class:`PeriodicOrbit`, a rod or
+        other body, a guess of the wrong form (not a unit quaternion, a half-turn or SRP
+        planar solution, one over another K), a count or tolerance out of range, or
+        ``symmetric`` without a mirror-symmetric orbit and guess.
+    ConvergenceError
+        The corrector stopped without converging (its reason, steps and residual named).
+
+    Examples
+    --------
+    >>> import librate, math
+    >>> halo = librate.halo("earth-moon", 2, "south", period_days=13.0)
+    >>> body = librate.RigidBody(0.8, 0.9, 1.0)
+    >>> guess = ([0, 0, 0, 1.0], [0, 0, 1 - 2 * math.pi / halo.period])
+    >>> s = librate.periodic_attitude_3d(halo, body, guess=guess)
+    >>> s.planar, round(s.turns, 6), bool(s.residual < 1e-9)
+    (False, -1.0, True)
+    >>> half = librate.periodic_attitude_3d(halo, body, guess=guess, symmetric=True)
+    >>> bool(abs(half.w0 - s.w0).max() < 1e-9)
+    True
     """
     if not isinstance(orbit, PeriodicOrbit):
         raise ValueError(f"invalid argument `orbit`: must be a librate.PeriodicOrbit, got {type(orbit).__name__}")
@@ -247,9 +334,39 @@ def verified_solution_3d(orbit: PeriodicOrbit, body: RigidBody, n_periods: int, 
 
 
 def out_of_plane_stability(solution: AttitudeSolution) -> AttitudeSolution3D:
-    """The planar ``solution`` as a 3-D motion (body z on synodic Z, the body of its Kz,
-    Ix + Iy = Iz), with its roll/yaw multipliers next to the in-plane pair
-    (:attr:`AttitudeSolution3D.out_of_plane_multipliers`)."""
+    """The planar ``solution`` as a 3-D motion, with its out-of-plane (roll/yaw) multipliers.
+
+    The motion is corrected by :func:`periodic_attitude_3d` from the planar solution, with body
+    z along synodic Z and the planar body of its Kz (Ix + Iy = Iz,
+    :meth:`RigidBody.from_kz`). Its roll/yaw multipliers
+    (:attr:`AttitudeSolution3D.out_of_plane_multipliers`) stand next to the in-plane pair.
+
+    Parameters
+    ----------
+    solution : AttitudeSolution
+        A planar periodic solution without SRP, of a body with |Kz| < 1 (not a thin rod).
+
+    Returns
+    -------
+    AttitudeSolution3D
+        The planar motion in 3-D (``planar`` True).
+
+    Raises
+    ------
+    ValueError
+        ``solution`` not an :class:`AttitudeSolution`, a thin rod (|Kz| = 1), a half-turn
+        solution or one with SRP.
+    ConvergenceError
+        The 3-D corrector did not converge.
+
+    Examples
+    --------
+    >>> import librate
+    >>> orbit = librate.dro(period_days=12.66)
+    >>> s = librate.out_of_plane_stability(librate.periodic_attitude(orbit, kz=0.8, n=-1))
+    >>> sorted(abs(s.out_of_plane_multipliers).round(4).tolist())
+    [0.8843, 0.8843, 1.1308, 1.1308]
+    """
     if not isinstance(solution, AttitudeSolution):
         raise ValueError(f"invalid argument `solution`: must be a librate.AttitudeSolution, got {type(solution).__name__}")
     if abs(solution.kz) >= 1:
