@@ -18,8 +18,6 @@ from .._core import __version__
 from .._errors import LibrateError
 from ..orbits.system import System
 from .commands import demo_summary, map_3d_summary, map_solutions_summary, solutions_table, solve_3d_summary
-from .jobs import run_family, run_map, run_solve, run_transition
-from .study import Study3D
 
 _CONTEXT = {"help_option_names": ["-h", "--help"], "max_content_width": 100}
 
@@ -364,6 +362,7 @@ def family(study, kind, point, branch, x0, members, system_name, fmt, sets, out_
     _check_writable(st.output_dir(out_dir), "--out" if out_dir else "output.folder")
     t0 = time.perf_counter()
     try:
+        from .jobs import run_family
         from .progress import reporter
 
         fam, path = run_family(st, out_dir, force=not resume, say=_say, progress=reporter("orbit family", "member", _show(quiet)))
@@ -423,7 +422,9 @@ def solve(study, sets, out_dir, resume, quiet, scheduler) -> None:
     solve_multipliers.png (Floquet multipliers along the family) and solve_body_axes.png
     (the body axes along the first member's orbit).
     """
+    from .jobs import run_solve
     from .progress import reporter
+    from .study import Study3D
 
     st = _load_study(study, "solve", _overrides(sets), force=not resume, quiet=quiet)
     _check_writable(st.output_dir(out_dir), "--out" if out_dir else "output.folder")
@@ -483,6 +484,8 @@ def map_(study, out_dir, quiet, scheduler, resume, sets) -> None:
     With [attitude] model = "3d": the six 3-D closure residuals over (orbit, two rate grids)
     in map.zarr (or .nc), saved orbit by orbit (resumable), and map_residual_norm.png.
     """
+    from .jobs import run_map
+
     st = _load_study(study, "map", _overrides(sets), force=not resume, quiet=quiet)
     _check_writable(st.output_dir(out_dir), "--out" if out_dir else "output.folder")
     t0 = time.perf_counter()
@@ -539,6 +542,8 @@ def transition(study, out_dir, quiet, scheduler, resume, sets) -> None:
       transition_defects.png    the node defects of every epoch
       transition_sweep.png      departure and perilune range against the epoch (2+ epochs)
     """
+    from .jobs import run_transition
+
     st = _load_study(study, "transition", _overrides(sets))
     _check_writable(st.output_dir(out_dir), "--out" if out_dir else "output.folder")
     t0 = time.perf_counter()
