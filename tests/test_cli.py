@@ -247,7 +247,7 @@ def test_plot_a_family_and_refuse_non_results(run, tmp_path):
 
 def test_demo_dros_and_info_still_work(run, tmp_path):
     res = run("demo", "--orbits", "3", "--rates", "50", "--out", "d")
-    assert "periodicity map: 3 orbits x 50 rates" in res.output
+    assert "periodicity map: 4 orbits x 50 rates" in res.output  # 3 and the 12.66-day DRO
     assert (tmp_path / "d" / "demo.nc").exists()
     assert "closure" in run("dros", "--x0", "0.9").output
     out = run("info").output
@@ -414,6 +414,40 @@ def test_demo_summary_says_what_it_omits(run, tmp_path):
     assert sum(int(line.split()[2]) for line in rows) == listed
     res = run("demo", "--orbits", "4", "--rates", "50", "--out", "d", "--kz", "0.5", code=2)
     assert "changed: --kz 0.8 -> 0.5" in res.stderr and "--force" in res.stderr
+
+
+def test_demo_residuals_figure_is_on_the_12_66_day_dro(run, tmp_path, monkeypatch):
+    """Issue 23: thesis Fig. 23 draws the residuals of the 12.66-day DRO (period within 0.01 d,
+    the thesis's two decimals), which the demo's family holds beside its x0 grid; its residual
+    dwz crosses zero there (the figure shows the crossings). The study records that member, so
+    a demo map stored without it (librate before this) is refused naming the key."""
+    import librate.plotting as lp
+
+    drawn = []
+    draw = lp.plot_residuals
+
+    def spy(ds, *args, **kwargs):
+        drawn.append(kwargs["orbit_index"])
+        return draw(ds, *args, **kwargs)
+
+    monkeypatch.setattr(lp, "plot_residuals", spy)
+    run("demo", "--orbits", "3", "--rates", "50", "--out", "d")
+    ds = librate.open_result(tmp_path / "d" / "demo.nc").load()
+    period = ds["period_days"].values
+    assert ds.sizes["orbit"] == 4 and len(drawn) == 1
+    assert abs(period[drawn[0]] - 12.66) <= 0.01, period
+    grid = np.delete(ds["x0"].values, drawn[0])
+    np.testing.assert_allclose(grid, np.linspace(0.95, 0.15, 3), rtol=0, atol=1e-12)  # x0 held by the continuation
+    dwz = ds["dwz"].values[drawn[0], 0]
+    assert np.count_nonzero(np.diff(np.sign(dwz)) != 0) >= 2
+    assert json.loads(ds.attrs["study"])["orbits"]["period_days"] == [12.66]
+
+    old = json.loads(ds.attrs["study"])
+    del old["orbits"]["period_days"]
+    ds.attrs["study"] = json.dumps(old, sort_keys=True)
+    ds.to_netcdf(tmp_path / "d" / "demo.nc")
+    res = run("demo", "--orbits", "3", "--rates", "50", "--out", "d", code=2)
+    assert "changed: orbits.period_days: (unset) -> [12.66]" in res.stderr and "--force" in res.stderr
 
 
 def test_a_giant_map_is_refused_with_the_keys_and_exit_2(run, tmp_path):

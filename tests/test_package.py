@@ -36,11 +36,11 @@ def test_cli_info_dros_and_demo(tmp_path):
     assert len(rows) == 1 and float(rows[0][6]) < 1e-10  # closure after one period
     demo = runner.invoke(main, ["demo", "--orbits", "4", "--rates", "200", "--out", str(tmp_path)])
     assert demo.exit_code == 0, demo.output
-    assert "4 orbits x 200 rates" in demo.output
+    assert "5 orbits x 200 rates" in demo.output  # 4 and the 12.66-day DRO
     import xarray as xr
 
     ds = xr.open_dataset(tmp_path / "demo.nc", engine="scipy")
-    assert ds.dwz.shape == (4, 1, 200) and ds.sizes["solution"] > 0
+    assert ds.dwz.shape == (5, 1, 200) and ds.sizes["solution"] > 0
     assert float(ds.sol_residual.max()) < 1e-9
     bad = runner.invoke(main, ["demo", "--kz", "2"])
     assert bad.exit_code != 0 and "kz" in bad.output.lower()

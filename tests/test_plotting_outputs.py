@@ -105,6 +105,7 @@ def test_demo_figures(cli, tmp_path, written):
     0, -1 families (Figs. 27-29) and the orbits."""
     cli("demo", "--out", tmp_path / "demo")
     check_figures(written, tmp_path / "demo", {"demo_contours.png", "demo_residuals.png", "demo_solutions.png", "demo_orbits.png"})
+    assert "orbit T = 12.66 d" in written["demo_residuals.png"].axes[0].get_title()  # the title's period, to 0.01 d
 
 
 @pytest.mark.slow

@@ -18,8 +18,6 @@ from .._core import __version__
 from .._errors import LibrateError
 from ..orbits.system import System
 from .commands import demo_summary, map_3d_summary, map_solutions_summary, solutions_table, solve_3d_summary
-from .jobs import run_family, run_map, run_solve, run_transition
-from .study import Study3D
 
 _CONTEXT = {"help_option_names": ["-h", "--help"], "max_content_width": 100}
 
@@ -119,7 +117,8 @@ def _in_cli_words(message: str, keys: dict[str, str]) -> str:
 @main.command(context_settings=_CONTEXT, short_help="The DRO attitude periodicity map at Kz = 0.8, no study needed.")
 @click.option("--system", "system_name", default="earth-moon", show_default=True, type=_PRESET, help="System preset.")
 @click.option("--kz", default=0.8, show_default=True, type=click.FloatRange(-1, 1), help="Inertia parameter Kz = (Iy - Ix)/Iz.")
-@click.option("--orbits", "n_orbits", default=60, show_default=True, type=click.IntRange(2, 2000), help="DRO family members, x0 from 0.95 to 0.15.")
+@click.option("--orbits", "n_orbits", default=60, show_default=True, type=click.IntRange(2, 2000),
+              help="DRO family members with x0 evenly from 0.95 to 0.15; the 12.66-day DRO (thesis Fig. 23) is added to them.")
 @click.option("--rates", "n_rates", default=1000, show_default=True, type=click.IntRange(10, 100000), help="Initial rates, phidot0 in [-4, 1] (wz0 in [-3, 2]).")
 @click.option("--out", "out_dir", default="librate-out", show_default=True, type=click.Path(file_okay=False), help="Output folder for demo.nc and the demo_*.png figures.")
 @click.option("--resume/--force", default=True, help=_FORCE_HELP)
@@ -138,7 +137,7 @@ def demo(system_name: str, kz: float, n_orbits: int, n_rates: int, out_dir: str,
       demo.nc        the map (as `librate map` writes it): dwz, dphi, phi_T over
                      (orbit, kz, wz0), the solutions sol_*, units and parameters
       demo_contours.png, demo_residuals.png, demo_solutions.png, demo_orbits.png
-                     Fig. 24, Fig. 23 (first orbit), Figs. 27-29, Fig. 3
+                     Fig. 24, Fig. 23 (the 12.66-day DRO), Figs. 27-29, Fig. 3
     `librate plot OUT/demo.nc` re-draws the first three from the file.
     """
     from .commands import run_demo
@@ -363,6 +362,7 @@ def family(study, kind, point, branch, x0, members, system_name, fmt, sets, out_
     _check_writable(st.output_dir(out_dir), "--out" if out_dir else "output.folder")
     t0 = time.perf_counter()
     try:
+        from .jobs import run_family
         from .progress import reporter
 
         fam, path = run_family(st, out_dir, force=not resume, say=_say, progress=reporter("orbit family", "member", _show(quiet)))
@@ -422,7 +422,9 @@ def solve(study, sets, out_dir, resume, quiet, scheduler) -> None:
     solve_multipliers.png (Floquet multipliers along the family) and solve_body_axes.png
     (the body axes along the first member's orbit).
     """
+    from .jobs import run_solve
     from .progress import reporter
+    from .study import Study3D
 
     st = _load_study(study, "solve", _overrides(sets), force=not resume, quiet=quiet)
     _check_writable(st.output_dir(out_dir), "--out" if out_dir else "output.folder")
@@ -476,12 +478,14 @@ def map_(study, out_dir, quiet, scheduler, resume, sets) -> None:
                    attributes (map.nc too with output.format = "netcdf")
       map_contours.png   zero contours of dwz and dphi over (orbit period, phidot0) with
                    the solutions by N (one file per Kz: map_contours_kz<Kz>.png)
-      map_residuals.png  dwz and dphi against phidot0, first orbit (thesis Fig. 23)
+      map_residuals.png  dwz and dphi against phidot0, the orbit nearest 12.66 d (thesis Fig. 23)
       map_solutions.png  the solution families across the orbits (thesis Figs. 27-29)
 
     With [attitude] model = "3d": the six 3-D closure residuals over (orbit, two rate grids)
     in map.zarr (or .nc), saved orbit by orbit (resumable), and map_residual_norm.png.
     """
+    from .jobs import run_map
+
     st = _load_study(study, "map", _overrides(sets), force=not resume, quiet=quiet)
     _check_writable(st.output_dir(out_dir), "--out" if out_dir else "output.folder")
     t0 = time.perf_counter()
@@ -546,6 +550,8 @@ def transition(study, out_dir, quiet, scheduler, resume, sets) -> None:
     carried along the ephemeris orbit at each epoch and corrected by multiple shooting; the
     table then adds per solution the largest pointing error and the corrected motion's defects.
     """
+    from .jobs import run_transition
+
     st = _load_study(study, "transition", _overrides(sets))
     _check_writable(st.output_dir(out_dir), "--out" if out_dir else "output.folder")
     t0 = time.perf_counter()
@@ -579,7 +585,7 @@ def plot(result_path, quiet) -> None:
                  (period in days against x0, with the 1:k resonances), STEM_stability.png
       a map      STEM_contours.png (zero contours and solutions; STEM_contours_kz<Kz>.png
                  per Kz when several), STEM_residuals.png (dwz, dphi against phidot0 for
-                 the first orbit), STEM_solutions.png (solution families across the orbits)
+                 the orbit nearest 12.66 d), STEM_solutions.png (solution families across the orbits)
       solutions  STEM_solutions.png (initial rates phidot0 of the solutions against x0)
       3-D solutions  STEM_multipliers.png (Floquet multipliers along the family),
                  STEM_body_axes.png (body axes along the first member's orbit)

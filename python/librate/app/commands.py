@@ -12,8 +12,8 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["demo_study", "demo_summary", "describe_for_plot", "draw_figures", "dro_closures", "map_3d_summary", "map_solutions_summary", "refuse_damaged",
-           "result_kind_of", "run_demo", "solutions_table", "solve_3d_summary", "writable_problem"]
+__all__ = ["demo_family", "demo_study", "demo_summary", "describe_for_plot", "draw_figures", "dro_closures", "map_3d_summary", "map_solutions_summary",
+           "refuse_damaged", "result_kind_of", "run_demo", "solutions_table", "solve_3d_summary", "writable_problem"]
 
 
 def dro_closures(system, xs: Sequence[float]) -> Iterator[tuple[float, object, float, float]]:
@@ -51,23 +51,49 @@ def writable_problem(folder: Path) -> str | None:
 
 
 def demo_study(system_name: str, kz: float, n_orbits: int, n_rates: int) -> str:
-    """The demo's inputs as the study its result records (JSON)."""
+    """The demo's inputs as the study its result records (JSON): its members are ``n_orbits``
+    DROs with x0 evenly from 0.95 to 0.15 and the DRO of period RESIDUALS_PERIOD_DAYS (12.66 d,
+    thesis Fig. 23), as :func:`demo_family` computes them."""
     import json
 
-    return json.dumps({"system": {"preset": system_name}, "orbits": {"kind": "dro", "x0": {"start": 0.95, "stop": 0.15, "num": n_orbits}},
-                       "body": {"kz": kz}, "rates": {"wz0": {"start": -3.0, "stop": 2.0, "num": n_rates}}}, sort_keys=True)
+    from ..results.kinds import RESIDUALS_PERIOD_DAYS
+
+    orbits = {"kind": "dro", "x0": {"start": 0.95, "stop": 0.15, "num": n_orbits}, "period_days": [RESIDUALS_PERIOD_DAYS]}
+    return json.dumps({"system": {"preset": system_name}, "orbits": orbits, "body": {"kz": kz},
+                       "rates": {"wz0": {"start": -3.0, "stop": 2.0, "num": n_rates}}}, sort_keys=True)
+
+
+def demo_family(system, n_orbits: int):
+    """The demo's DRO family: ``n_orbits`` members with x0 evenly from 0.95 to 0.15 (natural
+    continuation, :func:`librate.dro_family`) and, in x0 order among them, the DRO of thesis
+    Fig. 23, of period RESIDUALS_PERIOD_DAYS (12.66 d), corrected with that period imposed
+    (:meth:`librate.OrbitFamily.member`). The members' stability comes from one batched
+    propagation (:meth:`librate.OrbitFamily.from_members`; bifurcations interpolated between
+    consecutive members). Returns ``(family, index of the 12.66-day DRO)``."""
+    from ..orbits.families import dro_family
+    from ..orbits.orbit_family import OrbitFamily
+    from ..results.kinds import RESIDUALS_PERIOD_DAYS
+
+    grid = dro_family(system, x0=np.linspace(0.95, 0.15, n_orbits))
+    fig23 = grid.member(period_days=RESIDUALS_PERIOD_DAYS)
+    k = int(np.searchsorted(-grid.x0, -fig23.x0))  # x0 decreases along the grid
+    if k < len(grid) and grid.x0[k] == fig23.x0:
+        return grid, k
+    members = list(grid)
+    members.insert(k, fig23)
+    return OrbitFamily.from_members(system, "dro", False, members, grid.end_reason, grid.parameters), k
 
 
 def run_demo(system_name: str, kz: float, n_orbits: int, n_rates: int, path: Path, *, force: bool, say: Callable[[str], None],
              echo: Callable[[str], None], progress=None):
-    """The demo's map: the DRO family (``n_orbits`` members, x0 from 0.95 to 0.15), its
-    periodicity map at ``kz`` over ``n_rates`` inertial rates wz0 in [-3, 2] with the solutions,
-    saved at ``path``. Returns ``(ds, family)``; ``family`` is None when the map at ``path`` was
-    made from the same options and is reused (``say`` tells). ``echo`` receives the timing
-    lines. Raises :class:`~librate.app.results.ResultExists` for a map of other options (unless
-    ``force``) and OSError when ``path`` cannot be written."""
+    """The demo's map: the DRO family (:func:`demo_family`: ``n_orbits`` members with x0 from
+    0.95 to 0.15, and the 12.66-day DRO of thesis Fig. 23), its periodicity map at ``kz`` over
+    ``n_rates`` inertial rates wz0 in [-3, 2] with the solutions, saved at ``path``. Returns
+    ``(ds, family)``; ``family`` is None when the map at ``path`` was made from the same options
+    and is reused (``say`` tells). ``echo`` receives the timing lines. Raises
+    :class:`~librate.app.results.ResultExists` for a map of other options (unless ``force``)
+    and OSError when ``path`` cannot be written."""
     from .._core import __version__
-    from ..orbits.families import dro_family
     from ..orbits.system import System
     from ..periodicity.maps import periodicity_map
     from .results import check_output, open_result, save_dataset
@@ -78,10 +104,11 @@ def run_demo(system_name: str, kz: float, n_orbits: int, n_rates: int, path: Pat
         return open_result(path), None
     system = System.preset(system_name)
     t0 = time.perf_counter()
-    fam = dro_family(system, x0=np.linspace(0.95, 0.15, n_orbits))
+    fam, k = demo_family(system, n_orbits)
     t1 = time.perf_counter()
     echo(f"DRO family: {len(fam)} members, x0 {fam.x0[0]:.3f} -> {fam.x0[-1]:.3f}, "
-         f"period {fam.period_days.min():.2f} to {fam.period_days.max():.2f} d ({t1 - t0:.2f} s)")
+         f"period {fam.period_days.min():.2f} to {fam.period_days.max():.2f} d, with the {fam.period_days[k]:.2f}-day DRO "
+         f"(thesis Fig. 23) at x0 = {fam.x0[k]:.4f} ({t1 - t0:.2f} s)")
     ds = periodicity_map(fam, kz=kz, wz0=np.linspace(-3.0, 2.0, n_rates), progress=progress)
     t2 = time.perf_counter()
     n_traj = ds.dwz.size

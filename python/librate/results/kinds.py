@@ -13,10 +13,10 @@ import numpy as np
 
 from .store import StoreSchema, Var
 
-__all__ = ["FIGURE_FILES", "FamilyResult", "KINDS", "Map3DResult", "MAP_3D_VARIABLES", "MAP_VARIABLES", "MapResult",
-           "ResultKind", "Solutions3DResult",
-           "SolutionsResult", "TRANSITION_ATTITUDE_VARIABLES", "TRANSITION_VARIABLES", "TransitionResult", "kind_of", "map3d_schema",
-           "map_schema", "transition_schema", "transition_variables"]
+__all__ = ["FIGURE_FILES", "FamilyResult", "KINDS", "Map3DResult", "MAP_3D_VARIABLES", "MAP_VARIABLES", "MapResult", "RESIDUALS_PERIOD_DAYS",
+           "RESIDUALS_PERIOD_TOL_DAYS", "ResultKind", "Solutions3DResult", "SolutionsResult", "TRANSITION_ATTITUDE_VARIABLES",
+           "TRANSITION_VARIABLES", "TransitionResult", "kind_of", "map3d_schema", "map_schema", "residuals_orbit", "transition_schema",
+           "transition_variables"]
 
 #: The per-orbit variables of a planar map: units and long names (periodicity_map, run_map and
 #: the store all take them from here).
@@ -124,6 +124,20 @@ def transition_schema(n_epochs: int, sizes: dict, coords: dict) -> StoreSchema:
         fill = 255 if dtype == "u1" else (None if dtype == "i8" else np.nan)
         v[k] = Var(dtype, tuple(sizes[d] for d in dims), dims, fill, dict(attrs))
     return StoreSchema("ephemeris_transition", "epoch", n_epochs, v, coords)
+
+
+#: The period (days) of the DRO whose residuals thesis Fig. 23 draws, the 12.66-day DRO of the
+#: Earth-Moon system; a map's residuals figure is drawn on the orbit of that period, within
+#: :data:`RESIDUALS_PERIOD_TOL_DAYS`, when the map holds one (the demo's map does).
+RESIDUALS_PERIOD_DAYS = 12.66
+RESIDUALS_PERIOD_TOL_DAYS = 0.01
+
+
+def residuals_orbit(period_days) -> int:
+    """The index of the orbit a map's residuals figure is drawn on (thesis Fig. 23), from the
+    orbits' periods in days: the orbit of period :data:`RESIDUALS_PERIOD_DAYS` (within
+    :data:`RESIDUALS_PERIOD_TOL_DAYS`) when the map holds one, else the orbit nearest it."""
+    return int(np.nanargmin(np.abs(np.asarray(period_days, dtype=float) - RESIDUALS_PERIOD_DAYS)))
 
 
 #: The file suffix of each figure: a result STEM.zarr gets STEM_<suffix>.png beside it.
@@ -279,8 +293,9 @@ class MapResult(ResultKind):
 
     @classmethod
     def figures(cls, result, names=None, skip=None, **data) -> list[Figure]:
-        """The map's zero contours (one figure per Kz), the residuals of the orbit nearest the
-        12.66-day DRO (thesis Fig. 23) and the solution families across the orbits (Figs. 27-29)."""
+        """The map's zero contours (one figure per Kz), the residuals of the 12.66-day DRO, or
+        of the orbit nearest it (thesis Fig. 23, :func:`residuals_orbit`), and the solution
+        families across the orbits (Figs. 27-29)."""
         lp = _plotting()
         kzs = np.atleast_1d(result["kz"].values)
         out: list[Figure] = []
@@ -293,8 +308,7 @@ class MapResult(ResultKind):
                 for j, kz in enumerate(kzs):
                     out.append((FIGURE_FILES["map"] + ("" if kzs.size == 1 else f"_kz{kz:g}"), lambda j=j: lp.plot_map(result, kz_index=j)))
             elif name == "residuals":
-                # thesis Fig. 23 is drawn on the 12.66-day DRO: the orbit nearest that period
-                near = int(np.argmin(np.abs(np.asarray(result["period_days"].values, dtype=float) - 12.66)))
+                near = residuals_orbit(result["period_days"].values)
                 out.append((FIGURE_FILES["residuals"], lambda near=near: lp.plot_residuals(result, orbit_index=near, kz=float(kzs[0]))))
             elif name == "solutions" and "sol_wz0" in result.variables:
                 if result.sizes["orbit"] < 2 or result.sizes.get("solution", 0) == 0:
