@@ -13,8 +13,8 @@ import numpy as np
 
 from .store import StoreSchema, Var
 
-__all__ = ["FIGURE_FILES", "FamilyResult", "KINDS", "Map3DResult", "MAP_3D_VARIABLES", "MAP_VARIABLES", "MapResult", "RESIDUALS_PERIOD_DAYS",
-           "RESIDUALS_PERIOD_TOL_DAYS", "ResultKind", "Solutions3DResult", "SolutionsResult", "TRANSITION_ATTITUDE_VARIABLES",
+__all__ = ["FIGURE_FILES", "FamilyResult", "KINDS", "Map3DResult", "MAP_3D_VARIABLES", "MAP_VARIABLES", "MapResult",
+           "RESIDUALS_PERIOD_DAYS", "RESIDUALS_PERIOD_TOL_DAYS", "ResultKind", "Solutions3DResult", "SolutionsResult", "TRANSITION_ATTITUDE_VARIABLES",
            "TRANSITION_VARIABLES", "TransitionResult", "kind_of", "map3d_schema", "map_schema", "residuals_orbit", "transition_schema",
            "transition_variables"]
 
