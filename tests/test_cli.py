@@ -41,7 +41,8 @@ def fake_runner(monkeypatch):
     calls = []
     mod = types.ModuleType("librate.app.runner")
 
-    def run_map(orbits, *, kz, wz0, phi0=0.0, n_periods=1, srp=None, out=None, resume=True, scheduler=None, progress=None, solve=True, attrs=None):
+    def run_map(orbits, *, kz, wz0, phi0=0.0, n_periods=1, srp=None, out=None, resume=True, scheduler=None, progress=None,
+                solve=True, attrs=None):
         calls.append(dict(orbits=orbits, kz=kz, wz0=wz0, phi0=phi0, n_periods=n_periods, srp=srp, out=out, resume=resume,
                           scheduler=scheduler, progress=progress, solve=solve, attrs=attrs))
         ds = librate.periodicity_map(orbits, kz=kz, wz0=wz0, phi0=phi0, n_periods=n_periods, srp=srp, solve=solve)
@@ -60,10 +61,12 @@ def fake_runner(monkeypatch):
     (["init"], ["commented example", "Kz = 0.8", "1/TU"]),
     (["family"], ["continuation", "family.zarr", "Jacobi", "LU/TU", "--x0", "START:STOP:NUM"]),
     (["solve"], ["wz(T) = wz0", "phi(T) = phi0 + 2 pi N", "solve.zarr", "1/TU", "residual", "stable"]),
-    (["map"], ["wz(T) - wz0 (1/TU)", "map.zarr", "resumable", "--scheduler", "--quiet", "map_contours.png", "map_residuals.png", "--force"]),
+    (["map"], ["wz(T) - wz0 (1/TU)", "map.zarr", "resumable", "--scheduler", "--quiet", "map_contours.png",
+               "map_residuals.png", "--force"]),
     (["plot"], ["without recomputing", "STEM_orbits.png", "STEM_contours.png", "STEM_residuals.png", "demo"]),
     (["info"], ["presets"]),
-    (["transition"], ["[ephemeris]", "DE440", "multiple shooting", "transition.zarr", "Moon-centred ICRF", "--scheduler", "transition_rotating.png"]),
+    (["transition"], ["[ephemeris]", "DE440", "multiple shooting", "transition.zarr", "Moon-centred ICRF", "--scheduler",
+                      "transition_rotating.png"]),
 ])
 def test_help_teaches(run, cmd, words):
     out = run(*cmd, "--help").output
@@ -93,7 +96,8 @@ def test_init_map_plot_end_to_end(run, tmp_path, no_runner):
     res = run("map", "study.toml", *TINY)
     out = tmp_path / "librate-out"
     assert "periodicity map: 3 orbits x 1 Kz x 50 rates = 150 attitude trajectories" in res.output
-    assert "map: 3 (orbits.x0) x 1 (body.kz) x 50 (rates.wz0) = 150 trajectories of 1 orbit period" in res.output  # the size, before the run
+    # the size, before the run
+    assert "map: 3 (orbits.x0) x 1 (body.kz) x 50 (rates.wz0) = 150 trajectories of 1 orbit period" in res.output
     assert "solutions (wz(T) = wz0" in res.output
     store = out / "map.zarr"
     ds = librate.open_result(store)
@@ -119,7 +123,8 @@ def test_map_drives_the_runner_interface(run, tmp_path, fake_runner):
     (call,) = fake_runner
     assert isinstance(call["orbits"], librate.OrbitFamily) and len(call["orbits"]) == 3
     assert call["kz"].tolist() == [0.8] and call["wz0"].tolist() == np.linspace(-3, 2, 50).tolist()
-    assert (call["phi0"], call["n_periods"], call["srp"], call["solve"], call["resume"], call["scheduler"]) == (0.0, 1, None, True, True, None)
+    assert (call["phi0"], call["n_periods"], call["srp"], call["solve"], call["resume"],
+            call["scheduler"]) == (0.0, 1, None, True, True, None)
     assert call["out"] == str(tmp_path / "runs" / "a" / "map.zarr")
     assert call["progress"] is False  # --quiet: no bars
     study = json.loads(call["attrs"]["study"])

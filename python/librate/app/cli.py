@@ -119,8 +119,10 @@ def _in_cli_words(message: str, keys: dict[str, str]) -> str:
 @click.option("--kz", default=0.8, show_default=True, type=click.FloatRange(-1, 1), help="Inertia parameter Kz = (Iy - Ix)/Iz.")
 @click.option("--orbits", "n_orbits", default=60, show_default=True, type=click.IntRange(2, 2000),
               help="DRO family members with x0 evenly from 0.95 to 0.15; the 12.66-day DRO (thesis Fig. 23) is added to them.")
-@click.option("--rates", "n_rates", default=1000, show_default=True, type=click.IntRange(10, 100000), help="Initial rates, phidot0 in [-4, 1] (wz0 in [-3, 2]).")
-@click.option("--out", "out_dir", default="librate-out", show_default=True, type=click.Path(file_okay=False), help="Output folder for demo.nc and the demo_*.png figures.")
+@click.option("--rates", "n_rates", default=1000, show_default=True, type=click.IntRange(10, 100000),
+              help="Initial rates, phidot0 in [-4, 1] (wz0 in [-3, 2]).")
+@click.option("--out", "out_dir", default="librate-out", show_default=True, type=click.Path(file_okay=False),
+              help="Output folder for demo.nc and the demo_*.png figures.")
 @click.option("--resume/--force", default=True, help=_FORCE_HELP)
 @click.option("--quiet", "-q", is_flag=True, help="No progress bars and no table; print only the written paths.")
 def demo(system_name: str, kz: float, n_orbits: int, n_rates: int, out_dir: str, resume: bool, quiet: bool) -> None:
@@ -148,7 +150,8 @@ def demo(system_name: str, kz: float, n_orbits: int, n_rates: int, out_dir: str,
     path = out / "demo.nc"
     _check_writable(out, "--out")
     try:
-        ds, fam = run_demo(system_name, kz, n_orbits, n_rates, path, force=not resume, say=lambda text: _say(_in_cli_words(text, _DEMO_KEYS)),
+        ds, fam = run_demo(system_name, kz, n_orbits, n_rates, path, force=not resume,
+                           say=lambda text: _say(_in_cli_words(text, _DEMO_KEYS)),
                            echo=lambda text: _echo(quiet, text),
                            progress=reporter("periodicity map (and solutions)", "orbit", None if not quiet else False))
     except ResultExists as err:
@@ -168,7 +171,8 @@ def demo(system_name: str, kz: float, n_orbits: int, n_rates: int, out_dir: str,
 
 @main.command(name="dros", context_settings=_CONTEXT, short_help="Correct distant retrograde orbits and check that each closes.")
 @click.option("--system", "system_name", default="earth-moon", show_default=True, type=_PRESET, help="System preset.")
-@click.option("--x0", "x0_values", multiple=True, type=float, help="DRO start(s) on the x axis, between the primaries (default: 0.96 0.93 0.90 0.87 0.84 0.81).")
+@click.option("--x0", "x0_values", multiple=True, type=float,
+              help="DRO start(s) on the x axis, between the primaries (default: 0.96 0.93 0.90 0.87 0.84 0.81).")
 def dros(system_name: str, x0_values: tuple[float, ...]) -> None:
     """Correct a set of distant retrograde orbits and check each over one full period.
 
@@ -249,7 +253,8 @@ def _load_study(path: str | None, purpose: str, overrides: dict, force: bool = F
 
     try:
         if path is None:
-            st = Study.from_dict(apply_overrides({}, overrides), purpose=purpose, base_dir=Path.cwd(), source="(command-line options)", force=force)
+            st = Study.from_dict(apply_overrides({}, overrides), purpose=purpose, base_dir=Path.cwd(),
+                                 source="(command-line options)", force=force)
         else:
             st = Study.from_toml(path, purpose=purpose, overrides=overrides, force=force)
     except StudyError as err:
@@ -324,7 +329,8 @@ def _x0_option(text: str):
 @click.option("--system", "system_name", help="System preset, e.g. earth-moon or earth-moon-jpl (system.preset).")
 @click.option("--format", "fmt", help="zarr or netcdf (output.format).")
 @click.option("--set", "sets", multiple=True, metavar="KEY=VALUE", help=_SET_HELP)
-@click.option("--out", "out_dir", type=click.Path(file_okay=False), help="Output folder (default: output.folder of the study, else librate-out).")
+@click.option("--out", "out_dir", type=click.Path(file_okay=False),
+              help="Output folder (default: output.folder of the study, else librate-out).")
 @click.option("--resume/--force", default=True, help=_FORCE_HELP)
 @click.option("--quiet", "-q", is_flag=True, help="Print only the written paths.")
 def family(study, kind, point, branch, x0, members, system_name, fmt, sets, out_dir, resume, quiet) -> None:
@@ -391,7 +397,8 @@ def _quote(v):
 @click.option("--out", "out_dir", type=click.Path(file_okay=False), help="Output folder (default: output.folder of the study).")
 @click.option("--resume/--force", default=True, help=_FORCE_HELP)
 @click.option("--quiet", "-q", is_flag=True, help="No progress and no table; print only the written path.")
-@click.option("--scheduler", metavar="tcp://HOST:PORT", help="Solve each orbit and Kz as a task on this Dask scheduler (planar studies; needs dask.distributed).")
+@click.option("--scheduler", metavar="tcp://HOST:PORT",
+              help="Solve each orbit and Kz as a task on this Dask scheduler (planar studies; needs dask.distributed).")
 def solve(study, sets, out_dir, resume, quiet, scheduler) -> None:
     """Find the periodic attitude motions of each orbit and Kz of STUDY in its rate window.
 
@@ -431,7 +438,8 @@ def solve(study, sets, out_dir, resume, quiet, scheduler) -> None:
     three_d = isinstance(st, Study3D)
     t0 = time.perf_counter()
     try:
-        ds, path = run_solve(st, out_dir, progress=reporter("3-D solutions" if three_d else "solutions", "member" if three_d else "orbit-Kz",
+        ds, path = run_solve(st, out_dir, progress=reporter("3-D solutions" if three_d else "solutions",
+                                                           "member" if three_d else "orbit-Kz",
                                                            _show(quiet)), force=not resume, say=_say, scheduler=scheduler)
     except _FAILURES as err:
         raise _failure(err) from None
@@ -452,9 +460,11 @@ def solve(study, sets, out_dir, resume, quiet, scheduler) -> None:
 
 @main.command(name="map", context_settings=_CONTEXT, short_help="The attitude periodicity map of a study (thesis Fig. 24).")
 @click.argument("study", type=click.Path(exists=True, dir_okay=False))
-@click.option("--out", "out_dir", type=click.Path(file_okay=False), help="Output folder (default: output.folder of the study); the map goes to OUT/map.zarr.")
+@click.option("--out", "out_dir", type=click.Path(file_okay=False),
+              help="Output folder (default: output.folder of the study); the map goes to OUT/map.zarr.")
 @click.option("--quiet", "-q", is_flag=True, help="No progress bar and no summary; print only the written paths.")
-@click.option("--scheduler", metavar="tcp://HOST:PORT", help="Run the map's orbits (planar or 3-D) as tasks on this Dask scheduler (needs dask.distributed).")
+@click.option("--scheduler", metavar="tcp://HOST:PORT",
+              help="Run the map's orbits (planar or 3-D) as tasks on this Dask scheduler (needs dask.distributed).")
 @click.option("--resume/--force", default=True, help=_FORCE_HELP)
 @click.option("--set", "sets", multiple=True, metavar="KEY=VALUE", help=_SET_HELP)
 def map_(study, out_dir, quiet, scheduler, resume, sets) -> None:
@@ -511,7 +521,8 @@ def map_(study, out_dir, quiet, scheduler, resume, sets) -> None:
 
 @main.command(context_settings=_CONTEXT, short_help="Carry the study's orbit into the ephemeris model at its epochs.")
 @click.argument("study", type=click.Path(exists=True, dir_okay=False))
-@click.option("--out", "out_dir", type=click.Path(file_okay=False), help="Output folder (default: output.folder of the study); the result goes to OUT/transition.zarr.")
+@click.option("--out", "out_dir", type=click.Path(file_okay=False),
+              help="Output folder (default: output.folder of the study); the result goes to OUT/transition.zarr.")
 @click.option("--quiet", "-q", is_flag=True, help="No progress bar and no table; print only the written paths.")
 @click.option("--scheduler", metavar="tcp://HOST:PORT", help="Run each epoch as a task on this Dask scheduler (needs dask.distributed).")
 @click.option("--resume/--force", default=True, help=_FORCE_HELP)

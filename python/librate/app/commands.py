@@ -12,7 +12,8 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["demo_family", "demo_study", "demo_summary", "describe_for_plot", "draw_figures", "dro_closures", "map_3d_summary", "map_solutions_summary",
+__all__ = ["demo_family", "demo_study", "demo_summary", "describe_for_plot", "draw_figures", "dro_closures", "map_3d_summary",
+           "map_solutions_summary",
            "refuse_damaged", "result_kind_of", "run_demo", "solutions_table", "solve_3d_summary", "writable_problem"]
 
 
@@ -175,7 +176,8 @@ def draw_figures(result, path: Path, names=None, *, show: bool | None = None, ex
 
         from .. import plotting as lp
     except ImportError as err:
-        print(f"figures skipped: matplotlib, a required dependency of librate, cannot be imported ({err}); reinstall librate", file=sys.stderr)
+        print("figures skipped: matplotlib, a required dependency of librate, cannot be imported "
+              f"({err}); reinstall librate", file=sys.stderr)
         return []
     from .progress import bar
     from .results import solution_3d
@@ -206,7 +208,8 @@ def draw_figures(result, path: Path, names=None, *, show: bool | None = None, ex
                 plt.close(fig)
                 with contextlib.suppress(OSError):
                     (folder / name).unlink(missing_ok=True)
-                raise OSError(err.errno, f"cannot write the figure ({err.strerror or type(err).__name__}); the result {path} is kept, complete",
+                raise OSError(err.errno, f"cannot write the figure ({err.strerror or type(err).__name__}); the result "
+                                         f"{path} is kept, complete",
                               str(folder / name)) from None
             plt.close(fig)
             progress.update(1)
@@ -220,15 +223,18 @@ def demo_summary(ds, shown_n: int = 3) -> list[str]:
     n_, kind_ = ds.sol_n.values, ds.sol_kind.values.astype(str)
     listed = np.abs(n_) <= shown_n
     total = int(ds.sizes["solution"])
-    omitted = "" if listed.all() else f"; listed below: |N| <= {shown_n} ({int(listed.sum())}), {total - int(listed.sum())} with |N| > {shown_n} omitted"
-    out.append(f"solutions (phi(T) = 2 pi N, wz(T) = wz0, refined by Newton, residual from an independent re-propagation): {total}{omitted}")
+    omitted = "" if listed.all() else (f"; listed below: |N| <= {shown_n} ({int(listed.sum())}), "
+                                       f"{total - int(listed.sum())} with |N| > {shown_n} omitted")
+    out.append("solutions (phi(T) = 2 pi N, wz(T) = wz0, refined by Newton, residual from an independent "
+               f"re-propagation): {total}{omitted}")
     out.append(f"{'N':>4} {'kind':>10} {'count':>6} {'stable':>7} {'phidot0 range [1/TU]':>24} {'max residual':>13}")
     for (n, kind) in sorted(set(zip(n_.tolist(), kind_.tolist())), key=lambda x: (x[1], x[0])):
         if abs(n) > shown_n:
             continue
         sel = (n_ == n) & (kind_ == kind)
         pd = ds.sol_phidot0.values[sel]
-        out.append(f"{n:>4g} {kind:>10} {int(sel.sum()):>6} {int(ds.sol_stable.values[sel].sum()):>7} {pd.min():>11.4f} .. {pd.max():<10.4f} {ds.sol_residual.values[sel].max():>13.1e}")
+        out.append(f"{n:>4g} {kind:>10} {int(sel.sum()):>6} {int(ds.sol_stable.values[sel].sum()):>7} {pd.min():>11.4f} .. "
+                   f"{pd.max():<10.4f} {ds.sol_residual.values[sel].max():>13.1e}")
     return out
 
 
@@ -242,8 +248,10 @@ def solve_3d_summary(ds, elapsed: float) -> list[str]:
 
     m = multipliers_3d(ds)
     n = ds.sizes["member"]
-    out.append(f"periodic 3-D attitude motion along {n} of {ds.attrs.get('members_requested', n)} member(s) of the {ds.attrs.get('orbit_family')} family, "
-               f"body moments ({', '.join(f'{v:.6g}' for v in np.atleast_1d(ds.attrs['body_moments']))}) kg m^2, K = {ds.attrs['n_periods']} ({elapsed:.2f} s); start: {ds.attrs.get('start_description')}")
+    out.append(f"periodic 3-D attitude motion along {n} of {ds.attrs.get('members_requested', n)} member(s) of the "
+               f"{ds.attrs.get('orbit_family')} family, body moments "
+               f"({', '.join(f'{v:.6g}' for v in np.atleast_1d(ds.attrs['body_moments']))}) kg m^2, K = {ds.attrs['n_periods']} "
+               f"({elapsed:.2f} s); start: {ds.attrs.get('start_description')}")
     out.append(f"{'member':>6} {'T [d]':>9} {'x0 [LU]':>9} {'z0 [LU]':>9} {'q0 (x, y, z, w)':>36} {'w0 [1/TU] (x, y, z)':>36} "
                f"{'max|mult|':>10} {'stable':>6} {'turns':>6} {'residual':>9}")
     for j in range(n):
@@ -251,7 +259,8 @@ def solve_3d_summary(ds, elapsed: float) -> list[str]:
         turns = ds["turns"].values[j]
         out.append(f"{j:>6d} {ds['period_days'].values[j]:>9.5f} {ds['x0'].values[j]:>9.5f} {ds['z0'].values[j]:>9.5f} "
                    f"{' '.join(f'{v:8.5f}' for v in q):>36} {' '.join(f'{v:11.7f}' for v in w):>36} {np.abs(m[j]).max():>10.6g} "
-                   f"{'yes' if ds['stable'].values[j] else 'no':>6} {'-' if np.isnan(turns) else f'{round(turns, 3) + 0.0:.3f}':>6} {ds['residual'].values[j]:>9.1e}")
+                   f"{'yes' if ds['stable'].values[j] else 'no':>6} {'-' if np.isnan(turns) else f'{round(turns, 3) + 0.0:.3f}':>6} "
+                   f"{ds['residual'].values[j]:>9.1e}")
     out.append(f"continuation: {ds.attrs.get('end_reason')}")
     for ch in ast.literal_eval(ds.attrs.get("stability_changes", "[]")):
         where = f"at T = {ch['at']:.10g} d" + ("" if ch["located"] else " (interpolated)")
@@ -275,7 +284,8 @@ def map_3d_summary(ds, elapsed: float) -> list[str]:
         r = ds["residual_norm"].isel(orbit=i)
         k = np.unravel_index(int(np.nanargmin(r.values)), r.shape)
         at = ", ".join(f"{d} = {float(ds[d].values[j]):.4f}" for d, j in zip(grid, k))
-        out.append(f"  orbit {i} (T = {float(ds['period_days'].values[i]):.4f} d): smallest max |residual| {float(r.values[k]):.2e} at {at}")
+        out.append(f"  orbit {i} (T = {float(ds['period_days'].values[i]):.4f} d): smallest max |residual| "
+                   f"{float(r.values[k]):.2e} at {at}")
     return out
 
 
@@ -290,7 +300,8 @@ def map_solutions_summary(ds) -> list[str]:
     out.append(f"{'N':>4} {'kind':>10} {'count':>6} {'stable':>7} {'phidot0 range [1/TU]':>24} {'max residual':>13}")
     for n, kind in sorted(set(zip(n_.tolist(), kind_.tolist())), key=lambda x: (x[1], -x[0])):
         sel = (n_ == n) & (kind_ == kind)
-        out.append(f"{n:>4g} {kind:>10} {int(sel.sum()):>6} {int(stable[sel].sum()):>7} {pd[sel].min():>11.4f} .. {pd[sel].max():<10.4f} {res[sel].max():>13.1e}")
+        out.append(f"{n:>4g} {kind:>10} {int(sel.sum()):>6} {int(stable[sel].sum()):>7} {pd[sel].min():>11.4f} .. {pd[sel].max():<10.4f} "
+                   f"{res[sel].max():>13.1e}")
     return out
 
 
@@ -301,6 +312,7 @@ def solutions_table(ds) -> list[str]:
            f"{'trace':>10} {'stable':>6} {'residual':>9}"]
     for j in range(ds.sizes["solution"]):
         r = {k: ds[f"sol_{k}"].values[j] for k in cols}
-        out.append(f"{r['orbit']:>5d} {r['x0']:>9.5f} {r['period_days']:>8.4f} {r['kz']:>6.3g} {r['n']:>4g} {r['kind']:>9} {r['wz0']:>13.8f} "
-                   f"{r['phidot0']:>13.8f} {r['phi0']:>9.5f} {r['trace']:>10.4g} {'yes' if r['stable'] else 'no':>6} {r['residual']:>9.1e}")
+        out.append(f"{r['orbit']:>5d} {r['x0']:>9.5f} {r['period_days']:>8.4f} {r['kz']:>6.3g} {r['n']:>4g} "
+                   f"{r['kind']:>9} {r['wz0']:>13.8f} {r['phidot0']:>13.8f} {r['phi0']:>9.5f} {r['trace']:>10.4g} "
+                   f"{'yes' if r['stable'] else 'no':>6} {r['residual']:>9.1e}")
     return out

@@ -325,7 +325,8 @@ def plot_map_3d(ds, ax=None, *, orbits=None) -> Figure:
     idx = list(range(min(3, ds.sizes["orbit"]))) if has_orbit and orbits is None else list(orbits or [None])
     rate_dims = [d for d in ds["residual_norm"].dims if d in ("wx0", "wy0", "wz0")]
     if len(rate_dims) != 2 or len(ds["residual_norm"].dims) != 2 + has_orbit:
-        raise ValueError(f"invalid argument `ds`: the figure needs exactly two rate grids (and at most an orbit dimension), got dims {ds['residual_norm'].dims}")
+        raise ValueError("invalid argument `ds`: the figure needs exactly two rate grids (and at most an orbit dimension), got dims "
+                         f"{ds['residual_norm'].dims}")
     fig, axs = figure_axes(ax, len(idx))
     for a, i in zip(axs, idx):
         r = ds["residual_norm"] if i is None else ds["residual_norm"].isel(orbit=i)

@@ -170,7 +170,8 @@ def plot_transition_sweep(epochs_tdb, max_departure_km, perilune_km, iterations=
     per = _array(perilune_km, "perilune_km", (1, 2))
     per = per[:, None] if per.ndim == 1 else per
     if dep.size != t.size or per.shape[0] != t.size:
-        raise ValueError(f"invalid arguments: one value per epoch ({t.size}), got max_departure_km {dep.shape}, perilune_km {np.shape(perilune_km)}")
+        raise ValueError(f"invalid arguments: one value per epoch ({t.size}), got max_departure_km {dep.shape}, perilune_km "
+                         f"{np.shape(perilune_km)}")
     n = 2 if iterations is None else 3
     fig, axs = figure_axes(ax, n, figsize=(5.0 * n, 4.2))
     axs[0].plot(t, dep, color="tab:red", marker="." if t.size < 60 else None, gid="departure")

@@ -192,7 +192,8 @@ def plot_flexible_coordinate(quasi, traj=None, ax=None, *, index=None, period: f
         raise ValueError(f"invalid argument `quasi`: must be a librate.attitude.QuasiStaticResponse, got {type(quasi).__name__}")
     if traj is not None:
         if getattr(traj, "flex", None) is None:
-            raise ValueError("invalid argument `traj`: must be a flexible librate.AttitudeTrajectory (propagate_attitude with a FlexibleBody)")
+            raise ValueError("invalid argument `traj`: must be a flexible librate.AttitudeTrajectory (propagate_attitude "
+                             "with a FlexibleBody)")
         if traj.t.shape != quasi.t.shape or not np.allclose(traj.t, quasi.t, rtol=0, atol=1e-12 * max(1.0, float(np.max(np.abs(quasi.t))))):
             raise ValueError("invalid argument `traj`: must be sampled at the closed form's times (same t_eval)")
     idx = _indices(quasi.body.n, index)

@@ -117,7 +117,8 @@ def plot_family(
         projection = ("xy", "xz") if fam.spatial else "xy"
     projs = [projection] if isinstance(projection, str) else list(projection)
     if not projs or any(p not in PROJECTIONS for p in projs):
-        raise ValueError(f"invalid argument `projection`: must be one of {', '.join(PROJECTIONS)} or a sequence of them, got {projection!r}")
+        raise ValueError(f"invalid argument `projection`: must be one of {', '.join(PROJECTIONS)} or a sequence of "
+                         f"them, got {projection!r}")
     if isinstance(samples, bool) or not isinstance(samples, (int, np.integer)) or samples < 2:
         raise ValueError(f"invalid argument `samples`: must be an integer >= 2, got {samples!r}")
     scale, unit = length_scale(sys_, units)
@@ -507,7 +508,8 @@ def plot_eci(
     orbits = list(orbits)
     if not orbits or not all(isinstance(o, PeriodicOrbit) for o in orbits):
         raise ValueError("invalid argument `orbits`: must be a librate.PeriodicOrbit or a non-empty sequence of them")
-    if n_periods is not None and not (isinstance(n_periods, (int, float, np.integer, np.floating)) and math.isfinite(n_periods) and n_periods > 0):
+    if n_periods is not None and not (isinstance(n_periods, (int, float, np.integer,
+                                                             np.floating)) and math.isfinite(n_periods) and n_periods > 0):
         raise ValueError(f"invalid argument `n_periods`: must be a number > 0 or None, got {n_periods!r}")
     if isinstance(samples_per_period, bool) or not isinstance(samples_per_period, (int, np.integer)) or samples_per_period < 8:
         raise ValueError(f"invalid argument `samples_per_period`: must be an integer >= 8, got {samples_per_period!r}")

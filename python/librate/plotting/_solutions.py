@@ -183,7 +183,8 @@ def plot_solution_scatter(ds, ax=None) -> Figure:
     (the colours of the map figures), marker by kind, filled when linearly stable
     (``gid="solutions"``). Returns the Figure."""
     if not hasattr(ds, "data_vars") or not all(v in ds.variables for v in ("sol_n", "sol_stable", "sol_x0", "sol_phidot0")):
-        raise ValueError(f"invalid argument `ds`: must be an xarray Dataset with the sol_* variables of librate solve, got {type(ds).__name__}")
+        raise ValueError("invalid argument `ds`: must be an xarray Dataset with the sol_* variables of librate solve, "
+                         f"got {type(ds).__name__}")
     fig, (a,) = figure_axes(ax, 1, figsize=(6.4, 4.8))
     n = ds["sol_n"].values
     kind = ds["sol_kind"].values.astype(str) if "sol_kind" in ds.variables else np.full(n.shape, "periodic")

@@ -63,8 +63,8 @@ def plot_srp_map(
     the fixed phi0): the gravity-only ones start on the contours' crossings at eps = 0 and leave
     them. ``reference``:
     an eps (or (eps, label)) marked by a vertical line (``gid="eps-reference"``; only named in the
-    legend when outside the map's range), e.g. the plate of a given A/m. ``rate``: ``"relative"`` (phidot(0) = wz(0) - 1, default) or ``"inertial"``.
-    ``kinds``: the solutions shown. Returns the Figure.
+    legend when outside the map's range), e.g. the plate of a given A/m. ``rate``: ``"relative"`` (phidot(0) = wz(0) - 1, default) or
+    ``"inertial"``. ``kinds``: the solutions shown. Returns the Figure.
 
     Parameters
     ----------
@@ -238,7 +238,8 @@ def plot_srp_maps(maps, ax=None, *, titles: Sequence[str] | None = None, **kwarg
     common = [k for k in names if k not in varying]
     label = dict(_MAP_PARAMETERS)
     created = ax is None
-    fig, axs = figure_axes(ax, len(maps), figsize=(8.6, 5.8) if len(maps) == 1 else (5.0 * min(len(maps), 3) + 2.6, 5.4 * math.ceil(len(maps) / 3)))
+    fig, axs = figure_axes(ax, len(maps), figsize=(8.6, 5.8) if len(maps) == 1 else (5.0 * min(len(maps), 3) + 2.6,
+                                                                                     5.4 * math.ceil(len(maps) / 3)))
     import inspect
 
     takes = {f: set(inspect.signature(f).parameters) - {"ds", "ax"} for f in (plot_srp_map, plot_map)}

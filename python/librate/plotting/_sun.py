@@ -125,7 +125,8 @@ def plot_sun_motion(
         c, s = math.cos(ang), math.sin(ang)
         color = cm(0.85 * k / n_directions)
         (h,) = a_geo.plot([0.0, radius * c], [0.0, radius * s], color=color, linewidth=2.0 if k == 0 else 1.0, zorder=2,
-                          label=f"Sun direction at $t$ = 0 ($\\theta_{{s0}}$ = {math.degrees(theta_sun0):.4g} deg)" if k == 0 else "_nolegend_")
+                          label=f"Sun direction at $t$ = 0 ($\\theta_{{s0}}$ = {math.degrees(theta_sun0):.4g} deg)" if k == 0
+                          else "_nolegend_")
         h.set_gid("sun-direction")
         (h,) = a_geo.plot([radius * c], [radius * s], marker="o", markersize=11 if k == 0 else 8, color=SUN_COLOR,
                           markeredgecolor=color, markeredgewidth=1.5, linestyle="none", zorder=4)
@@ -263,7 +264,8 @@ def plot_sun_resonant(
                 a.annotate(name, (pos[0], pos[1]), xytext=(dx, dy), textcoords="offset points", fontsize=8, ha=ha)
             else:  # drawn, but kept out of the data limits: an arrow at the edge points to it
                 h = a.add_artist(Line2D([pos[0]], [pos[1]], **style))
-                a.annotate(f"$\\leftarrow$ {name} at $x$ = {pos[0]:.4g} {unit}" if pos[0] < lo[0] else f"{name} at $x$ = {pos[0]:.4g} {unit} $\\rightarrow$",
+                a.annotate(f"$\\leftarrow$ {name} at $x$ = {pos[0]:.4g} {unit}" if pos[0] < lo[0]
+                           else f"{name} at $x$ = {pos[0]:.4g} {unit} $\\rightarrow$",
                            xy=(0.0 if pos[0] < lo[0] else 1.0, 0.5), xycoords="axes fraction", xytext=(4 if pos[0] < lo[0] else -4, 8),
                            textcoords="offset points", ha="left" if pos[0] < lo[0] else "right", va="center", fontsize=8,
                            color="0.3").set_gid(f"{gid}-direction")
@@ -365,7 +367,8 @@ def plot_sun_pointing(
     z = a.axhline(0.0, color="0.5", linewidth=0.7)
     z.set_gid("zero")
     (h,) = a.plot(t * tscale, gg, color="tab:blue", linewidth=1.4,
-                  label=f"gravity gradient $\\frac{{3}}{{2}} K_z (S\\cos 2\\varphi - C\\sin 2\\varphi)$, max |.| = {np.max(np.abs(gg)):.3g}")
+                  label="gravity gradient $\\frac{3}{2} K_z (S\\cos 2\\varphi - C\\sin 2\\varphi)$, max |.| = "
+                        f"{np.max(np.abs(gg)):.3g}")
     h.set_gid("gravity-gradient")
     (h,) = a.plot(t * tscale, srp, color=SRP_COLOR, linewidth=1.4, label=f"SRP ({what}), max |.| = {np.max(np.abs(srp)):.3g}")
     h.set_gid("srp")

@@ -14,9 +14,9 @@ import numpy as np
 from .store import StoreSchema, Var
 
 __all__ = ["FIGURE_FILES", "FamilyResult", "KINDS", "Map3DResult", "MAP_3D_VARIABLES", "MAP_VARIABLES", "MapResult",
-           "RESIDUALS_PERIOD_DAYS", "RESIDUALS_PERIOD_TOL_DAYS", "ResultKind", "Solutions3DResult", "SolutionsResult", "TRANSITION_ATTITUDE_VARIABLES",
-           "TRANSITION_VARIABLES", "TransitionResult", "kind_of", "map3d_schema", "map_schema", "residuals_orbit", "transition_schema",
-           "transition_variables"]
+           "RESIDUALS_PERIOD_DAYS", "RESIDUALS_PERIOD_TOL_DAYS", "ResultKind", "Solutions3DResult", "SolutionsResult",
+           "TRANSITION_ATTITUDE_VARIABLES", "TRANSITION_VARIABLES", "TransitionResult", "kind_of", "map3d_schema", "map_schema",
+           "residuals_orbit", "transition_schema", "transition_variables"]
 
 #: The per-orbit variables of a planar map: units and long names (periodicity_map, run_map and
 #: the store all take them from here).
