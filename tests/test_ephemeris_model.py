@@ -97,3 +97,32 @@ def test_synodic_maps_round_trip(eph):
     f = eph.rotating_frame(t)
     rho = np.linalg.norm(np.asarray(d.state0[:3]) - [1 - em.mu, 0, 0])
     assert np.linalg.norm(x[:3]) == pytest.approx(rho * f.distance_km, rel=1e-12)
+
+
+def test_batch_propagation_equals_one_leg_at_a_time_and_keeps_the_good_legs(eph):
+    """librate.propagate_ephemeris_many: 9:2 NRHO states at 6 daily epochs, each over half a
+    period, with the STM: the same bits as propagate_ephemeris run leg by leg (each leg is
+    integrated alone, on rayon); a leg that cannot be integrated (started 1 m from the Moon's
+    centre) is reported in ``errors`` with NaN rows and ``ok`` False, the other legs kept."""
+    em = librate.System.preset("earth-moon")
+    nrho = librate.halo(em, 2, "south", period_days=29.530589 / 4.5)
+    t0 = tdb_seconds("2030-01-01T00:00:00 TDB")
+    epochs = [t0 + k * DAY for k in range(6)]
+    states = np.array([eph.synodic_to_ephemeris(nrho.state0, t, em.mu) for t in epochs])
+    half = 0.5 * nrho.period * em.tu_s
+    batch = librate.propagate_ephemeris_many(states, epochs, half, ephemeris=eph, stm=True)
+    assert batch.ok.all() and not batch.errors and batch.stm.shape == (6, 6, 6)
+    for i, t in enumerate(epochs):
+        one = librate.propagate_ephemeris(states[i], t, half, ephemeris=eph, stm=True, t_eval=[half])
+        assert np.array_equal(batch.states_km[i], one.states_km[-1]) and np.array_equal(batch.stm[i], one.stm)
+    bad = states.copy()
+    bad[2] = [1e-3, 0.0, 0.0, 0.0, 0.0, 0.0]
+    out = librate.propagate_ephemeris_many(bad, epochs, [half] * 6, ephemeris=eph)
+    assert list(out.errors) == [2] and isinstance(out.errors[2], librate.IntegrationError)
+    assert out.ok.tolist() == [True, True, False, True, True, True] and np.isnan(out.states_km[2]).all()
+    plain = librate.propagate_ephemeris_many(states, epochs, half, ephemeris=eph)  # no STM: its own steps
+    assert np.array_equal(np.delete(out.states_km, 2, axis=0), np.delete(plain.states_km, 2, axis=0))
+    with pytest.raises(ValueError, match="`epochs`, `durations_s`"):
+        librate.propagate_ephemeris_many(states, epochs[:5], half, ephemeris=eph)
+    with pytest.raises(ValueError, match="`rtol`"):
+        librate.propagate_ephemeris_many(states, epochs, half, ephemeris=eph, rtol=1.0)

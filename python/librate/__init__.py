@@ -26,7 +26,7 @@ from .attitude import (
     quasi_static,
     quaternion_from_euler,
 )
-from .ephemeris import Ephemeris, EphemerisTrajectory, propagate_ephemeris
+from .ephemeris import Ephemeris, EphemerisBatch, EphemerisTrajectory, propagate_ephemeris, propagate_ephemeris_many
 from .orbits import (
     BatchResult,
     EphemerisOrbit,
@@ -97,6 +97,8 @@ __all__ = [
     "Ephemeris",
     "EphemerisTrajectory",
     "propagate_ephemeris",
+    "EphemerisBatch",
+    "propagate_ephemeris_many",
     "EphemerisOrbit",
     "to_ephemeris",
     "ephemeris_sweep",

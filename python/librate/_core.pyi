@@ -871,6 +871,14 @@ class EphemerisCore:
         atol: float = 1e-9,
         gm: tuple[float, float, float] | None = None,
     ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], npt.NDArray[np.float64] | None]: ...
+    def propagate_batch(
+        self,
+        states_km: npt.NDArray[np.float64],
+        epochs: npt.NDArray[np.float64],
+        durations_s: npt.NDArray[np.float64],
+        stm: bool = False,
+        integration: tuple[float, float] = ...,
+    ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64] | None, dict[int, Exception]]: ...
     def transition(
         self,
         states_km: npt.NDArray[np.float64],

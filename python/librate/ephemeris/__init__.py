@@ -2,6 +2,7 @@
 scale (epochs), the Chebyshev segments evaluated in Rust, the Moon-centred ICRF point-mass
 dynamics with the STM, and the instantaneous Earth-Moon frame (model)."""
 
-from .model import Ephemeris, EphemerisTrajectory, RotatingFrame, propagate_ephemeris, sun_phase
+from .model import Ephemeris, EphemerisBatch, EphemerisTrajectory, RotatingFrame, propagate_ephemeris, propagate_ephemeris_many, sun_phase
 
-__all__ = ["Ephemeris", "EphemerisTrajectory", "RotatingFrame", "propagate_ephemeris", "sun_phase"]
+__all__ = ["Ephemeris", "EphemerisBatch", "EphemerisTrajectory", "RotatingFrame", "propagate_ephemeris", "propagate_ephemeris_many",
+           "sun_phase"]

@@ -12,7 +12,9 @@ from .. import _core
 from .epochs import tdb_seconds
 from .spk import embedded_spk_path, read_spk
 
-__all__ = ["Ephemeris", "EphemerisTrajectory", "RotatingFrame", "default_ephemeris", "epoch_seconds", "propagate_ephemeris", "sun_phase"]
+__all__ = ["Ephemeris", "EphemerisBatch", "EphemerisTrajectory", "RotatingFrame", "default_ephemeris",
+           "epoch_seconds", "propagate_ephemeris",
+           "propagate_ephemeris_many", "sun_phase"]
 
 #: NAIF ids
 SUN, EMB, MOON, EARTH = 10, 3, 301, 399
@@ -50,6 +52,29 @@ class EphemerisTrajectory:
     t_tdb: np.ndarray
     states_km: np.ndarray
     stm: np.ndarray | None = None
+
+
+@dataclass(frozen=True, eq=False)
+class EphemerisBatch:
+    """The final states of many legs propagated at once (:func:`propagate_ephemeris_many`).
+
+    Attributes
+    ----------
+    states_km : numpy.ndarray, shape (n, 6)
+        Each leg's final Moon-centred ICRF state (km, km/s); NaN for a leg that failed.
+    stm : numpy.ndarray, shape (n, 6, 6), or None
+        Each leg's state transition matrix from its start to its end, when asked.
+    ok : numpy.ndarray of bool, shape (n,)
+        Whether each leg reached its end.
+    errors : dict
+        ``{index: exception}`` (a :class:`librate.IntegrationError` or a subclass) for the legs
+        that failed; the others are kept.
+    """
+
+    states_km: np.ndarray
+    stm: np.ndarray | None
+    ok: np.ndarray
+    errors: dict
 
 
 class Ephemeris:
@@ -133,6 +158,65 @@ def propagate_ephemeris(
     t, y, phi = e._core.propagate(np.ascontiguousarray(state_km, dtype=float).ravel(), t0, float(duration_s), bool(stm), te,
                                   float(rtol), float(atol))
     return EphemerisTrajectory(t, y, phi)
+
+
+def propagate_ephemeris_many(states_km, epochs, durations_s, *, ephemeris: Ephemeris | None = None, stm: bool = False,
+                             rtol: float = 1e-13, atol: float = 1e-9) -> EphemerisBatch:
+    """Propagate many Moon-centred ICRF states at once, on all cores (Rust, the GIL released).
+
+    Each leg ``i`` starts from ``states_km[i]`` at ``epochs[i]`` and runs for ``durations_s[i]``
+    seconds, as :func:`propagate_ephemeris` would run it alone: the results are the same bits,
+    whatever the number of legs or threads. Only the final states (and STMs) are kept.
+
+    Parameters
+    ----------
+    states_km : array_like, shape (n, 6)
+        Initial states (km, km/s).
+    epochs : sequence of str or float, length n
+        Start epochs (ISO strings with a scale, or TDB seconds past J2000).
+    durations_s : array_like, shape (n,) or a number
+        Durations (s, finite; negative runs backwards), one per leg or one for all.
+    ephemeris : Ephemeris, optional
+        The ephemeris; None, the embedded DE440 excerpt.
+    stm : bool, default False
+        Also integrate each leg's 6x6 state transition matrix.
+    rtol, atol : float, default 1e-13 and 1e-9
+        Integration tolerances (atol in km and km/s).
+
+    Returns
+    -------
+    EphemerisBatch
+        The final states, the STMs, and which legs failed and why (a failed leg does not lose
+        the others).
+
+    Raises
+    ------
+    ValueError
+        Shapes that do not match, a non-finite duration or state, a tolerance out of range, an
+        epoch that cannot be read.
+    """
+    from .._checks import as_tolerance
+
+    e = default_ephemeris(ephemeris)
+    x = np.ascontiguousarray(np.asarray(states_km, dtype=float))
+    if x.ndim != 2 or x.shape[1] != 6 or not np.all(np.isfinite(x)):
+        raise ValueError(f"invalid argument `states_km`: must be a finite array of shape (n, 6), got shape {x.shape}")
+    n = x.shape[0]
+    if isinstance(epochs, (str, bytes)) or np.ndim(epochs) == 0:
+        raise ValueError(f"invalid argument `epochs`: must be a sequence of {n} epochs, got {epochs!r}")
+    t0 = np.ascontiguousarray([epoch_seconds(t) for t in epochs], dtype=float)
+    d = np.ascontiguousarray(np.broadcast_to(np.asarray(durations_s, dtype=float), (n,)) if np.ndim(durations_s) == 0
+                             else np.asarray(durations_s, dtype=float))
+    if t0.shape != (n,) or d.shape != (n,):
+        raise ValueError(f"invalid argument `epochs`, `durations_s`: one per state ({n}), got {t0.size} epochs and "
+                         f"durations of shape {d.shape}")
+    if not np.all(np.isfinite(d)):
+        raise ValueError("invalid argument `durations_s`: must be finite")
+    integration = (as_tolerance(rtol, "rtol"), as_tolerance(atol, "atol"))
+    finals, phis, errors = e._core.propagate_batch(x, t0, d, bool(stm), integration)
+    ok = np.ones(n, dtype=bool)
+    ok[list(errors)] = False
+    return EphemerisBatch(finals, phis, ok, dict(errors))
 
 
 def sun_phase(epoch, ephemeris: Ephemeris | None = None) -> float:

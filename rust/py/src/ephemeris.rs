@@ -3,12 +3,12 @@
 
 use librate_core::ephemeris::{self as eph, Ephemeris, EphemerisDynamics, RotatingFrame, Segment, TransitionSettings};
 use librate_core::integrate::Options;
-use numpy::ndarray::Array2;
-use numpy::{IntoPyArray, PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3, PyUntypedArrayMethods};
+use numpy::ndarray::{Array2, Array3};
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray3, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use crate::convert::fixed;
+use crate::convert::{fixed, rows};
 use crate::errors::{invalid, to_py};
 
 /// The ephemeris (Chebyshev segments evaluated in Rust).
@@ -100,6 +100,56 @@ impl EphemerisCore {
             None => None,
         };
         Ok((tr.t_tdb.into_pyarray(py), states, phi))
+    }
+    /// Propagate many legs, `states_km` (n, 6) from `epochs` (n,) for `durations_s` (n,), on all
+    /// cores (each leg alone: the results do not depend on the thread count); only the final
+    /// states (and STMs) are kept. Returns (finals (n, 6), stms (n, 6, 6) or None, errors
+    /// {index: exception}): a failed leg's rows are NaN and its typed error is in `errors`.
+    #[pyo3(signature = (states_km, epochs, durations_s, stm=false, integration=(1e-13, 1e-9)))]
+    fn propagate_batch<'py>(
+        &self,
+        py: Python<'py>,
+        states_km: PyReadonlyArray2<'_, f64>,
+        epochs: PyReadonlyArray1<'_, f64>,
+        durations_s: PyReadonlyArray1<'_, f64>,
+        stm: bool,
+        integration: (f64, f64),
+    ) -> PyResult<(Bound<'py, PyArray2<f64>>, Option<Bound<'py, PyArray3<f64>>>, Bound<'py, PyDict>)> {
+        let states = rows::<6>(&states_km, "states_km", None)?;
+        let n = states.len();
+        let epochs = epochs.as_slice()?.to_vec();
+        let durations = durations_s.as_slice()?.to_vec();
+        if epochs.len() != n || durations.len() != n {
+            return Err(invalid(format!("invalid argument `epochs`, `durations_s`: one per state ({n}), got {} and {}", epochs.len(), durations.len())));
+        }
+        let legs: Vec<([f64; 6], f64, f64)> = (0..n).map(|i| (states[i], epochs[i], durations[i])).collect();
+        let opts = Options::with_tolerances(integration.0, integration.1);
+        let gm = [eph::GM_EARTH, eph::GM_MOON, eph::GM_SUN];
+        let results = py.detach(|| eph::propagate_ephemeris_batch(&self.inner, gm, &legs, stm, &opts));
+        let mut finals = Vec::with_capacity(n * 6);
+        let mut phis = Vec::with_capacity(if stm { n * 36 } else { 0 });
+        let errors = PyDict::new(py);
+        for (i, r) in results.into_iter().enumerate() {
+            match r {
+                Ok(tr) => {
+                    finals.extend_from_slice(&tr.state_final);
+                    if stm {
+                        phis.extend_from_slice(&tr.stm.unwrap_or([f64::NAN; 36]));
+                    }
+                }
+                Err(e) => {
+                    finals.extend([f64::NAN; 6]);
+                    if stm {
+                        phis.extend([f64::NAN; 36]);
+                    }
+                    errors.set_item(i, to_py(e).into_value(py))?;
+                }
+            }
+        }
+        let shape_err = |e: numpy::ndarray::ShapeError| pyo3::exceptions::PyRuntimeError::new_err(e.to_string());
+        let finals = Array2::from_shape_vec((n, 6), finals).map_err(shape_err)?.into_pyarray(py);
+        let phis = if stm { Some(Array3::from_shape_vec((n, 6, 6), phis).map_err(shape_err)?.into_pyarray(py)) } else { None };
+        Ok((finals, phis, errors))
     }
     /// The multiple-shooting transition of guess nodes (n, 6) at `epochs` (n,) to a continuous
     /// trajectory of the model. `tol` = (km, km/s) per leg; `scales` = (length km, time s) of
