@@ -195,6 +195,31 @@ def fig_ephemeris_sweep():
     return lp.plot_transition_sweep(ds["epoch"].values, ds["max_departure_km"].values, ds["perilune_km"].values, ds["iterations"].values)
 
 
+def _attitude_2030():
+    """The N = 0 periodic attitude motion (Kz = 0.8) of the 70,000 km DRO carried into the ephemeris
+    model along the DRO's transition at 2030-01-01 TDB over 4 revolutions, corrected."""
+    from librate.orbits.transition import to_ephemeris
+
+    orbit = _dro_70000()
+    sols = librate.find_periodic_attitudes(orbit, kz=0.8, wz0_range=(-3.0, 2.0), kinds=("periodic",))
+    sol = min((s for s in sols if s.n == 0), key=lambda s: abs(s.wz0))
+    eo = to_ephemeris(orbit, "2030-01-01T00:00:00 TDB", revolutions=4)
+    return librate.attitude_to_ephemeris(sol, eo)
+
+
+def fig_ephemeris_attitude():
+    """The attitude angles of the DRO's N = 0 motion in both models (relative to the rotating frame), 2030, 4 revolutions."""
+    a = _attitude_2030()
+    cr3bp, eph = a.angles_deg()
+    return lp.plot_ephemeris_attitude((a.t_tdb - a.t_tdb[0]) / 86400.0, cr3bp, eph)
+
+
+def fig_ephemeris_pointing():
+    """The pointing error of each body axis of the DRO's N = 0 motion carried into the ephemeris model, 2030, 4 revolutions."""
+    a = _attitude_2030()
+    return lp.plot_pointing_error((a.t_tdb - a.t_tdb[0]) / 86400.0, a.pointing_error_deg)
+
+
 FIGURES = {name: f for name, f in sorted(globals().items()) if name.startswith("fig") and callable(f)}
 
 
