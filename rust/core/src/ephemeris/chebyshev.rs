@@ -37,7 +37,6 @@ pub struct Segment {
 
 impl Segment {
     /// Check the shape and values of a segment.
-    #[allow(clippy::too_many_arguments)]
     pub fn new(target: i32, center: i32, start: f64, end: f64, init: f64, intlen: f64, n_records: usize, n_coef: usize, coef: Vec<f64>) -> Result<Self> {
         if !(start.is_finite() && end.is_finite() && start < end) {
             return Err(invalid("segments", format!("segment {target} rel. {center}: coverage [{start}, {end}] must be finite with start < end")));

@@ -324,7 +324,6 @@ pub(crate) trait Scheme<I: Isa, M> {
     fn begin(&mut self) {}
     /// One step of size h from (t, y), all lanes: writes the propagated solution and returns
     /// the scaled max-norm error per lane.
-    #[allow(clippy::too_many_arguments)]
     fn step(&mut self, m: &M, t: f64, y: &Self::Y, h: f64, out: &mut Self::Y, rtol: F8<I>, atol: F8<I>) -> F8<I>;
     fn finite(y: &Self::Y) -> bool;
 }
