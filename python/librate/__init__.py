@@ -171,15 +171,16 @@ __all__ = [
 #: Old names kept importable for a while: ``librate.<old>`` warns and returns the new object.
 _DEPRECATED = {"FlatPlateSRP": ("FlatPlate", FlatPlate), "SunModel": ("Sun", Sun)}
 #: The application layer (pydantic, tqdm; studies, result files, the map runner) is loaded on
-#: first use only, so that ``import librate`` stays light: ``librate.Study`` imports it.
-_APP = {"Study": "study", "StudyError": "study", "open_result": "results", "run_map": "runner"}
+#: first use only, so that ``import librate`` stays light: ``librate.Study`` imports it (through
+#: ``librate.app``, which loads each name's own module on first use).
+_APP = ("Study", "StudyError", "open_result", "run_map")
 
 
 def __getattr__(name: str):
     if name in _APP:
         import importlib
 
-        obj = getattr(importlib.import_module(f"librate.app.{_APP[name]}"), name)
+        obj = getattr(importlib.import_module("librate.app"), name)
         globals()[name] = obj
         return obj
     if name in _DEPRECATED:
