@@ -35,6 +35,9 @@ from .solutions import (
 __all__ = ["srp_map", "sun_pointing_accelerations", "sun_resonance", "sun_angle"]
 
 
+#: Marked points re-propagated per task of srp_map's pool (a piece takes ~15 ms at K = 2).
+VERIFY_PIECE = 32
+
 
 def sun_resonance(orbit: PeriodicOrbit, tol: float = 1e-6) -> int | None:
     """K when the orbit is Sun-resonant, K T = Ts (relative tolerance ``tol``), else None."""
@@ -180,17 +183,20 @@ def srp_map(
                 (one pseudo-arclength run to the last value, corrected exactly at each grid value
                 on the way; only those re-propagated), ending at the grid's end or at a located
                 fold. The branches run in lock step (:func:`eps_branches`: each round's corrections
-                of every branch in one Rust call); their marked points are re-propagated in one
-                batch beside what follows (a one-thread engine pool, as the grid)."""
+                of every branch in one Rust call); their marked points are re-propagated beside what
+                follows, in pieces of :data:`VERIFY_PIECE` on the pool (one-thread engine calls, as
+                the grid)."""
                 advance(0, len(jobs))
                 brs = eps_branches([(start, plate.with_eps(float(values[-1])), [float(e) for e in values]) for start, _, values, _ in jobs],
                                    steps=steps, done=lambda _: advance())
                 owners = [(start, p) for (start, _, _, _), br in zip(jobs, brs) for p in br.marked]
-                checked = pool.submit(verified, orbit, kz=kz, n_total=[s_.n_total for s_, _ in owners], kind=[s_.kind for s_, _ in owners],
-                                      phi0=[p.x[1] for _, p in owners], wz0=[p.x[2] for _, p in owners], n_periods=n_periods,
-                                      plates=[plate.with_eps(float(p.x[0])) for _, p in owners],
-                                      iterations=[p.iterations for _, p in owners],
-                                      threads=1)
+                # in pieces, which both workers take (each item's result depends on it alone): the
+                # last run's re-propagation is not left to one core once the branches are done
+                checked = [pool.submit(verified, orbit, kz=kz, n_total=[s_.n_total for s_, _ in part], kind=[s_.kind for s_, _ in part],
+                                       phi0=[p.x[1] for _, p in part], wz0=[p.x[2] for _, p in part], n_periods=n_periods,
+                                       plates=[plate.with_eps(float(p.x[0])) for _, p in part], iterations=[p.iterations for _, p in part],
+                                       threads=1)
+                           for part in (owners[a:a + VERIFY_PIECE] for a in range(0, len(owners), VERIFY_PIECE))]
                 runs.append((jobs, lead, brs, checked))
 
             def found_at(e_end):
@@ -203,7 +209,7 @@ def srp_map(
             def record(jobs, lead, brs, checked):
                 """The branches of one run, recorded in order, each after its ``lead`` solutions
                 ((eps, solution) recorded at the branch's index first)."""
-                checked = iter(checked.result())
+                checked = (s_ for piece in checked for s_ in piece.result())
                 for (start, e_start, _, origin), br, first in zip(jobs, brs, lead):
                     pts = [(float(p.x[0]), float(p.x[2]), float(p.x[1]), float(p.data["trace"])) for p in br.points]
                     marked = [(float(p.x[0]), next(checked)) for p in br.marked]
