@@ -151,6 +151,27 @@ def test_the_same_run_reuses_a_changed_one_is_refused_by_key(example, tmp_path):
     assert res.exit_code == 2 and "changed: ephemeris.revolutions: 4 -> 3" in res.output and "--force" in res.output
 
 
+def test_plot_of_a_transition_without_attitude_says_nothing_of_the_attitude_figures(example, tmp_path):
+    """The example has no ephemeris.attitude_n: `librate plot` redraws its three figures and
+    mentions no attitude figure (not asked for, as a map without solutions leaves out its
+    solutions figure); asked for by name, each attitude figure is skipped with its reason."""
+    from click.testing import CliRunner
+    from librate.app.cli import main
+    from librate.results.kinds import TransitionResult
+
+    d, _ = example
+    path = tmp_path / "transition.zarr"
+    shutil.copytree(d / "librate-out" / "transition.zarr", path)
+    res = CliRunner().invoke(main, ["plot", str(path)], catch_exceptions=False)
+    assert res.exit_code == 0, res.output
+    assert "skipped" not in res.output and "attitude" not in res.stderr, res.output
+    assert {p.name for p in tmp_path.glob("*.png")} == {"transition_rotating.png", "transition_defects.png", "transition_sweep.png"}
+    told: list[tuple[str, str]] = []
+    assert TransitionResult.figures(librate.open_result(path), ["attitude", "pointing"], skip=lambda *a: told.append(a)) == []
+    assert told == [("attitude", "the transition carries no attitude (ephemeris.attitude_n)"),
+                    ("pointing", "the transition carries no attitude (ephemeris.attitude_n)")]
+
+
 def test_a_killed_run_keeps_its_epochs_and_resumes_to_the_same_arrays(example, tmp_path, monkeypatch):
     """An interruption after the first epoch (its commit done): the store keeps that epoch, and
     the same call finishes the others, equal to the uninterrupted run bit for bit (the kill by
