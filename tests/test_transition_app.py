@@ -428,6 +428,22 @@ def test_bad_attitude_input_names_the_key_and_the_allowed_range(change, key, all
     assert len(hits) == 1 and allowed in hits[0], err.value.problems
 
 
+@pytest.mark.parametrize("start", ["planar", "spin"])
+def test_a_3d_transition_takes_its_n_from_attitude_n_and_a_solve_still_needs_attitude_n(start):
+    """With ephemeris.attitude_n, a 3-D [attitude] needs no attitude.n (as the planar model needs
+    none): the transition starts each 3-D motion with n = N. A solve of the same study starts
+    from attitude.n, and its absence is named by key; without attitude_n it is required as before."""
+    raw = {**ATTITUDE_STUDY, "body": {"ix": 100.0, "iy": 900.0, "iz": 1000.0}, "attitude": {"model": "3d", "start": start}}
+    for purpose in (None, "transition"):
+        assert Study.from_dict(raw, purpose=purpose).attitude.n is None
+    plain = {k: v for k, v in raw.items() if k != "ephemeris"}
+    for study, purpose in ((raw, "solve"), (plain, None), (plain, "solve")):
+        with pytest.raises(StudyError) as err:
+            Study.from_dict(study, purpose=purpose)
+        hits = [p for p in err.value.problems if p.startswith("attitude.n: missing")]
+        assert len(hits) == 1 and f'attitude.start = "{start}" needs the net turns n' in hits[0], err.value.problems
+
+
 def test_an_n_without_a_solution_is_named(tmp_path):
     from librate.app.jobs import run_transition
 
@@ -482,7 +498,8 @@ def test_a_3d_study_carries_the_3d_motion_and_agrees_with_the_planar_one(attitud
 
     d, _ = attitude_run
     planar = librate.open_result(d / "out" / "transition.zarr")
-    raw = {**ATTITUDE_STUDY, "body": {"ix": 100.0, "iy": 900.0, "iz": 1000.0}, "attitude": {"model": "3d", "start": "planar", "n": 0}}
+    # no attitude.n: each 3-D motion takes its n from ephemeris.attitude_n
+    raw = {**ATTITUDE_STUDY, "body": {"ix": 100.0, "iy": 900.0, "iz": 1000.0}, "attitude": {"model": "3d", "start": "planar"}}
     ds, _ = run_transition(Study.from_dict(raw, purpose="transition", base_dir=tmp_path))
     assert ds.attrs["attitude_model"] == "3d" and ds.attrs["attitude_body_moments"] == [100.0, 900.0, 1000.0]
     assert ds["attitude_status"].values.tolist() == [[0]] and ds["attitude_q0"].dims == ("attitude", "quaternion")
