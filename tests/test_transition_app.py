@@ -390,7 +390,14 @@ def test_the_attitude_inputs_count_only_with_attitude_n():
     assert fp == tr._fingerprint(orbit, np.array([9e8]), 2, 9, "d", ()) and tr.transition_sizes(2, 9) == tr.transition_sizes(2, 9, 0)
 
 
-def test_a_failed_attitude_correction_keeps_the_orbit_and_says_why(tmp_path, monkeypatch):
+@pytest.fixture
+def one_revolution(tmp_path):
+    """The attitude study over one revolution, its output under tmp_path (the runs that fail on purpose)."""
+    return Study.from_dict({**ATTITUDE_STUDY, "ephemeris": {**ATTITUDE_STUDY["ephemeris"], "revolutions": 1}}, purpose="transition",
+                           base_dir=tmp_path)
+
+
+def test_a_failed_attitude_correction_keeps_the_orbit_and_says_why(one_revolution, monkeypatch):
     from librate import ConvergenceError
     from librate.app.jobs import run_transition
     from librate.app.transition import transition_summary
@@ -400,9 +407,7 @@ def test_a_failed_attitude_correction_keeps_the_orbit_and_says_why(tmp_path, mon
         raise ConvergenceError("attitude_to_ephemeris: the multiple-shooting corrector stopped (test)")
 
     monkeypatch.setattr(ephemeris_attitude, "attitude_to_ephemeris", fails)
-    st = Study.from_dict({**ATTITUDE_STUDY, "ephemeris": {**ATTITUDE_STUDY["ephemeris"], "revolutions": 1}}, purpose="transition",
-                         base_dir=tmp_path)
-    ds, path = run_transition(st)
+    ds, path = run_transition(one_revolution)
     assert verify_result(path)[0] and ds["status"].values.tolist() == [0] and np.isfinite(ds["states_km"].values).all()
     assert ds["attitude_status"].values.tolist() == [[1]] and np.isnan(ds["attitude_q"].values).all()
     assert json.loads(ds.attrs["attitude_failures"]) == {"0/0": "ConvergenceError: attitude_to_ephemeris: the multiple-shooting corrector "
@@ -509,14 +514,12 @@ def test_a_3d_study_carries_the_3d_motion_and_agrees_with_the_planar_one(attitud
         Study.from_dict({**raw, "attitude": {"model": "3d", "start": "given", "w0": [0.0, 0.0, 1.0]}}, purpose="transition")
 
 
-def test_an_epoch_whose_orbit_fails_marks_its_attitude_not_computed(tmp_path, monkeypatch):
+def test_an_epoch_whose_orbit_fails_marks_its_attitude_not_computed(one_revolution, monkeypatch):
     from librate.app.jobs import run_transition
     from librate.orbits import transition
 
     real = transition.to_ephemeris
     monkeypatch.setattr(transition, "to_ephemeris", lambda orbit, epoch, **kw: real(orbit, epoch, **kw, max_iter=1))
-    st = Study.from_dict({**ATTITUDE_STUDY, "ephemeris": {**ATTITUDE_STUDY["ephemeris"], "revolutions": 1}}, purpose="transition",
-                         base_dir=tmp_path)
-    ds, path = run_transition(st)
+    ds, path = run_transition(one_revolution)
     assert verify_result(path)[0] and ds["status"].values.tolist() == [1] and ds["attitude_status"].values.tolist() == [[2]]
     assert np.isnan(ds["attitude_pointing_deg"].values).all() and json.loads(ds.attrs["attitude_failures"]) == {}
