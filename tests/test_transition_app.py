@@ -151,6 +151,27 @@ def test_the_same_run_reuses_a_changed_one_is_refused_by_key(example, tmp_path):
     assert res.exit_code == 2 and "changed: ephemeris.revolutions: 4 -> 3" in res.output and "--force" in res.output
 
 
+def test_plot_of_a_transition_without_attitude_says_nothing_of_the_attitude_figures(example, tmp_path):
+    """The example has no ephemeris.attitude_n: `librate plot` redraws its three figures and
+    mentions no attitude figure (not asked for, as a map without solutions leaves out its
+    solutions figure); asked for by name, each attitude figure is skipped with its reason."""
+    from click.testing import CliRunner
+    from librate.app.cli import main
+    from librate.results.kinds import TransitionResult
+
+    d, _ = example
+    path = tmp_path / "transition.zarr"
+    shutil.copytree(d / "librate-out" / "transition.zarr", path)
+    res = CliRunner().invoke(main, ["plot", str(path)], catch_exceptions=False)
+    assert res.exit_code == 0, res.output
+    assert "skipped" not in res.output and "attitude" not in res.stderr, res.output
+    assert {p.name for p in tmp_path.glob("*.png")} == {"transition_rotating.png", "transition_defects.png", "transition_sweep.png"}
+    told: list[tuple[str, str]] = []
+    assert TransitionResult.figures(librate.open_result(path), ["attitude", "pointing"], skip=lambda *a: told.append(a)) == []
+    assert told == [("attitude", "the transition carries no attitude (ephemeris.attitude_n)"),
+                    ("pointing", "the transition carries no attitude (ephemeris.attitude_n)")]
+
+
 def test_a_killed_run_keeps_its_epochs_and_resumes_to_the_same_arrays(example, tmp_path, monkeypatch):
     """An interruption after the first epoch (its commit done): the store keeps that epoch, and
     the same call finishes the others, equal to the uninterrupted run bit for bit (the kill by
@@ -369,7 +390,14 @@ def test_the_attitude_inputs_count_only_with_attitude_n():
     assert fp == tr._fingerprint(orbit, np.array([9e8]), 2, 9, "d", ()) and tr.transition_sizes(2, 9) == tr.transition_sizes(2, 9, 0)
 
 
-def test_a_failed_attitude_correction_keeps_the_orbit_and_says_why(tmp_path, monkeypatch):
+@pytest.fixture
+def one_revolution(tmp_path):
+    """The attitude study over one revolution, its output under tmp_path (the runs that fail on purpose)."""
+    return Study.from_dict({**ATTITUDE_STUDY, "ephemeris": {**ATTITUDE_STUDY["ephemeris"], "revolutions": 1}}, purpose="transition",
+                           base_dir=tmp_path)
+
+
+def test_a_failed_attitude_correction_keeps_the_orbit_and_says_why(one_revolution, monkeypatch):
     from librate import ConvergenceError
     from librate.app.jobs import run_transition
     from librate.app.transition import transition_summary
@@ -379,9 +407,7 @@ def test_a_failed_attitude_correction_keeps_the_orbit_and_says_why(tmp_path, mon
         raise ConvergenceError("attitude_to_ephemeris: the multiple-shooting corrector stopped (test)")
 
     monkeypatch.setattr(ephemeris_attitude, "attitude_to_ephemeris", fails)
-    st = Study.from_dict({**ATTITUDE_STUDY, "ephemeris": {**ATTITUDE_STUDY["ephemeris"], "revolutions": 1}}, purpose="transition",
-                         base_dir=tmp_path)
-    ds, path = run_transition(st)
+    ds, path = run_transition(one_revolution)
     assert verify_result(path)[0] and ds["status"].values.tolist() == [0] and np.isfinite(ds["states_km"].values).all()
     assert ds["attitude_status"].values.tolist() == [[1]] and np.isnan(ds["attitude_q"].values).all()
     assert json.loads(ds.attrs["attitude_failures"]) == {"0/0": "ConvergenceError: attitude_to_ephemeris: the multiple-shooting corrector "
@@ -405,6 +431,22 @@ def test_bad_attitude_input_names_the_key_and_the_allowed_range(change, key, all
         Study.from_dict(raw, purpose="transition")
     hits = [p for p in err.value.problems if p.startswith(key)]
     assert len(hits) == 1 and allowed in hits[0], err.value.problems
+
+
+@pytest.mark.parametrize("start", ["planar", "spin"])
+def test_a_3d_transition_takes_its_n_from_attitude_n_and_a_solve_still_needs_attitude_n(start):
+    """With ephemeris.attitude_n, a 3-D [attitude] needs no attitude.n (as the planar model needs
+    none): the transition starts each 3-D motion with n = N. A solve of the same study starts
+    from attitude.n, and its absence is named by key; without attitude_n it is required as before."""
+    raw = {**ATTITUDE_STUDY, "body": {"ix": 100.0, "iy": 900.0, "iz": 1000.0}, "attitude": {"model": "3d", "start": start}}
+    for purpose in (None, "transition"):
+        assert Study.from_dict(raw, purpose=purpose).attitude.n is None
+    plain = {k: v for k, v in raw.items() if k != "ephemeris"}
+    for study, purpose in ((raw, "solve"), (plain, None), (plain, "solve")):
+        with pytest.raises(StudyError) as err:
+            Study.from_dict(study, purpose=purpose)
+        hits = [p for p in err.value.problems if p.startswith("attitude.n: missing")]
+        assert len(hits) == 1 and f'attitude.start = "{start}" needs the net turns n' in hits[0], err.value.problems
 
 
 def test_an_n_without_a_solution_is_named(tmp_path):
@@ -461,7 +503,8 @@ def test_a_3d_study_carries_the_3d_motion_and_agrees_with_the_planar_one(attitud
 
     d, _ = attitude_run
     planar = librate.open_result(d / "out" / "transition.zarr")
-    raw = {**ATTITUDE_STUDY, "body": {"ix": 100.0, "iy": 900.0, "iz": 1000.0}, "attitude": {"model": "3d", "start": "planar", "n": 0}}
+    # no attitude.n: each 3-D motion takes its n from ephemeris.attitude_n
+    raw = {**ATTITUDE_STUDY, "body": {"ix": 100.0, "iy": 900.0, "iz": 1000.0}, "attitude": {"model": "3d", "start": "planar"}}
     ds, _ = run_transition(Study.from_dict(raw, purpose="transition", base_dir=tmp_path))
     assert ds.attrs["attitude_model"] == "3d" and ds.attrs["attitude_body_moments"] == [100.0, 900.0, 1000.0]
     assert ds["attitude_status"].values.tolist() == [[0]] and ds["attitude_q0"].dims == ("attitude", "quaternion")
@@ -471,14 +514,12 @@ def test_a_3d_study_carries_the_3d_motion_and_agrees_with_the_planar_one(attitud
         Study.from_dict({**raw, "attitude": {"model": "3d", "start": "given", "w0": [0.0, 0.0, 1.0]}}, purpose="transition")
 
 
-def test_an_epoch_whose_orbit_fails_marks_its_attitude_not_computed(tmp_path, monkeypatch):
+def test_an_epoch_whose_orbit_fails_marks_its_attitude_not_computed(one_revolution, monkeypatch):
     from librate.app.jobs import run_transition
     from librate.orbits import transition
 
     real = transition.to_ephemeris
     monkeypatch.setattr(transition, "to_ephemeris", lambda orbit, epoch, **kw: real(orbit, epoch, **kw, max_iter=1))
-    st = Study.from_dict({**ATTITUDE_STUDY, "ephemeris": {**ATTITUDE_STUDY["ephemeris"], "revolutions": 1}}, purpose="transition",
-                         base_dir=tmp_path)
-    ds, path = run_transition(st)
+    ds, path = run_transition(one_revolution)
     assert verify_result(path)[0] and ds["status"].values.tolist() == [1] and ds["attitude_status"].values.tolist() == [[2]]
     assert np.isnan(ds["attitude_pointing_deg"].values).all() and json.loads(ds.attrs["attitude_failures"]) == {}

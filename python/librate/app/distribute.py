@@ -4,8 +4,8 @@ Dask cluster, each result checksummed on arrival and handed to the caller's comm
 Every long job is one caller: a planar map (a task per orbit row), a 3-D map (a task per orbit),
 a solve over many orbits (a task per orbit and Kz), and any sweep of the same shape (e.g. over
 ephemeris epochs): the caller lists :class:`Task` objects (a module-level function and its
-picklable arguments), and a ``commit(key, result)`` that stores each result (a part store's
-:meth:`~librate.results.PartStore.write_part`, or memory).
+picklable arguments), and a ``commit(key, result)`` that stores each result (into a part store
+through :class:`PartCommits`, or memory).
 
 ``scheduler``: None (this process, the tasks in order), a ``distributed.Client``, or a scheduler
 address ("tcp://host:port"; a client is opened and closed here). On a cluster:
@@ -33,10 +33,11 @@ import uuid
 from collections.abc import Callable, Hashable, Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 from ..results.checksum import value_digest
 
-__all__ = ["ArrivalError", "Region", "Task", "Written", "client_of", "run_tasks"]
+__all__ = ["ArrivalError", "PartCommits", "Region", "Task", "Written", "client_of", "run_tasks"]
 
 #: Submissions of one task before its loss is an error.
 ATTEMPTS = 4
@@ -144,6 +145,49 @@ def run_tasks(tasks: Iterable[Task], commit: Callable[[Hashable, object], None],
     finally:
         if owned:
             client.close()
+
+
+@dataclass
+class PartCommits:
+    """The two commits :func:`run_tasks` takes when each part of a part store
+    (:class:`~librate.results.PartStore`) is one task's result: :meth:`commit` writes a result
+    that arrived as data (:meth:`~librate.results.PartStore.write_part`: data, digests, then the
+    done flag), :meth:`commit_written` commits a part a worker wrote into the store itself
+    (:meth:`~librate.results.PartStore.commit_written`, :class:`ArrivalError` when it does not
+    check out). Each sets ``done[index]`` and then moves ``bar`` (if any) by one.
+
+    ``what`` names a part in the error ("orbit", "epoch"). ``prepare(key, result)``, if given,
+    turns a task's key and result into the ``(index, data)`` of the part to write, or None while
+    the part is not complete (a part gathered from several tasks); it is also where a caller
+    notes what a result says besides its arrays (e.g. a failure's reason). Without it the key is
+    the part's index and the result its data."""
+
+    store: Any
+    done: Any
+    what: str = "part"
+    bar: Any = None
+    prepare: Callable[[Hashable, Any], tuple[int, dict] | None] | None = None
+
+    def commit(self, key: Hashable, result) -> None:
+        """Write the part of a result that arrived as data."""
+        if self.prepare is not None:
+            got = self.prepare(key, result)
+            if got is None:
+                return
+            key, result = got
+        self.store.write_part(key, result)
+        self._done(key)
+
+    def commit_written(self, index: int, digests: tuple) -> None:
+        """Commit the part a worker wrote into the store itself, or raise ArrivalError."""
+        if not self.store.commit_written(index, digests):
+            raise ArrivalError(f"{self.what} {index}: the region written by a worker does not match its digests")
+        self._done(index)
+
+    def _done(self, index) -> None:
+        self.done[index] = True
+        if self.bar is not None:
+            self.bar.update(1)
 
 
 def _lost_errors() -> tuple[type[BaseException], ...]:

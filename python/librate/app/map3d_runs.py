@@ -109,7 +109,7 @@ def run_map_3d_to(orbits, store: str | Path, *, body, rates: dict, q0, n_periods
 
     from ..periodicity.map3d import COMPONENTS, map3d_dataset, map3d_grid
     from ..periodicity.maps import orbits_of
-    from .distribute import ArrivalError, Region, Task, run_tasks
+    from .distribute import PartCommits, Region, Task, run_tasks
     from .progress import bar as progress_bar
 
     store = Path(store)
@@ -153,34 +153,27 @@ def run_map_3d_to(orbits, store: str | Path, *, body, rates: dict, q0, n_periods
                     for i in left for a in range(0, grid.n_cases, step)]
         pieces: dict[int, dict] = {}
 
-        def commit(key, part):
-            if step is not None:
-                i, a = key
-                pieces.setdefault(i, {})[a] = part
-                if len(pieces[i]) < -(-grid.n_cases // step):
-                    return
-                mine = pieces.pop(i)
-                got = [mine[a] for a in range(0, grid.n_cases, step)]
-                ds_i = map3d_dataset(olist[i], grid, np.concatenate([g["residual"] for g in got]),
-                                     np.concatenate([g["status"] for g in got]),
-                                     n_periods=n_periods, tol=tol)
-                part = {k: np.asarray(ds_i[k].values) for k in schema.variables}
-                key = i
-            pstore.write_part(key, part)
-            done[key] = True
-            bar.update(1)
-
-        def commit_written(i, sums):
-            if not pstore.commit_written(i, sums):
-                raise ArrivalError(f"orbit {i}: the region written by a worker does not match its digests")
-            done[i] = True
-            bar.update(1)
+        def gather(key, part):
+            """A chunk's result kept until its orbit is complete, then the orbit's part (None before)."""
+            if step is None:
+                return key, part
+            i, a = key
+            pieces.setdefault(i, {})[a] = part
+            if len(pieces[i]) < -(-grid.n_cases // step):
+                return None
+            mine = pieces.pop(i)
+            got = [mine[a] for a in range(0, grid.n_cases, step)]
+            ds_i = map3d_dataset(olist[i], grid, np.concatenate([g["residual"] for g in got]),
+                                 np.concatenate([g["status"] for g in got]),
+                                 n_periods=n_periods, tol=tol)
+            return i, {k: np.asarray(ds_i[k].values) for k in schema.variables}
 
         with progress_bar(len(olist), "3-D attitude map", "orbit", progress, initial=int(done.sum())) as bar:
+            commits = PartCommits(pstore, done, "orbit", bar, gather)
             try:
-                run_tasks(todo, commit, scheduler=scheduler,
+                run_tasks(todo, commits.commit, scheduler=scheduler,
                           region=None if scheduler is None or step is not None else Region.of(pstore, lock),
-                          commit_written=commit_written)
+                          commit_written=commits.commit_written)
             except KeyboardInterrupt as err:  # the finished orbits are kept
                 raise KeyboardInterrupt(f"3-D map interrupted ({err}); {int(done.sum())} finished orbit(s) kept in {parts}") from None
         # the same for every orbit

@@ -117,6 +117,10 @@ def rules_3d(s: dict[str, Table], given: dict, purpose: str | None) -> list[str]
             if g is not None and not isinstance(g, (int, float)):  # a number is a fixed rate of a 3-D map; every grid increases
                 _check_increasing(f"rates.{k}", g, problems)
     problems += _check_3d(att, start, s, given)
+    eph = s.get("ephemeris")
+    if start in ("planar", "spin") and att.n is None and (purpose == "solve" or eph is None or eph.attitude_n is None):
+        # a transition's 3-D motions take their n from ephemeris.attitude_n (as the planar model needs no n at all)
+        problems.append(missing("attitude.n", f"missing: attitude.start = \"{start}\" needs the net turns n per attitude period"))
     if purpose in ("solve", "map"):
         problems += _needs_3d(purpose, start, s, given)
     return problems

@@ -28,7 +28,7 @@ from ..results.atomic import clean_orphans, remove_path, replace_path, temporary
 from ..results.kinds import map_schema
 from ..results.lock import writer_lock
 from ..results.store import PartStore
-from .distribute import ArrivalError, Region, Task, run_tasks
+from .distribute import PartCommits, Region, Task, run_tasks
 from .progress import bar as progress_bar
 
 __all__ = ["run_map"]
@@ -183,20 +183,19 @@ def _run(olist, family, kzs, wz, coords, fp, args, out, resume, scheduler, progr
         mem = {k: np.full((no, nk, nw), np.nan) for k in _GRID}
         mem["status"] = np.full((no, nk, nw), 255, dtype=np.uint8)
 
-    def write(i, row):
-        if store is not None:
-            store.write_part(i, row)  # data, digests, then the done flag
-        else:
-            for k in (*_GRID, "status"):
-                mem[k][i] = row[k]
+    def remember(i, row):
+        for k in (*_GRID, "status"):
+            mem[k][i] = row[k]
         done[i] = True
 
+    # a stored row: its data, digests, then the done flag (or a worker's own write, checked)
+    commits = PartCommits(store, done) if store is not None else None
     todo = [i for i in range(no) if not done[i]]
     bar = progress_bar(no, "periodicity map", "orbit", progress, initial=no - len(todo))
     region = None if store is None or lock is None or scheduler is None else Region.of(store, lock)
     try:
-        run_tasks([Task(i, _row, (olist[i], *args)) for i in todo], write, scheduler=scheduler, bar=bar,
-                  region=region, commit_written=lambda i, sums: _commit_written(store, done, i, sums))
+        run_tasks([Task(i, _row, (olist[i], *args)) for i in todo], remember if commits is None else commits.commit, scheduler=scheduler,
+                  bar=bar, region=region, commit_written=None if commits is None else commits.commit_written)
     finally:
         bar.close()
 
@@ -218,13 +217,6 @@ def _run(olist, family, kzs, wz, coords, fp, args, out, resume, scheduler, progr
         sol = {v: (("solution",), np.ascontiguousarray(ds[v].values), dict(ds[v].attrs)) for v in ds.data_vars if v.startswith("sol_")}
         store.finalise(sol, dict(ds.attrs), complete=bool(ds.attrs.get("complete", 0)))
     return ds
-
-
-def _commit_written(store, done, i, sums) -> None:
-    """Commit a part a worker wrote into the store itself, or say it did not check out."""
-    if not store.commit_written(i, sums):
-        raise ArrivalError(f"part {i}: the region written by a worker does not match its digests")
-    done[i] = True
 
 
 def _check_replaceable(out: Path) -> None:

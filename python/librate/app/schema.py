@@ -365,7 +365,7 @@ class AttitudeSection(Table):
                                                                          "attitude.w0), with attitude.model = '3d'")
     n: int | None = Field(None, ge=-100, le=100,
                           description="an integer in [-100, 100], net turns about synodic Z per attitude period, with attitude.start "
-                                      "= 'planar' or 'spin'")
+                                      "= 'planar' or 'spin' (a transition takes each N from ephemeris.attitude_n instead)")
     q0: list[float] | None = Field(None, min_length=4, max_length=4,
                                    description="four numbers, a unit quaternion (scalar last): the body relative to the synodic frame at t "
                                                "= 0, with attitude.start = 'given' or 'spin'")
@@ -431,8 +431,7 @@ class Attitude3D(AttitudeSection):
             problems.append(problem("attitude.w0", self.w0,
                                      "cannot be combined with attitude.start = \"spin\" (the spin is w = (1 + 2 pi n / (K T)) e_Z)",
                                      "attitude.w0 with attitude.start = 'given'"))
-        if start in ("planar", "spin") and self.n is None:
-            problems.append(missing("attitude.n", f"missing: attitude.start = \"{start}\" needs the net turns n per attitude period"))
+        # a missing attitude.n is a rule between sections (rules_3d): ephemeris.attitude_n may stand in for it
         if start == "given":
             if self.w0 is None:
                 problems.append(missing("attitude.w0",
@@ -524,7 +523,7 @@ class EphemerisSection(Table):
         None, min_length=1, max_length=MAX_ATTITUDES,
         description=f"a list of at most {MAX_ATTITUDES} distinct integers N in [-100, 100]: for each N, the first periodic attitude "
         "solution with N net turns that `librate solve` finds on the orbit ([body], [rates], [solver]; with attitude.model = '3d', "
-        "the 3-D motion started with attitude.n = N) is carried along the ephemeris orbit at every epoch and corrected")
+        "the 3-D motion started with n = N, attitude.n not needed) is carried along the ephemeris orbit at every epoch and corrected")
 
     def epochs_tdb(self) -> np.ndarray:
         """The epochs in TDB seconds past J2000, (n,) (a range: start + k step, up to stop)."""

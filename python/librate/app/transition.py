@@ -259,7 +259,7 @@ def run_transition_to(orbit, store: str | Path, *, epochs_tdb, revolutions: int,
     from ..results.kinds import transition_schema
     from ..results.lock import writer_lock
     from ..results.store import PartStore, store_kind
-    from .distribute import ArrivalError, Region, Task, run_tasks
+    from .distribute import PartCommits, Region, Task, run_tasks
     from .progress import bar as progress_bar
     from .results import check_output, open_result, publish_parts
 
@@ -308,25 +308,19 @@ def run_transition_to(orbit, store: str | Path, *, epochs_tdb, revolutions: int,
         todo = [Task(j, _transition_epoch, (orbit, float(epochs[j]), int(revolutions), npr, eph_path, sizes, *extra))
                 for j in range(epochs.size) if not done[j]]
 
-        def commit(j, part):
+        def note(j, part):
+            """An epoch's part, its failure reasons noted (they go into the result's attributes)."""
             if "reason" in part:
                 failures[str(j)] = part["reason"]
             for k, why in part.get("attitude_reasons", {}).items():
                 att_failures[f"{j}/{k}"] = why
-            pstore.write_part(j, part)
-            done[j] = True
-            bar.update(1)
-
-        def commit_written(j, sums):
-            if not pstore.commit_written(j, sums):
-                raise ArrivalError(f"epoch {j}: the region written by a worker does not match its digests")
-            done[j] = True
-            bar.update(1)
+            return j, part
 
         with progress_bar(epochs.size, "ephemeris transitions", "epoch", progress, initial=int(done.sum())) as bar:
+            commits = PartCommits(pstore, done, "epoch", bar, note)
             try:
-                run_tasks(todo, commit, scheduler=scheduler, region=None if scheduler is None else Region.of(pstore, lock),
-                          commit_written=commit_written)
+                run_tasks(todo, commits.commit, scheduler=scheduler, region=None if scheduler is None else Region.of(pstore, lock),
+                          commit_written=commits.commit_written)
             except KeyboardInterrupt as err:  # the finished epochs are kept
                 raise KeyboardInterrupt(f"transition interrupted ({err}); {int(done.sum())} finished epoch(s) kept in {parts}") from None
         # a failure written by a worker's region carries no reason back: its status says it

@@ -375,7 +375,9 @@ class TransitionResult(ResultKind):
         defects of every epoch, (two epochs or more) the sweep's departure and perilune range
         against the epoch, and, with attitude solutions, the attitude angles in both models and
         the pointing error of each body axis (the first epoch where the first solution was
-        corrected)."""
+        corrected). A transition without attitude (no ``ephemeris.attitude_n``) leaves the
+        attitude figures out, silently unless ``names`` asks for them (as a map without
+        solutions leaves out its solutions figure)."""
         lp = _plotting()
         ok = np.flatnonzero(np.asarray(result["status"].values) == 0)
         out: list[Figure] = []
@@ -383,6 +385,8 @@ class TransitionResult(ResultKind):
             if name not in cls.figure_names:
                 continue
             if name in ("attitude", "pointing"):
+                if names is None and "attitude_status" not in result.variables:
+                    continue  # not asked for: the study has no ephemeris.attitude_n
                 out += cls._attitude_figure(result, name, skip, lp)
                 continue
             if ok.size == 0:
