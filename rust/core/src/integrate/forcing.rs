@@ -16,6 +16,7 @@ use crate::cr3bp::check_mu;
 use crate::error::{check_finite, check_positive, invalid, Error, Result};
 use crate::integrate::{Options, Output};
 use crate::propagation::{propagate_checked, Collision};
+use crate::scalar::F8;
 use crate::simd::Isa;
 
 /// Chebyshev degree per segment.
@@ -217,6 +218,48 @@ impl<const N: usize> OrbitTable<N> {
         }
         std::array::from_fn(|i| fma(x, b1[i], c[i] - b2[i]))
     }
+
+    /// The N components at eight times at once on the lanes of `isa`: the same values as
+    /// [`Self::eval_at`] at each, bit for bit (the same operations per lane). One vector
+    /// Clenshaw recurrence when the times lie in at most two segments (a Runge-Kutta step's
+    /// nodes, unless the step is longer than a segment), the coefficients chosen per lane;
+    /// otherwise one scalar evaluation per time.
+    #[inline(always)]
+    pub fn eval8_at<I: Isa>(&self, isa: I, ts: &[f64; 8]) -> [[f64; N]; 8] {
+        let loc: [(usize, f64); 8] = std::array::from_fn(|l| self.locate(ts[l]));
+        let (lo, hi) = loc.iter().fold((usize::MAX, 0), |(a, b), &(s, _)| (a.min(s), b.max(s)));
+        if loc.iter().any(|&(s, _)| s != lo && s != hi) {
+            return std::array::from_fn(|l| self.eval_at::<I>(ts[l]));
+        }
+        let x = F8::new(isa, loc.map(|(_, x)| x));
+        let (ca, cb) = (&self.coef[lo * NC * N..(lo + 1) * NC * N], &self.coef[hi * NC * N..(hi + 1) * NC * N]);
+        let v: [F8<I>; N] = if lo == hi {
+            clenshaw8(x, |j| F8::splat(isa, ca[j]))
+        } else {
+            let seg = F8::new(isa, loc.map(|(s, _)| s as f64));
+            let lo_f = F8::splat(isa, lo as f64);
+            clenshaw8(x, |j| seg.le_select(lo_f, F8::splat(isa, ca[j]), F8::splat(isa, cb[j])))
+        };
+        let v = v.map(|c| c.to_array());
+        std::array::from_fn(|l| std::array::from_fn(|i| v[i][l]))
+    }
+}
+
+/// [`OrbitTable::eval_with`]'s recurrence on eight lanes, coefficient j of the segment's
+/// [k][component] layout from `coef(j)`.
+#[inline(always)]
+fn clenshaw8<I: Isa, const N: usize>(x: F8<I>, coef: impl Fn(usize) -> F8<I>) -> [F8<I>; N] {
+    let isa = x.isa();
+    let (mut b1, mut b2) = ([F8::splat(isa, 0.0); N], [F8::splat(isa, 0.0); N]);
+    let x2 = F8::splat(isa, 2.0) * x;
+    for k in (1..NC).rev() {
+        for i in 0..N {
+            let tk = x2.mul_add(b1[i], coef(N * k + i) - b2[i]);
+            b2[i] = b1[i];
+            b1[i] = tk;
+        }
+    }
+    std::array::from_fn(|i| x.mul_add(b1[i], coef(i) - b2[i]))
 }
 
 impl Forcing for OrbitTable<2> {

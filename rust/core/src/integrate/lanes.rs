@@ -210,22 +210,31 @@ fn lincomb<I: Isa, const D: usize, const M: usize>(out: &mut [F8<I>; D], y: &[F8
     }
 }
 
+/// What the planar lanes need of the orbit at one time, the same for every lane: the gravity
+/// gradient's forcing S, C and, with SRP, (sin, cos) of the Sun's phase w t (zeros without).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct PlanarAt {
+    s: f64,
+    c: f64,
+    swt: f64,
+    cwt: f64,
+}
+
 /// The lanes' angular acceleration wzdot(t, phi) and its derivative k = d wzdot / d phi (only
-/// used with the STM: compiled away otherwise), from (cos phi, sin phi): gravity gradient and,
-/// with SRP, the flat plate.
+/// used with the STM: compiled away otherwise), from (cos phi, sin phi) and the orbit's data at t:
+/// gravity gradient and, with SRP, the flat plate.
 #[inline(always)]
-fn accel<I: Isa, const SRP: bool>(f: &OrbitForcing, t: f64, cp: F8<I>, sp: F8<I>, p: &Params<I>) -> (F8<I>, F8<I>) {
-    let (a, k, _) = accel_sens::<I, SRP, false>(f, t, cp, sp, p);
+fn accel<I: Isa, const SRP: bool>(at: &PlanarAt, cp: F8<I>, sp: F8<I>, p: &Params<I>) -> (F8<I>, F8<I>) {
+    let (a, k, _) = accel_sens::<I, SRP, false>(at, cp, sp, p);
     (a, k)
 }
 
 /// [`accel`] and, with `SENS`, d wzdot / d parameter at fixed phi (the torques are linear in Kz
 /// and in eps: the same laws at unit Kz or unit plate amplitude, weighted per the parameter).
 #[inline(always)]
-fn accel_sens<I: Isa, const SRP: bool, const SENS: bool>(f: &OrbitForcing, t: f64, cp: F8<I>, sp: F8<I>, p: &Params<I>) -> (F8<I>, F8<I>, F8<I>) {
+fn accel_sens<I: Isa, const SRP: bool, const SENS: bool>(at: &PlanarAt, cp: F8<I>, sp: F8<I>, p: &Params<I>) -> (F8<I>, F8<I>, F8<I>) {
     let isa = cp.isa();
-    let (s, c) = f.sc_at::<I>(t);
-    let (s, c) = (F8::splat(isa, s), F8::splat(isa, c));
+    let (s, c) = (F8::splat(isa, at.s), F8::splat(isa, at.c));
     let c2 = cp * cp - sp * sp;
     let s2 = (cp + cp) * sp;
     let (mut dwz, mut k) = gravity_gradient_wzdot(p.kz15, s, c, c2, s2);
@@ -236,8 +245,7 @@ fn accel_sens<I: Isa, const SRP: bool, const SENS: bool>(f: &OrbitForcing, t: f6
     if SRP {
         // Sun angle theta = w t + theta0_l: (cos, sin)(w t) turned by each lane's theta0_l;
         // alpha = theta - phi (sin alpha, like k, is compiled away without the STM)
-        let (swt, cwt) = p.sun.angle(t).sin_cos();
-        let (swt, cwt) = (F8::splat(isa, swt), F8::splat(isa, cwt));
+        let (swt, cwt) = (F8::splat(isa, at.swt), F8::splat(isa, at.cwt));
         let ct = cwt * p.c0 - swt * p.s0;
         let st = swt * p.c0 + cwt * p.s0;
         let ca = ct.mul_add(cp, st * sp);
@@ -253,14 +261,14 @@ fn accel_sens<I: Isa, const SRP: bool, const SENS: bool>(f: &OrbitForcing, t: f6
 }
 
 #[inline(always)]
-fn rhs<I: Isa, const D: usize, const SRP: bool>(f: &OrbitForcing, t: f64, y: &[F8<I>; D], p: &Params<I>, dy: &mut [F8<I>; D]) {
+fn rhs<I: Isa, const D: usize, const SRP: bool>(at: &PlanarAt, y: &[F8<I>; D], p: &Params<I>, dy: &mut [F8<I>; D]) {
     let isa = y[0].isa();
     let w = y[1] - F8::splat(isa, 1.0);
     let (cp, sp) = (y[2], y[3]);
     dy[0] = w;
     dy[2] = -(w * sp);
     dy[3] = w * cp;
-    let (dwz, k, dp) = if D == 10 { accel_sens::<I, SRP, true>(f, t, cp, sp, p) } else { accel_sens::<I, SRP, false>(f, t, cp, sp, p) };
+    let (dwz, k, dp) = if D == 10 { accel_sens::<I, SRP, true>(at, cp, sp, p) } else { accel_sens::<I, SRP, false>(at, cp, sp, p) };
     dy[1] = dwz;
     if D >= 8 {
         dy[4] = y[6];
@@ -276,9 +284,15 @@ fn rhs<I: Isa, const D: usize, const SRP: bool>(f: &OrbitForcing, t: f64, y: &[F
 }
 
 /// A right-hand side of D states on the lanes at a shared time (the planar model here, the 3-D
-/// rigid body in [`super::lanes3d`]).
+/// rigid body in [`super::lanes3d`]), split in two: what it needs of the orbit at a time (the
+/// same for every lane: [`Rhs::at`], or [`Rhs::at8`] for eight times at once) and the lanes'
+/// derivatives given that ([`Rhs::eval_at`]).
 pub(crate) trait Rhs<I: Isa, const D: usize> {
-    fn eval(&self, t: f64, y: &[F8<I>; D], dy: &mut [F8<I>; D]);
+    type At: Copy;
+    fn at(&self, t: f64) -> Self::At;
+    /// [`Rhs::at`] at eight times, the same values bit for bit.
+    fn at8(&self, ts: &[f64; 8]) -> [Self::At; 8];
+    fn eval_at(&self, at: &Self::At, y: &[F8<I>; D], dy: &mut [F8<I>; D]);
 }
 
 /// The planar model on the lanes: the orbit's forcing table and the lanes' parameters.
@@ -287,10 +301,46 @@ pub(crate) struct Planar<'a, I, const SRP: bool> {
     p: Params<I>,
 }
 
-impl<I: Isa, const D: usize, const SRP: bool> Rhs<I, D> for Planar<'_, I, SRP> {
+impl<I: Isa, const SRP: bool> Planar<'_, I, SRP> {
+    /// The Sun's phase (sin, cos)(w t) with SRP (zeros without).
     #[inline(always)]
-    fn eval(&self, t: f64, y: &[F8<I>; D], dy: &mut [F8<I>; D]) {
-        rhs::<I, D, SRP>(self.f, t, y, &self.p, dy);
+    fn sun(&self, t: f64) -> (f64, f64) {
+        if SRP {
+            self.p.sun.angle(t).sin_cos()
+        } else {
+            (0.0, 0.0)
+        }
+    }
+
+    /// The orbit's data at time t.
+    #[inline(always)]
+    fn orbit_at(&self, t: f64) -> PlanarAt {
+        let (s, c) = self.f.sc_at::<I>(t);
+        let (swt, cwt) = self.sun(t);
+        PlanarAt { s, c, swt, cwt }
+    }
+}
+
+impl<I: Isa, const D: usize, const SRP: bool> Rhs<I, D> for Planar<'_, I, SRP> {
+    type At = PlanarAt;
+
+    #[inline(always)]
+    fn at(&self, t: f64) -> PlanarAt {
+        self.orbit_at(t)
+    }
+
+    #[inline(always)]
+    fn at8(&self, ts: &[f64; 8]) -> [PlanarAt; 8] {
+        let sc = self.f.eval8_at(self.p.kz15.isa(), ts);
+        std::array::from_fn(|l| {
+            let (swt, cwt) = self.sun(ts[l]);
+            PlanarAt { s: sc[l][0], c: sc[l][1], swt, cwt }
+        })
+    }
+
+    #[inline(always)]
+    fn eval_at(&self, at: &PlanarAt, y: &[F8<I>; D], dy: &mut [F8<I>; D]) {
+        rhs::<I, D, SRP>(at, y, &self.p, dy);
     }
 }
 
@@ -308,10 +358,68 @@ pub(crate) struct Fehlberg;
 pub(crate) struct PrinceDormand;
 
 macro_rules! stage {
-    ($a:ident, $c:ident, $st:ident, $m:ident, $t:ident, $y:ident, $h:ident, $s:literal; $($j:literal),+) => {{
+    ($a:ident, $ats:ident, $st:ident, $m:ident, $y:ident, $h:ident, $s:literal; $($j:literal),+) => {{
         lincomb(&mut $st.tmp, $y, F8::splat($y[0].isa(), $h), [$($a[$s][$j]),+], [$(&$st.k[$j]),+]);
-        $m.eval($c[$s].mul_add($h, $t), &$st.tmp, &mut $st.k[$s]);
+        $m.eval_at(&$ats[$s], &$st.tmp, &mut $st.k[$s]);
     }};
+}
+
+/// Where each of a 13-stage pair's stages takes its orbit data: `-1 - l` from lane l of one
+/// [`Rhs::at8`] over the stages `vec`, `j >= 0` from the earlier stage j at the same node, or
+/// [`OWN`] from its own [`Rhs::at`].
+const OWN: i8 = i8::MAX;
+
+const fn stage_plan(c: &[f64; 13], vec: [usize; 8]) -> [i8; 13] {
+    let mut plan = [OWN; 13];
+    let mut l = 0;
+    while l < 8 {
+        plan[vec[l]] = -1 - l as i8;
+        l += 1;
+    }
+    let mut s = 0;
+    while s < 13 {
+        if plan[s] == OWN {
+            let mut j = 0;
+            while j < s {
+                if c[j] == c[s] {
+                    plan[s] = j as i8;
+                    break;
+                }
+                j += 1;
+            }
+        }
+        s += 1;
+    }
+    plan
+}
+
+/// RKF7(8)'s plan: eight distinct nodes on the lanes, t and t + h once each (c = 1/6, 0 and 1
+/// recur).
+const FEHLBERG_PLAN: [i8; 13] = stage_plan(&C, [1, 2, 3, 4, 5, 6, 8, 9]);
+/// RK8(7)13M's plan: its first eight non-zero nodes on the lanes, the other three once each.
+const DP87_PLAN: [i8; 13] = stage_plan(&DP_C, [1, 2, 3, 4, 5, 6, 7, 8]);
+
+/// The orbit data at a 13-stage pair's nodes, t_s = c_s h + t (one fused multiply-add, as
+/// always), by `plan` ([`stage_plan`]): the same values as one [`Rhs::at`] per stage.
+#[inline(always)]
+fn stage_data<I: Isa, const D: usize, M: Rhs<I, D>>(m: &M, c: &[f64; 13], plan: &[i8; 13], t: f64, h: f64) -> [M::At; 13] {
+    let ts: [f64; 13] = std::array::from_fn(|s| c[s].mul_add(h, t));
+    let mut lanes = [0.0; 8];
+    for s in 0..13 {
+        if plan[s] < 0 {
+            lanes[(-1 - plan[s]) as usize] = ts[s];
+        }
+    }
+    let v = m.at8(&lanes);
+    let mut out = [v[0]; 13];
+    for s in 0..13 {
+        out[s] = match plan[s] {
+            OWN => m.at(ts[s]),
+            p if p < 0 => v[(-1 - p) as usize],
+            j => out[j as usize],
+        };
+    }
+    out
 }
 
 /// A lane integration scheme on the model `M`: its state and one step.
@@ -388,8 +496,9 @@ impl<I: Isa, const D: usize, M: Rhs<I, D>> Scheme<I, M> for Stages<I, D, Fehlber
     #[inline(always)]
     fn step(&mut self, m: &M, t: f64, y: &[F8<I>; D], h: f64, out: &mut [F8<I>; D], rtol: F8<I>, atol: F8<I>) -> F8<I> {
         let isa = y[0].isa();
-        m.eval(t, y, &mut self.k[0]);
-        rkf78_stages!(stage!(A, C, self, m, t, y, h));
+        let ats = stage_data(m, &C, &FEHLBERG_PLAN, t, h);
+        m.eval_at(&ats[0], y, &mut self.k[0]);
+        rkf78_stages!(stage!(A, ats, self, m, y, h));
         let k = &self.k;
         let hv = F8::splat(isa, h);
         lincomb(out, y, hv, [B8[5], B8[6], B8[7], B8[8], B8[9], B8[11], B8[12]], [&k[5], &k[6], &k[7], &k[8], &k[9], &k[11], &k[12]]);
@@ -426,8 +535,9 @@ impl<I: Isa, const D: usize, M: Rhs<I, D>> Scheme<I, M> for Stages<I, D, PrinceD
     #[inline(always)]
     fn step(&mut self, m: &M, t: f64, y: &[F8<I>; D], h: f64, out: &mut [F8<I>; D], rtol: F8<I>, atol: F8<I>) -> F8<I> {
         let isa = y[0].isa();
-        m.eval(t, y, &mut self.k[0]);
-        dp87_stages!(stage!(DP_A, DP_C, self, m, t, y, h));
+        let ats = stage_data(m, &DP_C, &DP87_PLAN, t, h);
+        m.eval_at(&ats[0], y, &mut self.k[0]);
+        dp87_stages!(stage!(DP_A, ats, self, m, y, h));
         let k = &self.k;
         let hv = F8::splat(isa, h);
         let w = DP_B8;
@@ -472,9 +582,9 @@ struct NyState<I, const P: usize> {
 
 impl<I: Isa, const P: usize> Nystrom<I, P> {
     #[inline(always)]
-    fn acc<const SRP: bool>(f: &OrbitForcing, t: f64, x: &[F8<I>; P], p: &Params<I>, out: &mut [F8<I>; P]) {
+    fn acc<const SRP: bool>(m: &Planar<'_, I, SRP>, t: f64, x: &[F8<I>; P], out: &mut [F8<I>; P]) {
         let (sp, cp) = x[0].sin_cos();
-        let (a, k) = accel::<I, SRP>(f, t, cp, sp, p);
+        let (a, k) = accel::<I, SRP>(&m.orbit_at(t), cp, sp, &m.p);
         out[0] = a;
         for i in 1..P {
             out[i] = k * x[i];
@@ -525,13 +635,12 @@ impl<I: Isa, const P: usize, const SRP: bool> Scheme<I, Planar<'_, I, SRP>> for 
 
     #[inline(always)]
     fn step(&mut self, m: &Planar<'_, I, SRP>, t: f64, y: &NyState<I, P>, h: f64, out: &mut NyState<I, P>, rtol: F8<I>, atol: F8<I>) -> F8<I> {
-        let (f, p) = (m.f, &m.p);
         let isa = y.x[0].isa();
         let (hv, h2) = (F8::splat(isa, h), F8::splat(isa, h * h));
         let same = |a: &[F8<I>; P], b: &[F8<I>; P]| (0..P).all(|i| a[i].to_array().iter().zip(b[i].to_array().iter()).all(|(u, v)| u.to_bits() == v.to_bits()));
         match self.last_at {
             Some((tl, ref xl)) if tl.to_bits() == t.to_bits() && same(xl, &y.x) => self.k[0] = self.last,
-            _ => Self::acc::<SRP>(f, t, &y.x, p, &mut self.k[0]),
+            _ => Self::acc::<SRP>(m, t, &y.x, &mut self.k[0]),
         }
         for s in 1..RKN_STAGES - 1 {
             for i in 0..P {
@@ -542,7 +651,7 @@ impl<I: Isa, const P: usize, const SRP: bool> Scheme<I, Planar<'_, I, SRP>> for 
                 self.tmp[i] = h2.mul_add(acc, (hv * F8::splat(isa, RKN_C[s])).mul_add(y.v[i], y.x[i]));
             }
             let tmp = self.tmp;
-            Self::acc::<SRP>(f, RKN_C[s].mul_add(h, t), &tmp, p, &mut self.k[s]);
+            Self::acc::<SRP>(m, RKN_C[s].mul_add(h, t), &tmp, &mut self.k[s]);
         }
         // the new position (the last stage's: A's last row is B), then the last stage there
         for i in 0..P {
@@ -553,7 +662,7 @@ impl<I: Isa, const P: usize, const SRP: bool> Scheme<I, Planar<'_, I, SRP>> for 
             out.x[i] = h2.mul_add(acc, hv.mul_add(y.v[i], y.x[i]));
         }
         let xnew = out.x;
-        Self::acc::<SRP>(f, t + h, &xnew, p, &mut self.k[RKN_STAGES - 1]);
+        Self::acc::<SRP>(m, t + h, &xnew, &mut self.k[RKN_STAGES - 1]);
         self.last = self.k[RKN_STAGES - 1];
         self.last_at = Some((t + h, xnew));
         let mut err = F8::splat(isa, 0.0);
@@ -821,6 +930,7 @@ mod tests {
             Case { phi0: -2.9 + 0.8 * x, wz0: -2.0 + 0.6 * x, kz: 0.9 - 0.25 * x, eps: [0.0, 0.05, 0.3, -0.2][l % 4], cs: 0.1 * (l % 3) as f64, cd: 0.2, theta_sun0: 0.9 * x - 3.0 }
         });
         let (p, plates) = Params::new(ISA, |l| cases[l], LaneOptions::default().sun_omega, Sensitivity::None);
+        let model = Planar::<I, true> { f: &f, p };
         let stm = [0.7, -1.3, 2.1, 0.4];
         for t in [0.0, 0.37 * o.period, 0.81 * o.period, 3.3 * o.period] {
             let mut y = [V::splat(ISA, 0.0); 8];
@@ -832,7 +942,7 @@ mod tests {
                 y[4 + i] = V::splat(ISA, stm[i]);
             }
             let mut dy = [V::splat(ISA, 0.0); 8];
-            rhs::<I, 8, true>(&f, t, &y, &p, &mut dy);
+            rhs::<I, 8, true>(&model.orbit_at(t), &y, &model.p, &mut dy);
             let (s, c) = f.sc(t);
             for (l, case) in cases.iter().enumerate() {
                 let scalar = PlanarForced { kz: case.kz, forcing: &f, srp: if case.eps != 0.0 { Some(plates[l]) } else { None } };
@@ -847,6 +957,48 @@ mod tests {
                 assert_eq!(lane(&dy[2], l), -(ds[0] * case.phi0.sin()));
                 assert_eq!(lane(&dy[3], l), ds[0] * case.phi0.cos());
             }
+        }
+    }
+
+    /// The orbit data of a step's 13 nodes, eight of them on the lanes ([`stage_data`]), equal
+    /// one scalar evaluation per node bit for bit at every SIMD level this CPU has: steps inside
+    /// one segment of the forcing table, across a segment boundary, across the period's end, and
+    /// longer than a segment (the scalar fallback); with the Sun's phase (SRP). The plans take
+    /// every recurring node (RKF7(8)'s c = 0, 1/6, 1; RK8(7)13M's c = 1) from its first stage.
+    #[test]
+    fn stage_data_equals_one_evaluation_per_node() {
+        assert_eq!(FEHLBERG_PLAN, [OWN, -1, -2, -3, -4, -5, -6, 3, -7, -8, OWN, 0, 10]);
+        assert_eq!(DP87_PLAN, [OWN, -1, -2, -3, -4, -5, -6, -7, -8, OWN, OWN, OWN, 11]);
+        let mu = 0.01215;
+        let (x0, d) = (0.7, 1.0 - mu - 0.7);
+        let o = correct_planar_symmetric(mu, x0, (mu / d).sqrt() + d, 1e-12, 30, &Options::with_tolerances(1e-13, 1e-13)).unwrap();
+        let f = OrbitForcing::new(mu, &o.state0, o.period, [true, true], 1e-13).unwrap();
+        let seg = o.period / f.segments() as f64;
+        assert!(f.segments() >= 4, "{} segments", f.segments());
+        // (t, h): inside segment 1, across the boundary of segments 1 and 2, across the period's
+        // end, two segments long
+        let steps = [(1.1 * seg, 0.3 * seg), (1.9 * seg, 0.4 * seg), (o.period - 0.2 * seg, 0.5 * seg), (0.5 * seg, 2.0 * seg)];
+        struct Probe<'a>(&'a OrbitForcing, [(f64, f64); 4]);
+        impl Kernel for Probe<'_> {
+            type Output = ();
+            fn run<I: Isa>(self, isa: I) {
+                let case = Case { eps: 0.05, theta_sun0: 0.7, ..Case::new(0.1, 0.3, 0.8) };
+                let (p, _) = Params::new(isa, |_| case, LaneOptions::default().sun_omega, Sensitivity::None);
+                let m = Planar::<I, true> { f: self.0, p };
+                for (t, h) in self.1 {
+                    for (c, plan) in [(&C, &FEHLBERG_PLAN), (&DP_C, &DP87_PLAN)] {
+                        let got = stage_data::<I, 4, _>(&m, c, plan, t, h);
+                        for s in 0..13 {
+                            let want = m.orbit_at(c[s].mul_add(h, t));
+                            let bits = |a: &PlanarAt| [a.s, a.c, a.swt, a.cwt].map(f64::to_bits);
+                            assert_eq!(bits(&got[s]), bits(&want), "{}: t {t}, h {h}, stage {s}", I::LEVEL);
+                        }
+                    }
+                }
+            }
+        }
+        for &level in &crate::simd::available() {
+            crate::simd::run_at(level, Probe(&f, steps)).unwrap();
         }
     }
 }

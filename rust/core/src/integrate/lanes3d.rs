@@ -58,10 +58,21 @@ struct Rigid<'a, I> {
 }
 
 impl<I: Isa> Rhs<I, D> for Rigid<'_, I> {
+    type At = [f64; 6];
+
     #[inline(always)]
-    fn eval(&self, t: f64, y: &[F8<I>; D], dy: &mut [F8<I>; D]) {
+    fn at(&self, t: f64) -> [f64; 6] {
+        self.table.eval_at::<I>(t)
+    }
+
+    #[inline(always)]
+    fn at8(&self, ts: &[f64; 8]) -> [[f64; 6]; 8] {
+        self.table.eval8_at(self.one.isa(), ts)
+    }
+
+    #[inline(always)]
+    fn eval_at(&self, m6: &[f64; 6], y: &[F8<I>; D], dy: &mut [F8<I>; D]) {
         let isa = y[0].isa();
-        let m6 = self.table.eval_at::<I>(t);
         let m = [F8::splat(isa, m6[0]), F8::splat(isa, m6[1]), F8::splat(isa, m6[2]), F8::splat(isa, m6[3]), F8::splat(isa, m6[4]), F8::splat(isa, m6[5])];
         let q = [y[0], y[1], y[2], y[3]];
         let w = [y[4], y[5], y[6]];
