@@ -173,7 +173,7 @@ def srp_map(
         # (its own one-thread engine pool; the engine releases the GIL) and fills the cores the
         # branches' small corrector batches leave idle. Results do not depend on it: each
         # trajectory's result depends only on its group of lanes, never on the threads.
-        with ThreadPoolExecutor(max_workers=2) as pool:
+        with ThreadPoolExecutor(max_workers=2) as pool, ThreadPoolExecutor(max_workers=1) as scanner:
             grid = pool.submit(grid_sweep, 1)
             window = (float(wz[0]), float(wz[-1]))
             runs = []  # (jobs, lead, branches, their marks' re-propagation (a future)), in order
@@ -249,18 +249,21 @@ def srp_map(
                         jobs.append((s0, 0.0, side, "gravity"))
                         lead.append(first)
                         first = []
-            run(jobs, lead)
             # Solutions at the grid's far ends (SRP-dominated ones too), continued back towards eps = 0
-            # unless a branch from eps = 0 already reached them.
+            # unless a branch from eps = 0 already reached them. The scans of the ends do not depend
+            # on the branches from eps = 0 (only which of their solutions are new does): they run
+            # beside those branches, on a thread of their own.
             zero = np.array([0.0] if 0.0 in es else [])
             ends = (([(float(es[-1]), np.concatenate([pos[::-1][1:], zero]))] if es[-1] > 0 else [])
                     + ([(float(es[0]), np.concatenate([neg[::-1][1:], zero]))] if es[0] < 0 else []))
-            for e_end, inward in ends:
+            # phi0 is free: each end scanned from four initial attitudes (one sweep, one corrector call)
+            scans = [scanner.submit(find_periodic_attitudes, orbit, kz=kz, wz0_range=window,
+                                    phi0=[phi0 + s_ for s_ in (0.0, 0.5 * math.pi, math.pi, -0.5 * math.pi)],
+                                    kinds=kinds, n_periods=n_periods, srp=plate.with_eps(e_end)) for e_end, _ in ends]
+            run(jobs, lead)
+            for (e_end, inward), scan in zip(ends, scans):
                 known = found_at(e_end)
-                # phi0 is free: scan from four initial attitudes (one sweep, one corrector call)
-                found = find_periodic_attitudes(orbit, kz=kz, wz0_range=window,
-                                                phi0=[phi0 + s_ for s_ in (0.0, 0.5 * math.pi, math.pi, -0.5 * math.pi)],
-                                                kinds=kinds, n_periods=n_periods, srp=plate.with_eps(e_end))
+                found = scan.result()
                 jobs, lead = [], []
                 for s1 in sorted(found, key=lambda x: x.wz0):
                     if any(k.n_total == s1.n_total and k.kind == s1.kind and abs(k.wz0 - s1.wz0) < 1e-7
