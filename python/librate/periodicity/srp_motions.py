@@ -176,7 +176,7 @@ def srp_map(
         with ThreadPoolExecutor(max_workers=2) as pool, ThreadPoolExecutor(max_workers=1) as scanner:
             grid = pool.submit(grid_sweep, 1)
             window = (float(wz[0]), float(wz[-1]))
-            runs = []  # (jobs, lead, branches, their marks' re-propagation (a future)), in order
+            runs = []  # (jobs, lead, branches, per branch its marks' re-propagations (future, index)), in order
 
             def run(jobs, lead):
                 """Continue each job's ``start`` (at e_start) through the grid ``values`` in order
