@@ -381,9 +381,10 @@ def candidates(phi_t, phi0, wz, level, max_crossings: int | None = None):
     if max_crossings is not None:
         ok &= hi - lo + 1 <= max_crossings
     out = []
-    for i in np.flatnonzero(ok & (hi >= lo)):
+    for i in np.flatnonzero(ok & (hi >= lo)).tolist():
+        ai, bi, w0, w1 = float(a[i]), float(b[i]), float(wz[i]), float(wz[i + 1])  # the same arithmetic on Python floats
         for k in range(int(lo[i]), int(hi[i]) + 1):
-            out.append((k, float(wz[i] + (k - a[i]) / (b[i] - a[i]) * (wz[i + 1] - wz[i]))))
+            out.append((k, w0 + (k - ai) / (bi - ai) * (w1 - w0)))
     return out
 
 
@@ -422,13 +423,13 @@ def refine_groups(orbit, kz, phi0, cands, *, n_periods, srp, closure, window, ki
                 **({"max_iter": STEP_MAX_ITER, "max_halvings": 3} if quick else {}))
     lo, hi = window
     order = {g: j for j, g in enumerate(dict.fromkeys(grp.tolist()))}
-    conv = sorted(np.flatnonzero(b.converged & (b.wz0 >= lo) & (b.wz0 <= hi)), key=lambda i: (order[grp[i]], kzs[i], b.wz0[i]))
+    # the same comparisons on plain Python values (numpy scalars cost ~1 us each)
+    g_, k_, nt_, kd_, w_ = grp.tolist(), kzs.tolist(), n_total.tolist(), kind.tolist(), b.wz0.tolist()
+    conv = sorted(np.flatnonzero(b.converged & (b.wz0 >= lo) & (b.wz0 <= hi)).tolist(), key=lambda i: (order[g_[i]], k_[i], w_[i]))
     ok: list[int] = []  # one per solution: candidates that converged onto the same one are verified once
     for i in conv:
-        if not any(grp[j] == grp[i] and kzs[j] == kzs[i] and n_total[j] == n_total[i] and kind[j] == kind[i]
-                   and abs(b.wz0[j] - b.wz0[i]) < 1e-8
-                   for j in ok):
-            ok.append(int(i))
+        if not any(g_[j] == g_[i] and k_[j] == k_[i] and nt_[j] == nt_[i] and kd_[j] == kd_[i] and abs(w_[j] - w_[i]) < 1e-8 for j in ok):
+            ok.append(i)
     sols = verified(orbit, kz=kzs[ok], n_total=n_total[ok], kind=kind[ok], phi0=b.phi0[ok], wz0=b.wz0[ok], n_periods=n_periods,
                     plates=None if srp is None else [srp] * len(ok), iterations=b.iterations[ok])
     return [(int(grp[i]), s) for i, s in zip(ok, sols) if s.residual <= 1e-8]

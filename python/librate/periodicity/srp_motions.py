@@ -173,30 +173,45 @@ def srp_map(
         # (its own one-thread engine pool; the engine releases the GIL) and fills the cores the
         # branches' small corrector batches leave idle. Results do not depend on it: each
         # trajectory's result depends only on its group of lanes, never on the threads.
-        with ThreadPoolExecutor(max_workers=2) as pool:
+        with ThreadPoolExecutor(max_workers=2) as pool, ThreadPoolExecutor(max_workers=1) as scanner:
             grid = pool.submit(grid_sweep, 1)
             window = (float(wz[0]), float(wz[-1]))
-            runs = []  # (jobs, lead, branches, their marks' re-propagation (a future)), in order
+            runs = []  # (jobs, lead, branches, per branch its marks' re-propagations (future, index)), in order
 
             def run(jobs, lead):
                 """Continue each job's ``start`` (at e_start) through the grid ``values`` in order
                 (one pseudo-arclength run to the last value, corrected exactly at each grid value
                 on the way; only those re-propagated), ending at the grid's end or at a located
                 fold. The branches run in lock step (:func:`eps_branches`: each round's corrections
-                of every branch in one Rust call); their marked points are re-propagated beside what
-                follows, in pieces of :data:`VERIFY_PIECE` on the pool (one-thread engine calls, as
-                the grid)."""
+                of every branch in one Rust call); each branch's marked points are queued for
+                re-propagation as the branch ends, beside the branches still running, in pieces of
+                :data:`VERIFY_PIECE` on the pool (one-thread engine calls, as the grid)."""
                 advance(0, len(jobs))
+                pieces, queue, slots = [], [], [[] for _ in jobs]  # futures; (job, point) waiting; (piece, index) per mark
+
+                def submit(part):
+                    for k, (j, _) in enumerate(part):
+                        slots[j].append((len(pieces), k))
+                    starts = [jobs[j][0] for j, _ in part]
+                    pieces.append(pool.submit(verified, orbit, kz=kz, n_total=[s_.n_total for s_ in starts],
+                                              kind=[s_.kind for s_ in starts], phi0=[p.x[1] for _, p in part],
+                                              wz0=[p.x[2] for _, p in part], n_periods=n_periods,
+                                              plates=[plate.with_eps(float(p.x[0])) for _, p in part],
+                                              iterations=[p.iterations for _, p in part], threads=1))
+
+                def ended(j, br):
+                    # each item's re-propagation depends on it alone: the pieces may form in any order
+                    advance()
+                    queue.extend((j, p) for p in (br.marked if br is not None else ()))
+                    while len(queue) >= VERIFY_PIECE:
+                        submit(queue[:VERIFY_PIECE])
+                        del queue[:VERIFY_PIECE]
+
                 brs = eps_branches([(start, plate.with_eps(float(values[-1])), [float(e) for e in values]) for start, _, values, _ in jobs],
-                                   steps=steps, done=lambda _: advance())
-                owners = [(start, p) for (start, _, _, _), br in zip(jobs, brs) for p in br.marked]
-                # in pieces, which both workers take (each item's result depends on it alone): the
-                # last run's re-propagation is not left to one core once the branches are done
-                checked = [pool.submit(verified, orbit, kz=kz, n_total=[s_.n_total for s_, _ in part], kind=[s_.kind for s_, _ in part],
-                                       phi0=[p.x[1] for _, p in part], wz0=[p.x[2] for _, p in part], n_periods=n_periods,
-                                       plates=[plate.with_eps(float(p.x[0])) for _, p in part], iterations=[p.iterations for _, p in part],
-                                       threads=1)
-                           for part in (owners[a:a + VERIFY_PIECE] for a in range(0, len(owners), VERIFY_PIECE))]
+                                   steps=steps, done=ended)
+                if queue:
+                    submit(queue)
+                checked = [[(pieces[a], k) for a, k in slot] for slot in slots]
                 runs.append((jobs, lead, brs, checked))
 
             def found_at(e_end):
@@ -209,10 +224,9 @@ def srp_map(
             def record(jobs, lead, brs, checked):
                 """The branches of one run, recorded in order, each after its ``lead`` solutions
                 ((eps, solution) recorded at the branch's index first)."""
-                checked = (s_ for piece in checked for s_ in piece.result())
-                for (start, e_start, _, origin), br, first in zip(jobs, brs, lead):
+                for (start, e_start, _, origin), br, first, slot in zip(jobs, brs, lead, checked):
                     pts = [(float(p.x[0]), float(p.x[2]), float(p.x[1]), float(p.data["trace"])) for p in br.points]
-                    marked = [(float(p.x[0]), next(checked)) for p in br.marked]
+                    marked = [(float(p.x[0]), piece.result()[k]) for p, (piece, k) in zip(br.marked, slot)]
                     if br.reached:
                         end = (math.nan, math.nan, False, "reached the end of the eps grid")
                     else:
@@ -235,18 +249,21 @@ def srp_map(
                         jobs.append((s0, 0.0, side, "gravity"))
                         lead.append(first)
                         first = []
-            run(jobs, lead)
             # Solutions at the grid's far ends (SRP-dominated ones too), continued back towards eps = 0
-            # unless a branch from eps = 0 already reached them.
+            # unless a branch from eps = 0 already reached them. The scans of the ends do not depend
+            # on the branches from eps = 0 (only which of their solutions are new does): they run
+            # beside those branches, on a thread of their own.
             zero = np.array([0.0] if 0.0 in es else [])
             ends = (([(float(es[-1]), np.concatenate([pos[::-1][1:], zero]))] if es[-1] > 0 else [])
                     + ([(float(es[0]), np.concatenate([neg[::-1][1:], zero]))] if es[0] < 0 else []))
-            for e_end, inward in ends:
+            # phi0 is free: each end scanned from four initial attitudes (one sweep, one corrector call)
+            scans = [scanner.submit(find_periodic_attitudes, orbit, kz=kz, wz0_range=window,
+                                    phi0=[phi0 + s_ for s_ in (0.0, 0.5 * math.pi, math.pi, -0.5 * math.pi)],
+                                    kinds=kinds, n_periods=n_periods, srp=plate.with_eps(e_end)) for e_end, _ in ends]
+            run(jobs, lead)
+            for (e_end, inward), scan in zip(ends, scans):
                 known = found_at(e_end)
-                # phi0 is free: scan from four initial attitudes (one sweep, one corrector call)
-                found = find_periodic_attitudes(orbit, kz=kz, wz0_range=window,
-                                                phi0=[phi0 + s_ for s_ in (0.0, 0.5 * math.pi, math.pi, -0.5 * math.pi)],
-                                                kinds=kinds, n_periods=n_periods, srp=plate.with_eps(e_end))
+                found = scan.result()
                 jobs, lead = [], []
                 for s1 in sorted(found, key=lambda x: x.wz0):
                     if any(k.n_total == s1.n_total and k.kind == s1.kind and abs(k.wz0 - s1.wz0) < 1e-7

@@ -207,16 +207,23 @@ def _mark_guess(x0: np.ndarray, m0: np.ndarray, x1: np.ndarray, m1: np.ndarray, 
         u2, u3 = u * u, u * u * u
         return (2 * u3 - 3 * u2 + 1) * x0 + (u3 - 2 * u2 + u) * m0 + (3 * u2 - 2 * u3) * x1 + (u3 - u2) * m1
 
+    # component k of curve(u), the same operations on floats (the Newton iteration needs no more)
+    xk0, mk0, xk1, mk1 = float(x0[k]), float(m0[k]), float(x1[k]), float(m1[k])
+
+    def curve_k(u: float) -> float:
+        u2, u3 = u * u, u * u * u
+        return (2 * u3 - 3 * u2 + 1) * xk0 + (u3 - 2 * u2 + u) * mk0 + (3 * u2 - 2 * u3) * xk1 + (u3 - u2) * mk1
+
     def slope(u: float) -> float:
         u2 = u * u
-        return float((6 * u2 - 6 * u) * x0[k] + (3 * u2 - 4 * u + 1) * m0[k] + (6 * u - 6 * u2) * x1[k] + (3 * u2 - 2 * u) * m1[k])
+        return (6 * u2 - 6 * u) * xk0 + (3 * u2 - 4 * u + 1) * mk0 + (6 * u - 6 * u2) * xk1 + (3 * u2 - 2 * u) * mk1
 
     if slope(0.0) * slope(1.0) <= 0 or slope(0.5) * slope(0.0) <= 0:
         return chord
     u = w
     for _ in range(20):
         d = slope(u)
-        step = (curve(u)[k] - value) / d
+        step = (curve_k(u) - value) / d
         u -= step
         if not 0.0 <= u <= 1.0:
             return chord

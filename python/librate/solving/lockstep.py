@@ -107,13 +107,14 @@ def correct_together(requests: list) -> list[Point | None]:
     return out
 
 
-def run_lockstep(branches: Sequence[tuple[Any, Any]], done: Callable[[int], None] | None = None) -> list:
+def run_lockstep(branches: Sequence[tuple[Any, Any]], done: Callable[[int, Any], None] | None = None) -> list:
     """Run several continuations in lock step: ``branches`` are (problem, steps) pairs, steps a
     generator from :func:`arclength_steps` (or :func:`natural_steps`); each round, every live
     branch's pending correction is gathered and corrected together (:func:`correct_together`).
     Returns each generator's result (a Branch), in order. Each branch takes exactly the path it
-    takes alone: only the grouping of the corrector calls changes. ``done(i)`` is called as
-    branch i ends (e.g. for progress)."""
+    takes alone: only the grouping of the corrector calls changes. ``done(i, result)`` is called
+    as branch i ends, with its result (e.g. for progress, or to start work on that branch while
+    the others go on)."""
     results: list = [None] * len(branches)
     pending: dict[int, tuple] = {}
     for i, (problem, steps) in enumerate(branches):
@@ -122,7 +123,7 @@ def run_lockstep(branches: Sequence[tuple[Any, Any]], done: Callable[[int], None
         except StopIteration as end:
             results[i] = end.value
             if done is not None:
-                done(i)
+                done(i, end.value)
     while pending:
         order = sorted(pending)
         single = [i for i in order if not isinstance(pending[i], Marks)]
@@ -139,6 +140,6 @@ def run_lockstep(branches: Sequence[tuple[Any, Any]], done: Callable[[int], None
                 results[i] = end.value
                 del pending[i]
                 if done is not None:
-                    done(i)
+                    done(i, end.value)
     return results
 
