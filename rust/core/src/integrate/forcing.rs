@@ -207,16 +207,7 @@ impl<const N: usize> OrbitTable<N> {
     fn eval_with(&self, t: f64, fma: impl Fn(f64, f64, f64) -> f64) -> [f64; N] {
         let (s, x) = self.locate(t);
         let c = &self.coef[s * NC * N..(s + 1) * NC * N];
-        let (mut b1, mut b2) = ([0.0; N], [0.0; N]);
-        let x2 = 2.0 * x;
-        for k in (1..NC).rev() {
-            for i in 0..N {
-                let tk = fma(x2, b1[i], c[N * k + i] - b2[i]);
-                b2[i] = b1[i];
-                b1[i] = tk;
-            }
-        }
-        std::array::from_fn(|i| fma(x, b1[i], c[i] - b2[i]))
+        clenshaw(x, 2.0 * x, 0.0, |j| c[j], fma)
     }
 
     /// The N components at eight times at once on the lanes of `isa`: the same values as
@@ -233,33 +224,34 @@ impl<const N: usize> OrbitTable<N> {
         }
         let x = F8::new(isa, loc.map(|(_, x)| x));
         let (ca, cb) = (&self.coef[lo * NC * N..(lo + 1) * NC * N], &self.coef[hi * NC * N..(hi + 1) * NC * N]);
+        let (x2, zero) = (F8::splat(isa, 2.0) * x, F8::splat(isa, 0.0));
+        let fma = |a: F8<I>, b: F8<I>, c: F8<I>| a.mul_add(b, c);
         let v: [F8<I>; N] = if lo == hi {
-            clenshaw8(x, |j| F8::splat(isa, ca[j]))
+            clenshaw(x, x2, zero, |j| F8::splat(isa, ca[j]), fma)
         } else {
             let seg = F8::new(isa, loc.map(|(s, _)| s as f64));
             let lo_f = F8::splat(isa, lo as f64);
-            clenshaw8(x, |j| seg.le_select(lo_f, F8::splat(isa, ca[j]), F8::splat(isa, cb[j])))
+            clenshaw(x, x2, zero, |j| seg.le_select(lo_f, F8::splat(isa, ca[j]), F8::splat(isa, cb[j])), fma)
         };
         let v = v.map(|c| c.to_array());
         std::array::from_fn(|l| std::array::from_fn(|i| v[i][l]))
     }
 }
 
-/// [`OrbitTable::eval_with`]'s recurrence on eight lanes, coefficient j of the segment's
-/// [k][component] layout from `coef(j)`.
+/// Clenshaw's recurrence for the N components of one segment at x (x2 = 2 x), on a scalar or on
+/// the lanes: coefficient j of the segment's [k][component] layout from `coef(j)`, `fma(a, b, c)`
+/// = a b + c.
 #[inline(always)]
-fn clenshaw8<I: Isa, const N: usize>(x: F8<I>, coef: impl Fn(usize) -> F8<I>) -> [F8<I>; N] {
-    let isa = x.isa();
-    let (mut b1, mut b2) = ([F8::splat(isa, 0.0); N], [F8::splat(isa, 0.0); N]);
-    let x2 = F8::splat(isa, 2.0) * x;
+fn clenshaw<T: Copy + std::ops::Sub<Output = T>, const N: usize>(x: T, x2: T, zero: T, coef: impl Fn(usize) -> T, fma: impl Fn(T, T, T) -> T) -> [T; N] {
+    let (mut b1, mut b2) = ([zero; N], [zero; N]);
     for k in (1..NC).rev() {
         for i in 0..N {
-            let tk = x2.mul_add(b1[i], coef(N * k + i) - b2[i]);
+            let tk = fma(x2, b1[i], coef(N * k + i) - b2[i]);
             b2[i] = b1[i];
             b1[i] = tk;
         }
     }
-    std::array::from_fn(|i| x.mul_add(b1[i], coef(i) - b2[i]))
+    std::array::from_fn(|i| fma(x, b1[i], coef(i) - b2[i]))
 }
 
 impl Forcing for OrbitTable<2> {

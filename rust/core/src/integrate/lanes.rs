@@ -212,7 +212,7 @@ fn lincomb<I: Isa, const D: usize, const M: usize>(out: &mut [F8<I>; D], y: &[F8
 
 /// What the planar lanes need of the orbit at one time, the same for every lane: the gravity
 /// gradient's forcing S, C and, with SRP, (sin, cos) of the Sun's phase w t (zeros without).
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy)]
 pub(crate) struct PlanarAt {
     s: f64,
     c: f64,
@@ -364,11 +364,12 @@ macro_rules! stage {
     }};
 }
 
-/// Where each of a 13-stage pair's stages takes its orbit data: `-1 - l` from lane l of one
-/// [`Rhs::at8`] over the stages `vec`, `j >= 0` from the earlier stage j at the same node, or
-/// [`OWN`] from its own [`Rhs::at`].
+/// A stage that takes its orbit data from its own [`Rhs::at`] ([`stage_plan`]).
 const OWN: i8 = i8::MAX;
 
+/// Where each of a 13-stage pair's stages takes its orbit data: `-1 - l` from lane l of one
+/// [`Rhs::at8`] over the stages `vec`, `j >= 0` from the earlier stage j at the same node, or
+/// [`OWN`].
 const fn stage_plan(c: &[f64; 13], vec: [usize; 8]) -> [i8; 13] {
     let mut plan = [OWN; 13];
     let mut l = 0;
