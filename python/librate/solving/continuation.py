@@ -203,16 +203,12 @@ def _mark_guess(x0: np.ndarray, m0: np.ndarray, x1: np.ndarray, m1: np.ndarray, 
     chord = x0 + w * (x1 - x0)
     chord[k] = value
 
-    def curve(u: float) -> np.ndarray:
+    def hermite(u: float, a0, b0, a1, b1):
         u2, u3 = u * u, u * u * u
-        return (2 * u3 - 3 * u2 + 1) * x0 + (u3 - 2 * u2 + u) * m0 + (3 * u2 - 2 * u3) * x1 + (u3 - u2) * m1
+        return (2 * u3 - 3 * u2 + 1) * a0 + (u3 - 2 * u2 + u) * b0 + (3 * u2 - 2 * u3) * a1 + (u3 - u2) * b1
 
-    # component k of curve(u), the same operations on floats (the Newton iteration needs no more)
+    # the Newton iteration needs only component k: the same operations on floats
     xk0, mk0, xk1, mk1 = float(x0[k]), float(m0[k]), float(x1[k]), float(m1[k])
-
-    def curve_k(u: float) -> float:
-        u2, u3 = u * u, u * u * u
-        return (2 * u3 - 3 * u2 + 1) * xk0 + (u3 - 2 * u2 + u) * mk0 + (3 * u2 - 2 * u3) * xk1 + (u3 - u2) * mk1
 
     def slope(u: float) -> float:
         u2 = u * u
@@ -223,13 +219,13 @@ def _mark_guess(x0: np.ndarray, m0: np.ndarray, x1: np.ndarray, m1: np.ndarray, 
     u = w
     for _ in range(20):
         d = slope(u)
-        step = (curve_k(u) - value) / d
+        step = (hermite(u, xk0, mk0, xk1, mk1) - value) / d
         u -= step
         if not 0.0 <= u <= 1.0:
             return chord
         if abs(step) <= 1e-15:
             break
-    guess = curve(u)
+    guess = hermite(u, x0, m0, x1, m1)
     guess[k] = value
     return guess if np.all(np.isfinite(guess)) else chord
 
