@@ -363,6 +363,11 @@ mod x86 {
             let (a, b, c) = (h(a), h(b), h(c));
             uh([self.0.fma._mm256_fmadd_pd(a[0], b[0], c[0]), self.0.fma._mm256_fmadd_pd(a[1], b[1], c[1])])
         }
+        #[inline(always)]
+        fn floor8(self, a: A8) -> A8 {
+            let a = h(a);
+            uh([self.0.avx._mm256_floor_pd(a[0]), self.0.avx._mm256_floor_pd(a[1])])
+        }
     }
 
     impl Isa for Avx512 {
@@ -404,6 +409,11 @@ mod x86 {
         #[inline(always)]
         fn mul_add8(self, a: A8, b: A8, c: A8) -> A8 {
             uz(self.0.avx512f._mm512_fmadd_pd(z(a), z(b), z(c)))
+        }
+        #[inline(always)]
+        fn floor8(self, a: A8) -> A8 {
+            // rounding toward -infinity (1), precision exception suppressed (8), scale 0
+            uz(self.0.avx512f._mm512_roundscale_pd::<0x09>(z(a)))
         }
     }
 }

@@ -19,7 +19,8 @@
 //! trigonometric calls of the gravity gradient (cos 2phi = c^2 - s^2, sin 2phi = 2 c s); phi
 //! itself is integrated (phidot = wz - 1) and gives the unwrapped phi(T). The flat-plate SRP
 //! law (docs/physics.md, solar radiation pressure) is C1 only: a step never spans a lane's Sun-terminator crossing
-//! (cos(theta_sun - phi) = 0); the step is cut there (Illinois iterations on its length).
+//! (cos(theta_sun - phi) = 0); the step is cut just past it ([`CUT_TOL`]: a Hermite first guess,
+//! then Newton on cos alpha along trial steps).
 //!
 //! Nothing of the physics or the step control is written here: the lanes call the laws the
 //! scalar planar model calls ([`gravity_gradient_wzdot`], [`flat_plate_wzdot`], [`Sun::angle`],
@@ -245,11 +246,7 @@ fn accel_sens<I: Isa, const SRP: bool, const SENS: bool>(at: &PlanarAt, cp: F8<I
     if SRP {
         // Sun angle theta = w t + theta0_l: (cos, sin)(w t) turned by each lane's theta0_l;
         // alpha = theta - phi (sin alpha, like k, is compiled away without the STM)
-        let (swt, cwt) = (F8::splat(isa, at.swt), F8::splat(isa, at.cwt));
-        let ct = cwt * p.c0 - swt * p.s0;
-        let st = swt * p.c0 + cwt * p.s0;
-        let ca = ct.mul_add(cp, st * sp);
-        let sa = st.mul_add(cp, -(ct * sp));
+        let (ca, sa) = sun_alpha(at.swt, at.cwt, p, cp, sp);
         let (v, d) = flat_plate_wzdot(p.a1, p.a2, ca, sa);
         dwz += v;
         k += d;
@@ -258,6 +255,18 @@ fn accel_sens<I: Isa, const SRP: bool, const SENS: bool>(at: &PlanarAt, cp: F8<I
         }
     }
     (dwz, k, dp)
+}
+
+/// (cos, sin) of each lane's Sun angle from its plate normal, alpha = theta_l - phi: the Sun's
+/// shared phase (sin, cos)(w t) turned by each lane's theta0_l, then by -phi from (cos phi, sin
+/// phi). The law's kinks and the steps' cuts are where cos alpha = 0.
+#[inline(always)]
+fn sun_alpha<I: Isa>(swt: f64, cwt: f64, p: &Params<I>, cp: F8<I>, sp: F8<I>) -> (F8<I>, F8<I>) {
+    let isa = cp.isa();
+    let (swt, cwt) = (F8::splat(isa, swt), F8::splat(isa, cwt));
+    let ct = cwt * p.c0 - swt * p.s0;
+    let st = swt * p.c0 + cwt * p.s0;
+    (ct.mul_add(cp, st * sp), st.mul_add(cp, -(ct * sp)))
 }
 
 #[inline(always)]
@@ -302,13 +311,34 @@ pub(crate) struct Planar<'a, I, const SRP: bool> {
 }
 
 impl<I: Isa, const SRP: bool> Planar<'_, I, SRP> {
-    /// The Sun's phase (sin, cos)(w t) with SRP (zeros without).
+    /// The Sun's phase (sin, cos)(w t) with SRP (zeros without), from the lanes' sin_cos (one
+    /// lane of [`Self::sun8`]'s evaluation, the same bits).
     #[inline(always)]
     fn sun(&self, t: f64) -> (f64, f64) {
         if SRP {
-            self.p.sun.angle(t).sin_cos()
+            let (s, c) = F8::splat(self.p.kz15.isa(), self.p.sun.angle(t)).sin_cos();
+            (lane(&s, 0), lane(&c, 0))
         } else {
             (0.0, 0.0)
+        }
+    }
+
+    /// (cos alpha, sin alpha) of the lanes in the state y at t, as the right-hand side has them.
+    #[inline(always)]
+    fn alpha<Y: PlanarY<I>>(&self, t: f64, y: &Y) -> (F8<I>, F8<I>) {
+        let (swt, cwt) = self.sun(t);
+        let (cp, sp) = y.cos_sin();
+        sun_alpha(swt, cwt, &self.p, cp, sp)
+    }
+
+    /// [`Self::sun`] at eight times, in one vector evaluation.
+    #[inline(always)]
+    fn sun8(&self, ts: &[f64; 8]) -> ([f64; 8], [f64; 8]) {
+        if SRP {
+            let (s, c) = F8::new(self.p.kz15.isa(), ts.map(|t| self.p.sun.angle(t))).sin_cos();
+            (s.to_array(), c.to_array())
+        } else {
+            ([0.0; 8], [0.0; 8])
         }
     }
 
@@ -332,10 +362,8 @@ impl<I: Isa, const D: usize, const SRP: bool> Rhs<I, D> for Planar<'_, I, SRP> {
     #[inline(always)]
     fn at8(&self, ts: &[f64; 8]) -> [PlanarAt; 8] {
         let sc = self.f.eval8_at(self.p.kz15.isa(), ts);
-        std::array::from_fn(|l| {
-            let (swt, cwt) = self.sun(ts[l]);
-            PlanarAt { s: sc[l][0], c: sc[l][1], swt, cwt }
-        })
+        let (swt, cwt) = self.sun8(ts);
+        std::array::from_fn(|l| PlanarAt { s: sc[l][0], c: sc[l][1], swt: swt[l], cwt: cwt[l] })
     }
 
     #[inline(always)]
@@ -443,6 +471,10 @@ trait PlanarY<I: Isa>: Copy {
     fn start(isa: I, pick: impl Fn(usize) -> Case) -> Self;
     /// The lanes' phi.
     fn phi(&self) -> F8<I>;
+    /// The lanes' (cos phi, sin phi), as the right-hand side sees them.
+    fn cos_sin(&self) -> (F8<I>, F8<I>);
+    /// The lanes' phidot = wz - 1.
+    fn rate(&self) -> F8<I>;
     /// Lane l's (phi, wz, 2x2 STM row-major or NaN, d(phi, wz)/d parameter or NaN).
     fn end(&self, l: usize) -> (f64, f64, [f64; 4], [f64; 2]);
 }
@@ -471,6 +503,14 @@ impl<I: Isa, const D: usize> PlanarY<I> for [F8<I>; D] {
 
     fn phi(&self) -> F8<I> {
         self[0]
+    }
+
+    fn cos_sin(&self) -> (F8<I>, F8<I>) {
+        (self[2], self[3])
+    }
+
+    fn rate(&self) -> F8<I> {
+        self[1] - F8::splat(self[1].isa(), 1.0)
     }
 
     fn end(&self, l: usize) -> (f64, f64, [f64; 4], [f64; 2]) {
@@ -607,6 +647,15 @@ impl<I: Isa, const P: usize> PlanarY<I> for NyState<I, P> {
 
     fn phi(&self) -> F8<I> {
         self.x[0]
+    }
+
+    fn cos_sin(&self) -> (F8<I>, F8<I>) {
+        let (sp, cp) = self.x[0].sin_cos();
+        (cp, sp)
+    }
+
+    fn rate(&self) -> F8<I> {
+        self.v[0]
     }
 
     fn end(&self, l: usize) -> (f64, f64, [f64; 4], [f64; 2]) {
@@ -758,15 +807,80 @@ pub(crate) fn run_steps<I: Isa, M, S: Scheme<I, M>>(isa: I, st: &mut S, m: &M, y
     Run { accepted, rejected, status }
 }
 
+/// How far past a terminator crossing a cut step may end (TU). A step across a kink of the plate
+/// law (a jump J in the third derivative of phi) at a distance d from its end errs by about
+/// b J d^2 h (b the weight of the step's last nodes, about 0.05): below 1e-20 for d = 1e-10,
+/// J <= 100 and h <= 1.
+const CUT_TOL: f64 = 1e-10;
+
 /// The planar SRP cut: an accepted step never spans a lane's Sun-terminator crossing (where its
-/// plate acts); it is cut just past the earliest one (Illinois iterations on its length).
+/// plate acts, cos alpha = 0 in the right-hand side's own alpha); it is cut less than
+/// [`CUT_TOL`] past the earliest one. Per crossing lane, a first guess from the cubic Hermite
+/// interpolant of phi over the step (no evaluations), then Newton iterations on cos alpha along
+/// trial steps (its time derivative, -sin alpha (w - phidot), from the trial's end state),
+/// bracketed, with regula falsi where a Newton iterate leaves the bracket. Lanes are taken in
+/// the order of their guesses; a lane that has not crossed yet at the cut found so far needs no
+/// trial steps.
 struct Terminators<I, Y> {
-    plates: [FlatPlate; LANES],
+    /// The lanes whose steps stop at their crossings (a plate acts, or the sensitivity to eps
+    /// does; a short group's copies of its last lane follow that lane).
     plate: [bool; LANES],
-    /// Scratch state of the trial steps.
+    /// Scratch states: the trial step, and the latest trial ending past the crossing.
     yc: Y,
+    yb: Y,
     rtol: F8<I>,
     atol: F8<I>,
+}
+
+/// Whether g changes sign strictly between a and b.
+#[inline(always)]
+fn crosses(a: f64, b: f64) -> bool {
+    (a < 0.0 && b > 0.0) || (a > 0.0 && b < 0.0)
+}
+
+/// The first guess of a lane's crossing time within a step of length h: where
+/// alpha(tau) = w tau + theta_0 - phi(tau), with phi its cubic Hermite interpolant on (phi, phidot)
+/// at both ends, first reaches an odd multiple of pi/2 from alpha(0) = atan2(sa0, ca0) (Newton on
+/// the cubic, bracketed); the secant of cos alpha, `lin`, where the interpolant misses.
+fn crossing_guess(h: f64, w: f64, (phi0, phi1): (f64, f64), (r0, r1): (f64, f64), (ca0, sa0): (f64, f64), lin: f64) -> f64 {
+    use std::f64::consts::{FRAC_PI_2, PI};
+    let a0 = sa0.atan2(ca0);
+    let dphi = phi1 - phi0;
+    let u1 = w * h - dphi;
+    let target = if u1 > 0.0 { (FRAC_PI_2 - a0).rem_euclid(PI) } else { -(a0 - FRAC_PI_2).rem_euclid(PI) };
+    // F(s) = alpha(s h) - alpha(0) - target on s in [0, 1]
+    let f = |s: f64| {
+        let s2 = s * s;
+        let (h01, h10, h11) = (s2 * (3.0 - 2.0 * s), s * (s - 1.0) * (s - 1.0), s2 * (s - 1.0));
+        let (d01, d10, d11) = (6.0 * s * (1.0 - s), (3.0 * s - 1.0) * (s - 1.0), s * (3.0 * s - 2.0));
+        let v = w * h * s - (h * r0 * h10 + dphi * h01 + h * r1 * h11) - target;
+        let d = w * h - (h * r0 * d10 + dphi * d01 + h * r1 * d11);
+        (v, d)
+    };
+    let (fa, fb) = (f(0.0).0, f(1.0).0);
+    if !crosses(fa, fb) {
+        return lin;
+    }
+    let (mut sa, mut sb, mut s) = (0.0f64, 1.0f64, (target / u1).clamp(0.0, 1.0));
+    for _ in 0..12 {
+        let (v, d) = f(s);
+        if v == 0.0 {
+            break;
+        }
+        if (v > 0.0) == (fa > 0.0) {
+            sa = s;
+        } else {
+            sb = s;
+        }
+        let next = s - v / d;
+        let next = if next > sa && next < sb { next } else { 0.5 * (sa + sb) };
+        if (next - s).abs() <= 1e-13 {
+            s = next;
+            break;
+        }
+        s = next;
+    }
+    s * h
 }
 
 impl<'a, I: Isa, S: Scheme<I, Planar<'a, I, SRP>>, const SRP: bool> Cut<I, Planar<'a, I, SRP>, S> for Terminators<I, S::Y>
@@ -779,53 +893,75 @@ where
             return None;
         }
         let (rtol, atol) = (self.rtol, self.atol);
-        let plates = &self.plates;
-        let g = |l: usize, tt: f64, phi: f64| plates[l].terminator(tt, phi);
-        // Cut the step at the earliest terminator crossing of any lane with a plate.
-        let mut cut = f64::INFINITY;
-        for (l, &has_plate) in self.plate.iter().enumerate() {
-            if !has_plate {
-                continue;
+        let w = model.p.sun.omega;
+        let (ca0, sa0) = model.alpha(t, y);
+        let (ca1, _) = model.alpha(t + heff, ynew);
+        let (ca0, sa0, ca1) = (ca0.to_array(), sa0.to_array(), ca1.to_array());
+        let (phi0, phi1, r0, r1) = (y.phi().to_array(), ynew.phi().to_array(), y.rate().to_array(), ynew.rate().to_array());
+        let mut order = [(0.0f64, 0usize); LANES];
+        let mut n = 0;
+        for l in 0..LANES {
+            if self.plate[l] && crosses(ca0[l], ca1[l]) {
+                let lin = heff * ca0[l] / (ca0[l] - ca1[l]);
+                order[n] = (crossing_guess(heff, w, (phi0[l], phi1[l]), (r0[l], r1[l]), (ca0[l], sa0[l]), lin), l);
+                n += 1;
             }
-            let g0 = g(l, t, lane(&y.phi(), l));
-            let g1 = g(l, t + heff, lane(&ynew.phi(), l));
-            if !((g0 < 0.0 && g1 > 0.0) || (g0 > 0.0 && g1 < 0.0)) {
-                continue;
+        }
+        if n == 0 {
+            return None;
+        }
+        order[..n].sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        // the earliest crossing found so far; `ynew` is the state there
+        let mut cut = heff;
+        let mut ends = ca1;
+        for &(guess, l) in &order[..n] {
+            let g0 = ca0[l];
+            if !crosses(g0, ends[l]) {
+                continue; // not crossed yet at `cut`
             }
-            let (mut ta, mut tb, mut ga, mut gb, mut side) = (0.0f64, heff, g0, g1, 0i8);
+            let (mut ta, mut tb, mut ga, mut gb) = (0.0f64, cut, g0, ends[l]);
+            // every iterate aims half a tolerance past its estimate of the crossing
+            let aim = 0.5 * CUT_TOL;
+            let mut tau = if guess + aim > ta && guess + aim < tb { guess + aim } else { tb - gb * (tb - ta) / (gb - ga) };
+            let mut found = false;
             for _ in 0..60 {
-                if (tb - ta).abs() <= 1e-15 * (1.0 + t.abs()) + 4.0 * f64::EPSILON * tb.abs() {
-                    break;
-                }
-                let tau = (tb - gb * (tb - ta) / (gb - ga)).clamp(ta.min(tb), ta.max(tb));
                 st.step(model, t, y, tau, &mut self.yc, rtol, atol);
-                let gc = g(l, t + tau, lane(&self.yc.phi(), l));
-                if (gc > 0.0) == (gb > 0.0) {
+                let (ca, sa) = model.alpha(t + tau, &self.yc);
+                let gc = lane(&ca, l);
+                // Newton's estimate of the crossing is d from tau
+                let d = gc / (lane(&sa, l) * (w - lane(&self.yc.rate(), l)));
+                if gc == 0.0 || (gc > 0.0) == (gb > 0.0) {
                     tb = tau;
                     gb = gc;
-                    if side == 1 {
-                        ga *= 0.5;
+                    self.yb = self.yc;
+                    found = true;
+                    if gc == 0.0 || (-CUT_TOL..=0.0).contains(&d) {
+                        break; // past the crossing, by at most the tolerance
                     }
-                    side = 1;
                 } else {
                     ta = tau;
                     ga = gc;
-                    if side == -1 {
-                        gb *= 0.5;
-                    }
-                    side = -1;
                 }
+                if tb - ta <= CUT_TOL {
+                    break;
+                }
+                let mut next = tau + d + aim;
+                if !(next > ta && next < tb) {
+                    next = tb - gb * (tb - ta) / (gb - ga);
+                    if !(next > ta && next < tb) || (next - ta).min(tb - next) < 0.01 * (tb - ta) {
+                        next = 0.5 * (ta + tb);
+                    }
+                }
+                tau = next;
             }
             // just past the crossing, unless it is at the very start (a restart)
-            if tb > 1e-12 * (1.0 + t.abs()) {
-                cut = cut.min(tb);
+            if found && tb > 1e-12 * (1.0 + t.abs()) {
+                cut = tb;
+                *ynew = self.yb;
+                ends = model.alpha(t + cut, ynew).0.to_array();
             }
         }
-        if cut < heff {
-            st.step(model, t, y, cut, ynew, rtol, atol);
-            return Some(cut);
-        }
-        None
+        (cut < heff).then_some(cut)
     }
 }
 
@@ -842,9 +978,10 @@ where
     let (p, plates) = Params::new(isa, pick, opts.sun_omega, opts.sensitivity);
     let model = Planar::<I, SRP> { f, p };
     // the steps stop at a lane's terminator crossings where its plate acts, or where the
-    // sensitivity to eps does (the law's kink is there for any amplitude)
-    let plate: [bool; LANES] = std::array::from_fn(|l| plates[l].eps != 0.0 || opts.sensitivity == Sensitivity::Eps);
-    let mut cut = Terminators { plates, plate, yc: y, rtol: F8::splat(isa, opts.rtol), atol: F8::splat(isa, opts.atol) };
+    // sensitivity to eps does (the law's kink is there for any amplitude); a short group's copies
+    // of its last lane are that lane, bit for bit, and cross with it
+    let plate: [bool; LANES] = std::array::from_fn(|l| l < n && (plates[l].eps != 0.0 || opts.sensitivity == Sensitivity::Eps));
+    let mut cut = Terminators { plate, yc: y, yb: y, rtol: F8::splat(isa, opts.rtol), atol: F8::splat(isa, opts.atol) };
     let Run { accepted, rejected, status } = run_steps(isa, st, &model, &mut y, t_final, opts, &mut cut);
     std::array::from_fn(|l| {
         if status != LaneStatus::Ok {
@@ -1001,5 +1138,70 @@ mod tests {
         for &level in &crate::simd::available() {
             crate::simd::run_at(level, Probe(&f, steps)).unwrap();
         }
+    }
+
+    /// The SRP cut (analytic property of [`Terminators`]): along a trajectory of eight lanes with
+    /// plates (different Sun phases and rates; RKF7(8) with the STM, and the Nystrom lanes), every
+    /// accepted step that spans a crossing of cos alpha ends past the earliest one by at most
+    /// [`CUT_TOL`]: at the cut some lane has crossed, and CUT_TOL before it none had; the state
+    /// returned is the step to the cut, bit for bit; a step with no crossing is never cut.
+    #[test]
+    fn srp_cut_ends_just_past_the_earliest_crossing() {
+        let mu = 0.01215;
+        let (x0, d) = (0.7, 1.0 - mu - 0.7);
+        let o = correct_planar_symmetric(mu, x0, (mu / d).sqrt() + d, 1e-12, 30, &Options::with_tolerances(1e-13, 1e-13)).unwrap();
+        let f = OrbitForcing::new(mu, &o.state0, o.period, [true, true], 1e-13).unwrap();
+        let cases: [Case; LANES] = std::array::from_fn(|l| {
+            let x = l as f64;
+            Case { eps: 0.3 + 0.2 * x, cs: 0.4, cd: 0.1, theta_sun0: 0.8 * x - 2.0, ..Case::new(0.3 * x, -2.5 + 0.7 * x, 0.8) }
+        });
+        fn check<S: Scheme<I, Planar<'static, I, true>>>(f: &'static OrbitForcing, cases: &[Case; LANES], t_end: f64) -> usize
+        where
+            S::Y: PlanarY<I>,
+        {
+            let opts = LaneOptions::default();
+            let (rtol, atol) = (V::splat(ISA, opts.rtol), V::splat(ISA, opts.atol));
+            let (p, _) = Params::new(ISA, |l| cases[l], opts.sun_omega, Sensitivity::None);
+            let m = Planar::<I, true> { f, p };
+            let mut st = S::new(ISA);
+            let mut y = <S::Y as PlanarY<I>>::start(ISA, |l| cases[l]);
+            let mut cut = Terminators { plate: [true; LANES], yc: y, yb: y, rtol, atol };
+            let (mut t, h, mut cuts) = (0.0, 0.05, 0);
+            let (mut ynew, mut yc) = (y, y);
+            let sign = |v: &V| v.to_array().map(|g| g > 0.0);
+            while t < t_end {
+                st.step(&m, t, &y, h, &mut ynew, rtol, atol);
+                let full = ynew;
+                let g0 = sign(&m.alpha(t, &y).0);
+                match cut.cut(&mut st, &m, t, h, &y, &mut ynew) {
+                    None => {
+                        let g1 = sign(&m.alpha(t + h, &full).0);
+                        let gap = (0..LANES).find(|&l| g0[l] != g1[l]).map(|l| (l, m.alpha(t + h, &full).0.to_array()[l]));
+                        assert!(gap.is_none() || gap.unwrap().1.abs() < 1e-9, "t {t}: a crossing not cut, {gap:?}");
+                        y = full;
+                        t += h;
+                    }
+                    Some(c) => {
+                        cuts += 1;
+                        assert!(c > 0.0 && c < h, "t {t}: cut {c}");
+                        st.step(&m, t, &y, c, &mut yc, rtol, atol);
+                        assert!((0..LANES).all(|l| yc.phi().to_array()[l].to_bits() == ynew.phi().to_array()[l].to_bits()), "t {t}: state at the cut");
+                        let at = sign(&m.alpha(t + c, &ynew).0);
+                        assert!((0..LANES).any(|l| at[l] != g0[l]), "t {t}: cut {c} before every crossing");
+                        st.step(&m, t, &y, c - CUT_TOL, &mut yc, rtol, atol);
+                        let before = sign(&m.alpha(t + c - CUT_TOL, &yc).0);
+                        assert_eq!(before, g0, "t {t}: cut {c} more than CUT_TOL past a crossing");
+                        y = ynew;
+                        t += c;
+                    }
+                }
+            }
+            cuts
+        }
+        let f: &'static OrbitForcing = Box::leak(Box::new(f));
+        let n = check::<Stages<I, 8>>(f, &cases, 8.0);
+        assert!(n > 20, "{n} cuts");
+        let n = check::<Nystrom<I, 3>>(f, &cases, 8.0);
+        assert!(n > 20, "{n} cuts");
     }
 }
