@@ -304,10 +304,22 @@ pub(crate) trait Rhs<I: Isa, const D: usize> {
     fn eval_at(&self, at: &Self::At, y: &[F8<I>; D], dy: &mut [F8<I>; D]);
 }
 
-/// The planar model on the lanes: the orbit's forcing table and the lanes' parameters.
+/// The planar model on the lanes: the orbit's forcing table and the lanes' parameters, and the
+/// orbit data of the last two single times asked for ([`Rhs::at`]: a step's first node is the
+/// previous step's last, or a rejected step's first).
 pub(crate) struct Planar<'a, I, const SRP: bool> {
     f: &'a OrbitForcing,
     p: Params<I>,
+    /// (t as bits, data at t) of the two latest single evaluations, the latest second.
+    recent: std::cell::Cell<[(u64, PlanarAt); 2]>,
+}
+
+impl<'a, I: Isa, const SRP: bool> Planar<'a, I, SRP> {
+    fn new(f: &'a OrbitForcing, p: Params<I>) -> Self {
+        // NaN bits that no time has: the cache starts empty
+        let none = (u64::MAX, PlanarAt { s: f64::NAN, c: f64::NAN, swt: f64::NAN, cwt: f64::NAN });
+        Planar { f, p, recent: std::cell::Cell::new([none; 2]) }
+    }
 }
 
 impl<I: Isa, const SRP: bool> Planar<'_, I, SRP> {
@@ -326,9 +338,10 @@ impl<I: Isa, const SRP: bool> Planar<'_, I, SRP> {
     /// (cos alpha, sin alpha) of the lanes in the state y at t, as the right-hand side has them.
     #[inline(always)]
     fn alpha<Y: PlanarY<I>>(&self, t: f64, y: &Y) -> (F8<I>, F8<I>) {
-        let (swt, cwt) = self.sun(t);
+        // a step's ends and the cut's trial ends: the data its stages had there
+        let at = <Self as Rhs<I, 4>>::at(self, t);
         let (cp, sp) = y.cos_sin();
-        sun_alpha(swt, cwt, &self.p, cp, sp)
+        sun_alpha(at.swt, at.cwt, &self.p, cp, sp)
     }
 
     /// [`Self::sun`] at eight times, in one vector evaluation.
@@ -356,7 +369,18 @@ impl<I: Isa, const D: usize, const SRP: bool> Rhs<I, D> for Planar<'_, I, SRP> {
 
     #[inline(always)]
     fn at(&self, t: f64) -> PlanarAt {
-        self.orbit_at(t)
+        let key = t.to_bits();
+        let [a, b] = self.recent.get();
+        if b.0 == key {
+            return b.1;
+        }
+        if a.0 == key {
+            self.recent.set([b, a]);
+            return a.1;
+        }
+        let at = self.orbit_at(t);
+        self.recent.set([b, (key, at)]);
+        at
     }
 
     #[inline(always)]
@@ -976,7 +1000,7 @@ where
     let mut y = <S::Y as PlanarY<I>>::start(isa, pick);
     st.begin();
     let (p, plates) = Params::new(isa, pick, opts.sun_omega, opts.sensitivity);
-    let model = Planar::<I, SRP> { f, p };
+    let model = Planar::<I, SRP>::new(f, p);
     // the steps stop at a lane's terminator crossings where its plate acts, or where the
     // sensitivity to eps does (the law's kink is there for any amplitude); a short group's copies
     // of its last lane are that lane, bit for bit, and cross with it
@@ -1068,7 +1092,7 @@ mod tests {
             Case { phi0: -2.9 + 0.8 * x, wz0: -2.0 + 0.6 * x, kz: 0.9 - 0.25 * x, eps: [0.0, 0.05, 0.3, -0.2][l % 4], cs: 0.1 * (l % 3) as f64, cd: 0.2, theta_sun0: 0.9 * x - 3.0 }
         });
         let (p, plates) = Params::new(ISA, |l| cases[l], LaneOptions::default().sun_omega, Sensitivity::None);
-        let model = Planar::<I, true> { f: &f, p };
+        let model = Planar::<I, true>::new(&f, p);
         let stm = [0.7, -1.3, 2.1, 0.4];
         for t in [0.0, 0.37 * o.period, 0.81 * o.period, 3.3 * o.period] {
             let mut y = [V::splat(ISA, 0.0); 8];
@@ -1122,7 +1146,7 @@ mod tests {
             fn run<I: Isa>(self, isa: I) {
                 let case = Case { eps: 0.05, theta_sun0: 0.7, ..Case::new(0.1, 0.3, 0.8) };
                 let (p, _) = Params::new(isa, |_| case, LaneOptions::default().sun_omega, Sensitivity::None);
-                let m = Planar::<I, true> { f: self.0, p };
+                let m = Planar::<I, true>::new(self.0, p);
                 for (t, h) in self.1 {
                     for (c, plan) in [(&C, &FEHLBERG_PLAN), (&DP_C, &DP87_PLAN)] {
                         let got = stage_data::<I, 4, _>(&m, c, plan, t, h);
@@ -1162,7 +1186,7 @@ mod tests {
             let opts = LaneOptions::default();
             let (rtol, atol) = (V::splat(ISA, opts.rtol), V::splat(ISA, opts.atol));
             let (p, _) = Params::new(ISA, |l| cases[l], opts.sun_omega, Sensitivity::None);
-            let m = Planar::<I, true> { f, p };
+            let m = Planar::<I, true>::new(f, p);
             let mut st = S::new(ISA);
             let mut y = <S::Y as PlanarY<I>>::start(ISA, |l| cases[l]);
             let mut cut = Terminators { plate: [true; LANES], yc: y, yb: y, rtol, atol };
