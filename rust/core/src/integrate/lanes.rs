@@ -1076,6 +1076,14 @@ mod tests {
     type V = F8<I>;
     const ISA: I = Baseline;
 
+    /// The Earth-Moon DRO through x0 = 0.7 (mu = 0.01215): its period and forcing table.
+    fn dro_forcing() -> (f64, OrbitForcing) {
+        let mu = 0.01215;
+        let (x0, d) = (0.7, 1.0 - mu - 0.7);
+        let o = correct_planar_symmetric(mu, x0, (mu / d).sqrt() + d, 1e-12, 30, &Options::with_tolerances(1e-13, 1e-13)).unwrap();
+        (o.period, OrbitForcing::new(mu, &o.state0, o.period, [true, true], 1e-13).unwrap())
+    }
+
     /// The lanes' right-hand side (gravity gradient and flat plate through the shared generic
     /// laws, cos 2phi and sin 2phi from the (cos phi, sin phi) states, the Sun turned per lane)
     /// equals the scalar planar model's (`PlanarForced` on the same forcing table, with each
@@ -1083,10 +1091,7 @@ mod tests {
     /// (1 + 3 |Kz| max(|S|, |C|) + 3 |eps|, times max |STM entry|).
     #[test]
     fn lane_rhs_equals_scalar_model() {
-        let mu = 0.01215;
-        let (x0, d) = (0.7, 1.0 - mu - 0.7);
-        let o = correct_planar_symmetric(mu, x0, (mu / d).sqrt() + d, 1e-12, 30, &Options::with_tolerances(1e-13, 1e-13)).unwrap();
-        let f = OrbitForcing::new(mu, &o.state0, o.period, [true, true], 1e-13).unwrap();
+        let (period, f) = dro_forcing();
         let cases: [Case; LANES] = std::array::from_fn(|l| {
             let x = l as f64;
             Case { phi0: -2.9 + 0.8 * x, wz0: -2.0 + 0.6 * x, kz: 0.9 - 0.25 * x, eps: [0.0, 0.05, 0.3, -0.2][l % 4], cs: 0.1 * (l % 3) as f64, cd: 0.2, theta_sun0: 0.9 * x - 3.0 }
@@ -1094,7 +1099,7 @@ mod tests {
         let (p, plates) = Params::new(ISA, |l| cases[l], LaneOptions::default().sun_omega, Sensitivity::None);
         let model = Planar::<I, true>::new(&f, p);
         let stm = [0.7, -1.3, 2.1, 0.4];
-        for t in [0.0, 0.37 * o.period, 0.81 * o.period, 3.3 * o.period] {
+        for t in [0.0, 0.37 * period, 0.81 * period, 3.3 * period] {
             let mut y = [V::splat(ISA, 0.0); 8];
             y[0] = V::new(ISA, cases.map(|c| c.phi0));
             y[1] = V::new(ISA, cases.map(|c| c.wz0));
@@ -1131,15 +1136,12 @@ mod tests {
     fn stage_data_equals_one_evaluation_per_node() {
         assert_eq!(FEHLBERG_PLAN, [OWN, -1, -2, -3, -4, -5, -6, 3, -7, -8, OWN, 0, 10]);
         assert_eq!(DP87_PLAN, [OWN, -1, -2, -3, -4, -5, -6, -7, -8, OWN, OWN, OWN, 11]);
-        let mu = 0.01215;
-        let (x0, d) = (0.7, 1.0 - mu - 0.7);
-        let o = correct_planar_symmetric(mu, x0, (mu / d).sqrt() + d, 1e-12, 30, &Options::with_tolerances(1e-13, 1e-13)).unwrap();
-        let f = OrbitForcing::new(mu, &o.state0, o.period, [true, true], 1e-13).unwrap();
-        let seg = o.period / f.segments() as f64;
+        let (period, f) = dro_forcing();
+        let seg = period / f.segments() as f64;
         assert!(f.segments() >= 4, "{} segments", f.segments());
         // (t, h): inside segment 1, across the boundary of segments 1 and 2, across the period's
         // end, two segments long
-        let steps = [(1.1 * seg, 0.3 * seg), (1.9 * seg, 0.4 * seg), (o.period - 0.2 * seg, 0.5 * seg), (0.5 * seg, 2.0 * seg)];
+        let steps = [(1.1 * seg, 0.3 * seg), (1.9 * seg, 0.4 * seg), (period - 0.2 * seg, 0.5 * seg), (0.5 * seg, 2.0 * seg)];
         struct Probe<'a>(&'a OrbitForcing, [(f64, f64); 4]);
         impl Kernel for Probe<'_> {
             type Output = ();
@@ -1171,10 +1173,7 @@ mod tests {
     /// returned is the step to the cut, bit for bit; a step with no crossing is never cut.
     #[test]
     fn srp_cut_ends_just_past_the_earliest_crossing() {
-        let mu = 0.01215;
-        let (x0, d) = (0.7, 1.0 - mu - 0.7);
-        let o = correct_planar_symmetric(mu, x0, (mu / d).sqrt() + d, 1e-12, 30, &Options::with_tolerances(1e-13, 1e-13)).unwrap();
-        let f = OrbitForcing::new(mu, &o.state0, o.period, [true, true], 1e-13).unwrap();
+        let (_, f) = dro_forcing();
         let cases: [Case; LANES] = std::array::from_fn(|l| {
             let x = l as f64;
             Case { eps: 0.3 + 0.2 * x, cs: 0.4, cd: 0.1, theta_sun0: 0.8 * x - 2.0, ..Case::new(0.3 * x, -2.5 + 0.7 * x, 0.8) }
