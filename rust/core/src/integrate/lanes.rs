@@ -304,21 +304,50 @@ pub(crate) trait Rhs<I: Isa, const D: usize> {
     fn eval_at(&self, at: &Self::At, y: &[F8<I>; D], dy: &mut [F8<I>; D]);
 }
 
+/// The orbit data of a lane model at its K latest evaluated times (a step's first node is the
+/// previous step's last, or a rejected step's first; a pair's recurring nodes): a pure memo, so
+/// the values, and every result, are those of evaluating each time.
+pub(crate) struct Recent<T, const K: usize> {
+    /// (t as bits, data at t) in a ring, and where the next one goes; the key u64::MAX (NaN bits
+    /// that no time has) marks an empty entry.
+    entries: std::cell::Cell<([(u64, T); K], usize)>,
+}
+
+impl<T: Copy, const K: usize> Recent<T, K> {
+    pub(crate) fn new(empty: T) -> Self {
+        Recent { entries: std::cell::Cell::new(([(u64::MAX, empty); K], 0)) }
+    }
+
+    /// The data kept at t, or None, and then the caller evaluates it and [`Self::keep`]s it. (No
+    /// closure here: a closure is compiled outside the dispatched kernel's target features, and
+    /// the lanes' evaluations in it would not be inlined.)
+    #[inline(always)]
+    pub(crate) fn find(&self, t: f64) -> Option<T> {
+        let key = t.to_bits();
+        self.entries.get().0.iter().find(|e| e.0 == key).map(|e| e.1)
+    }
+
+    /// Keep the data v at t, in place of the oldest.
+    #[inline(always)]
+    pub(crate) fn keep(&self, t: f64, v: T) -> T {
+        let (mut e, next) = self.entries.get();
+        e[next] = (t.to_bits(), v);
+        self.entries.set((e, (next + 1) % K));
+        v
+    }
+}
+
 /// The planar model on the lanes: the orbit's forcing table and the lanes' parameters, and the
-/// orbit data of the last two single times asked for ([`Rhs::at`]: a step's first node is the
-/// previous step's last, or a rejected step's first).
+/// orbit data of its last four single times ([`Rhs::at`]).
 pub(crate) struct Planar<'a, I, const SRP: bool> {
     f: &'a OrbitForcing,
     p: Params<I>,
-    /// (t as bits, data at t) of the two latest single evaluations, the latest second.
-    recent: std::cell::Cell<[(u64, PlanarAt); 2]>,
+    recent: Recent<PlanarAt, 4>,
 }
 
 impl<'a, I: Isa, const SRP: bool> Planar<'a, I, SRP> {
     fn new(f: &'a OrbitForcing, p: Params<I>) -> Self {
-        // NaN bits that no time has: the cache starts empty
-        let none = (u64::MAX, PlanarAt { s: f64::NAN, c: f64::NAN, swt: f64::NAN, cwt: f64::NAN });
-        Planar { f, p, recent: std::cell::Cell::new([none; 2]) }
+        Planar { f, p, recent: Recent::new(PlanarAt { s: f64::NAN, c: f64::NAN, swt: f64::NAN, cwt: f64::NAN }) }
     }
 }
 
@@ -369,18 +398,10 @@ impl<I: Isa, const D: usize, const SRP: bool> Rhs<I, D> for Planar<'_, I, SRP> {
 
     #[inline(always)]
     fn at(&self, t: f64) -> PlanarAt {
-        let key = t.to_bits();
-        let [a, b] = self.recent.get();
-        if b.0 == key {
-            return b.1;
+        match self.recent.find(t) {
+            Some(at) => at,
+            None => self.recent.keep(t, self.orbit_at(t)),
         }
-        if a.0 == key {
-            self.recent.set([b, a]);
-            return a.1;
-        }
-        let at = self.orbit_at(t);
-        self.recent.set([b, (key, at)]);
-        at
     }
 
     #[inline(always)]
@@ -935,6 +956,8 @@ where
             return None;
         }
         order[..n].sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        // every iterate aims half a tolerance past its estimate of the crossing
+        let aim = 0.5 * CUT_TOL;
         // the earliest crossing found so far; `ynew` is the state there
         let mut cut = heff;
         let mut ends = ca1;
@@ -944,8 +967,6 @@ where
                 continue; // not crossed yet at `cut`
             }
             let (mut ta, mut tb, mut ga, mut gb) = (0.0f64, cut, g0, ends[l]);
-            // every iterate aims half a tolerance past its estimate of the crossing
-            let aim = 0.5 * CUT_TOL;
             let mut tau = if guess + aim > ta && guess + aim < tb { guess + aim } else { tb - gb * (tb - ta) / (gb - ga) };
             let mut found = false;
             for _ in 0..60 {

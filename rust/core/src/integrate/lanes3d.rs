@@ -15,7 +15,7 @@
 use rayon::prelude::*;
 
 use super::forcing::TidalTable;
-use super::lanes::{lane, run_steps, Fehlberg, LaneOptions, LaneStatus, Method, NoCut, PrinceDormand, Rhs, Run, Scheme, Stages, LANES};
+use super::lanes::{lane, run_steps, Fehlberg, LaneOptions, LaneStatus, Method, NoCut, PrinceDormand, Recent, Rhs, Run, Scheme, Stages, LANES};
 use crate::attitude::{dcm_with, euler_rate, gravity_gradient_torque, quat_rate, RigidBody};
 use crate::error::{check_finite, check_positive, invalid, Result};
 use crate::attitude::attitude_residual;
@@ -55,10 +55,9 @@ struct Rigid<'a, I> {
     inertia: [F8<I>; 3],
     inv: [F8<I>; 3],
     one: F8<I>,
-    /// The tidal tensor at the latest four stage times (time as bits), newest at `next - 1`: a
-    /// step's recurring nodes (RKF7(8)'s c = 1/6 and 1) and its first node (the previous
-    /// step's last) take it from here.
-    recent: std::cell::Cell<([(u64, [f64; 6]); 4], usize)>,
+    /// The tidal tensor at the latest four stage times: a step's recurring nodes (RKF7(8)'s
+    /// c = 1/6 and 1) and its first node (the previous step's last) take it from here.
+    recent: Recent<[f64; 6], 4>,
 }
 
 /// The rigid body's orbit data is its stage's time: each stage evaluates the tidal table itself,
@@ -80,16 +79,9 @@ impl<I: Isa> Rhs<I, D> for Rigid<'_, I> {
 
     #[inline(always)]
     fn eval_at(&self, t: &f64, y: &[F8<I>; D], dy: &mut [F8<I>; D]) {
-        let key = t.to_bits();
-        let (mut ring, next) = self.recent.get();
-        let m6 = match (1..=4).map(|k| ring[(next + 4 - k) % 4]).find(|e| e.0 == key) {
-            Some((_, m6)) => m6,
-            None => {
-                let m6 = self.table.eval_at::<I>(*t);
-                ring[next] = (key, m6);
-                self.recent.set((ring, (next + 1) % 4));
-                m6
-            }
+        let m6 = match self.recent.find(*t) {
+            Some(m6) => m6,
+            None => self.recent.keep(*t, self.table.eval_at::<I>(*t)),
         };
         let isa = y[0].isa();
         let m = [F8::splat(isa, m6[0]), F8::splat(isa, m6[1]), F8::splat(isa, m6[2]), F8::splat(isa, m6[3]), F8::splat(isa, m6[4]), F8::splat(isa, m6[5])];
@@ -112,8 +104,7 @@ fn integrate_group<'a, I: Isa, S: Scheme<I, Rigid<'a, I>, Y = [F8<I>; D]>>(isa: 
     let moments = |i: usize| F8::new(isa, std::array::from_fn(|l| pick(l).body.moments()[i]));
     let inertia = [moments(0), moments(1), moments(2)];
     let one = F8::splat(isa, 1.0);
-    // NaN bits that no time has: the cache starts empty
-    let model = Rigid { table, inertia, inv: inertia.map(|v| one / v), one, recent: std::cell::Cell::new(([(u64::MAX, [f64::NAN; 6]); 4], 0)) };
+    let model = Rigid { table, inertia, inv: inertia.map(|v| one / v), one, recent: Recent::new([f64::NAN; 6]) };
     let mut y: [F8<I>; D] = std::array::from_fn(|i| F8::new(isa, std::array::from_fn(|l| if i < 4 { pick(l).q0[i] } else { pick(l).w0[i - 4] })));
     st.begin();
     let Run { accepted, rejected, status } = run_steps(isa, st, &model, &mut y, t_final, opts, &mut NoCut);
