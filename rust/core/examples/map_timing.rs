@@ -16,7 +16,7 @@ use std::time::Instant;
 
 use librate_core::integrate::Options;
 use librate_core::integrate::forcing::OrbitForcing;
-use librate_core::integrate::lanes::{Case, LaneOptions, Outcome};
+use librate_core::integrate::lanes::{Case, LaneOptions, Method, Outcome};
 use librate_core::map::sweep;
 use librate_core::orbit::correct_planar_symmetric;
 
@@ -32,28 +32,49 @@ fn main() {
     let reps: usize = arg("--reps").map(|s| s.parse().unwrap()).unwrap_or(15);
 
     let x0 = 0.70;
-    let d = 1.0 - MU - x0;
-    let o = correct_planar_symmetric(MU, x0, (MU / d).sqrt() + d, 1e-12, 30, &Options::with_tolerances(1e-13, 1e-13)).unwrap();
+    // ydot0 guess 0.69 (the DRO's is 0.69350, period 4.8588 TU; the guess sqrt(mu/d) + d = 0.49
+    // converges to another symmetric orbit, of period 10.79)
+    let o = correct_planar_symmetric(MU, x0, 0.69, 1e-12, 30, &Options::with_tolerances(1e-13, 1e-13)).unwrap();
+    assert!((o.period - 4.858760).abs() < 1e-5, "not the DRO through x0 = 0.70: period {}", o.period);
     let f = OrbitForcing::new(MU, &o.state0, o.period, [true, true], 1e-13).unwrap();
     println!("orbit: x0 = {:.17e}, ydot0 = {:.17e}, period = {:.17e}; forcing table error {:.3e}", o.state0[0], o.state0[4], o.period, f.max_error);
     let n = 2000;
     let grid: Vec<Case> = (0..n).map(|i| Case::new(0.0, -3.0 + 5.0 * i as f64 / (n - 1) as f64, 0.8)).collect();
     let srp: Vec<Case> = grid.iter().map(|c| Case { eps: 0.05, cs: 0.4, cd: 0.1, theta_sun0: 0.7, ..*c }).collect();
-    let opts = LaneOptions { rtol: 1e-12, atol: 1e-12, ..LaneOptions::default() };
+    let tol: f64 = arg("--rtol").map(|s| s.parse().unwrap()).unwrap_or(1e-12);
+    let method = arg("--method").map(|s| Method::parse(&s).expect("--method: rkf78, rkn86 or dp87")).unwrap_or_default();
+    let opts = LaneOptions { rtol: tol, atol: tol, method, ..LaneOptions::default() };
+    println!("method {}, rtol = atol = {tol:.0e}", method.name());
 
     let runs: [(&str, &[Case], bool); 3] = [("gravity, no STM", &grid, false), ("gravity, STM", &grid, true), ("SRP, STM", &srp, true)];
     let mut best = [f64::INFINITY; 3];
     let mut results: Vec<Vec<f64>> = vec![Vec::new(); 3];
+    let mut steps = [0.0f64; 3];
     for _ in 0..reps {
         for (k, (_, cases, stm)) in runs.iter().enumerate() {
             let t0 = Instant::now();
             let out = sweep(&f, o.period, cases, &opts, *stm, 64, Some(1)).unwrap();
             best[k] = best[k].min(t0.elapsed().as_secs_f64());
             results[k] = values(&out);
+            steps[k] = out.iter().map(|o| (o.accepted + o.rejected) as f64).sum::<f64>() / n as f64;
         }
     }
     for (k, (name, _, _)) in runs.iter().enumerate() {
         println!("{name:>16}: best of {reps}: {:8.2} ms  ({:.2} us per trajectory)", 1e3 * best[k], 1e6 * best[k] / n as f64);
+    }
+    if args.iter().any(|a| a == "--accuracy") {
+        // against RKF7(8) at rtol = atol = 1e-15 (bench/bench_lanes.py's reference and metric):
+        // max over the map of max(|d phi(T)|, |d wz(T)|) / max(1, |phi|, |wz|)
+        let ref_opts = LaneOptions { rtol: 1e-15, atol: 1e-15, method: Method::Rkf78, ..LaneOptions::default() };
+        for (k, (name, cases, stm)) in runs.iter().enumerate() {
+            let r = sweep(&f, o.period, cases, &ref_opts, *stm, 64, None).unwrap();
+            let mut err = 0.0f64;
+            for (i, o) in r.iter().enumerate() {
+                let (phi, wz) = (results[k][6 * i], results[k][6 * i + 1]);
+                err = err.max((phi - o.phi_t).abs().max((wz - o.wz_t).abs()) / o.phi_t.abs().max(o.wz_t.abs()).max(1.0));
+            }
+            println!("{name:>16}: accuracy {err:.2e} against RKF7(8) at 1e-15, {:.1} steps per trajectory", steps[k]);
+        }
     }
     let all: Vec<f64> = results.concat();
     if let Some(path) = arg("--save") {

@@ -282,9 +282,15 @@ impl<I: Isa> F8<I> {
         let q = (xa * k(std::f64::consts::FRAC_2_PI) + k(0.5)).floor();
         let r = (-q).mul_add(k(DP[2]), (-q).mul_add(k(DP[1]), (-q).mul_add(k(DP[0]), xa)));
         let r2 = r * r;
-        let poly = |c: &[f64; 6]| c[..5].iter().rev().fold(k(c[5]), |acc, &ci| acc.mul_add(r2, k(ci)));
-        let s = (r * r2).mul_add(poly(&PS), r);
-        let c = (r2 * r2).mul_add(poly(&PC), r2.mul_add(k(-0.5), k(1.0)));
+        // Horner by index loops, no closure: a closure (or an iterator's rfold) may be compiled
+        // outside the kernel's target features, with its intrinsics called out of line
+        let (mut ps, mut pc) = (k(PS[5]), k(PC[5]));
+        for j in (0..5).rev() {
+            ps = ps.mul_add(r2, k(PS[j]));
+            pc = pc.mul_add(r2, k(PC[j]));
+        }
+        let s = (r * r2).mul_add(ps, r);
+        let c = (r2 * r2).mul_add(pc, r2.mul_add(k(-0.5), k(1.0)));
         // q mod 4 selects and signs: sin = (s, c, -s, -c)[q], cos = (c, -s, -c, s)[q]
         let m = q - (q * k(0.25)).floor() * k(4.0);
         let odd = m - (m * k(0.5)).floor() * k(2.0);

@@ -356,7 +356,10 @@ mod x86 {
         fn le_select8(self, a: A8, b: A8, x: A8, y: A8) -> A8 {
             let (a, b, x, y) = (h(a), h(b), h(x), h(y));
             let avx = self.0.avx;
-            uh(std::array::from_fn(|k| avx._mm256_blendv_pd(y[k], x[k], avx._mm256_cmp_pd::<_CMP_LE_OQ>(a[k], b[k]))))
+            // both halves written out: a closure (array::from_fn's) is compiled outside the
+            // kernel's target features, and the intrinsics in it become calls
+            let m = [avx._mm256_cmp_pd::<_CMP_LE_OQ>(a[0], b[0]), avx._mm256_cmp_pd::<_CMP_LE_OQ>(a[1], b[1])];
+            uh([avx._mm256_blendv_pd(y[0], x[0], m[0]), avx._mm256_blendv_pd(y[1], x[1], m[1])])
         }
         #[inline(always)]
         fn mul_add8(self, a: A8, b: A8, c: A8) -> A8 {

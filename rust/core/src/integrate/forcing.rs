@@ -251,7 +251,13 @@ fn clenshaw<T: Copy + std::ops::Sub<Output = T>, const N: usize>(x: T, x2: T, ze
             b1[i] = tk;
         }
     }
-    std::array::from_fn(|i| fma(x, b1[i], coef(i) - b2[i]))
+    // a loop, not array::from_fn: its closure would be compiled outside the lanes' target
+    // features, and their intrinsics called out of line
+    let mut out = [zero; N];
+    for i in 0..N {
+        out[i] = fma(x, b1[i], coef(i) - b2[i]);
+    }
+    out
 }
 
 impl Forcing for OrbitTable<2> {

@@ -550,6 +550,7 @@ impl<I: Isa, const D: usize> PlanarY<I> for [F8<I>; D] {
         self[0]
     }
 
+    #[inline(always)]
     fn cos_sin(&self) -> (F8<I>, F8<I>) {
         (self[2], self[3])
     }
@@ -694,6 +695,7 @@ impl<I: Isa, const P: usize> PlanarY<I> for NyState<I, P> {
         self.x[0]
     }
 
+    #[inline(always)]
     fn cos_sin(&self) -> (F8<I>, F8<I>) {
         let (sp, cp) = self.x[0].sin_cos();
         (cp, sp)
