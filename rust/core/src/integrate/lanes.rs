@@ -202,12 +202,18 @@ impl<I: Isa> Params<I> {
 #[inline(always)]
 fn lincomb<I: Isa, const D: usize, const M: usize>(out: &mut [F8<I>; D], y: &[F8<I>; D], h: F8<I>, coef: [f64; M], ks: [&[F8<I>; D]; M]) {
     let isa = h.isa();
-    for i in 0..D {
-        let mut acc = F8::splat(isa, 0.0);
-        for m in 0..M {
-            acc = F8::splat(isa, coef[m]).mul_add(ks[m][i], acc);
+    // term by term across the components: each coefficient broadcast once for all D of them
+    // (the D accumulators stay in registers); per component the same operations in the same
+    // order as a sum per component
+    let mut acc = [F8::splat(isa, 0.0); D];
+    for m in 0..M {
+        let c = F8::splat(isa, coef[m]);
+        for i in 0..D {
+            acc[i] = c.mul_add(ks[m][i], acc[i]);
         }
-        out[i] = h.mul_add(acc, y[i]);
+    }
+    for i in 0..D {
+        out[i] = h.mul_add(acc[i], y[i]);
     }
 }
 

@@ -104,7 +104,8 @@ fn integrate_group<'a, I: Isa, S: Scheme<I, Rigid<'a, I>, Y = [F8<I>; D]>>(isa: 
     let moments = |i: usize| F8::new(isa, std::array::from_fn(|l| pick(l).body.moments()[i]));
     let inertia = [moments(0), moments(1), moments(2)];
     let one = F8::splat(isa, 1.0);
-    let model = Rigid { table, inertia, inv: inertia.map(|v| one / v), one, recent: Recent::new([f64::NAN; 6]) };
+    // written out: array::map's closure would call the division out of line
+    let model = Rigid { table, inertia, inv: [one / inertia[0], one / inertia[1], one / inertia[2]], one, recent: Recent::new([f64::NAN; 6]) };
     let mut y: [F8<I>; D] = std::array::from_fn(|i| F8::new(isa, std::array::from_fn(|l| if i < 4 { pick(l).q0[i] } else { pick(l).w0[i - 4] })));
     st.begin();
     let Run { accepted, rejected, status } = run_steps(isa, st, &model, &mut y, t_final, opts, &mut NoCut);
