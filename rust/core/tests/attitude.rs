@@ -4,15 +4,10 @@
 use librate_core::attitude::{dcm, forcing_sc, propagate_attitude, propagate_planar, Coupled, GravityGradient, OrbitMode, PlanarForced, RigidBody, Torque};
 use librate_core::integrate::{solve, Options, Output, System};
 use librate_core::integrate::forcing::OrbitForcing;
-use librate_core::orbit::correct_planar_symmetric;
 
-const MU: f64 = 0.01215;
+mod common;
+use common::{dro, MU};
 
-fn dro(x0: f64) -> ([f64; 6], f64) {
-    let d = 1.0 - MU - x0;
-    let o = correct_planar_symmetric(MU, x0, (MU / d).sqrt() + d, 1e-12, 30, &Options::with_tolerances(1e-13, 1e-13)).unwrap();
-    (o.state0, o.period)
-}
 
 fn tight() -> Options {
     Options::with_tolerances(1e-13, 1e-13)

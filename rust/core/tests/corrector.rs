@@ -13,18 +13,14 @@ use librate_core::attitude::{
     correct_bordered, correct_planar_attitudes, verify_planar_attitudes, Bordered, Candidate, Closure, Correction, CorrectorOptions,
     Free, Parameter, PlanarStart, StopReason,
 };
-use librate_core::orbit::{correct_planar_symmetric, Constraint, SymmetricShooting};
+use librate_core::orbit::{Constraint, SymmetricShooting};
 use std::f64::consts::PI;
 
-const MU: f64 = 0.01215;
+mod common;
+use common::{dro, MU};
 /// Earth-Moon TU: 375190 s (docs/physics.md).
 const TU_S: f64 = 375190.0;
 
-fn dro_x0(x0: f64) -> ([f64; 6], f64) {
-    let d = 1.0 - MU - x0;
-    let o = correct_planar_symmetric(MU, x0, (MU / d).sqrt() + d, 1e-12, 30, &Options::with_tolerances(1e-13, 1e-13)).unwrap();
-    (o.state0, o.period)
-}
 
 /// The DRO with the given period (TU), from a guess (x0, vy0).
 fn dro_period(period: f64, x0: f64, vy0: f64) -> ([f64; 6], f64) {
@@ -66,7 +62,7 @@ fn lane_opts() -> LaneOptions {
 /// solution): the minimum-norm step keeps phi0 and converges. The monodromy is [[1, KT], [0, 1]].
 #[test]
 fn val_torque_free_solutions_are_analytic() {
-    let (s0, t) = dro_x0(0.8);
+    let (s0, t) = dro(0.8);
     let f = table(&s0, t);
     let opts = CorrectorOptions::default();
     for k in [1.0, 2.0] {
@@ -302,7 +298,7 @@ fn val_corrector_rejects_invalid_arguments() {
     assert_eq!(name(correct_planar_attitudes(&f, t, Closure::Full, Free::Phi0, &[c], &CorrectorOptions { max_iter: 0, ..o })), "max_iter");
     assert_eq!(name(correct_planar_attitudes(&f, f64::NAN, Closure::Full, Free::Phi0, &[c], &o)), "t_final");
     // an orbit that is not x-symmetric on its start: the half closure is refused
-    let (s1, t1) = dro_x0(0.8);
+    let (s1, t1) = dro(0.8);
     let mut shifted = [0.0; 6];
     let tr = librate_core::propagation::propagate(MU, &s1, 0.0, 0.1 * t1, &Options::with_tolerances(1e-13, 1e-13), false, librate_core::integrate::Output::Final, &[]).unwrap();
     shifted.copy_from_slice(&tr.states[tr.states.len() - 6..]);
@@ -410,13 +406,13 @@ fn val_per_candidate_conditions_batch_branches() {
 #[test]
 fn val_correction_across_the_orbit_family() {
     use librate_core::attitude::{correct_across_family, PlanarFamily};
-    let members: Vec<([f64; 6], f64)> = [0.80, 0.83, 0.86, 0.89].iter().map(|&x| dro_x0(x)).collect();
+    let members: Vec<([f64; 6], f64)> = [0.80, 0.83, 0.86, 0.89].iter().map(|&x| dro(x)).collect();
     let x0s: Vec<f64> = members.iter().map(|m| m.0[0]).collect();
     let vy0s: Vec<f64> = members.iter().map(|m| m.0[4]).collect();
     let fam = PlanarFamily::new(MU, &x0s, &vy0s).unwrap();
     let opts = CorrectorOptions::default();
     let plain = |x0: f64| {
-        let (s0, t) = dro_x0(x0);
+        let (s0, t) = dro(x0);
         correct_planar_attitudes(&table(&s0, t), 0.5 * t, Closure::Half, Free::Phi0, &[Candidate::new(0.0, 1.8, 0.8, 0.0)], &opts).unwrap()[0]
     };
     let p = plain(0.85);
@@ -450,7 +446,7 @@ fn val_correction_across_the_orbit_family() {
 #[test]
 fn val_linearised_family_orbit_is_second_order() {
     use librate_core::attitude::PlanarFamily;
-    let members: Vec<([f64; 6], f64)> = [0.80, 0.83, 0.86, 0.89].iter().map(|&x| dro_x0(x)).collect();
+    let members: Vec<([f64; 6], f64)> = [0.80, 0.83, 0.86, 0.89].iter().map(|&x| dro(x)).collect();
     let x0s: Vec<f64> = members.iter().map(|m| m.0[0]).collect();
     let vy0s: Vec<f64> = members.iter().map(|m| m.0[4]).collect();
     let fam = PlanarFamily::new(MU, &x0s, &vy0s).unwrap();

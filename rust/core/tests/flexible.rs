@@ -6,15 +6,10 @@
 use librate_core::attitude::{forcing_sc, gravity_gradient_wzdot, propagate_planar};
 use librate_core::flexible::{tidal_field, BodyField, evaluate_energies, propagate_flexible, propagate_quasi_static, quasi_static_point, Appendage, FlexibleBody};
 use librate_core::integrate::{Options, Output};
-use librate_core::orbit::correct_planar_symmetric;
 
-const MU: f64 = 0.01215;
+mod common;
+use common::{dro, MU};
 
-fn dro(x0: f64) -> ([f64; 6], f64) {
-    let d = 1.0 - MU - x0;
-    let o = correct_planar_symmetric(MU, x0, (MU / d).sqrt() + d, 1e-12, 30, &Options::with_tolerances(1e-13, 1e-13)).unwrap();
-    (o.state0, o.period)
-}
 
 fn tight() -> Options {
     Options { max_steps: 5_000_000, ..Options::with_tolerances(1e-13, 1e-13) }

@@ -10,13 +10,9 @@ use librate_core::simd;
 use librate_core::orbit::correct_planar_symmetric;
 use librate_core::propagation::propagate;
 
-const MU: f64 = 0.01215;
+mod common;
+use common::{dro, MU};
 
-fn dro(x0: f64) -> ([f64; 6], f64) {
-    let d = 1.0 - MU - x0;
-    let o = correct_planar_symmetric(MU, x0, (MU / d).sqrt() + d, 1e-12, 30, &Options::with_tolerances(1e-13, 1e-13)).unwrap();
-    (o.state0, o.period)
-}
 
 fn grid(n: usize, kz: f64) -> Vec<Case> {
     (0..n).map(|i| Case::new(0.0, -3.0 + 5.0 * i as f64 / (n - 1) as f64, kz)).collect()

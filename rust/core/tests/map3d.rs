@@ -10,20 +10,16 @@ use librate_core::integrate::lanes::{Case, LaneOptions, LaneStatus};
 use librate_core::integrate::lanes3d::Case3d;
 use librate_core::map::{residuals, sweep, sweep_3d};
 use librate_core::attitude::attitude_residual;
-use librate_core::orbit::{correct_planar_symmetric, Constraint, SymmetricShooting, Var};
+use librate_core::orbit::{Constraint, SymmetricShooting, Var};
 use librate_core::propagation::propagate;
 
-const MU: f64 = 0.01215;
+mod common;
+use common::{dro, MU};
 
 fn tight() -> Options {
     Options::with_tolerances(1e-13, 1e-13)
 }
 
-fn dro(x0: f64) -> ([f64; 6], f64) {
-    let d = 1.0 - MU - x0;
-    let o = correct_planar_symmetric(MU, x0, (MU / d).sqrt() + d, 1e-12, 30, &tight()).unwrap();
-    (o.state0, o.period)
-}
 
 /// An Earth-Moon L2 southern halo (z0 = -0.1227 LU, period 3.27 TU, 14.2 days), corrected
 /// by the spatial symmetric shooting.

@@ -4,12 +4,12 @@
 use librate_core::cr3bp::{jacobi, lagrange_points, Cr3bp, Cr3bpStm, SystemConstants, STM_DIM};
 use librate_core::error::{Error, IntegrationError};
 use librate_core::integrate::{solve, Event, Options, Output, Status, System};
-use librate_core::orbit::{correct_planar_symmetric, SymmetricOrbit};
 use librate_core::propagation::{propagate, propagate_many, EventKind, EventSpec};
 use nalgebra::Matrix6;
 use std::f64::consts::PI;
 
-const MU: f64 = 0.01215;
+mod common;
+use common::{dro_orbit, MU};
 
 /// y' = y^2, y(0) = 1: y = 1 / (1 - t).
 struct Riccati;
@@ -178,17 +178,12 @@ fn val_integration_errors_carry_context() {
     assert!((r2 - 1737.4 / 384400.0).abs() < 1e-12, "distance {r2}");
 }
 
-fn dro(x0: f64) -> SymmetricOrbit {
-    let d = 1.0 - MU - x0;
-    let guess = (MU / d).sqrt() + d;
-    correct_planar_symmetric(MU, x0, guess, 1e-12, 30, &Options::with_tolerances(1e-13, 1e-13)).unwrap()
-}
 
 /// Jacobi constant conserved along ten periods of a Moon-bound DRO (x0 = 0.9) at
 /// rtol = atol = 1e-13 (the exact flow conserves it). Tolerance: drift below 1e-12.
 #[test]
 fn val_jacobi_conserved_over_ten_periods() {
-    let orbit = dro(0.9);
+    let orbit = dro_orbit(0.9);
     let opts = Options::with_tolerances(1e-13, 1e-13);
     let tr = propagate(MU, &orbit.state0, 0.0, 10.0 * orbit.period, &opts, false, Output::Steps, &[]).unwrap();
     let c0 = jacobi(MU, &orbit.state0);
@@ -204,7 +199,7 @@ fn val_jacobi_conserved_over_ten_periods() {
 /// 1e-6 of the matrix norm), and det(STM) = 1 (Liouville: the flow preserves volume), to 1e-10.
 #[test]
 fn val_stm_matches_finite_differences_and_has_unit_determinant() {
-    let orbit = dro(0.85);
+    let orbit = dro_orbit(0.85);
     let opts = Options::with_tolerances(1e-13, 1e-13);
     let t = orbit.period;
     let tr = propagate(MU, &orbit.state0, 0.0, t, &opts, true, Output::Final, &[]).unwrap();
@@ -326,7 +321,7 @@ fn val_batch_matches_single_calls_for_any_thread_count() {
 /// time directly (same augmented dynamics; tolerance 1e-9).
 #[test]
 fn val_event_state_carries_stm() {
-    let orbit = dro(0.95);
+    let orbit = dro_orbit(0.95);
     assert!(orbit.residual < 1e-12);
     let opts = Options::with_tolerances(1e-13, 1e-13);
     let ev = EventSpec { kind: EventKind::Crossing { index: 1, value: 0.0 }, direction: -1, terminal: true };
@@ -371,7 +366,7 @@ fn val_bad_arguments_name_the_parameter() {
 #[test]
 fn val_multiple_shooting_recovers_a_dro() {
     use librate_core::orbit::{correct_multiple_shooting, MemberCondition};
-    let orbit = dro(0.8);
+    let orbit = dro_orbit(0.8);
     let opts = Options::with_tolerances(1e-13, 1e-13);
     let n = 4;
     let times: Vec<f64> = (0..n).map(|i| orbit.period / 3.0 + i as f64 * orbit.period / n as f64).collect();

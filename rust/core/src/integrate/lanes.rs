@@ -1108,8 +1108,9 @@ mod tests {
     /// The Earth-Moon DRO through x0 = 0.7 (mu = 0.01215): its period and forcing table.
     fn dro_forcing() -> (f64, OrbitForcing) {
         let mu = 0.01215;
-        let (x0, d) = (0.7, 1.0 - mu - 0.7);
-        let o = correct_planar_symmetric(mu, x0, (mu / d).sqrt() + d, 1e-12, 30, &Options::with_tolerances(1e-13, 1e-13)).unwrap();
+        // ydot0 guess 0.6935, the family's (tests/common/mod.rs)
+        let o = correct_planar_symmetric(mu, 0.7, 0.6935, 1e-12, 30, &Options::with_tolerances(1e-13, 1e-13)).unwrap();
+        assert!((o.period - 4.858760231).abs() < 1e-6, "not the DRO: period {}", o.period);
         (o.period, OrbitForcing::new(mu, &o.state0, o.period, [true, true], 1e-13).unwrap())
     }
 
