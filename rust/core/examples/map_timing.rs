@@ -7,18 +7,21 @@
 //! Cs = 0.4, Cd = 0.1, Sun phase 0.7, STM on). One thread, best of `--reps` runs (default 15),
 //! cases alternating round-robin so that a load change on the shared machine hits all alike.
 //!
-//!   cargo run --release -p librate-core --example map_timing -- [--reps N] [--save FILE] [--compare FILE]
+//!   cargo run --release -p librate-core --example map_timing -- [--reps N] [--method M] [--rtol R] [--accuracy] [--save FILE] [--compare FILE]
+//!   cargo run --release -p librate-core --example map_timing -- --3d [--reps N] [--method M] [--rtol R] [--save FILE] [--compare FILE]
 //!
 //! `--save` writes every outcome (phi_t, wz_t, stm) as raw f64 bits; `--compare` reads such a
 //! file and prints the largest absolute and relative differences per case.
 
 use std::time::Instant;
 
+use librate_core::attitude::RigidBody;
 use librate_core::integrate::Options;
-use librate_core::integrate::forcing::OrbitForcing;
+use librate_core::integrate::forcing::{OrbitForcing, TidalTable};
+use librate_core::integrate::lanes3d::{sweep_3d, Case3d};
 use librate_core::integrate::lanes::{Case, LaneOptions, Method, Outcome};
 use librate_core::map::sweep;
-use librate_core::orbit::correct_planar_symmetric;
+use librate_core::orbit::{correct_planar_symmetric, Constraint, SymmetricShooting, Var};
 
 const MU: f64 = 0.01215;
 
@@ -26,10 +29,53 @@ fn values(out: &[Outcome]) -> Vec<f64> {
     out.iter().flat_map(|o| [o.phi_t, o.wz_t, o.stm[0], o.stm[1], o.stm[2], o.stm[3]]).collect()
 }
 
+/// `--3d`: the 3-D lanes on an L2 southern halo (z0 = -0.1227, period 3.3 TU) with its tidal
+/// table: 40 wx0 in [-0.2, 0.2] x 50 wz0 in [w - 0.5, w + 0.5] (w = 1 - 2 pi / T), wy0 = 0, q0 the
+/// identity, body 0.8 : 0.9 : 1, one period (bench/bench_map3d.py's grid), one thread.
+fn timing_3d(reps: usize, tol: f64, method: Method, save: Option<String>, compare: Option<String>) {
+    let mut sh = SymmetricShooting::new(MU, true, Options::with_tolerances(1e-13, 1e-13));
+    sh.tol = 1e-12;
+    let o = sh.correct([1.1608, -0.1227, -0.2077], Constraint::Fix(Var::Z0, -0.1227)).unwrap();
+    let table = TidalTable::tidal(MU, &o.state0, o.period, [true, true], 1e-13).unwrap();
+    println!("halo: x0 = {:.6}, z0 = {:.6}, period = {:.6}; tidal table: {} segments", o.state0[0], o.state0[2], o.period, table.segments());
+    let w = 1.0 - 2.0 * std::f64::consts::PI / o.period;
+    let body = RigidBody::new(0.8, 0.9, 1.0).unwrap();
+    let cases: Vec<Case3d> = (0..40)
+        .flat_map(|i| (0..50).map(move |j| (i, j)))
+        .map(|(i, j)| Case3d { q0: [0.0, 0.0, 0.0, 1.0], w0: [-0.2 + 0.4 * i as f64 / 39.0, 0.0, w - 0.5 + j as f64 / 49.0], body })
+        .collect();
+    let opts = LaneOptions { rtol: tol, atol: tol, method, ..LaneOptions::default() };
+    let mut best = f64::INFINITY;
+    let mut out = Vec::new();
+    for _ in 0..reps {
+        let t0 = Instant::now();
+        out = sweep_3d(&table, o.period, &cases, &opts, 64, Some(1)).unwrap();
+        best = best.min(t0.elapsed().as_secs_f64());
+    }
+    let steps = out.iter().map(|o| (o.accepted + o.rejected) as f64).sum::<f64>() / cases.len() as f64;
+    println!("3-D, {} trajectories, rtol = atol = {tol:.0e}: best of {reps}: {:8.2} ms ({steps:.1} steps per trajectory)", cases.len(), 1e3 * best);
+    let all: Vec<f64> = out.iter().flat_map(|o| o.q_t.into_iter().chain(o.w_t)).collect();
+    if let Some(path) = save {
+        std::fs::write(&path, all.iter().flat_map(|v| v.to_bits().to_le_bytes()).collect::<Vec<u8>>()).unwrap();
+        println!("saved {} values to {path}", all.len());
+    }
+    if let Some(path) = compare {
+        let old: Vec<f64> = std::fs::read(&path).unwrap().chunks_exact(8).map(|b| f64::from_bits(u64::from_le_bytes(b.try_into().unwrap()))).collect();
+        let differ = all.iter().zip(&old).filter(|(a, b)| a.to_bits() != b.to_bits()).count();
+        let max = all.iter().zip(&old).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
+        println!("3-D: {differ} of {} values differ from {path}; max |diff| {max:.3e}", all.len());
+    }
+}
+
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     let arg = |name: &str| args.iter().position(|a| a == name).map(|i| args[i + 1].clone());
     let reps: usize = arg("--reps").map(|s| s.parse().unwrap()).unwrap_or(15);
+    if args.iter().any(|a| a == "--3d") {
+        let tol: f64 = arg("--rtol").map(|s| s.parse().unwrap()).unwrap_or(5e-11);
+        let method = arg("--method").map(|s| Method::parse(&s).expect("--method: rkf78 or dp87")).unwrap_or_default();
+        return timing_3d(reps, tol, method, arg("--save"), arg("--compare"));
+    }
 
     let x0 = 0.70;
     // ydot0 guess 0.69 (the DRO's is 0.69350, period 4.8588 TU; the guess sqrt(mu/d) + d = 0.49

@@ -4,8 +4,9 @@
 //! (planar or spatial) whose tidal tensor is tabulated once ([`TidalTable`]).
 //!
 //! As in the planar engine ([`super::lanes`]): the eight share the time and the step (the
-//! smallest any of them needs), so the orbit's tidal tensor is one scalar Chebyshev evaluation
-//! per stage, broadcast to the lanes; trajectories are grouped eight by eight in case order from
+//! smallest any of them needs), so the orbit's tidal tensor is evaluated once per stage time
+//! (a step's eight distinct inner nodes in one vector Chebyshev recurrence), broadcast to the
+//! lanes; trajectories are grouped eight by eight in case order from
 //! the start of the slice (chunks are multiples of eight), so results are bit-identical for any
 //! chunking and thread count. The step loop, the RKF7(8) stages and the controller are the
 //! planar engine's ([`run_steps`], [`Stages`]); the physics are the scalar 3-D model's own laws
@@ -55,34 +56,32 @@ struct Rigid<'a, I> {
     inertia: [F8<I>; 3],
     inv: [F8<I>; 3],
     one: F8<I>,
-    /// The tidal tensor at the latest four stage times: a step's recurring nodes (RKF7(8)'s
-    /// c = 1/6 and 1) and its first node (the previous step's last) take it from here.
+    /// The tidal tensor at the latest four single times ([`Rhs::at`]): a step's first node (the
+    /// previous step's last, or a rejected step's first) and its last.
     recent: Recent<[f64; 6], 4>,
 }
 
-/// The rigid body's orbit data is its stage's time: each stage evaluates the tidal table itself,
-/// between the lanes' vector work (up front, as the planar lanes do, the 3-D lanes were slower:
-/// 14.1 ms against 10.2 ms for 2000 trajectories on one thread with the six components'
-/// vector recurrence, 25 ms with ten scalar ones, on an AVX-512 Xeon).
+/// The rigid body's orbit data is the tidal tensor at a stage's time: a step's eight distinct
+/// nodes in one vector Clenshaw recurrence of the table ([`TidalTable::eval8_at`], the same
+/// values bit for bit), its first and last node from the memo or one scalar evaluation.
 impl<I: Isa> Rhs<I, D> for Rigid<'_, I> {
-    type At = f64;
+    type At = [f64; 6];
 
     #[inline(always)]
-    fn at(&self, t: f64) -> f64 {
-        t
-    }
-
-    #[inline(always)]
-    fn at8(&self, ts: &[f64; 8]) -> [f64; 8] {
-        *ts
-    }
-
-    #[inline(always)]
-    fn eval_at(&self, t: &f64, y: &[F8<I>; D], dy: &mut [F8<I>; D]) {
-        let m6 = match self.recent.find(*t) {
+    fn at(&self, t: f64) -> [f64; 6] {
+        match self.recent.find(t) {
             Some(m6) => m6,
-            None => self.recent.keep(*t, self.table.eval_at::<I>(*t)),
-        };
+            None => self.recent.keep(t, self.table.eval_at::<I>(t)),
+        }
+    }
+
+    #[inline(always)]
+    fn at8(&self, ts: &[f64; 8]) -> [[f64; 6]; 8] {
+        self.table.eval8_at(self.one.isa(), ts)
+    }
+
+    #[inline(always)]
+    fn eval_at(&self, m6: &[f64; 6], y: &[F8<I>; D], dy: &mut [F8<I>; D]) {
         let isa = y[0].isa();
         let m = [F8::splat(isa, m6[0]), F8::splat(isa, m6[1]), F8::splat(isa, m6[2]), F8::splat(isa, m6[3]), F8::splat(isa, m6[4]), F8::splat(isa, m6[5])];
         let q = [y[0], y[1], y[2], y[3]];
