@@ -8,7 +8,7 @@
 //! cases alternating round-robin so that a load change on the shared machine hits all alike.
 //!
 //!   cargo run --release -p librate-core --example map_timing -- [--reps N] [--method M] [--rtol R] [--accuracy] [--save FILE] [--compare FILE]
-//!   cargo run --release -p librate-core --example map_timing -- --3d [--reps N] [--method M] [--rtol R] [--save FILE] [--compare FILE]
+//!   cargo run --release -p librate-core --example map_timing -- --3d [--12d] [--reps N] [--method M] [--rtol R] [--save FILE] [--compare FILE]
 //!
 //! `--save` writes every outcome (phi_t, wz_t, stm) as raw f64 bits; `--compare` reads such a
 //! file and prints the largest absolute and relative differences per case.
@@ -29,13 +29,19 @@ fn values(out: &[Outcome]) -> Vec<f64> {
     out.iter().flat_map(|o| [o.phi_t, o.wz_t, o.stm[0], o.stm[1], o.stm[2], o.stm[3]]).collect()
 }
 
-/// `--3d`: the 3-D lanes on an L2 southern halo (z0 = -0.1227, period 3.3 TU) with its tidal
+/// `--3d`: the 3-D lanes on an L2 southern halo (z0 = -0.1227, period 3.3 TU, or with `--12d`
+/// the 12-day one, z0 = -0.1946) with its tidal
 /// table: 40 wx0 in [-0.2, 0.2] x 50 wz0 in [w - 0.5, w + 0.5] (w = 1 - 2 pi / T), wy0 = 0, q0 the
 /// identity, body 0.8 : 0.9 : 1, one period (bench/bench_map3d.py's grid), one thread.
-fn timing_3d(reps: usize, tol: f64, method: Method, save: Option<String>, compare: Option<String>) {
+fn timing_3d(reps: usize, tol: f64, method: Method, twelve_days: bool, save: Option<String>, compare: Option<String>) {
     let mut sh = SymmetricShooting::new(MU, true, Options::with_tolerances(1e-13, 1e-13));
     sh.tol = 1e-12;
-    let o = sh.correct([1.1608, -0.1227, -0.2077], Constraint::Fix(Var::Z0, -0.1227)).unwrap();
+    let o = if twelve_days {
+        // the 12-day halo of bench/bench_map3d.py (z0 = -0.19462, period 2.7634 TU)
+        sh.correct([1.10933, -0.19462, -0.22112], Constraint::Fix(Var::Z0, -0.1946204962529079)).unwrap()
+    } else {
+        sh.correct([1.1608, -0.1227, -0.2077], Constraint::Fix(Var::Z0, -0.1227)).unwrap()
+    };
     let table = TidalTable::tidal(MU, &o.state0, o.period, [true, true], 1e-13).unwrap();
     println!("halo: x0 = {:.6}, z0 = {:.6}, period = {:.6}; tidal table: {} segments", o.state0[0], o.state0[2], o.period, table.segments());
     let w = 1.0 - 2.0 * std::f64::consts::PI / o.period;
@@ -74,7 +80,7 @@ fn main() {
     if args.iter().any(|a| a == "--3d") {
         let tol: f64 = arg("--rtol").map(|s| s.parse().unwrap()).unwrap_or(5e-11);
         let method = arg("--method").map(|s| Method::parse(&s).expect("--method: rkf78 or dp87")).unwrap_or_default();
-        return timing_3d(reps, tol, method, arg("--save"), arg("--compare"));
+        return timing_3d(reps, tol, method, args.iter().any(|a| a == "--12d"), arg("--save"), arg("--compare"));
     }
 
     let x0 = 0.70;

@@ -217,10 +217,20 @@ impl<const N: usize> OrbitTable<N> {
     /// otherwise one scalar evaluation per time.
     #[inline(always)]
     pub fn eval8_at<I: Isa>(&self, isa: I, ts: &[f64; 8]) -> [[f64; N]; 8] {
+        match self.try_eval8_at(isa, ts) {
+            Some(v) => v,
+            None => std::array::from_fn(|l| self.eval_at::<I>(ts[l])),
+        }
+    }
+
+    /// [`Self::eval8_at`]'s vector recurrence, or None when the times lie in more than two
+    /// segments (the caller then evaluates each time where it needs it).
+    #[inline(always)]
+    pub fn try_eval8_at<I: Isa>(&self, isa: I, ts: &[f64; 8]) -> Option<[[f64; N]; 8]> {
         let loc: [(usize, f64); 8] = std::array::from_fn(|l| self.locate(ts[l]));
         let (lo, hi) = loc.iter().fold((usize::MAX, 0), |(a, b), &(s, _)| (a.min(s), b.max(s)));
         if loc.iter().any(|&(s, _)| s != lo && s != hi) {
-            return std::array::from_fn(|l| self.eval_at::<I>(ts[l]));
+            return None;
         }
         let x = F8::new(isa, loc.map(|(_, x)| x));
         let (ca, cb) = (&self.coef[lo * NC * N..(lo + 1) * NC * N], &self.coef[hi * NC * N..(hi + 1) * NC * N]);
@@ -234,7 +244,7 @@ impl<const N: usize> OrbitTable<N> {
             clenshaw(x, x2, zero, |j| seg.le_select(lo_f, F8::splat(isa, ca[j]), F8::splat(isa, cb[j])), fma)
         };
         let v = v.map(|c| c.to_array());
-        std::array::from_fn(|l| std::array::from_fn(|i| v[i][l]))
+        Some(std::array::from_fn(|l| std::array::from_fn(|i| v[i][l])))
     }
 }
 

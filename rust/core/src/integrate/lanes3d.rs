@@ -62,26 +62,35 @@ struct Rigid<'a, I> {
 }
 
 /// The rigid body's orbit data is the tidal tensor at a stage's time: a step's eight distinct
-/// nodes in one vector Clenshaw recurrence of the table ([`TidalTable::eval8_at`], the same
-/// values bit for bit), its first and last node from the memo or one scalar evaluation.
+/// nodes in one vector Clenshaw recurrence of the table ([`TidalTable::try_eval8_at`], the same
+/// values bit for bit) when they lie in at most two of its segments, else each stage evaluates
+/// the table itself, between the lanes' vector work (eight scalar recurrences up front were
+/// slower); a step's first and last node from the memo. The data: (t, the tensor or None).
 impl<I: Isa> Rhs<I, D> for Rigid<'_, I> {
-    type At = [f64; 6];
+    type At = (f64, Option<[f64; 6]>);
 
     #[inline(always)]
-    fn at(&self, t: f64) -> [f64; 6] {
+    fn at(&self, t: f64) -> (f64, Option<[f64; 6]>) {
         match self.recent.find(t) {
-            Some(m6) => m6,
-            None => self.recent.keep(t, self.table.eval_at::<I>(t)),
+            Some(m6) => (t, Some(m6)),
+            None => (t, Some(self.recent.keep(t, self.table.eval_at::<I>(t)))),
         }
     }
 
     #[inline(always)]
-    fn at8(&self, ts: &[f64; 8]) -> [[f64; 6]; 8] {
-        self.table.eval8_at(self.one.isa(), ts)
+    fn at8(&self, ts: &[f64; 8]) -> [(f64, Option<[f64; 6]>); 8] {
+        match self.table.try_eval8_at(self.one.isa(), ts) {
+            Some(v) => std::array::from_fn(|l| (ts[l], Some(v[l]))),
+            None => ts.map(|t| (t, None)),
+        }
     }
 
     #[inline(always)]
-    fn eval_at(&self, m6: &[f64; 6], y: &[F8<I>; D], dy: &mut [F8<I>; D]) {
+    fn eval_at(&self, at: &(f64, Option<[f64; 6]>), y: &[F8<I>; D], dy: &mut [F8<I>; D]) {
+        let m6 = match at.1 {
+            Some(m6) => m6,
+            None => self.table.eval_at::<I>(at.0),
+        };
         let isa = y[0].isa();
         let m = [F8::splat(isa, m6[0]), F8::splat(isa, m6[1]), F8::splat(isa, m6[2]), F8::splat(isa, m6[3]), F8::splat(isa, m6[4]), F8::splat(isa, m6[5])];
         let q = [y[0], y[1], y[2], y[3]];
