@@ -29,6 +29,17 @@ fn values(out: &[Outcome]) -> Vec<f64> {
     out.iter().flat_map(|o| [o.phi_t, o.wz_t, o.stm[0], o.stm[1], o.stm[2], o.stm[3]]).collect()
 }
 
+/// Write values as raw f64 bits (little-endian).
+fn save_bits(path: &str, values: &[f64]) {
+    std::fs::write(path, values.iter().flat_map(|v| v.to_bits().to_le_bytes()).collect::<Vec<u8>>()).unwrap();
+    println!("saved {} values to {path}", values.len());
+}
+
+/// Values written by [`save_bits`].
+fn read_bits(path: &str) -> Vec<f64> {
+    std::fs::read(path).unwrap().chunks_exact(8).map(|b| f64::from_bits(u64::from_le_bytes(b.try_into().unwrap()))).collect()
+}
+
 /// `--3d`: the 3-D lanes on an L2 southern halo (z0 = -0.1227, period 3.3 TU, or with `--12d`
 /// the 12-day one, z0 = -0.1946) with its tidal
 /// table: 40 wx0 in [-0.2, 0.2] x 50 wz0 in [w - 0.5, w + 0.5] (w = 1 - 2 pi / T), wy0 = 0, q0 the
@@ -62,11 +73,10 @@ fn timing_3d(reps: usize, tol: f64, method: Method, twelve_days: bool, save: Opt
     println!("3-D, {} trajectories, rtol = atol = {tol:.0e}: best of {reps}: {:8.2} ms ({steps:.1} steps per trajectory)", cases.len(), 1e3 * best);
     let all: Vec<f64> = out.iter().flat_map(|o| o.q_t.into_iter().chain(o.w_t)).collect();
     if let Some(path) = save {
-        std::fs::write(&path, all.iter().flat_map(|v| v.to_bits().to_le_bytes()).collect::<Vec<u8>>()).unwrap();
-        println!("saved {} values to {path}", all.len());
+        save_bits(&path, &all);
     }
     if let Some(path) = compare {
-        let old: Vec<f64> = std::fs::read(&path).unwrap().chunks_exact(8).map(|b| f64::from_bits(u64::from_le_bytes(b.try_into().unwrap()))).collect();
+        let old = read_bits(&path);
         let differ = all.iter().zip(&old).filter(|(a, b)| a.to_bits() != b.to_bits()).count();
         let max = all.iter().zip(&old).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
         println!("3-D: {differ} of {} values differ from {path}; max |diff| {max:.3e}", all.len());
@@ -130,13 +140,10 @@ fn main() {
     }
     let all: Vec<f64> = results.concat();
     if let Some(path) = arg("--save") {
-        let bytes: Vec<u8> = all.iter().flat_map(|v| v.to_bits().to_le_bytes()).collect();
-        std::fs::write(&path, bytes).unwrap();
-        println!("saved {} values to {path}", all.len());
+        save_bits(&path, &all);
     }
     if let Some(path) = arg("--compare") {
-        let bytes = std::fs::read(&path).unwrap();
-        let old: Vec<f64> = bytes.chunks_exact(8).map(|b| f64::from_bits(u64::from_le_bytes(b.try_into().unwrap()))).collect();
+        let old = read_bits(&path);
         assert_eq!(old.len(), all.len(), "different number of values");
         let per = all.len() / 3;
         for (k, (name, _, _)) in runs.iter().enumerate() {
