@@ -20,7 +20,13 @@ pub struct Rkf78<S: State> {
 fn lincomb<I: Isa, const M: usize>(out: &mut [f64], y: &[f64], h: f64, coef: [f64; M], ks: [&[f64]; M]) {
     let n = out.len();
     let y = &y[..n];
-    let ks = ks.map(|k| &k[..n]);
+    // written out: `ks.map(..)`'s closure was compiled out of line, outside the dispatched
+    // kernel's target features, and called once per stage
+    let mut kn: [&[f64]; M] = [&[]; M];
+    for m in 0..M {
+        kn[m] = &ks[m][..n];
+    }
+    let ks = kn;
     for i in 0..n {
         let mut acc = 0.0;
         for m in 0..M {
