@@ -219,7 +219,13 @@ impl<const N: usize> OrbitTable<N> {
     pub fn eval8_at<I: Isa>(&self, isa: I, ts: &[f64; 8]) -> [[f64; N]; 8] {
         match self.try_eval8_at(isa, ts) {
             Some(v) => v,
-            None => std::array::from_fn(|l| self.eval_at::<I>(ts[l])),
+            None => {
+                let mut out = [[0.0; N]; 8];
+                for l in 0..8 {
+                    out[l] = self.eval_at::<I>(ts[l]);
+                }
+                out
+            }
         }
     }
 
@@ -227,24 +233,39 @@ impl<const N: usize> OrbitTable<N> {
     /// segments (the caller then evaluates each time where it needs it).
     #[inline(always)]
     pub fn try_eval8_at<I: Isa>(&self, isa: I, ts: &[f64; 8]) -> Option<[[f64; N]; 8]> {
-        let loc: [(usize, f64); 8] = std::array::from_fn(|l| self.locate(ts[l]));
+        // loops, not array::from_fn / map: their closures were compiled out of line, outside the
+        // lanes' target features, and called at every step
+        let mut loc = [(0usize, 0.0f64); 8];
+        for l in 0..8 {
+            loc[l] = self.locate(ts[l]);
+        }
         let (lo, hi) = loc.iter().fold((usize::MAX, 0), |(a, b), &(s, _)| (a.min(s), b.max(s)));
         if loc.iter().any(|&(s, _)| s != lo && s != hi) {
             return None;
         }
-        let x = F8::new(isa, loc.map(|(_, x)| x));
+        let (mut xs, mut segs) = ([0.0; 8], [0.0; 8]);
+        for l in 0..8 {
+            (segs[l], xs[l]) = (loc[l].0 as f64, loc[l].1);
+        }
+        let x = F8::new(isa, xs);
         let (ca, cb) = (&self.coef[lo * NC * N..(lo + 1) * NC * N], &self.coef[hi * NC * N..(hi + 1) * NC * N]);
         let (x2, zero) = (F8::splat(isa, 2.0) * x, F8::splat(isa, 0.0));
         let fma = |a: F8<I>, b: F8<I>, c: F8<I>| a.mul_add(b, c);
         let v: [F8<I>; N] = if lo == hi {
             clenshaw(x, x2, zero, |j| F8::splat(isa, ca[j]), fma)
         } else {
-            let seg = F8::new(isa, loc.map(|(s, _)| s as f64));
+            let seg = F8::new(isa, segs);
             let lo_f = F8::splat(isa, lo as f64);
             clenshaw(x, x2, zero, |j| seg.le_select(lo_f, F8::splat(isa, ca[j]), F8::splat(isa, cb[j])), fma)
         };
-        let v = v.map(|c| c.to_array());
-        Some(std::array::from_fn(|l| std::array::from_fn(|i| v[i][l])))
+        let mut out = [[0.0; N]; 8];
+        for i in 0..N {
+            let vi = v[i].to_array();
+            for l in 0..8 {
+                out[l][i] = vi[l];
+            }
+        }
+        Some(out)
     }
 }
 

@@ -383,7 +383,11 @@ impl<I: Isa, const SRP: bool> Planar<'_, I, SRP> {
     #[inline(always)]
     fn sun8(&self, ts: &[f64; 8]) -> ([f64; 8], [f64; 8]) {
         if SRP {
-            let (s, c) = F8::new(self.p.kz15.isa(), ts.map(|t| self.p.sun.angle(t))).sin_cos();
+            let mut angles = [0.0; 8];
+            for l in 0..8 {
+                angles[l] = self.p.sun.angle(ts[l]);
+            }
+            let (s, c) = F8::new(self.p.kz15.isa(), angles).sin_cos();
             (s.to_array(), c.to_array())
         } else {
             ([0.0; 8], [0.0; 8])
@@ -414,7 +418,12 @@ impl<I: Isa, const D: usize, const SRP: bool> Rhs<I, D> for Planar<'_, I, SRP> {
     fn at8(&self, ts: &[f64; 8]) -> [PlanarAt; 8] {
         let sc = self.f.eval8_at(self.p.kz15.isa(), ts);
         let (swt, cwt) = self.sun8(ts);
-        std::array::from_fn(|l| PlanarAt { s: sc[l][0], c: sc[l][1], swt: swt[l], cwt: cwt[l] })
+        // a loop, not array::from_fn (its closure is compiled out of line)
+        let mut out = [PlanarAt { s: 0.0, c: 0.0, swt: 0.0, cwt: 0.0 }; 8];
+        for l in 0..8 {
+            out[l] = PlanarAt { s: sc[l][0], c: sc[l][1], swt: swt[l], cwt: cwt[l] };
+        }
+        out
     }
 
     #[inline(always)]
@@ -483,7 +492,10 @@ const DP87_PLAN: [i8; 13] = stage_plan(&DP_C, [1, 2, 3, 4, 5, 6, 7, 8]);
 /// always), by `plan` ([`stage_plan`]): the same values as one [`Rhs::at`] per stage.
 #[inline(always)]
 fn stage_data<I: Isa, const D: usize, M: Rhs<I, D>>(m: &M, c: &[f64; 13], plan: &[i8; 13], t: f64, h: f64) -> [M::At; 13] {
-    let ts: [f64; 13] = std::array::from_fn(|s| c[s].mul_add(h, t));
+    let mut ts = [0.0; 13];
+    for s in 0..13 {
+        ts[s] = c[s].mul_add(h, t);
+    }
     let mut lanes = [0.0; 8];
     for s in 0..13 {
         if plan[s] < 0 {
@@ -581,6 +593,7 @@ impl<I: Isa, const D: usize, M: Rhs<I, D>> Scheme<I, M> for Stages<I, D, Fehlber
         Stages { k: [[F8::splat(isa, 0.0); D]; 13], tmp: [F8::splat(isa, 0.0); D], tableau: std::marker::PhantomData }
     }
 
+    #[inline(always)]
     fn finite(y: &[F8<I>; D]) -> bool {
         finite_lanes(y)
     }
@@ -621,6 +634,7 @@ impl<I: Isa, const D: usize, M: Rhs<I, D>> Scheme<I, M> for Stages<I, D, PrinceD
         Stages { k: [[F8::splat(isa, 0.0); D]; 13], tmp: [F8::splat(isa, 0.0); D], tableau: std::marker::PhantomData }
     }
 
+    #[inline(always)]
     fn finite(y: &[F8<I>; D]) -> bool {
         finite_lanes(y)
     }
@@ -732,6 +746,7 @@ impl<I: Isa, const P: usize, const SRP: bool> Scheme<I, Planar<'_, I, SRP>> for 
         self.last_at = None;
     }
 
+    #[inline(always)]
     fn finite(y: &NyState<I, P>) -> bool {
         (0..P).all(|i| y.x[i].to_array().iter().chain(y.v[i].to_array().iter()).all(|v| v.is_finite()))
     }

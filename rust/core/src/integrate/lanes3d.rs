@@ -79,10 +79,13 @@ impl<I: Isa> Rhs<I, D> for Rigid<'_, I> {
 
     #[inline(always)]
     fn at8(&self, ts: &[f64; 8]) -> [(f64, Option<[f64; 6]>); 8] {
-        match self.table.try_eval8_at(self.one.isa(), ts) {
-            Some(v) => std::array::from_fn(|l| (ts[l], Some(v[l]))),
-            None => ts.map(|t| (t, None)),
+        // loops, not array::from_fn / map (their closures are compiled out of line)
+        let v = self.table.try_eval8_at(self.one.isa(), ts);
+        let mut out = [(0.0, None); 8];
+        for l in 0..8 {
+            out[l] = (ts[l], v.map(|v| v[l]));
         }
+        out
     }
 
     #[inline(always)]
