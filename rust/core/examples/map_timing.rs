@@ -7,7 +7,7 @@
 //! Cs = 0.4, Cd = 0.1, Sun phase 0.7, STM on). One thread, best of `--reps` runs (default 15),
 //! cases alternating round-robin so that a load change on the shared machine hits all alike.
 //!
-//!   cargo run --release -p librate-core --example map_timing -- [--reps N] [--method M] [--rtol R] [--accuracy] [--save FILE] [--compare FILE]
+//!   cargo run --release -p librate-core --example map_timing -- [--reps N] [--method M] [--rtol R] [--only K] [--accuracy [--solo]] [--table] [--save FILE] [--compare FILE]
 //!   cargo run --release -p librate-core --example map_timing -- --3d [--12d] [--reps N] [--method M] [--rtol R] [--save FILE] [--compare FILE]
 //!
 //! `--save` writes every outcome (phi_t, wz_t, stm) as raw f64 bits; `--compare` reads such a
@@ -100,6 +100,18 @@ fn main() {
     assert!((o.period - 4.858760).abs() < 1e-5, "not the DRO through x0 = 0.70: period {}", o.period);
     let f = OrbitForcing::new(MU, &o.state0, o.period, [true, true], 1e-13).unwrap();
     println!("orbit: x0 = {:.17e}, ydot0 = {:.17e}, period = {:.17e}; forcing table error {:.3e}", o.state0[0], o.state0[4], o.period, f.max_error);
+    if args.iter().any(|a| a == "--table") {
+        // the forcing table's fit (the scalar RKF7(8) along the orbit), best of `reps`
+        let mut best = f64::INFINITY;
+        for _ in 0..reps {
+            let t0 = Instant::now();
+            let g = OrbitForcing::new(MU, &o.state0, o.period, [true, true], 1e-13).unwrap();
+            best = best.min(t0.elapsed().as_secs_f64());
+            assert_eq!(g, f);
+        }
+        println!("forcing table ({} segments): best of {reps}: {:.3} ms", f.segments(), 1e3 * best);
+        return;
+    }
     let n = 2000;
     let grid: Vec<Case> = (0..n).map(|i| Case::new(0.0, -3.0 + 5.0 * i as f64 / (n - 1) as f64, 0.8)).collect();
     let srp: Vec<Case> = grid.iter().map(|c| Case { eps: 0.05, cs: 0.4, cd: 0.1, theta_sun0: 0.7, ..*c }).collect();
@@ -112,8 +124,13 @@ fn main() {
     let mut best = [f64::INFINITY; 3];
     let mut results: Vec<Vec<f64>> = vec![Vec::new(); 3];
     let mut steps = [0.0f64; 3];
+    // `--only K`: time only case K (0: no STM, 1: STM, 2: SRP), e.g. for a profiler
+    let only: Option<usize> = arg("--only").map(|s| s.parse().expect("--only: 0, 1 or 2"));
     for _ in 0..reps {
         for (k, (_, cases, stm)) in runs.iter().enumerate() {
+            if only.is_some_and(|o| o != k) {
+                continue;
+            }
             let t0 = Instant::now();
             let out = sweep(&f, o.period, cases, &opts, *stm, 64, Some(1)).unwrap();
             best[k] = best[k].min(t0.elapsed().as_secs_f64());
@@ -136,6 +153,13 @@ fn main() {
                 err = err.max((phi - o.phi_t).abs().max((wz - o.wz_t).abs()) / o.phi_t.abs().max(o.wz_t.abs()).max(1.0));
             }
             println!("{name:>16}: accuracy {err:.2e} against RKF7(8) at 1e-15, {:.1} steps per trajectory", steps[k]);
+            if args.iter().any(|a| a == "--solo") {
+                // each trajectory alone (its group's other lanes copies of it): the lock step's cost
+                let out = sweep(&f, o.period, cases, &opts, *stm, 64, None).unwrap();
+                let rej: f64 = out.iter().map(|o| o.rejected as f64).sum::<f64>() / n as f64;
+                let solo: f64 = cases.iter().map(|c| sweep(&f, o.period, std::slice::from_ref(c), &opts, *stm, 64, Some(1)).unwrap()[0]).map(|o| (o.accepted + o.rejected) as f64).sum::<f64>() / n as f64;
+                println!("{name:>16}: {rej:.1} rejected per trajectory; alone {solo:.1} steps per trajectory");
+            }
         }
     }
     let all: Vec<f64> = results.concat();
