@@ -124,7 +124,8 @@ fn main() {
     let mut best = [f64::INFINITY; 3];
     let mut results: Vec<Vec<f64>> = vec![Vec::new(); 3];
     let mut steps = [0.0f64; 3];
-    // `--only K`: time only case K (0: no STM, 1: STM, 2: SRP), e.g. for a profiler
+    // `--only K`: time only case K (0: no STM, 1: STM, 2: SRP), e.g. for a profiler; nothing is
+    // checked, saved or compared then
     let only: Option<usize> = arg("--only").map(|s| s.parse().expect("--only: 0, 1 or 2"));
     for _ in 0..reps {
         for (k, (_, cases, stm)) in runs.iter().enumerate() {
@@ -139,7 +140,12 @@ fn main() {
         }
     }
     for (k, (name, _, _)) in runs.iter().enumerate() {
-        println!("{name:>16}: best of {reps}: {:8.2} ms  ({:.2} us per trajectory)", 1e3 * best[k], 1e6 * best[k] / n as f64);
+        if only.is_none_or(|o| o == k) {
+            println!("{name:>16}: best of {reps}: {:8.2} ms  ({:.2} us per trajectory)", 1e3 * best[k], 1e6 * best[k] / n as f64);
+        }
+    }
+    if only.is_some() {
+        return; // the other cases were not run: nothing to check, save or compare
     }
     if args.iter().any(|a| a == "--accuracy") {
         // against RKF7(8) at rtol = atol = 1e-15 (bench/bench_lanes.py's reference and metric):
