@@ -4,7 +4,9 @@
 //! integrates the pending points of every candidate in ONE call per iteration and runs, per
 //! candidate, capped Newton steps (minimum-norm when the Jacobian is rank-deficient) with a
 //! backtracking line search (Armijo-type sufficient decrease of the residual's 2-norm, step
-//! halved up to `max_halvings` times). Each candidate reports why it stopped ([`StopReason`]);
+//! halved up to `max_halvings` times). Where the integrator runs lock-step groups, a batch's idle
+//! lanes carry the searching candidates' next halvings ahead of time ([`Settings::group`]): the
+//! same points and decisions, in fewer rounds. Each candidate reports why it stopped ([`StopReason`]);
 //! nothing panics and a non-finite result is never labelled converged.
 
 use nalgebra::{DMatrix, DVector};
@@ -73,6 +75,13 @@ pub(crate) struct Settings {
     pub tol: f64,
     pub max_iter: usize,
     pub max_halvings: u32,
+    /// The integrator's lock-step group: `integrate` runs its trajectories in consecutive
+    /// groups of this many (the SIMD lanes), a group costing the same however many of its lanes
+    /// are in use. The driver fills the last group's idle lanes with the next trial points of
+    /// the line searches that have halved their step (halved once more, and again), so that a
+    /// search that backtracks does not cost a round per halving. 1: no look-ahead (one
+    /// trajectory per call of a scalar integrator, or groups the driver cannot see).
+    pub group: usize,
 }
 
 #[derive(Debug, Clone, Copy)]
@@ -146,11 +155,31 @@ impl<const N: usize> Track<N> {
     fn pending(&self) -> Option<[f64; N]> {
         match self.phase {
             Phase::Start => Some(self.start),
-            Phase::Trial { lambda, .. } => {
-                let x = self.cur.as_ref()?.x;
-                Some(std::array::from_fn(|i| x[i] + lambda * self.dir[i]))
-            }
+            Phase::Trial { lambda, .. } => self.trial(lambda),
             Phase::Done(_) => None,
+        }
+    }
+
+    fn trial(&self, lambda: f64) -> Option<[f64; N]> {
+        let x = self.cur.as_ref()?.x;
+        Some(std::array::from_fn(|i| x[i] + lambda * self.dir[i]))
+    }
+
+    /// The trial point `level` halvings beyond the pending one, if the line search can get
+    /// there (the same arithmetic as the search itself: the point it would evaluate); only for
+    /// a search that has already halved its step once: a full step is accepted most of the
+    /// time near a solution, and a lane's trajectory is not free where lanes share their steps
+    /// (the SRP lanes end a step at every lane's terminator crossing).
+    fn ahead(&self, level: u32, s: &Settings) -> Option<[f64; N]> {
+        match self.phase {
+            Phase::Trial { lambda, halvings, .. } if halvings >= 1 && halvings + level <= s.max_halvings => {
+                let mut l = lambda;
+                for _ in 0..level {
+                    l *= 0.5;
+                }
+                self.trial(l)
+            }
+            _ => None,
         }
     }
 
@@ -231,28 +260,131 @@ pub(crate) fn solve<const N: usize, P: Problem<N>>(
         .collect();
     let mut batch: Vec<P::Traj> = Vec::with_capacity(per * tracks.len());
     let mut active: Vec<(usize, [f64; N], Option<usize>)> = Vec::with_capacity(tracks.len());
+    // look-ahead trial points: (index into `active`, point, where its trajectories start)
+    let mut ahead: Vec<(usize, [f64; N], Option<usize>)> = Vec::new();
+    let push = |i: usize, x: &[f64; N], batch: &mut Vec<P::Traj>| {
+        let at = batch.len();
+        let pushed = problem.push(&candidates[i], x, batch);
+        if !pushed {
+            batch.truncate(at);
+        }
+        pushed.then_some(at)
+    };
     loop {
         crate::interrupt::check()?;
         batch.clear();
         active.clear();
+        ahead.clear();
         for (i, t) in tracks.iter().enumerate() {
             if let Some(x) = t.pending() {
-                let at = batch.len();
-                let pushed = problem.push(&candidates[i], &x, &mut batch);
-                if !pushed {
-                    batch.truncate(at);
-                }
-                active.push((i, x, pushed.then_some(at)));
+                let at = push(i, &x, &mut batch);
+                active.push((i, x, at));
             }
         }
         if active.is_empty() {
             break;
         }
+        // the last group's idle lanes: each searching candidate's next halving, then the one
+        // after, ... (in candidate order; the same points whatever the thread count)
+        let group = settings.group.max(1);
+        let mut level = 1;
+        while !batch.is_empty() && (group - batch.len() % group) % group >= per {
+            let before = ahead.len();
+            for (a, &(i, _, _)) in active.iter().enumerate() {
+                if (group - batch.len() % group) % group < per {
+                    break;
+                }
+                if let Some(x) = tracks[i].ahead(level, settings) {
+                    let at = push(i, &x, &mut batch);
+                    ahead.push((a, x, at));
+                }
+            }
+            if ahead.len() == before {
+                break;
+            }
+            level += 1;
+        }
         let out = if batch.is_empty() { Vec::new() } else { integrate(&batch)? };
-        for &(i, x, at) in &active {
-            let pt = at.and_then(|k| out.get(k..k + per)).and_then(|o| problem.evaluate(&candidates[i], &x, o)).and_then(|e| point(problem, x, e));
-            tracks[i].advance(problem, pt, settings);
+        let eval = |i: usize, x: &[f64; N], at: Option<usize>| {
+            at.and_then(|k| out.get(k..k + per)).and_then(|o| problem.evaluate(&candidates[i], x, o)).and_then(|e| point(problem, *x, e))
+        };
+        for (a, &(i, x, at)) in active.iter().enumerate() {
+            tracks[i].advance(problem, eval(i, &x, at), settings);
+            // a rejected trial goes on with the look-ahead points already integrated, in order,
+            // while they are the points the search asks for next
+            for (_, y, at) in ahead.iter().filter(|h| h.0 == a) {
+                if tracks[i].pending().is_none_or(|p| p.map(f64::to_bits) != y.map(f64::to_bits)) || !matches!(tracks[i].phase, Phase::Trial { .. }) {
+                    break;
+                }
+                tracks[i].advance(problem, eval(i, y, *at), settings);
+            }
         }
     }
     Ok(tracks)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::cell::Cell;
+
+    /// F(x) = atan(x - c) in one unknown: Newton from far away overshoots (|x - c| > 1.39
+    /// diverges), so the line search backtracks several times a step; trajectories are pure
+    /// functions of x, so a look-ahead must leave every decision and every value unchanged.
+    struct Atan;
+    impl Problem<1> for Atan {
+        type Cand = f64;
+        type Traj = f64;
+        type Out = f64;
+        fn initial(&self, c: &f64) -> [f64; 1] {
+            [*c]
+        }
+        fn push(&self, _: &f64, x: &[f64; 1], out: &mut Vec<f64>) -> bool {
+            out.push(x[0]);
+            x[0].abs() < 1e3
+        }
+        fn per_point(&self) -> usize {
+            1
+        }
+        fn evaluate(&self, _: &f64, x: &[f64; 1], o: &[f64]) -> Option<Eval<1>> {
+            let u = x[0] - 0.3;
+            Some(Eval { f: [o[0]], jac: [[1.0 / (1.0 + u * u)]], keep: Vec::new() })
+        }
+        fn rows(&self) -> &[usize] {
+            &[0]
+        }
+        fn cols(&self) -> &[usize] {
+            &[0]
+        }
+        fn step_scale(&self, _: &[f64; 1]) -> f64 {
+            1.0
+        }
+    }
+
+    #[test]
+    fn look_ahead_changes_nothing_but_the_rounds() {
+        // starts near (converging in a few steps) and far (backtracking, some to NoDescent)
+        let starts = [0.31, 1.0, 2.5, -4.0, 9.0, 40.0, -150.0];
+        let run = |group: usize, max_halvings: u32| {
+            let rounds = Cell::new(0usize);
+            let s = Settings { tol: 1e-13, max_iter: 30, max_halvings, group };
+            let tracks = solve(&Atan, &starts, &s, &|b: &[f64]| {
+                rounds.set(rounds.get() + 1);
+                Ok(b.iter().map(|&x| (x - 0.3).atan()).collect())
+            })
+            .unwrap();
+            let out: Vec<(u64, usize, StopReason)> = tracks.iter().map(|t| (t.x()[0].to_bits(), t.iterations, t.reason())).collect();
+            (out, rounds.get())
+        };
+        for max_halvings in [0, 2, 10] {
+            let (plain, r1) = run(1, max_halvings);
+            let (ahead, r8) = run(8, max_halvings);
+            assert_eq!(plain, ahead, "max_halvings {max_halvings}");
+            assert!(r8 <= r1, "max_halvings {max_halvings}: {r8} rounds with the look-ahead, {r1} without");
+            if max_halvings == 10 {
+                assert!(r8 < r1, "the far starts backtrack: fewer rounds expected ({r8} against {r1})");
+                assert!(plain.iter().filter(|p| p.2 == StopReason::Converged).count() >= 4, "{plain:?}");
+            }
+        }
+    }
 }

@@ -44,7 +44,7 @@ use crate::cr3bp::check_mu;
 use crate::error::{check_finite, check_positive, invalid, Error, Result};
 use crate::integrate::{Options, Output};
 use crate::integrate::forcing::OrbitForcing;
-use crate::integrate::lanes::{Case, LaneOptions, LaneStatus, Outcome, Sensitivity};
+use crate::integrate::lanes::{Case, LaneOptions, LaneStatus, Outcome, Sensitivity, LANES};
 use crate::map;
 use crate::propagation::with_threads;
 
@@ -602,7 +602,7 @@ pub fn correct_planar_attitudes(
 ) -> Result<Vec<Correction>> {
     validate(forcing, t_final, closure, free, candidates, opts)?;
     let form = Form { closure, free, h: opts.phase_step, bordered: None, bounds: (f64::NEG_INFINITY, f64::INFINITY), max_wz_step: opts.max_wz_step, max_angle_step: opts.max_angle_step };
-    run(form, candidates, opts, &on_table(forcing, t_final, opts, Sensitivity::None))
+    run(form, candidates, opts, &on_table(forcing, t_final, opts, Sensitivity::None), LANES)
 }
 
 /// The bordered correction of continuation: as [`correct_planar_attitudes`], with the
@@ -627,7 +627,7 @@ pub fn correct_bordered(
     validate(forcing, t_final, closure, free, candidates, opts)?;
     let bounds = if bordered.parameter == Parameter::Kz { (-1.0, 1.0) } else { (f64::NEG_INFINITY, f64::INFINITY) };
     let form = Form { closure, free, h: opts.phase_step, bordered: Some(*bordered), bounds, max_wz_step: opts.max_wz_step, max_angle_step: opts.max_angle_step };
-    run(form, candidates, opts, &on_table(forcing, t_final, opts, form.sensitivity()))
+    run(form, candidates, opts, &on_table(forcing, t_final, opts, form.sensitivity()), LANES)
 }
 
 fn validate_condition(a: &[f64; 3], b: f64, closure: Closure, whose: &str) -> Result<()> {
@@ -683,8 +683,9 @@ const FAILED: Outcome = Outcome { phi_t: f64::NAN, wz_t: f64::NAN, stm: [f64::NA
 /// The planar forms on the one Newton driver ([`super::newton::solve`]): all pending points of
 /// all candidates integrated in one call of `integrate` per iteration, a line search per
 /// candidate; then the full-period monodromy of half-closure corrections.
-fn run(form: Form, candidates: &[Candidate], opts: &CorrectorOptions, integrate: &Integrate<'_>) -> Result<Vec<Correction>> {
-    let settings = Settings { tol: opts.tol, max_iter: opts.max_iter, max_halvings: opts.max_halvings };
+/// `group`: the lock-step group of `integrate`'s batches ([`Settings::group`]).
+fn run(form: Form, candidates: &[Candidate], opts: &CorrectorOptions, integrate: &Integrate<'_>, group: usize) -> Result<Vec<Correction>> {
+    let settings = Settings { tol: opts.tol, max_iter: opts.max_iter, max_halvings: opts.max_halvings, group };
     with_threads(opts.threads, || -> Result<Vec<Correction>> {
         let tracks = newton::solve(&form, candidates, &settings, &|b: &[(Case, f64)]| integrate_batch(integrate, b, false))?;
         let stm = |t: &Track<3>| t.cur.as_ref().map_or([f64::NAN; 4], |p| [p.keep[0], p.keep[1], p.keep[2], p.keep[3]]);
@@ -862,7 +863,8 @@ pub fn correct_across_family(family: &PlanarFamily, bordered: &Bordered, candida
         }
         Ok(out)
     };
-    run(form, candidates, opts, &integrate)
+    // each (orbit, value) is its own sweep: the batch's groups are not its consecutive blocks
+    run(form, candidates, opts, &integrate, 1)
 }
 
 /// One trajectory to re-propagate with [`verify_planar_attitudes`].
