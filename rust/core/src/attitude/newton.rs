@@ -287,11 +287,12 @@ pub(crate) fn solve<const N: usize, P: Problem<N>>(
         // the last group's idle lanes: each searching candidate's next halving, then the one
         // after, ... (in candidate order; the same points whatever the thread count)
         let group = settings.group.max(1);
+        let idle = |batch: &Vec<P::Traj>| (group - batch.len() % group) % group;
         let mut level = 1;
-        while !batch.is_empty() && (group - batch.len() % group) % group >= per {
+        while !batch.is_empty() && idle(&batch) >= per {
             let before = ahead.len();
             for (a, &(i, _, _)) in active.iter().enumerate() {
-                if (group - batch.len() % group) % group < per {
+                if idle(&batch) < per {
                     break;
                 }
                 if let Some(x) = tracks[i].ahead(level, settings) {
@@ -313,8 +314,8 @@ pub(crate) fn solve<const N: usize, P: Problem<N>>(
             // a rejected trial goes on with the look-ahead points already integrated, in order,
             // while they are the points the search asks for next
             for (_, y, at) in ahead.iter().filter(|h| h.0 == a) {
-                if tracks[i].pending().is_none_or(|p| p.map(f64::to_bits) != y.map(f64::to_bits)) || !matches!(tracks[i].phase, Phase::Trial { .. }) {
-                    break;
+                if tracks[i].pending().map(|p| p.map(f64::to_bits)) != Some(y.map(f64::to_bits)) {
+                    break; // accepted, or stopped
                 }
                 tracks[i].advance(problem, eval(i, y, *at), settings);
             }
