@@ -260,6 +260,21 @@ pub fn with_threads<R: Send>(threads: Option<usize>, f: impl FnOnce() -> R + Sen
     }
 }
 
+/// [`with_threads`] for a loop of many parallel rounds (a Newton driver integrating its
+/// candidates' pending points once per iteration): with `None`, `f` runs on a worker of the
+/// global pool, so that each round is split among the workers from inside the pool. Started
+/// from any other thread, each round would be injected into the pool and its caller woken at
+/// its end, two thread switches per round: the standard map's 13 crossings (9 rounds) took
+/// 0.43 ms in the corrector against 0.33 ms on a worker, and `srp_map` 0.50 s against 0.45 s
+/// (Intel Xeon, 2 cores). A single parallel sweep gains nothing from it (measured: slightly
+/// slower), so [`with_threads`] is unchanged.
+pub fn with_threads_rounds<R: Send>(threads: Option<usize>, f: impl FnOnce() -> R + Send) -> Result<R> {
+    match threads {
+        None if rayon::current_thread_index().is_none() => Ok(rayon::scope(|_| f())),
+        _ => with_threads(threads, f),
+    }
+}
+
 /// Propagate many states from t0 to their final times (one shared, or one per state) on all
 /// cores. Each member is integrated exactly as [`propagate`] would, independently of the
 /// others, so the results are bit-identical to one-at-a-time calls whatever the thread count.
@@ -298,4 +313,29 @@ pub fn propagate_many(
     // an interrupted batch is an error of the call, not of its members
     crate::interrupt::check()?;
     Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// with_threads_rounds: `None` runs the loop on a worker of the global pool (from outside it),
+    /// `Some(n)` on a pool of n workers, and the loop's parallel rounds give the same results as
+    /// [`with_threads`].
+    #[test]
+    fn with_threads_rounds_runs_on_a_pool_worker() {
+        let rounds = || -> (bool, Vec<u64>) {
+            let on_worker = rayon::current_thread_index().is_some();
+            let v = (0..5u64).flat_map(|r| (0..100u64).into_par_iter().map(move |i| i * i + r).collect::<Vec<_>>()).collect();
+            (on_worker, v)
+        };
+        let (outside, v0) = with_threads(None, rounds).unwrap();
+        let (inside, v1) = with_threads_rounds(None, rounds).unwrap();
+        let (inside2, v2) = with_threads_rounds(Some(2), rounds).unwrap();
+        assert!(!outside, "the test thread is not a worker");
+        assert!(inside && inside2);
+        assert_eq!(v0, v1);
+        assert_eq!(v0, v2);
+        assert!(with_threads_rounds(Some(0), rounds).is_err());
+    }
 }

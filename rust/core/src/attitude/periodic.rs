@@ -46,7 +46,7 @@ use crate::integrate::{Options, Output};
 use crate::integrate::forcing::OrbitForcing;
 use crate::integrate::lanes::{Case, LaneOptions, LaneStatus, Outcome, Sensitivity, LANES};
 use crate::map;
-use crate::propagation::with_threads;
+use crate::propagation::{with_threads, with_threads_rounds};
 
 use std::f64::consts::{FRAC_PI_2, PI};
 
@@ -686,7 +686,7 @@ const FAILED: Outcome = Outcome { phi_t: f64::NAN, wz_t: f64::NAN, stm: [f64::NA
 /// `group`: the lock-step group of `integrate`'s batches ([`Settings::group`]).
 fn run(form: Form, candidates: &[Candidate], opts: &CorrectorOptions, integrate: &Integrate<'_>, group: usize) -> Result<Vec<Correction>> {
     let settings = Settings { tol: opts.tol, max_iter: opts.max_iter, max_halvings: opts.max_halvings, group };
-    with_threads(opts.threads, || -> Result<Vec<Correction>> {
+    with_threads_rounds(opts.threads, || -> Result<Vec<Correction>> {
         let tracks = newton::solve(&form, candidates, &settings, &|b: &[(Case, f64)]| integrate_batch(integrate, b, false))?;
         let stm = |t: &Track<3>| t.cur.as_ref().map_or([f64::NAN; 4], |p| [p.keep[0], p.keep[1], p.keep[2], p.keep[3]]);
         let mut mono: Vec<[f64; 4]> = tracks.iter().map(stm).collect();

@@ -36,7 +36,7 @@ use crate::integrate::System;
 use crate::cr3bp::check_mu;
 use crate::error::{check_finite, check_positive, invalid, Result};
 use crate::integrate::{Options, Output};
-use crate::propagation::with_threads;
+use crate::propagation::{with_threads, with_threads_rounds};
 
 type Quat = [f64; 4];
 
@@ -371,7 +371,7 @@ pub fn correct_attitudes_3d(mu: f64, body: RigidBody, orbit0: &[f64; 6], t_final
     let one = |y: &Traj| run(y, t_solve);
     let settings = Settings { tol: opts.tol, max_iter: opts.max_iter, max_halvings: opts.max_halvings, group: 1 };
     let cands: Vec<usize> = (0..starts.len()).collect();
-    let (tracks, full) = with_threads(opts.threads, || -> Result<_> {
+    let (tracks, full) = with_threads_rounds(opts.threads, || -> Result<_> {
         let tracks = newton::solve(&form, &cands, &settings, &|b: &[Traj]| Ok(b.par_iter().map(one).collect()))?;
         // the half form's full-period monodromy: one more batch over K T at the final points
         let full: Vec<Option<[[f64; 6]; 6]>> = if opts.half {
@@ -707,7 +707,7 @@ pub fn correct_attitudes_3d_across(
     };
     let settings = Settings { tol: opts.tol, max_iter: opts.max_iter, max_halvings: opts.max_halvings, group: 1 };
     let cands: Vec<usize> = (0..starts.len()).collect();
-    let tracks = with_threads(opts.threads, || newton::solve(&form, &cands, &settings, &|b: &[(Traj, f64)]| Ok(b.par_iter().map(one).collect())))??;
+    let tracks = with_threads_rounds(opts.threads, || newton::solve(&form, &cands, &settings, &|b: &[(Traj, f64)]| Ok(b.par_iter().map(one).collect())))??;
     // the member at each final point (cheap: one symmetric shooting, no attitude integration)
     let members: Vec<Option<SymmetricOrbit>> = with_threads(opts.threads, || tracks.par_iter().map(|t| t.cur.as_ref().and_then(|p| family.member(p.x[6])).map(|m| m.0)).collect())?;
     Ok(tracks

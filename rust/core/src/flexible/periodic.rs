@@ -18,7 +18,7 @@ use super::propagate::propagate_flexible;
 use crate::error::{check_finite, check_positive, invalid, Result};
 use crate::integrate::{Options, Output};
 use crate::newton::{self, Problem, Settings, StopReason};
-use crate::propagation::with_threads;
+use crate::propagation::with_threads_rounds;
 
 /// The outcome of [`correct_flexible_periodic`].
 #[derive(Debug, Clone, PartialEq)]
@@ -83,7 +83,7 @@ pub fn correct_flexible_periodic(
         let y = flow(&x)?;
         Ok(DVector::from_fn(m, |i, _| (y[i] - x[i] - if i == 0 { 2.0 * std::f64::consts::PI * turns } else { 0.0 }) / scale[i]))
     };
-    with_threads(threads, || -> Result<FlexiblePeriodic> {
+    with_threads_rounds(threads, || -> Result<FlexiblePeriodic> {
         let mut problem = Closure {
             residual: &residual,
             jacobian: &|u: &DVector<f64>| -> Result<DMatrix<f64>> {
