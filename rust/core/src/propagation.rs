@@ -265,7 +265,7 @@ pub fn with_threads<R: Send>(threads: Option<usize>, f: impl FnOnce() -> R + Sen
 /// global pool, so that each round is split among the workers from inside the pool. Started
 /// from any other thread, each round would be injected into the pool and its caller woken at
 /// its end, two thread switches per round: the standard map's 13 crossings (9 rounds) took
-/// 0.43 ms in the corrector against 0.33 ms on a worker, and `srp_map` 0.50 s against 0.45 s
+/// 0.43 ms in the corrector against 0.40 ms on a worker, and `srp_map` 0.50 s against 0.45 s
 /// (Intel Xeon, 2 cores). A single parallel sweep gains nothing from it (measured: slightly
 /// slower), so [`with_threads`] is unchanged.
 pub fn with_threads_rounds<R: Send>(threads: Option<usize>, f: impl FnOnce() -> R + Send) -> Result<R> {
