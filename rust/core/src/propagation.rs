@@ -270,7 +270,8 @@ pub fn with_threads<R: Send>(threads: Option<usize>, f: impl FnOnce() -> R + Sen
 /// slower), so [`with_threads`] is unchanged.
 pub fn with_threads_rounds<R: Send>(threads: Option<usize>, f: impl FnOnce() -> R + Send) -> Result<R> {
     match threads {
-        None if rayon::current_thread_index().is_none() => Ok(rayon::scope(|_| f())),
+        // on a worker already, rayon::scope runs f in place
+        None => Ok(rayon::scope(|_| f())),
         _ => with_threads(threads, f),
     }
 }
