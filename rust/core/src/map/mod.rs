@@ -75,15 +75,19 @@ pub fn sweep_at(
             return Err(invalid("cs", format!("case {i}: need cs, cd >= 0 and cs + cd <= 1, got ({}, {})", c.cs, c.cd)));
         }
     }
+    // One kernel for the whole sweep: with SRP anywhere, every group takes the flat-plate kernel
+    // (its lanes without a plate add exact zeros: the gravity kernel's bits on the same group).
+    let srp = opts.sensitivity == lanes::Sensitivity::Eps || cases.iter().any(|c| c.eps != 0.0);
     // Lock-step groups are taken from the start of each chunk: chunks are multiples of the group
-    // size so that the groups, and so the results, are the same for any chunk size.
-    let chunk = chunk.div_ceil(lanes::LANES) * lanes::LANES;
+    // size (lanes::group_size: two lane vectors for the gravity map without the STM, else one)
+    // so that the groups, and so the results, are the same for any chunk size.
+    let group = lanes::group_size(with_stm, srp, opts);
+    let chunk = chunk.div_ceil(group) * group;
     if !level.is_available() {
         crate::simd::parse(Some(level.name()))?;
     }
     let run = |part: &[Case]| -> Result<Vec<Outcome>> {
         crate::interrupt::check()?;
-        let srp = opts.sensitivity == lanes::Sensitivity::Eps || part.chunks(lanes::LANES).any(|g| g.iter().any(|c| c.eps != 0.0));
         match (with_stm, srp) {
             (true, false) => integrate_cases::<8, false>(level, forcing, t_final, part, opts),
             (false, false) => integrate_cases::<4, false>(level, forcing, t_final, part, opts),
