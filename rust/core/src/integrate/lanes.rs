@@ -1194,10 +1194,8 @@ impl<I: Isa> Rhs<I, 8> for Wide<'_, I> {
         let (mut da, mut db) = ([F8::splat(isa, 0.0); 4], [F8::splat(isa, 0.0); 4]);
         rhs::<I, 4, false>(at, &ya, &self.m.p, &mut da);
         rhs::<I, 4, false>(at, &yb, &self.q, &mut db);
-        for i in 0..4 {
-            dy[i] = da[i];
-            dy[4 + i] = db[i];
-        }
+        dy[..4].copy_from_slice(&da);
+        dy[4..].copy_from_slice(&db);
     }
 }
 
