@@ -1149,8 +1149,8 @@ impl<'a> Groups<'a, 4, false> {
     /// group of at most [`LANES`] on one vector.
     #[inline(always)]
     fn wide<I: Isa>(self, isa: I) -> Vec<Outcome> {
-        let mut st: Stages<I, 8> = Stages { k: [[F8::splat(isa, 0.0); 8]; 13], tmp: [F8::splat(isa, 0.0); 8], tableau: std::marker::PhantomData };
-        let mut narrow: Stages<I, 4> = Stages { k: [[F8::splat(isa, 0.0); 4]; 13], tmp: [F8::splat(isa, 0.0); 4], tableau: std::marker::PhantomData };
+        let mut st = <Stages<I, 8> as Scheme<I, Wide<'a, I>>>::new(isa);
+        let mut narrow = <Stages<I, 4> as Scheme<I, Planar<'a, I, false>>>::new(isa);
         let mut out = Vec::with_capacity(self.cases.len());
         for group in self.cases.chunks(GROUP) {
             if group.len() > LANES {
