@@ -9,7 +9,7 @@ the synodic frame (the quantity on the thesis figures' axes).
 
 The grid work runs in the Rust engine (SIMD lanes, all cores, orbit forcing tabulated once per
 orbit); refinement uses the engine's 2x2 attitude STM; every reported solution is re-propagated
-independently (scalar model, orbit integrated alongside, tight tolerance).
+independently (the orbit integrated alongside instead of the forcing table, tight tolerance).
 """
 
 from __future__ import annotations
@@ -189,8 +189,8 @@ class AttitudeSolution:
     wz0 : float
         Inertial initial rate (1/TU).
     residual_dphi, residual_dwz : float
-        The closure residuals after the K periods, from an independent re-propagation (scalar
-        model, orbit integrated alongside, rtol = atol = 1e-14).
+        The closure residuals after the K periods, from an independent re-propagation (orbit
+        integrated alongside, rtol = atol = 1e-14).
     monodromy : numpy.ndarray, shape (2, 2)
         d(phi, wz)(KT) / d(phi0, wz0).
     iterations : int
@@ -332,9 +332,10 @@ def correct(orbit: PeriodicOrbit, *, kz, n_total, kind, phi0, wz0, n_periods: in
 def verified(orbit: PeriodicOrbit, *, kz, n_total, kind, phi0, wz0, n_periods: int = 1, plates=None, iterations=None,
              threads: int | None = None) -> list[AttitudeSolution]:
     """AttitudeSolutions for converged corrections: every one re-propagated independently in one
-    batched Rust call (scalar model, orbit integrated alongside, rtol = atol = 1e-14, in
-    parallel on ``threads``, default all cores; the results do not depend on it); ``plates``: one
-    FlatPlate (or None) per solution."""
+    batched Rust call (the orbit integrated alongside instead of the forcing table, rtol = atol =
+    1e-14, with the 2x2 STM: the SIMD lanes in lock-step groups of eight in the given order, the
+    groups in parallel on ``threads``, default all cores; the results depend on the order, never
+    on the threads); ``plates``: one FlatPlate (or None) per solution."""
     kz, n_total, phi0, wz0, kind = (np.ascontiguousarray(np.atleast_1d(v).ravel())
                                     for v in np.broadcast_arrays(np.asarray(kz, dtype=float), np.asarray(n_total, dtype=float),
                                                                  np.asarray(phi0, dtype=float),

@@ -89,7 +89,7 @@ fn val_torque_free_solutions_are_analytic() {
 /// Thesis Fig. 23 (docs/physics.md, periodic attitude motions): on the 12.66-day DRO (mu = 0.01215, TU = 375190 s) with
 /// Kz = 0.8 the N = -1 solution is at phidot0 = wz0 - 1 = -2.4545 (4 digits: 1e-4). From the
 /// torque-free guess the half-period form converges (residual <= 1e-12); the independent
-/// re-propagation over the full period (scalar model, orbit integrated alongside, 1e-14)
+/// re-propagation over the full period (the lanes with the orbit integrated alongside, 1e-14)
 /// closes to < 1e-11 and its monodromy equals the corrector's to 1e-8 relative.
 #[test]
 fn val_thesis_fig23_solution() {
@@ -235,7 +235,7 @@ fn val_line_search_globalises_newton() {
 /// phases only. On the 1:2 Sun-resonant DRO (T = Ts / 2, K = 2), Kz = 0.8, N = -2, a flat plate
 /// eps = 0.5, cs = 0.4, cd = 0.1: Free::SunPhase from the gravity-only solution and Sun phase
 /// 1.4 converges (residual <= 1e-12) to the phase pi/2 (to 1e-9; the solution of the Python
-/// corrector: wz0 = -1.43736, 1e-5); the scalar re-propagation with the plate closes to < 1e-9
+/// corrector: wz0 = -1.43736, 1e-5); the re-propagation with the plate closes to < 1e-9
 /// over 2 T and its STM equals the corrector's monodromy to 1e-7 relative (FD-free column).
 /// From the phases 1.6 and 0.3 (same batch) the result is converged and re-verified likewise, or
 /// an honest stop reason with a residual above tol (from 1.6 the line search ends in a local
@@ -270,6 +270,71 @@ fn val_sun_phase_with_srp() {
         let n = e.stm.iter().map(|v| v * v).sum::<f64>().sqrt();
         let d = (0..4).map(|i| (e.stm[i] - x.monodromy[i]).powi(2)).sum::<f64>().sqrt() / n;
         assert!(d < 1e-7, "monodromy {:?} vs {:?}", x.monodromy, e.stm);
+    }
+}
+
+/// The verifier (the SIMD lanes with the orbit's CR3BP states integrated alongside, 1e-14) against
+/// an independent reference: the scalar planar model with the orbit alongside
+/// (`propagate_planar`, integrated piecewise between the plate's terminator crossings located as
+/// events) at rtol = atol = 3e-15. Nineteen motions on the 1:2 Sun-resonant DRO over 2 T, Kz =
+/// 0.6, rates -1.6..1.2 (fast and slow, many terminator crossings), plates eps 0..2 (cs 0.4,
+/// cd 0.1, Sun phases 0..2) and three without: phi and wz within 1e-10 of the reference, each
+/// STM entry within 1e-8 relative to max(1, |entry|) (the scalar model at 1e-14 is within 5e-11
+/// and 1e-9 of it on such motions). Results do not depend on the threads; a motion's result
+/// depends on its group of eight (the first eight alone equal themselves in the full call).
+#[test]
+fn val_verifier_matches_the_scalar_model() {
+    use librate_core::attitude::propagate_planar;
+    use librate_core::integrate::Output;
+    let (s0, t) = sun12();
+    let items: Vec<PlanarStart> = (0..19)
+        .map(|i| {
+            let x = i as f64;
+            let plate = (i % 6 != 5).then(|| FlatPlate::new(0.11 * x, 0.4, 0.1, Sun { theta0: 0.1 * x, ..Sun::default() }).unwrap());
+            PlanarStart { kz: 0.6, phi0: 0.3 * x - 2.0, wz0: -1.6 + 2.8 * x / 18.0, plate }
+        })
+        .collect();
+    let v = verify_planar_attitudes(MU, &s0, 2.0 * t, &items, [true, true], None).unwrap();
+    let reference = Options::with_tolerances(3e-15, 3e-15);
+    for (it, e) in items.iter().zip(&v) {
+        assert!(e.error.is_none(), "{it:?}: {:?}", e.error);
+        let r = propagate_planar(MU, it.kz, [true, true], false, &s0, it.phi0, it.wz0, 0.0, 2.0 * t, &reference, true, Output::Final, it.plate).unwrap();
+        let (phi, wz, stm) = (*r.phi.last().unwrap(), *r.wz.last().unwrap(), r.stm_final.unwrap());
+        assert!((e.phi_t - phi).abs() < 1e-10 && (e.wz_t - wz).abs() < 1e-10, "{it:?}: ({}, {}) vs ({phi}, {wz})", e.phi_t, e.wz_t);
+        for k in 0..4 {
+            assert!((e.stm[k] - stm[k]).abs() < 1e-8 * stm[k].abs().max(1.0), "{it:?}: stm {:?} vs {stm:?}", e.stm);
+        }
+    }
+    let same = |a: &[librate_core::attitude::PlanarEnd], b: &[librate_core::attitude::PlanarEnd]| {
+        a.iter().zip(b).all(|(x, y)| x.phi_t.to_bits() == y.phi_t.to_bits() && x.wz_t.to_bits() == y.wz_t.to_bits() && x.stm.map(f64::to_bits) == y.stm.map(f64::to_bits))
+    };
+    let v1 = verify_planar_attitudes(MU, &s0, 2.0 * t, &items, [true, true], Some(1)).unwrap();
+    let v2 = verify_planar_attitudes(MU, &s0, 2.0 * t, &items, [true, true], Some(2)).unwrap();
+    assert!(same(&v, &v1) && same(&v, &v2));
+    let first = verify_planar_attitudes(MU, &s0, 2.0 * t, &items[..8], [true, true], Some(1)).unwrap();
+    assert!(same(&v[..8], &first));
+}
+
+/// A motion the lanes cannot integrate (here a rate so fast that the 1e-14 steps exceed the
+/// lanes' step limit) fails its group of eight; the verifier runs that group again one motion
+/// at a time, so its seven companions keep their values (equal to their values alone) and only
+/// it carries an integration error (maximum steps, with the time reached), with NaN values.
+#[test]
+fn val_verifier_keeps_a_failing_motions_companions() {
+    let (s0, t) = dro1266();
+    let mut items: Vec<PlanarStart> = (0..8).map(|i| PlanarStart { kz: 0.8, phi0: 0.0, wz0: -1.5 + 0.1 * i as f64, plate: None }).collect();
+    items[3].wz0 = 1e9;
+    let v = verify_planar_attitudes(MU, &s0, t, &items, [true, true], Some(1)).unwrap();
+    for (i, e) in v.iter().enumerate() {
+        if i == 3 {
+            assert!(e.phi_t.is_nan() && e.stm.iter().all(|x| x.is_nan()));
+            let msg = e.error.as_ref().map(|e| e.to_string()).unwrap_or_default();
+            assert!(msg.contains("maximum number of steps") && msg.contains("at t = "), "{msg}");
+        } else {
+            assert!(e.error.is_none(), "item {i}: {:?}", e.error);
+            let alone = verify_planar_attitudes(MU, &s0, t, &items[i..=i], [true, true], Some(1)).unwrap();
+            assert_eq!((e.phi_t.to_bits(), e.wz_t.to_bits()), (alone[0].phi_t.to_bits(), alone[0].wz_t.to_bits()), "item {i}");
+        }
     }
 }
 
@@ -316,6 +381,9 @@ fn val_corrector_rejects_invalid_arguments() {
     assert_eq!(vname(verify_planar_attitudes(MU, &s0, -1.0, &[item], [true, true], None)), "t_final");
     assert_eq!(vname(verify_planar_attitudes(MU, &[0.8, 0.0, 0.1, 0.0, 0.5, 0.0], t, &[item], [true, true], None)), "orbit_state0");
     assert_eq!(vname(verify_planar_attitudes(MU, &s0, t, &[item], [true, true], Some(0))), "threads");
+    let plate = |omega: f64| Some(FlatPlate::new(0.1, 0.4, 0.1, Sun { omega, ..Sun::default() }).unwrap());
+    let two_suns = [PlanarStart { plate: plate(-0.9), ..item }, PlanarStart { plate: plate(-0.5), ..item }];
+    assert_eq!(vname(verify_planar_attitudes(MU, &s0, t, &two_suns, [true, true], None)), "plate");
 }
 
 /// The bordered correction (continuation's corrector). References: (1) with the parameter fixed

@@ -313,8 +313,9 @@ impl PyPlanarVerification {
     }
 }
 
-/// Independent re-propagation of planar attitude motions (scalar model, orbit integrated
-/// alongside, rtol = atol = 1e-14) in parallel; a plate where the case's eps is non-zero.
+/// Independent re-propagation of planar attitude motions (the orbit integrated alongside, no
+/// forcing table, rtol = atol = 1e-14; the SIMD lanes in groups of eight in case order, the
+/// groups in parallel); a plate where the case's eps is non-zero.
 #[pyfunction]
 #[pyo3(signature = (mu, orbit_state0, t_final, cases, *, primaries=[true, true], threads=None))]
 fn planar_verify<'py>(

@@ -41,7 +41,8 @@
 //! generic over the lane type) and step with the scalar driver's [`Controller`] and tableau.
 
 use super::forcing::OrbitForcing;
-use crate::attitude::{flat_plate_wzdot, gravity_gradient_wzdot, FlatPlate, Sun};
+use crate::attitude::{flat_plate_wzdot, forcing_sc, gravity_gradient_wzdot, FlatPlate, Sun};
+use crate::attitude::planar::orbit_derivative;
 use crate::constants::SOLAR_PRESSURE_1AU;
 use crate::integrate::rkn::{A as RKN_A, B as RKN_B, BP as RKN_BP, BPT as RKN_BPT, BT as RKN_BT, C as RKN_C, ERROR_ORDER as RKN_ERROR_ORDER, STAGES as RKN_STAGES};
 use crate::integrate::tableau::dp87::{dp87_stages, A as DP_A, B8 as DP_B8, C as DP_C, E as DP_E};
@@ -420,20 +421,48 @@ impl<'a, I: Isa, const SRP: bool> Planar<'a, I, SRP> {
     }
 }
 
-impl<I: Isa, const SRP: bool> Planar<'_, I, SRP> {
+impl<I: Isa> Params<I> {
     /// The Sun's phase (sin, cos)(w t) with SRP (zeros without), from the lanes' sin_cos (one
     /// lane of [`Self::sun8`]'s evaluation, the same bits).
     #[inline(always)]
-    fn sun(&self, t: f64) -> (f64, f64) {
+    fn sun<const SRP: bool>(&self, t: f64) -> (f64, f64) {
         if SRP {
-            let (s, c) = F8::splat(self.p.kz15.isa(), self.p.sun.angle(t)).sin_cos();
+            let (s, c) = F8::splat(self.kz15.isa(), self.sun.angle(t)).sin_cos();
             (lane(&s, 0), lane(&c, 0))
         } else {
             (0.0, 0.0)
         }
     }
 
+    /// [`Self::sun`] at eight times, in one vector evaluation.
+    #[inline(always)]
+    fn sun8<const SRP: bool>(&self, ts: &[f64; 8]) -> ([f64; 8], [f64; 8]) {
+        if SRP {
+            let mut angles = [0.0; 8];
+            for l in 0..8 {
+                angles[l] = self.sun.angle(ts[l]);
+            }
+            let (s, c) = F8::new(self.kz15.isa(), angles).sin_cos();
+            (s.to_array(), c.to_array())
+        } else {
+            ([0.0; 8], [0.0; 8])
+        }
+    }
+}
+
+/// What the terminator cut ([`Terminators`]) needs of a planar lane model with the flat plate.
+trait SunLanes<I: Isa> {
+    /// Whether the flat-plate term is compiled in (without it, steps are never cut).
+    const SRP: bool;
     /// (cos alpha, sin alpha) of the lanes in the state y at t, as the right-hand side has them.
+    fn alpha<Y: PlanarY<I>>(&self, t: f64, y: &Y) -> (F8<I>, F8<I>);
+    /// The Sun's rate w (1/TU).
+    fn sun_omega(&self) -> f64;
+}
+
+impl<I: Isa, const SRP: bool> SunLanes<I> for Planar<'_, I, SRP> {
+    const SRP: bool = SRP;
+
     #[inline(always)]
     fn alpha<Y: PlanarY<I>>(&self, t: f64, y: &Y) -> (F8<I>, F8<I>) {
         // a step's ends and the cut's trial ends: the data its stages had there
@@ -442,26 +471,17 @@ impl<I: Isa, const SRP: bool> Planar<'_, I, SRP> {
         sun_alpha(at.swt, at.cwt, &self.p, cp, sp)
     }
 
-    /// [`Self::sun`] at eight times, in one vector evaluation.
-    #[inline(always)]
-    fn sun8(&self, ts: &[f64; 8]) -> ([f64; 8], [f64; 8]) {
-        if SRP {
-            let mut angles = [0.0; 8];
-            for l in 0..8 {
-                angles[l] = self.p.sun.angle(ts[l]);
-            }
-            let (s, c) = F8::new(self.p.kz15.isa(), angles).sin_cos();
-            (s.to_array(), c.to_array())
-        } else {
-            ([0.0; 8], [0.0; 8])
-        }
+    fn sun_omega(&self) -> f64 {
+        self.p.sun.omega
     }
+}
 
+impl<I: Isa, const SRP: bool> Planar<'_, I, SRP> {
     /// The orbit's data at time t.
     #[inline(always)]
     fn orbit_at(&self, t: f64) -> PlanarAt {
         let (s, c) = self.f.sc_at::<I>(t);
-        let (swt, cwt) = self.sun(t);
+        let (swt, cwt) = self.p.sun::<SRP>(t);
         PlanarAt { s, c, swt, cwt }
     }
 }
@@ -482,7 +502,7 @@ impl<I: Isa, const D: usize, const SRP: bool> Rhs<I, D> for Planar<'_, I, SRP> {
     #[inline(always)]
     fn at8(&self, ts: &[f64; 8]) -> [PlanarAt; 8] {
         let sc = self.f.eval8_at(self.p.kz15.isa(), ts);
-        let (swt, cwt) = self.sun8(ts);
+        let (swt, cwt) = self.p.sun8::<SRP>(ts);
         // a loop, not array::from_fn (its closure is compiled out of line)
         let mut out = [PlanarAt { s: 0.0, c: 0.0, swt: 0.0, cwt: 0.0 }; 8];
         for l in 0..8 {
@@ -868,12 +888,15 @@ pub(crate) fn lane<I: Isa>(v: &F8<I>, l: usize) -> f64 {
     v.to_array()[l]
 }
 
-/// How a lock-step run ended: steps taken (shared by the lanes) and the status.
+/// How a lock-step run ended: steps taken (shared by the lanes), the status, and where it
+/// stopped (the time reached and the last step size tried).
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Run {
     pub accepted: u32,
     pub rejected: u32,
     pub status: LaneStatus,
+    pub t: f64,
+    pub h: f64,
 }
 
 /// A hook of the step loop that may shorten an accepted step (the planar SRP terminators).
@@ -937,7 +960,7 @@ pub(crate) fn run_steps<I: Isa, M, S: Scheme<I, M>>(isa: I, st: &mut S, m: &M, y
         after_reject = false;
         h = h.max(heff) * fac;
     }
-    Run { accepted, rejected, status }
+    Run { accepted, rejected, status, t, h }
 }
 
 /// How far past a terminator crossing a cut step may end (TU). A step across a kink of the plate
@@ -1016,17 +1039,17 @@ fn crossing_guess(h: f64, w: f64, (phi0, phi1): (f64, f64), (r0, r1): (f64, f64)
     s * h
 }
 
-impl<'a, I: Isa, S: Scheme<I, Planar<'a, I, SRP>>, const SRP: bool> Cut<I, Planar<'a, I, SRP>, S> for Terminators<I, S::Y>
+impl<I: Isa, M: SunLanes<I>, S: Scheme<I, M>> Cut<I, M, S> for Terminators<I, S::Y>
 where
     S::Y: PlanarY<I>,
 {
     #[inline(always)]
-    fn cut(&mut self, st: &mut S, model: &Planar<'a, I, SRP>, t: f64, heff: f64, y: &S::Y, ynew: &mut S::Y) -> Option<f64> {
-        if !SRP {
+    fn cut(&mut self, st: &mut S, model: &M, t: f64, heff: f64, y: &S::Y, ynew: &mut S::Y) -> Option<f64> {
+        if !M::SRP {
             return None;
         }
         let (rtol, atol) = (self.rtol, self.atol);
-        let w = model.p.sun.omega;
+        let w = model.sun_omega();
         let (ca0, sa0) = model.alpha(t, y);
         let (ca1, _) = model.alpha(t + heff, ynew);
         let (ca0, sa0, ca1) = (ca0.to_array(), sa0.to_array(), ca1.to_array());
@@ -1110,12 +1133,27 @@ where
     st.begin();
     let (p, plates) = Params::new(isa, pick, opts.sun_omega, opts.sensitivity);
     let model = Planar::<I, SRP>::new(f, p);
-    // the steps stop at a lane's terminator crossings where its plate acts, or where the
-    // sensitivity to eps does (the law's kink is there for any amplitude); a short group's copies
-    // of its last lane are that lane, bit for bit, and cross with it
-    let plate: [bool; LANES] = std::array::from_fn(|l| l < n && (plates[l].eps != 0.0 || opts.sensitivity == Sensitivity::Eps));
-    let mut cut = Terminators { plate, yc: y, yb: y, rtol: F8::splat(isa, opts.rtol), atol: F8::splat(isa, opts.atol) };
-    let Run { accepted, rejected, status } = run_steps(isa, st, &model, &mut y, t_final, opts, &mut cut);
+    let mut cut = Terminators::new(isa, n, &plates, opts, y);
+    let run = run_steps(isa, st, &model, &mut y, t_final, opts, &mut cut);
+    outcomes(&y, run)
+}
+
+impl<I: Isa, Y: Copy> Terminators<I, Y> {
+    /// The cut of a group of `n` cases: the steps stop at a lane's terminator crossings where
+    /// its plate acts, or where the sensitivity to eps does (the law's kink is there for any
+    /// amplitude); a short group's copies of its last lane are that lane, bit for bit, and cross
+    /// with it.
+    #[inline(always)]
+    fn new(isa: I, n: usize, plates: &[FlatPlate; LANES], opts: &LaneOptions, y: Y) -> Self {
+        let plate: [bool; LANES] = std::array::from_fn(|l| l < n && (plates[l].eps != 0.0 || opts.sensitivity == Sensitivity::Eps));
+        Terminators { plate, yc: y, yb: y, rtol: F8::splat(isa, opts.rtol), atol: F8::splat(isa, opts.atol) }
+    }
+}
+
+/// The lanes' outcomes at the end of a planar run (NaN values unless it ended Ok).
+#[inline(always)]
+fn outcomes<I: Isa, Y: PlanarY<I>>(y: &Y, run: Run) -> [Outcome; LANES] {
+    let Run { accepted, rejected, status, .. } = run;
     std::array::from_fn(|l| {
         if status != LaneStatus::Ok {
             return Outcome { phi_t: f64::NAN, wz_t: f64::NAN, stm: [f64::NAN; 4], dparam: [f64::NAN; 2], accepted, rejected, status };
@@ -1245,7 +1283,7 @@ fn integrate_wide<I: Isa>(isa: I, f: &OrbitForcing, t_final: f64, group: &[Case]
     let (p, _) = Params::new(isa, pick, opts.sun_omega, Sensitivity::None);
     let (q, _) = Params::new(isa, |l| pick(LANES + l), opts.sun_omega, Sensitivity::None);
     let model = Wide { m: Planar::<I, false>::new(f, p), q };
-    let Run { accepted, rejected, status } = run_steps(isa, st, &model, &mut y, t_final, opts, &mut NoCut);
+    let Run { accepted, rejected, status, .. } = run_steps(isa, st, &model, &mut y, t_final, opts, &mut NoCut);
     std::array::from_fn(|l| {
         if status != LaneStatus::Ok {
             return Outcome { phi_t: f64::NAN, wz_t: f64::NAN, stm: [f64::NAN; 4], dparam: [f64::NAN; 2], accepted, rejected, status };
@@ -1254,6 +1292,138 @@ fn integrate_wide<I: Isa>(isa: I, f: &OrbitForcing, t_final: f64, group: &[Case]
         let (phi_t, wz_t) = (lane(&y[base], l % LANES), lane(&y[base + 1], l % LANES));
         Outcome { phi_t, wz_t, stm: [f64::NAN; 4], dparam: [f64::NAN; 2], accepted, rejected, status }
     })
+}
+
+/// States of the planar model with the orbit alongside ([`Along`]): the attitude's eight (phi,
+/// wz, cos phi, sin phi, the 2x2 STM), then the orbit's six.
+const ALONG: usize = 14;
+
+/// The planar model with the orbit integrated alongside, no forcing table: the re-propagation
+/// of solutions ([`integrate_along`]). The orbit's six states are the same in every lane (set
+/// from one state, advanced by the same operations, never cut differently), so each stage
+/// evaluates the CR3BP and the forcing S, C once, from lane 0, for all eight, with the scalar
+/// model's own functions ([`orbit_derivative`], [`forcing_sc`]); the attitude's derivatives are
+/// the planar lanes' ([`rhs`]). Its orbit data at a time is the Sun's phase alone.
+struct Along<I, const SRP: bool> {
+    mu: f64,
+    primaries: [bool; 2],
+    p: Params<I>,
+    recent: Recent<(f64, f64), 4>,
+}
+
+impl<I: Isa, const SRP: bool> Rhs<I, ALONG> for Along<I, SRP> {
+    type At = (f64, f64);
+    /// Not phi: [`rhs`] reads (wz, cos phi, sin phi) and the STM, the orbit part its state.
+    const READS: [bool; ALONG] = all_but(&[0]);
+
+    #[inline(always)]
+    fn at(&self, t: f64) -> (f64, f64) {
+        match self.recent.find(t) {
+            Some(at) => at,
+            None => self.recent.keep(t, self.p.sun::<SRP>(t)),
+        }
+    }
+
+    #[inline(always)]
+    fn at8(&self, ts: &[f64; 8]) -> [(f64, f64); 8] {
+        let (swt, cwt) = self.p.sun8::<SRP>(ts);
+        let mut out = [(0.0, 0.0); 8];
+        for l in 0..8 {
+            out[l] = (swt[l], cwt[l]);
+        }
+        out
+    }
+
+    #[inline(always)]
+    fn eval_at(&self, at: &(f64, f64), y: &[F8<I>; ALONG], dy: &mut [F8<I>; ALONG]) {
+        let isa = y[0].isa();
+        let mut orbit = [0.0; 6];
+        for i in 0..6 {
+            orbit[i] = lane(&y[8 + i], 0);
+        }
+        let mut d = [0.0; 6];
+        orbit_derivative(self.mu, false, 0.0, &orbit, &mut d);
+        let (s, c) = forcing_sc(self.mu, &orbit, self.primaries);
+        let mut ya = [y[0]; 8];
+        ya.copy_from_slice(&y[..8]);
+        let mut da = [y[0]; 8];
+        rhs::<I, 8, SRP>(&PlanarAt { s, c, swt: at.0, cwt: at.1 }, &ya, &self.p, &mut da);
+        dy[..8].copy_from_slice(&da);
+        for i in 0..6 {
+            dy[8 + i] = F8::splat(isa, d[i]);
+        }
+    }
+}
+
+impl<I: Isa, const SRP: bool> SunLanes<I> for Along<I, SRP> {
+    const SRP: bool = SRP;
+
+    #[inline(always)]
+    fn alpha<Y: PlanarY<I>>(&self, t: f64, y: &Y) -> (F8<I>, F8<I>) {
+        let (swt, cwt) = <Self as Rhs<I, ALONG>>::at(self, t);
+        let (cp, sp) = y.cos_sin();
+        sun_alpha(swt, cwt, &self.p, cp, sp)
+    }
+
+    fn sun_omega(&self) -> f64 {
+        self.p.sun.omega
+    }
+}
+
+/// Where and why a lane group's run failed (None if it ended Ok), from [`Run`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Stopped {
+    pub status: LaneStatus,
+    /// The time reached.
+    pub t: f64,
+    /// Steps taken (accepted and rejected).
+    pub steps: u32,
+    /// The last step size tried.
+    pub h: f64,
+}
+
+/// Integrate planar attitude motions with the 2x2 STM, and the orbit from `orbit0` integrated
+/// alongside (no forcing table: [`Along`]), from t = 0 to `t_final`, in lock-step groups of
+/// [`LANES`] taken in order from the start of `cases`, at the SIMD `level`, RKF7(8) at
+/// `opts.rtol`, `opts.atol` (`opts.method` is not read). Each outcome comes with the group's
+/// [`Stopped`] when its run failed. `SRP` compiles the flat-plate term in.
+pub fn integrate_along<const SRP: bool>(level: Level, mu: f64, primaries: [bool; 2], orbit0: &[f64; 6], t_final: f64, cases: &[Case], opts: &LaneOptions) -> Result<Vec<(Outcome, Option<Stopped>)>> {
+    crate::simd::run_at(level, AlongGroups::<SRP> { mu, primaries, orbit0, t_final, cases, opts })
+}
+
+/// [`integrate_along`] as a dispatched kernel.
+struct AlongGroups<'a, const SRP: bool> {
+    mu: f64,
+    primaries: [bool; 2],
+    orbit0: &'a [f64; 6],
+    t_final: f64,
+    cases: &'a [Case],
+    opts: &'a LaneOptions,
+}
+
+impl<const SRP: bool> Kernel for AlongGroups<'_, SRP> {
+    type Output = Vec<(Outcome, Option<Stopped>)>;
+    #[inline(always)]
+    fn run<I: Isa>(self, isa: I) -> Self::Output {
+        let mut st = <Stages<I, ALONG> as Scheme<I, Along<I, SRP>>>::new(isa);
+        let mut out = Vec::with_capacity(self.cases.len());
+        for group in self.cases.chunks(LANES) {
+            let n = group.len();
+            let pick = |l: usize| group[l.min(n - 1)];
+            let mut y = <[F8<I>; ALONG] as PlanarY<I>>::start(isa, pick);
+            for i in 0..6 {
+                y[8 + i] = F8::splat(isa, self.orbit0[i]);
+            }
+            <Stages<I, ALONG> as Scheme<I, Along<I, SRP>>>::begin(&mut st);
+            let (p, plates) = Params::new(isa, pick, self.opts.sun_omega, Sensitivity::None);
+            let model = Along::<I, SRP> { mu: self.mu, primaries: self.primaries, p, recent: Recent::new((f64::NAN, f64::NAN)) };
+            let mut cut = Terminators::new(isa, n, &plates, self.opts, y);
+            let run = run_steps(isa, &mut st, &model, &mut y, self.t_final, self.opts, &mut cut);
+            let stopped = (run.status != LaneStatus::Ok).then_some(Stopped { status: run.status, t: run.t, steps: run.accepted + run.rejected, h: run.h });
+            out.extend(outcomes(&y, run)[..n].iter().map(|o| (*o, stopped)));
+        }
+        out
+    }
 }
 
 #[cfg(test)]

@@ -119,7 +119,7 @@ fn integrate_group<'a, I: Isa, S: Scheme<I, Rigid<'a, I>, Y = [F8<I>; D]>>(isa: 
     let model = Rigid { table, inertia, inv: [one / inertia[0], one / inertia[1], one / inertia[2]], one, recent: Recent::new([f64::NAN; 6]) };
     let mut y: [F8<I>; D] = std::array::from_fn(|i| F8::new(isa, std::array::from_fn(|l| if i < 4 { pick(l).q0[i] } else { pick(l).w0[i - 4] })));
     st.begin();
-    let Run { accepted, rejected, status } = run_steps(isa, st, &model, &mut y, t_final, opts, &mut NoCut);
+    let Run { accepted, rejected, status, .. } = run_steps(isa, st, &model, &mut y, t_final, opts, &mut NoCut);
     std::array::from_fn(|l| {
         if status != LaneStatus::Ok {
             return Outcome3d { q_t: [f64::NAN; 4], w_t: [f64::NAN; 3], residual: [f64::NAN; 6], accepted, rejected, status };
