@@ -44,7 +44,7 @@ use crate::cr3bp::check_mu;
 use crate::error::{check_finite, check_positive, invalid, Error, IntegrationError, Result};
 use crate::integrate::Options;
 use crate::integrate::forcing::OrbitForcing;
-use crate::integrate::lanes::{integrate_along, Case, LaneOptions, LaneStatus, Outcome, Sensitivity, Stopped, LANES};
+use crate::integrate::lanes::{integrate_along, Case, LaneOptions, LaneStatus, Outcome, Sensitivity, LANES};
 use crate::map;
 use crate::propagation::{with_threads, with_threads_rounds};
 
@@ -942,7 +942,7 @@ pub fn verify_planar_attitudes(
     let opts = LaneOptions { rtol: 1e-14, atol: 1e-14, sun_omega: omega, ..LaneOptions::default() };
     let srp = cases.iter().any(|c| c.eps != 0.0);
     let level = crate::simd::active()?;
-    let run = |part: &[Case]| -> Result<Vec<(Outcome, Option<Stopped>)>> {
+    let run = |part: &[Case]| -> Result<Vec<(Outcome, Option<IntegrationError>)>> {
         crate::interrupt::check()?;
         if srp {
             integrate_along::<true>(level, mu, primaries, orbit_state0, t_final, part, &opts)
@@ -950,7 +950,7 @@ pub fn verify_planar_attitudes(
             integrate_along::<false>(level, mu, primaries, orbit_state0, t_final, part, &opts)
         }
     };
-    let group = |part: &[Case]| -> Result<Vec<(Outcome, Option<Stopped>)>> {
+    let group = |part: &[Case]| -> Result<Vec<(Outcome, Option<IntegrationError>)>> {
         let out = run(part)?;
         if part.len() > 1 && out.iter().any(|o| o.1.is_some()) {
             // a lane that fails fails its group: each item alone
@@ -962,17 +962,9 @@ pub fn verify_planar_attitudes(
     Ok(parts
         .concat()
         .into_iter()
-        .map(|(o, stopped)| match stopped {
+        .map(|(o, error)| match error {
             None => PlanarEnd { phi_t: o.phi_t, wz_t: o.wz_t, stm: o.stm, error: None },
-            Some(st) => {
-                let steps = st.steps as usize;
-                let e = match st.status {
-                    LaneStatus::MaxSteps => IntegrationError::MaxStepsExceeded { t: st.t, steps, max_steps: opts.max_steps as usize },
-                    _ if !(st.h.is_finite() && st.h > 0.0) => IntegrationError::NonFinite { t: st.t, steps },
-                    _ => IntegrationError::StepSizeUnderflow { t: st.t, steps, h: st.h, h_min: 1e-14 * t_final.max(1.0) },
-                };
-                PlanarEnd { phi_t: f64::NAN, wz_t: f64::NAN, stm: [f64::NAN; 4], error: Some(e.into()) }
-            }
+            Some(e) => PlanarEnd { phi_t: f64::NAN, wz_t: f64::NAN, stm: [f64::NAN; 4], error: Some(e.into()) },
         })
         .collect())
 }

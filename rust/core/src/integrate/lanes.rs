@@ -49,7 +49,7 @@ use crate::integrate::tableau::dp87::{dp87_stages, A as DP_A, B8 as DP_B8, C as 
 use crate::integrate::tableau::{rkf78_stages, A, B8, C, ERR};
 use crate::integrate::Controller;
 use crate::scalar::F8;
-use crate::error::Result;
+use crate::error::{IntegrationError, Result};
 use crate::simd::{Isa, Kernel, Level};
 
 /// The scalar driver's step-size controller with its default settings.
@@ -943,7 +943,7 @@ pub(crate) fn run_steps<I: Isa, M, S: Scheme<I, M>>(isa: I, st: &mut S, m: &M, y
             rejected += 1;
             after_reject = true;
             h = heff * S::CONTROLLER.factor_rejected(emax);
-            if h <= 1e-14 * t_final.max(1.0) {
+            if h <= min_step(t_final) {
                 status = LaneStatus::Failed;
                 break;
             }
@@ -961,6 +961,26 @@ pub(crate) fn run_steps<I: Isa, M, S: Scheme<I, M>>(isa: I, st: &mut S, m: &M, y
         h = h.max(heff) * fac;
     }
     Run { accepted, rejected, status, t, h }
+}
+
+/// The step size below which [`run_steps`] gives up (status Failed): relative to the span.
+#[inline(always)]
+fn min_step(t_final: f64) -> f64 {
+    1e-14 * t_final.max(1.0)
+}
+
+impl Run {
+    /// The run's failure as the scalar driver reports it (None if it ended Ok): the step limit
+    /// `max_steps` exceeded, or the step size fallen below [`min_step`] (non-finite states are
+    /// rejected until it does).
+    fn error(&self, t_final: f64, max_steps: u32) -> Option<IntegrationError> {
+        let steps = (self.accepted + self.rejected) as usize;
+        match self.status {
+            LaneStatus::Ok => None,
+            LaneStatus::MaxSteps => Some(IntegrationError::MaxStepsExceeded { t: self.t, steps, max_steps: max_steps as usize }),
+            LaneStatus::Failed => Some(IntegrationError::StepSizeUnderflow { t: self.t, steps, h: self.h, h_min: min_step(t_final) }),
+        }
+    }
 }
 
 /// How far past a terminator crossing a cut step may end (TU). A step across a kink of the plate
@@ -1370,24 +1390,12 @@ impl<I: Isa, const SRP: bool> SunLanes<I> for Along<I, SRP> {
     }
 }
 
-/// Where and why a lane group's run failed (None if it ended Ok), from [`Run`].
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Stopped {
-    pub status: LaneStatus,
-    /// The time reached.
-    pub t: f64,
-    /// Steps taken (accepted and rejected).
-    pub steps: u32,
-    /// The last step size tried.
-    pub h: f64,
-}
-
 /// Integrate planar attitude motions with the 2x2 STM, and the orbit from `orbit0` integrated
 /// alongside (no forcing table: [`Along`]), from t = 0 to `t_final`, in lock-step groups of
 /// [`LANES`] taken in order from the start of `cases`, at the SIMD `level`, RKF7(8) at
-/// `opts.rtol`, `opts.atol` (`opts.method` is not read). Each outcome comes with the group's
-/// [`Stopped`] when its run failed. `SRP` compiles the flat-plate term in.
-pub fn integrate_along<const SRP: bool>(level: Level, mu: f64, primaries: [bool; 2], orbit0: &[f64; 6], t_final: f64, cases: &[Case], opts: &LaneOptions) -> Result<Vec<(Outcome, Option<Stopped>)>> {
+/// `opts.rtol`, `opts.atol` (`opts.method` is not read). Each outcome comes with its group's
+/// integration error when the group's run failed. `SRP` compiles the flat-plate term in.
+pub fn integrate_along<const SRP: bool>(level: Level, mu: f64, primaries: [bool; 2], orbit0: &[f64; 6], t_final: f64, cases: &[Case], opts: &LaneOptions) -> Result<Vec<(Outcome, Option<IntegrationError>)>> {
     crate::simd::run_at(level, AlongGroups::<SRP> { mu, primaries, orbit0, t_final, cases, opts })
 }
 
@@ -1402,7 +1410,7 @@ struct AlongGroups<'a, const SRP: bool> {
 }
 
 impl<const SRP: bool> Kernel for AlongGroups<'_, SRP> {
-    type Output = Vec<(Outcome, Option<Stopped>)>;
+    type Output = Vec<(Outcome, Option<IntegrationError>)>;
     #[inline(always)]
     fn run<I: Isa>(self, isa: I) -> Self::Output {
         let mut st = <Stages<I, ALONG> as Scheme<I, Along<I, SRP>>>::new(isa);
@@ -1419,8 +1427,8 @@ impl<const SRP: bool> Kernel for AlongGroups<'_, SRP> {
             let model = Along::<I, SRP> { mu: self.mu, primaries: self.primaries, p, recent: Recent::new((f64::NAN, f64::NAN)) };
             let mut cut = Terminators::new(isa, n, &plates, self.opts, y);
             let run = run_steps(isa, &mut st, &model, &mut y, self.t_final, self.opts, &mut cut);
-            let stopped = (run.status != LaneStatus::Ok).then_some(Stopped { status: run.status, t: run.t, steps: run.accepted + run.rejected, h: run.h });
-            out.extend(outcomes(&y, run)[..n].iter().map(|o| (*o, stopped)));
+            let error = run.error(self.t_final, self.opts.max_steps);
+            out.extend(outcomes(&y, run)[..n].iter().map(|o| (*o, error.clone())));
         }
         out
     }
