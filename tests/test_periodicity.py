@@ -257,3 +257,43 @@ def test_a_rate_grid_that_does_not_resolve_the_angle_is_named_not_refined(em):
     row = librate.periodicity_map([o], kz=0.8, wz0=fine, solve=False).phi_T.values[0]
     kept, _, unresolved = maps.row_candidates([0.8], 0.0, fine, row)
     assert unresolved == 0 and kept == candidates(row[0], 0.0, fine, math.pi)
+
+
+def test_a_resolved_maps_crossings_are_refined_in_their_windows(em):
+    """Issue 22 (c): the standard map (DRO x0 = 0.70, Kz = 0.8, 2000 rates) has 13 crossings of
+    phi(T) through multiples of pi and 6 solutions. Refined without windows, 7 crossings travel
+    0.13-1.06 in wz0 (50-425 rate intervals) to a solution another crossing found in place, or to
+    none, taking three times the rounds. The grid resolves phi(T) (at most RESOLVED pi per
+    interval), so each crossing gets the window of its interval +- QUICK_WINDOW intervals:
+    exactly the 6 that converge in place converge (one or two Newton steps), the 7 others stop at
+    their first step ("left_window"), and the map's solutions are the same 6 as without windows
+    (wz0 to 1e-11: only the batch companions' last bits differ). A coarse grid (60 rates) keeps
+    the windows where it resolves phi(T) and searches without them elsewhere."""
+    import librate.periodicity.maps as maps
+    from librate.periodicity import solutions
+
+    o = librate.dro(em, x0=0.70)
+    wz = np.linspace(-3.0, 2.0, 2000)
+    row = librate.periodicity_map(o, kz=0.8, wz0=wz, solve=False).phi_T.values[0]
+    cands, kk, unresolved, (lo, hi) = maps.crossing_windows([0.8], 0.0, wz, row)
+    assert (len(cands), unresolved) == (13, 0)
+    w0 = np.array([w for _, w in cands])
+    h = wz[1] - wz[0]
+    assert np.all(lo <= w0) and np.all(w0 <= hi) and np.all(hi - lo <= (2 * maps.QUICK_WINDOW + 1) * h * (1 + 1e-9))
+    ks = np.array([k for k, _ in cands])
+    kw = dict(kz=0.8, n_total=ks // 2, kind=np.where(ks % 2 == 0, "periodic", "half-turn"), phi0=0.0, wz0=w0, closure="half",
+              monodromy=False, max_iter=solutions.STEP_MAX_ITER, max_halvings=3)
+    free, boxed = solutions.correct(o, **kw), solutions.correct(o, search=(lo, hi), **kw)
+    moved = np.abs(free.wz0 - w0) / h
+    assert np.sum(moved < 1.0) == 6 and np.all(moved[moved >= 1.0] > 40)
+    assert list(boxed.converged) == list(moved < 1.0)
+    assert set(boxed.reason[i] for i in np.flatnonzero(moved >= 1.0)) == {"left_window"}
+    assert np.all(boxed.iterations[boxed.converged] <= 2)
+    sols = maps.solutions_from_rows(o, [0.8], 0.0, wz, row, 1)
+    ref = solutions.refine(o, np.full(13, 0.8), 0.0, cands, n_periods=1, srp=None, closure="half", window=(wz[0], wz[-1]))
+    assert len(sols) == len(ref) == 6
+    assert max(abs(a.wz0 - b.wz0) for a, b in zip(sols, ref)) < 1e-11
+    coarse = np.linspace(-4.0, 3.0, 60)
+    row = librate.periodicity_map(o, kz=-0.9, wz0=coarse, solve=False).phi_T.values[0]
+    _, _, _, (lo, hi) = maps.crossing_windows([-0.9], 0.0, coarse, row)
+    assert np.any(np.isfinite(lo)) and np.any(np.isinf(lo))

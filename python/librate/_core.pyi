@@ -583,7 +583,7 @@ class CorrectionBatch:
 
 def attitude_correct(
     forcing: OrbitForcing, cases: PlanarCases, *, t_final: float, closure: Closure, free: Free, options: CorrectorOptions,
-    bordered: Bordered | None = None,
+    bordered: Bordered | None = None, window_lo: _F64 | None = None, window_hi: _F64 | None = None,
 ) -> CorrectionBatch: ...
 
 @final

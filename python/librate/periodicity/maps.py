@@ -38,7 +38,8 @@ from .solutions import (
 )
 
 __all__ = ["periodicity_map", "zero_contours", "orbits_of", "map_grid", "map_coords", "map_dataset", "solutions_from_row",
-           "solutions_from_rows", "row_candidates", "map_solutions_dataset", "solution_variables", "REFINE_BATCH_PERIODS", "MAX_CROSSINGS"]
+           "solutions_from_rows", "row_candidates", "crossing_windows", "map_solutions_dataset", "solution_variables",
+           "REFINE_BATCH_PERIODS", "MAX_CROSSINGS", "QUICK_WINDOW", "RESOLVED"]
 
 
 def orbits_of(orbits) -> tuple[list[PeriodicOrbit], OrbitFamily | None]:
@@ -307,13 +308,41 @@ REFINE_BATCH_MIN = 16
 MAX_CROSSINGS = 8
 
 
+#: A map's crossing is refined within its rate interval widened by this many intervals on each
+#: side, where the map resolves phi(KT) there (:data:`RESOLVED`): a solution there converges in
+#: one or two Newton steps, and a candidate whose Newton step leaves that neighbourhood has none
+#: nearby. The standard map's 13 crossings: 6 converge in place; the other 7 travelled 0.13-1.06
+#: in wz0 (50-425 intervals) to a solution another crossing found in place, or to none, and
+#: took three times the corrector's rounds.
+QUICK_WINDOW = 4
+
+#: The most phi(KT) may change between neighbouring rates, in multiples of pi, for the map to
+#: resolve it: then every solution (phi(KT) = phi0 + k pi with wz(KT) = wz0) lies at a crossing
+#: of its own and the crossings are refined in their windows (:data:`QUICK_WINDOW`). Where the
+#: grid is coarser they are searched for without a window, as a solution the grid does not
+#: resolve may be found from a crossing far away (14 DROs x 3 Kz on 50-400 rates: the only
+#: two found more than 4 intervals from their crossing lay where phi(KT) changed by 0.65 and
+#: 1.1 pi per interval; the crossings that travelled that far to no new solution, by a median of
+#: 0.03-0.6 pi).
+RESOLVED = 0.25
+
+
 def row_candidates(kzs, phi0, wz, phi_t_rows) -> tuple[list, list[float], int]:
     """The candidates of one orbit's rows (one per Kz: where phi(KT) - phi0 crosses a multiple of
     pi), the Kz of each, and the number of rate intervals left out as unresolved (more than
     :data:`MAX_CROSSINGS` crossings)."""
+    cands, kk, unresolved, _ = crossing_windows(kzs, phi0, wz, phi_t_rows)
+    return cands, kk, unresolved
+
+
+def crossing_windows(kzs, phi0, wz, phi_t_rows) -> tuple[list, list[float], int, tuple[np.ndarray, np.ndarray]]:
+    """:func:`row_candidates` with each candidate's search window (lo, hi) of wz0: its rate
+    interval widened by :data:`QUICK_WINDOW` intervals on each side where phi(KT) changes by at
+    most :data:`RESOLVED` pi per interval there, else (-inf, inf)."""
     kzs = np.atleast_1d(np.asarray(kzs, dtype=float))
     rows = np.atleast_2d(phi_t_rows)
-    cands, kk, unresolved = [], [], 0
+    wz = np.asarray(wz, dtype=float)
+    cands, kk, unresolved, lo, hi = [], [], 0, [], []
     for j, k in enumerate(kzs):
         c = candidates(rows[j], phi0, wz, math.pi, max_crossings=MAX_CROSSINGS)
         cands += c
@@ -323,19 +352,29 @@ def row_candidates(kzs, phi0, wz, phi_t_rows) -> tuple[list, list[float], int]:
         with np.errstate(invalid="ignore"):
             crossed = np.floor(np.maximum(a, b)) - np.ceil(np.minimum(a, b)) + 1  # as candidates() counts them
         unresolved += int(np.sum(np.isfinite(crossed) & (crossed > MAX_CROSSINGS)))
-    return cands, kk, unresolved
+        if c:
+            at = np.clip(np.searchsorted(wz, [w for _, w in c], side="right") - 1, 0, wz.size - 2)
+            first, last = np.maximum(at - QUICK_WINDOW, 0), np.minimum(at + QUICK_WINDOW, wz.size - 2)
+            near = np.minimum(first[:, None] + np.arange(2 * QUICK_WINDOW + 1), last[:, None])  # each window's intervals
+            with np.errstate(invalid="ignore"):
+                ok = np.all(np.abs(b - a)[near] <= RESOLVED, axis=1)  # NaN (a failed trajectory): not resolved
+            lo.append(np.where(ok, wz[first], -np.inf))
+            hi.append(np.where(ok, wz[last + 1], np.inf))
+    window = (np.concatenate(lo), np.concatenate(hi)) if lo else (np.empty(0), np.empty(0))
+    return cands, kk, unresolved, window
 
 
 def solutions_from_rows(orbit, kzs, phi0, wz, phi_t_rows, n_periods, srp=None,
                         progress: Callable[[int, int], None] | None = None) -> list[AttitudeSolution]:
     """The solutions of one orbit's rows (one per Kz): the candidates where phi(KT) - phi0 crosses
     a multiple of pi (:func:`row_candidates`), refined in ONE call of the Rust corrector (the
-    half-period form where the orbit and phi0 are symmetric and there is no SRP, else the
-    full-period form with phi0 free) and verified in one more; kept inside the row's rate window.
+    half-period form where the orbit and phi0 are symmetric and there is no SRP, each crossing
+    within its window of :func:`crossing_windows`; else the full-period form with phi0 free)
+    and verified in one more; kept inside the row's rate window.
     A batch of more than :data:`REFINE_BATCH_PERIODS` candidate-periods is refined in several
     calls, in order (solutions found twice kept once). ``progress(done, total)``: after each
     call, in candidates."""
-    cands, kk, unresolved = row_candidates(kzs, phi0, wz, phi_t_rows)
+    cands, kk, unresolved, (lo, hi) = crossing_windows(kzs, phi0, wz, phi_t_rows)
     if unresolved:
         warnings.warn(f"the rate grid does not resolve phi(KT) on the orbit x0 = {orbit.x0:.6g} LU (K = {int(n_periods)} periods): "
                       f"{unresolved} interval(s) of `wz0` where it turns through more than {MAX_CROSSINGS} half-turns are left out "
@@ -346,7 +385,7 @@ def solutions_from_rows(orbit, kzs, phi0, wz, phi_t_rows, n_periods, srp=None,
     for a in range(0, len(cands), size):
         sols += refine(orbit, np.array(kk[a:a + size]), phi0, cands[a:a + size], n_periods=n_periods, srp=srp,
                        closure="half" if symmetric else "full",
-                       window=(float(wz[0]), float(wz[-1])), quick=symmetric)
+                       window=(float(wz[0]), float(wz[-1])), search=(lo[a:a + size], hi[a:a + size]) if symmetric else None)
         if progress is not None:
             progress(min(a + size, len(cands)), len(cands))
     if len(cands) > size:  # candidates of two batches that converged onto one solution: kept once

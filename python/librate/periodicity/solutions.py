@@ -297,12 +297,14 @@ def turns_of(n_total, kind) -> np.ndarray:
 
 def correct(orbit: PeriodicOrbit, *, kz, n_total, kind, phi0, wz0, n_periods: int = 1, srp=None, closure: str = "half",
             free: str = "phi0", theta_sun0=None, eps=None, tol: float = 1e-12, max_iter: int = 40, bordered=None, monodromy: bool = True,
-            max_halvings: int = 10):
+            max_halvings: int = 10, search=None):
     """One call of the Rust corrector for a batch of candidates on ``orbit`` (arrays broadcast
     together: kz, n_total, kind, phi0, wz0, and theta_sun0 / eps overriding the plate's):
     ``closure`` "half" (symmetric, over K T / 2) or "full" (over K T); ``free`` "phi0" or
     "sun_phase"; ``bordered``: (parameter "kz" or "eps", condition (a_angle, a_wz0, a_parameter,
-    b), or one such row per candidate) for the continuation driver. Returns the core's CorrectionBatch."""
+    b), or one such row per candidate) for the continuation driver; ``search``: (lo, hi) of
+    wz0 per candidate, where a Newton step leaving it stops the candidate ("left_window").
+    Returns the core's CorrectionBatch."""
     cols = np.broadcast_arrays(np.asarray(kz, dtype=float), np.asarray(n_total, dtype=float), np.asarray(kind),
                                np.asarray(phi0, dtype=float),
                                np.asarray(wz0, dtype=float), np.asarray(0.0 if eps is None else eps, dtype=float),
@@ -324,9 +326,11 @@ def correct(orbit: PeriodicOrbit, *, kz, n_total, kind, phi0, wz0, n_periods: in
     options = _core.CorrectorOptions(_core.NewtonOptions(tol=float(tol), max_iter=int(max_iter), max_halvings=int(max_halvings)),
                                      _core.LaneOptions(rtol=SOLVE_RTOL, atol=SOLVE_ATOL), monodromy=bool(monodromy))
     cases = _core.PlanarCases(p, w, k, turns=turns_of(nt, kd), plates=plates)
+    lo, hi = (None, None) if search is None else (np.ascontiguousarray(np.broadcast_to(np.asarray(v, dtype=float), k.shape))
+                                                   for v in search)
     return _core.attitude_correct(orbit_forcing(orbit), cases, t_final=0.5 * T if closure == "half" else T,
                                   closure=_choice(_CLOSURES, closure, "closure"), free=_choice(_FREE, free, "free"), options=options,
-                                  bordered=border)
+                                  bordered=border, window_lo=lo, window_hi=hi)
 
 
 def verified(orbit: PeriodicOrbit, *, kz, n_total, kind, phi0, wz0, n_periods: int = 1, plates=None, iterations=None,
@@ -389,22 +393,23 @@ def candidates(phi_t, phi0, wz, level, max_crossings: int | None = None):
     return out
 
 
-def refine(orbit, kz, phi0, cands, *, n_periods, srp, closure, window, kinds=KINDS, quick=False) -> list[AttitudeSolution]:
+def refine(orbit, kz, phi0, cands, *, n_periods, srp, closure, window, kinds=KINDS, search=None) -> list[AttitudeSolution]:
     """Refine (k, wz0) candidates (k = 2 turns over the K periods, odd k a half turn) in ONE
     corrector call and verify the converged ones in one more: :func:`refine_groups` with every
     candidate in one group."""
     return [s for _, s in refine_groups(orbit, kz, phi0, cands, n_periods=n_periods, srp=srp, closure=closure, window=window, kinds=kinds,
-                                        quick=quick)]
+                                        search=search)]
 
 
-def refine_groups(orbit, kz, phi0, cands, *, n_periods, srp, closure, window, kinds=KINDS, quick=False,
+def refine_groups(orbit, kz, phi0, cands, *, n_periods, srp, closure, window, kinds=KINDS, search=None,
                   group=None) -> list[tuple[int, AttitudeSolution]]:
     """Refine (k, wz0) candidates (k = 2 turns over the K periods, odd k a half turn) in ONE
     corrector call and verify the converged ones in one more; keep those inside ``window``
     with an independent residual below 1e-8, one per (turns, kind, wz0 to 1e-8), sorted by wz0.
-    ``kz`` and ``phi0`` may be one value or one per candidate. ``quick``: the candidates are
-    close guesses of the half-period closure (a fine map's crossings), and one that needs more
-    than a few Newton steps has no solution nearby: the corrector gives up early. ``group``:
+    ``kz`` and ``phi0`` may be one value or one per candidate. ``search``: (lo, hi), a window
+    of wz0 per candidate: the candidates are a map's crossings, close guesses of the
+    half-period closure, each refined within its window (a Newton step leaving it stops it)
+    and given up after a few Newton steps (see ``periodicity.maps.crossing_windows``). ``group``:
     one integer label per candidate (default: all 0); duplicates are merged within a group only.
     Returns (group, solution) pairs, group by group (in order of first appearance), each group
     sorted by wz0."""
@@ -419,9 +424,10 @@ def refine_groups(orbit, kz, phi0, cands, *, n_periods, srp, closure, window, ki
     kind = np.where(ks % 2 == 0, "periodic", "half-turn")
     kzs = np.broadcast_to(np.asarray(kz, dtype=float), (n,))[keep]
     grp, p0 = grp[keep], p0[keep]
+    quick = {} if search is None else {"max_iter": STEP_MAX_ITER, "max_halvings": 3,
+                                       "search": tuple(np.asarray(v, dtype=float)[keep] for v in search)}
     b = correct(orbit, kz=kzs, n_total=n_total, kind=kind, phi0=p0, wz0=np.array([cands[i][1] for i in keep]), n_periods=n_periods, srp=srp,
-                closure=closure, monodromy=False,  # the verification brings the monodromy
-                **({"max_iter": STEP_MAX_ITER, "max_halvings": 3} if quick else {}))
+                closure=closure, monodromy=False, **quick)  # the verification brings the monodromy
     lo, hi = window
     order = {g: j for j, g in enumerate(dict.fromkeys(grp.tolist()))}
     # the same comparisons on plain Python values (numpy scalars cost ~1 us each)

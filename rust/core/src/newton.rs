@@ -43,10 +43,14 @@ pub enum StopReason {
     /// The integration failed (lane status not Ok, or non-finite results) at the starting
     /// point, or at every trial point of the last line search.
     IntegrationFailed,
+    /// The Newton step left the candidate's search window: no solution nearby (the attitude
+    /// driver, for candidates given a window, e.g. a map's crossings refined in place).
+    LeftWindow,
 }
 
 impl StopReason {
-    /// "converged", "max_iterations", "singular_jacobian", "no_descent", "integration_failed".
+    /// "converged", "max_iterations", "singular_jacobian", "no_descent", "integration_failed",
+    /// "left_window".
     pub fn as_str(&self) -> &'static str {
         match self {
             Self::Converged => "converged",
@@ -54,6 +58,7 @@ impl StopReason {
             Self::SingularJacobian => "singular_jacobian",
             Self::NoDescent => "no_descent",
             Self::IntegrationFailed => "integration_failed",
+            Self::LeftWindow => "left_window",
         }
     }
 }

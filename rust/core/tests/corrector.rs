@@ -362,6 +362,9 @@ fn val_corrector_rejects_invalid_arguments() {
     assert_eq!(name(correct_planar_attitudes(&f, t, Closure::Full, Free::Phi0, &[c], &CorrectorOptions { tol: 0.0, ..o })), "tol");
     assert_eq!(name(correct_planar_attitudes(&f, t, Closure::Full, Free::Phi0, &[c], &CorrectorOptions { max_iter: 0, ..o })), "max_iter");
     assert_eq!(name(correct_planar_attitudes(&f, f64::NAN, Closure::Full, Free::Phi0, &[c], &o)), "t_final");
+    for (lo, hi) in [(-1.3, -1.2), (-1.5, -1.45), (f64::NAN, -1.0), (-1.5, f64::NAN), (f64::INFINITY, f64::INFINITY)] {
+        assert_eq!(name(correct_planar_attitudes(&f, t, Closure::Full, Free::Phi0, &[c.with_window(lo, hi)], &o)), "window", "({lo}, {hi})");
+    }
     // an orbit that is not x-symmetric on its start: the half closure is refused
     let (s1, t1) = dro(0.8);
     let mut shifted = [0.0; 6];
@@ -384,6 +387,42 @@ fn val_corrector_rejects_invalid_arguments() {
     let plate = |omega: f64| Some(FlatPlate::new(0.1, 0.4, 0.1, Sun { omega, ..Sun::default() }).unwrap());
     let two_suns = [PlanarStart { plate: plate(-0.9), ..item }, PlanarStart { plate: plate(-0.5), ..item }];
     assert_eq!(vname(verify_planar_attitudes(MU, &s0, t, &two_suns, [true, true], None)), "plate");
+}
+
+/// A candidate's search window (a map's crossing refined in place). On the 12.66-day DRO at
+/// Kz = 0.8 (the N = -1 solution of Fig. 23, wz0 = -1.4545): (1) a start 1e-4 from the
+/// solution, in a window of +-0.01, converges exactly as without the window (bit for bit: the
+/// window never binds); (2) the torque-free start 0.3 away, which converges without a window
+/// (val_thesis_fig23_solution), stops at its first Newton step in a window of +-0.01
+/// (LeftWindow, no step accepted, the start's residual kept); (3) in a batch the stopped
+/// candidate takes no further rounds and the near one still converges to 1e-12 of its
+/// solution alone.
+#[test]
+fn val_search_window_stops_a_far_newton_step() {
+    let (s0, t) = dro1266();
+    let f = table(&s0, t);
+    let o = CorrectorOptions::default();
+    let solve = |cs: &[Candidate]| correct_planar_attitudes(&f, 0.5 * t, Closure::Half, Free::Phi0, cs, &o).unwrap();
+    let exact = solve(&[Candidate::new(0.0, -1.4545, 0.8, -1.0)])[0];
+    assert_eq!(exact.reason, StopReason::Converged);
+    let near = Candidate::new(0.0, exact.wz0 + 1e-4, 0.8, -1.0);
+    let w = |c: Candidate| c.with_window(c.case.wz0 - 0.01, c.case.wz0 + 0.01);
+    let (plain, windowed) = (solve(&[near])[0], solve(&[w(near)])[0]);
+    assert_eq!(windowed.reason, StopReason::Converged);
+    assert_eq!(bits(&plain), bits(&windowed));
+    let far = Candidate::new(0.0, 1.0 - 2.0 * PI / t, 0.8, -1.0);
+    assert_eq!(solve(&[far])[0].reason, StopReason::Converged);
+    let stopped = solve(&[w(far)])[0];
+    assert_eq!(stopped.reason, StopReason::LeftWindow, "{stopped:?}");
+    assert_eq!((stopped.iterations, stopped.wz0), (0, far.case.wz0));
+    assert!(stopped.residual_norm.is_finite() && stopped.residual_norm > 1e-3, "{stopped:?}");
+    let both = solve(&[w(far), w(near)]);
+    assert_eq!(both[0].reason, StopReason::LeftWindow);
+    assert_eq!(both[1].reason, StopReason::Converged);
+    assert!((both[1].wz0 - plain.wz0).abs() < 1e-12, "{} vs {}", both[1].wz0, plain.wz0);
+    // an unbounded window is no window
+    let open = solve(&[far.with_window(f64::NEG_INFINITY, f64::INFINITY)])[0];
+    assert_eq!(bits(&open), bits(&solve(&[far])[0]));
 }
 
 /// The bordered correction (continuation's corrector). References: (1) with the parameter fixed

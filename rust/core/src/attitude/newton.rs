@@ -61,6 +61,12 @@ pub(crate) trait Problem<const N: usize>: Sync {
     fn closure_rows(&self) -> &[usize] {
         self.rows()
     }
+    /// Whether x lies in the candidate's search window (default: everywhere). A Newton step
+    /// whose target leaves it stops the candidate ([`StopReason::LeftWindow`]): the accepted
+    /// points then stay inside (the window is convex: an interval per unknown).
+    fn admits(&self, _c: &Self::Cand, _x: &[f64; N]) -> bool {
+        true
+    }
 }
 
 /// The largest |d F / d x| of the closure rows at a point (at least 1): the factor by which
@@ -183,13 +189,13 @@ impl<const N: usize> Track<N> {
         }
     }
 
-    fn advance<P: Problem<N>>(&mut self, p: &P, pt: Option<Point<N>>, s: &Settings) {
+    fn advance<P: Problem<N>>(&mut self, p: &P, c: &P::Cand, pt: Option<Point<N>>, s: &Settings) {
         match self.phase {
             Phase::Start => match pt {
                 None => self.phase = Phase::Done(StopReason::IntegrationFailed),
                 Some(pt) => {
                     self.cur = Some(pt);
-                    self.next_step(p, s);
+                    self.next_step(p, c, s);
                 }
             },
             Phase::Trial { lambda, halvings, any_integrated } => {
@@ -200,7 +206,7 @@ impl<const N: usize> Track<N> {
                     Some(pt) => {
                         self.cur = Some(pt);
                         self.iterations += 1;
-                        self.next_step(p, s);
+                        self.next_step(p, c, s);
                     }
                     None if halvings >= s.max_halvings => {
                         self.phase = Phase::Done(if integrated && floor {
@@ -221,7 +227,7 @@ impl<const N: usize> Track<N> {
     }
 
     /// After accepting a point: stop, or set up the line search along the Newton direction.
-    fn next_step<P: Problem<N>>(&mut self, p: &P, s: &Settings) {
+    fn next_step<P: Problem<N>>(&mut self, p: &P, c: &P::Cand, s: &Settings) {
         let Some(cur) = self.cur.as_ref() else { return };
         if cur.norm <= s.tol {
             self.phase = Phase::Done(StopReason::Converged);
@@ -235,7 +241,12 @@ impl<const N: usize> Track<N> {
             None => self.phase = Phase::Done(StopReason::SingularJacobian),
             Some((d, deficient)) => {
                 let scale = p.step_scale(&d).min(1.0);
-                self.dir = d.map(|v| v * scale);
+                let dir = d.map(|v| v * scale);
+                if !p.admits(c, &std::array::from_fn(|i| cur.x[i] + dir[i])) {
+                    self.phase = Phase::Done(StopReason::LeftWindow);
+                    return;
+                }
+                self.dir = dir;
                 self.scale = scale;
                 self.rank_deficient = deficient;
                 self.phase = Phase::Trial { lambda: 1.0, halvings: 0, any_integrated: false };
@@ -310,14 +321,14 @@ pub(crate) fn solve<const N: usize, P: Problem<N>>(
             at.and_then(|k| out.get(k..k + per)).and_then(|o| problem.evaluate(&candidates[i], x, o)).and_then(|e| point(problem, *x, e))
         };
         for (a, &(i, x, at)) in active.iter().enumerate() {
-            tracks[i].advance(problem, eval(i, &x, at), settings);
+            tracks[i].advance(problem, &candidates[i], eval(i, &x, at), settings);
             // a rejected trial goes on with the look-ahead points already integrated, in order,
             // while they are the points the search asks for next
             for (_, y, at) in ahead.iter().filter(|h| h.0 == a) {
                 if tracks[i].pending().map(|p| p.map(f64::to_bits)) != Some(y.map(f64::to_bits)) {
                     break; // accepted, or stopped
                 }
-                tracks[i].advance(problem, eval(i, y, *at), settings);
+                tracks[i].advance(problem, &candidates[i], eval(i, y, *at), settings);
             }
         }
     }

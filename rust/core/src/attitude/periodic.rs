@@ -84,12 +84,23 @@ pub struct Candidate {
     /// This candidate's linear condition (a, b) of a bordered correction, replacing the
     /// [`Bordered`]'s own: candidates of different branches corrected in one batch.
     pub condition: Option<([f64; 3], f64)>,
+    /// The search window (lo, hi) of wz0 (None: unbounded; infinite bounds allowed): a Newton step whose target leaves
+    /// it stops the candidate ([`StopReason::LeftWindow`]). A map's crossing is refined in its
+    /// neighbourhood: a solution there converges in a few steps, and a candidate whose Newton
+    /// step leaves the neighbourhood has none nearby (it would find, far away, a solution that
+    /// has a crossing of its own, or none).
+    pub window: Option<(f64, f64)>,
 }
 
 impl Candidate {
     /// A gravity-gradient-only candidate.
     pub fn new(phi0: f64, wz0: f64, kz: f64, turns: f64) -> Self {
-        Self { case: Case::new(phi0, wz0, kz), turns, x0: f64::NAN, condition: None }
+        Self { case: Case::new(phi0, wz0, kz), turns, x0: f64::NAN, condition: None, window: None }
+    }
+
+    /// The same candidate searched for only in lo <= wz0 <= hi ([`Candidate::window`]).
+    pub fn with_window(self, lo: f64, hi: f64) -> Self {
+        Self { window: Some((lo, hi)), ..self }
     }
 
     /// The same candidate started on the orbit of the family member at `x0`
@@ -437,6 +448,9 @@ impl Problem<3> for Form {
     fn cols(&self) -> &[usize] {
         Form::cols(self)
     }
+    fn admits(&self, c: &Candidate, x: &[f64; 3]) -> bool {
+        c.window.is_none_or(|(lo, hi)| (lo..=hi).contains(&x[WZ]))
+    }
     fn step_scale(&self, d: &[f64; 3]) -> f64 {
         let cap = |v: f64, m: f64| if v.abs() > m { m / v.abs() } else { 1.0 };
         let mut scale = cap(d[WZ], self.max_wz_step).min(cap(d[ANGLE], self.max_angle_step));
@@ -561,6 +575,11 @@ fn validate_candidates(closure: Closure, free: Free, candidates: &[Candidate]) -
         }
         if !c.turns.is_finite() {
             return Err(invalid("turns", format!("candidate {i}: must be finite, got {}", c.turns)));
+        }
+        if let Some((lo, hi)) = c.window {
+            if !(lo <= k.wz0 && k.wz0 <= hi) {
+                return Err(invalid("window", format!("candidate {i}: need lo <= wz0 <= hi (infinite bounds allowed), got ({lo}, {hi}) with wz0 = {}", k.wz0)));
+            }
         }
         if !(k.eps.is_finite() && k.theta_sun0.is_finite()) {
             return Err(invalid("eps", format!("candidate {i}: eps and theta_sun0 must be finite, got ({}, {})", k.eps, k.theta_sun0)));
