@@ -279,7 +279,9 @@ class Plates:
 
 @final
 class PlanarCases:
-    def __new__(cls, phi0: _F64, wz0: _F64, kz: _F64, *, turns: _F64 | None = None, plates: Plates | None = None) -> PlanarCases: ...
+    def __new__(
+        cls, phi0: _F64, wz0: _F64, kz: _F64, *, turns: _F64 | None = None, plates: Plates | None = None, window: _F64 | None = None
+    ) -> PlanarCases: ...
     def __len__(self) -> int: ...
 
 @final
@@ -583,7 +585,7 @@ class CorrectionBatch:
 
 def attitude_correct(
     forcing: OrbitForcing, cases: PlanarCases, *, t_final: float, closure: Closure, free: Free, options: CorrectorOptions,
-    bordered: Bordered | None = None, window_lo: _F64 | None = None, window_hi: _F64 | None = None,
+    bordered: Bordered | None = None,
 ) -> CorrectionBatch: ...
 
 @final

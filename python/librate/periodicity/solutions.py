@@ -325,12 +325,11 @@ def correct(orbit: PeriodicOrbit, *, kz, n_total, kind, phi0, wz0, n_periods: in
             border = _core.Bordered(parameter, tuple(float(v) for v in cond))
     options = _core.CorrectorOptions(_core.NewtonOptions(tol=float(tol), max_iter=int(max_iter), max_halvings=int(max_halvings)),
                                      _core.LaneOptions(rtol=SOLVE_RTOL, atol=SOLVE_ATOL), monodromy=bool(monodromy))
-    cases = _core.PlanarCases(p, w, k, turns=turns_of(nt, kd), plates=plates)
-    lo, hi = (None, None) if search is None else (np.ascontiguousarray(np.broadcast_to(np.asarray(v, dtype=float), k.shape))
-                                                   for v in search)
+    window = None if search is None else np.column_stack([np.broadcast_to(np.asarray(v, dtype=float), k.shape) for v in search])
+    cases = _core.PlanarCases(p, w, k, turns=turns_of(nt, kd), plates=plates, window=window)
     return _core.attitude_correct(orbit_forcing(orbit), cases, t_final=0.5 * T if closure == "half" else T,
                                   closure=_choice(_CLOSURES, closure, "closure"), free=_choice(_FREE, free, "free"), options=options,
-                                  bordered=border, window_lo=lo, window_hi=hi)
+                                  bordered=border)
 
 
 def verified(orbit: PeriodicOrbit, *, kz, n_total, kind, phi0, wz0, n_periods: int = 1, plates=None, iterations=None,
@@ -355,15 +354,13 @@ def verified(orbit: PeriodicOrbit, *, kz, n_total, kind, phi0, wz0, n_periods: i
     T = n_periods * orbit.period
     cases = _core.PlanarCases(np.ascontiguousarray(phi0), np.ascontiguousarray(wz0), np.ascontiguousarray(kz), plates=per_plate)
     v = _core.planar_verify(orbit.system.mu, [float(x) for x in orbit.state0], T, cases, threads=threads)
-    turns = turns_of(n_total, kind)
-    its = np.zeros(m, dtype=int) if iterations is None else np.asarray(iterations)
-    out = []
-    for i in range(m):
-        dphi = float(v.phi_t[i] - phi0[i] - 2 * math.pi * turns[i])
-        dwz = float(v.wz_t[i] - wz0[i])
-        out.append(AttitudeSolution(orbit, float(kz[i]), int(n_total[i]), str(kind[i]), float(phi0[i]), float(wz0[i]), dphi, dwz,
-                                    np.array(v.stm[i]), int(its[i]), plates[i], int(n_periods)))
-    return out
+    # one AttitudeSolution per motion, from plain Python values (numpy scalars cost ~1 us each)
+    turns = turns_of(n_total, kind).tolist()
+    its = [0] * m if iterations is None else np.asarray(iterations).astype(int).tolist()
+    k_, nt_, kd_, p_, w_ = kz.tolist(), n_total.astype(int).tolist(), [str(x) for x in kind.tolist()], phi0.tolist(), wz0.tolist()
+    phi_t, wz_t, stm = np.asarray(v.phi_t).tolist(), np.asarray(v.wz_t).tolist(), np.array(v.stm)
+    return [AttitudeSolution(orbit, k_[i], nt_[i], kd_[i], p_[i], w_[i], phi_t[i] - p_[i] - 2 * math.pi * turns[i], wz_t[i] - w_[i], stm[i],
+                             its[i], plates[i], int(n_periods)) for i in range(m)]
 
 
 def _grid_for(T: float, lo: float, hi: float, n_grid: int | None) -> np.ndarray:

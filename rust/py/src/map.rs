@@ -178,8 +178,8 @@ impl PyCorrectionBatch {
 }
 
 /// The corrector's candidates of planar cases (their turns and plates), with the bordered
-/// conditions per candidate and the wz0 search windows (lo, hi) when given.
-fn candidates(c: &PlanarCases, bordered: Option<&Bordered>, windows: Option<(&[f64], &[f64])>) -> PyResult<Vec<Candidate>> {
+/// conditions per candidate and the cases' wz0 search windows when given.
+fn candidates(c: &PlanarCases, bordered: Option<&Bordered>) -> PyResult<Vec<Candidate>> {
     let n = c.wz0.len();
     let mut cands: Vec<Candidate> = (0..n).map(|i| Candidate::new(c.phi0[i], c.wz0[i], c.kz[i], c.turns[i]).with_plate(c.eps[i], c.cs[i], c.cd[i], c.theta_sun0[i])).collect();
     if let Some(rows) = bordered.and_then(|b| b.conditions.as_ref()) {
@@ -190,12 +190,9 @@ fn candidates(c: &PlanarCases, bordered: Option<&Bordered>, windows: Option<(&[f
             *cand = cand.with_condition([r[0], r[1], r[2]], r[3]);
         }
     }
-    if let Some((lo, hi)) = windows {
-        if lo.len() != n || hi.len() != n {
-            return Err(invalid(format!("invalid argument `window_lo`, `window_hi`: one value each per candidate ({n}), got {} and {}", lo.len(), hi.len())));
-        }
-        for (i, cand) in cands.iter_mut().enumerate() {
-            *cand = cand.with_window(lo[i], hi[i]);
+    if let Some(w) = &c.window {
+        for (cand, [lo, hi]) in cands.iter_mut().zip(w) {
+            *cand = cand.with_window(*lo, *hi);
         }
     }
     Ok(cands)
@@ -203,11 +200,9 @@ fn candidates(c: &PlanarCases, bordered: Option<&Bordered>, windows: Option<(&[f
 
 /// Correct many candidates at once to periodic planar attitude motions along the forcing's orbit
 /// (one Rust call for all Newton iterations; see librate_core::attitude::correct_planar_attitudes);
-/// `bordered`: the parameter freed with its condition(s); `window_lo`, `window_hi`: each
-/// candidate's search window in wz0 (both or neither; a Newton step leaving it stops the
-/// candidate, reason "left_window").
+/// `bordered`: the parameter freed with its condition(s).
 #[pyfunction]
-#[pyo3(signature = (forcing, cases, *, t_final, closure, free, options, bordered=None, window_lo=None, window_hi=None))]
+#[pyo3(signature = (forcing, cases, *, t_final, closure, free, options, bordered=None))]
 fn attitude_correct<'py>(
     py: Python<'py>,
     forcing: PyRef<'py, PyOrbitForcing>,
@@ -217,18 +212,11 @@ fn attitude_correct<'py>(
     free: Free,
     options: PyRef<'py, CorrectorOptions>,
     bordered: Option<PyRef<'py, Bordered>>,
-    window_lo: Option<PyReadonlyArray1<'py, f64>>,
-    window_hi: Option<PyReadonlyArray1<'py, f64>>,
 ) -> PyResult<PyCorrectionBatch> {
     if bordered.as_ref().is_some_and(|b| b.inner.parameter == Parameter::OrbitX0) {
         return Err(invalid("invalid argument `bordered`: the orbit's x0 is freed by attitude_correct_across"));
     }
-    let windows = match (&window_lo, &window_hi) {
-        (None, None) => None,
-        (Some(lo), Some(hi)) => Some((lo.as_slice()?, hi.as_slice()?)),
-        _ => return Err(invalid("invalid argument `window_lo`, `window_hi`: give both or neither")),
-    };
-    let cands = candidates(&cases, bordered.as_deref(), windows)?;
+    let cands = candidates(&cases, bordered.as_deref())?;
     let (closure, free, opts) = (closure.into(), free.into(), options.core());
     let border = bordered.as_ref().map(|b| b.inner);
     let f = &forcing.inner;

@@ -319,8 +319,9 @@ impl Plates {
     }
 }
 
-/// Planar attitude cases (arrays of one length): phi0, wz0, kz, the closure's turns (correctors)
-/// and their plates (zeros when None).
+/// Planar attitude cases (arrays of one length): phi0, wz0, kz, the closure's turns (correctors),
+/// their plates (zeros when None) and the correctors' search windows (lo, hi) of wz0, shape (n, 2)
+/// (none when None; a Newton step leaving its window stops the candidate, "left_window").
 #[pyclass(frozen, name = "PlanarCases", module = "librate._core")]
 pub struct PlanarCases {
     pub(crate) phi0: Vec<f64>,
@@ -331,13 +332,21 @@ pub struct PlanarCases {
     pub(crate) cs: Vec<f64>,
     pub(crate) cd: Vec<f64>,
     pub(crate) theta_sun0: Vec<f64>,
+    pub(crate) window: Option<Vec<[f64; 2]>>,
 }
 
 #[pymethods]
 impl PlanarCases {
     #[new]
-    #[pyo3(signature = (phi0, wz0, kz, *, turns=None, plates=None))]
-    fn new(phi0: PyReadonlyArray1<'_, f64>, wz0: PyReadonlyArray1<'_, f64>, kz: PyReadonlyArray1<'_, f64>, turns: Option<PyReadonlyArray1<'_, f64>>, plates: Option<PyRef<'_, Plates>>) -> PyResult<Self> {
+    #[pyo3(signature = (phi0, wz0, kz, *, turns=None, plates=None, window=None))]
+    fn new(
+        phi0: PyReadonlyArray1<'_, f64>,
+        wz0: PyReadonlyArray1<'_, f64>,
+        kz: PyReadonlyArray1<'_, f64>,
+        turns: Option<PyReadonlyArray1<'_, f64>>,
+        plates: Option<PyRef<'_, Plates>>,
+        window: Option<PyReadonlyArray2<'_, f64>>,
+    ) -> PyResult<Self> {
         let wz0 = vector(&wz0, "wz0", None)?;
         let n = wz0.len();
         let (phi0, kz) = (vector(&phi0, "phi0", Some(n))?, vector(&kz, "kz", Some(n))?);
@@ -347,7 +356,8 @@ impl PlanarCases {
             Some(p) => return Err(invalid(format!("invalid argument `plates`: must have the length of wz0 ({n}), got {}", p.eps.len()))),
             None => (vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]),
         };
-        Ok(Self { phi0, wz0, kz, turns, eps, cs, cd, theta_sun0 })
+        let window = window.map(|w| rows::<2>(&w, "window", Some(n))).transpose()?;
+        Ok(Self { phi0, wz0, kz, turns, eps, cs, cd, theta_sun0, window })
     }
     fn __len__(&self) -> usize {
         self.wz0.len()
