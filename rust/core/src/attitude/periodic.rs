@@ -84,11 +84,11 @@ pub struct Candidate {
     /// This candidate's linear condition (a, b) of a bordered correction, replacing the
     /// [`Bordered`]'s own: candidates of different branches corrected in one batch.
     pub condition: Option<([f64; 3], f64)>,
-    /// The search window (lo, hi) of wz0 (None: unbounded; infinite bounds allowed): a Newton step whose target leaves
-    /// it stops the candidate ([`StopReason::LeftWindow`]). A map's crossing is refined in its
-    /// neighbourhood: a solution there converges in a few steps, and a candidate whose Newton
-    /// step leaves the neighbourhood has none nearby (it would find, far away, a solution that
-    /// has a crossing of its own, or none).
+    /// The search window (lo, hi) of wz0 (None: unbounded; infinite bounds allowed): a Newton
+    /// step whose target leaves it stops the candidate ([`StopReason::LeftWindow`]). A map's
+    /// crossing is refined in its neighbourhood: a solution there converges in a few steps, and
+    /// a candidate whose Newton step leaves the neighbourhood has none nearby (it would find,
+    /// far away, a solution that has a crossing of its own, or none).
     pub window: Option<(f64, f64)>,
 }
 
