@@ -108,6 +108,7 @@ def test_info_prints_the_levels():
     out = CliRunner().invoke(main, ["info"], catch_exceptions=False).output
     b = librate.build_info()
     assert f"SIMD level {b['simd_active']}" in out and ", ".join(b["simd_available"]) in out
+    assert f"threads: {b['threads']} workers" in out and f"LIBRATE_BIND_THREADS={b['threads_binding']}" in out
 
 
 def test_scalar_integrator_at_every_level(dro_085, level):

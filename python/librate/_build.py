@@ -26,9 +26,16 @@ def build_info() -> dict[str, Any]:
     - ``simd_active``: the level the kernels run at;
     - ``version``: the package version; ``profile``: the cargo profile the extension was built
       with (``"dev"``, ``"release"`` or ``"dist"``, the published wheels'); ``debug_assertions``:
-      whether Rust's debug assertions are on (dev builds); ``target_arch``: the CPU architecture.
+      whether Rust's debug assertions are on (dev builds); ``target_arch``: the CPU architecture;
+    - ``threads``: the workers of the pool every parallel call runs on (``RAYON_NUM_THREADS``, else
+      one per CPU); ``threads_binding``: ``LIBRATE_BIND_THREADS`` (``"auto"``, the default,
+      ``"on"`` or ``"off"``); ``threads_cpus``: the CPU each worker is bound to (empty: left to
+      the kernel; ``auto`` binds only a pool with one worker per allowed CPU, on Linux);
+      ``threads_bound``: how many workers the kernel accepted on their CPU.
 
-    Raises ValueError naming ``LIBRATE_SIMD`` when it asks for an unknown or unavailable level.
+    Raises ValueError naming ``LIBRATE_SIMD`` when it asks for an unknown or unavailable level
+    (``LIBRATE_BIND_THREADS`` is read when the extension is imported: an invalid value fails the
+    import with a ValueError naming it).
     """
     return dict(_core.build_info())
 

@@ -86,6 +86,9 @@ def info() -> None:
     b = build_info()
     click.echo(f"  build: {b['profile']} ({b['target_arch']}); SIMD level {b['simd_active']} "
                f"(this CPU supports: {', '.join(b['simd_available'])}; LIBRATE_SIMD forces one)")
+    cpus = b["threads_cpus"]
+    bound = f"bound to CPUs {', '.join(map(str, cpus))}" if cpus else "not bound to CPUs"
+    click.echo(f"  threads: {b['threads']} workers, {bound} (LIBRATE_BIND_THREADS={b['threads_binding']})")
     for name in System.presets():
         s = System.preset(name)
         l1 = s.lagrange_points()[0, 0]

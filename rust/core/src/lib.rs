@@ -12,6 +12,7 @@
 //! - [`fourier`]: periodic orbits as truncated Fourier series, with analytic derivatives.
 //! - [`simd`]: runtime CPU dispatch of the hot kernels (baseline, AVX2, AVX-512, NEON).
 //! - [`interrupt`]: the Ctrl-C request the long loops poll.
+//! - [`threads`]: the global worker pool, its workers bound to CPUs.
 
 pub mod attitude;
 pub mod constants;
@@ -28,5 +29,6 @@ pub mod orbit;
 pub mod propagation;
 pub mod scalar;
 pub mod simd;
+pub mod threads;
 
 pub use error::{Error, IntegrationError, Result};

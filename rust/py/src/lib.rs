@@ -306,6 +306,8 @@ fn multiple_shooting<'py>(
 
 #[pymodule]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    // the global worker pool, bound to CPUs per LIBRATE_BIND_THREADS (an invalid value fails the import, naming it)
+    librate_core::threads::start_global_pool().map_err(to_py)?;
     errors::register(m)?;
     options::register(m)?;
     m.add_function(wrap_pyfunction!(propagate, m)?)?;

@@ -1,0 +1,211 @@
+//! The global worker pool and where its threads run.
+//!
+//! Every parallel loop of the core (map sweeps, batch propagation, the correctors' rounds) runs
+//! on rayon's global pool. [`start_global_pool`] builds it (the Python binding does so when it is
+//! imported) with one worker per CPU the process may use and, on Linux, each worker bound to its
+//! own CPU when the pool covers all of them. Unbound, a short call (a 2-ms map on two cores) can
+//! run at one core's speed: the kernel wakes an idle worker on the CPU of the thread that woke
+//! it, and the pair shares that CPU until the load balancer moves one, a few milliseconds later
+//! (measured on a 2-core Intel Xeon VM: the standard map in 1.9-3.4 ms unbound against 1.8-2.0
+//! ms bound, its one-thread time 3.1 ms; docs/benchmarks.md).
+//!
+//! `LIBRATE_BIND_THREADS` chooses: `auto` (the default) binds worker i to the i-th allowed CPU
+//! when the pool has as many workers as the process has allowed CPUs (at least two), so that a
+//! pool narrowed by `RAYON_NUM_THREADS`, or a process given fewer CPUs, is left to the kernel;
+//! `on` binds worker i to allowed CPU i mod n in any case; `off` never binds. Binding is
+//! Linux-only (elsewhere the pool is always unbound), and a worker whose binding the kernel
+//! refuses (a CPU set changed since) runs unbound: [`PoolInfo::bound`] counts the bound ones.
+
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::OnceLock;
+
+use crate::error::{invalid, Result};
+
+/// The environment variable that chooses the binding.
+pub const BIND_VAR: &str = "LIBRATE_BIND_THREADS";
+
+/// Whether the pool's workers are bound to CPUs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Binding {
+    /// Bound when the pool covers every allowed CPU (at least two).
+    Auto,
+    /// Worker i on allowed CPU i mod n.
+    On,
+    /// Left to the kernel.
+    Off,
+}
+
+impl Binding {
+    pub fn name(self) -> &'static str {
+        match self {
+            Binding::Auto => "auto",
+            Binding::On => "on",
+            Binding::Off => "off",
+        }
+    }
+}
+
+/// A `LIBRATE_BIND_THREADS` value (None or empty: auto).
+pub fn parse_binding(value: Option<&str>) -> Result<Binding> {
+    match value.map(|v| v.trim().to_ascii_lowercase()).as_deref() {
+        None | Some("") | Some("auto") => Ok(Binding::Auto),
+        Some("on") | Some("1") | Some("true") => Ok(Binding::On),
+        Some("off") | Some("0") | Some("false") => Ok(Binding::Off),
+        Some(other) => Err(invalid(BIND_VAR, format!("must be auto, on or off, got {other:?}"))),
+    }
+}
+
+/// The CPUs a binding gives the pool's workers, worker i on `cpus[i]` (empty: unbound).
+/// `allowed` are the process's allowed CPUs, in ascending order.
+pub fn plan(binding: Binding, workers: usize, allowed: &[usize]) -> Vec<usize> {
+    let n = allowed.len();
+    let bind = match binding {
+        Binding::Off => false,
+        Binding::On => n > 0,
+        Binding::Auto => n >= 2 && workers == n,
+    };
+    if bind {
+        (0..workers).map(|i| allowed[i % n]).collect()
+    } else {
+        Vec::new()
+    }
+}
+
+/// The global pool as [`start_global_pool`] left it.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct PoolInfo {
+    /// Its workers.
+    pub threads: usize,
+    /// The binding asked for.
+    pub binding: Binding,
+    /// The CPU of each worker, when bound (empty: unbound).
+    pub cpus: Vec<usize>,
+    /// False when the pool was already running (built by someone else: left as it is).
+    pub started_here: bool,
+}
+
+impl PoolInfo {
+    /// How many workers the kernel accepted on their CPU (their binding is set as they start).
+    pub fn bound(&self) -> usize {
+        BOUND.load(Ordering::Relaxed)
+    }
+}
+
+static BOUND: AtomicUsize = AtomicUsize::new(0);
+static STARTED: OnceLock<PoolInfo> = OnceLock::new();
+
+/// Build rayon's global pool with `LIBRATE_BIND_THREADS`'s binding (module docs), once per
+/// process; later calls return the first one's outcome. An invalid value is an error naming
+/// the variable, and leaves the pool unstarted. If the pool already runs (another library in
+/// the process started it), it is left as it is (`started_here` false, unbound).
+pub fn start_global_pool() -> Result<PoolInfo> {
+    if let Some(info) = STARTED.get() {
+        return Ok(info.clone());
+    }
+    let binding = parse_binding(std::env::var(BIND_VAR).ok().as_deref())?;
+    let allowed = allowed_cpus();
+    // rayon's own default size: RAYON_NUM_THREADS, else the available parallelism
+    let workers = match std::env::var("RAYON_NUM_THREADS").ok().and_then(|v| v.parse::<usize>().ok()) {
+        Some(n) if n > 0 => n,
+        _ => std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1),
+    };
+    let cpus = plan(binding, workers, &allowed);
+    let to_bind = cpus.clone();
+    let built = rayon::ThreadPoolBuilder::new()
+        .num_threads(workers)
+        .start_handler(move |i| {
+            if let Some(&cpu) = to_bind.get(i) {
+                if bind_current_thread(cpu) {
+                    BOUND.fetch_add(1, Ordering::Relaxed);
+                }
+            }
+        })
+        .build_global();
+    let info = match built {
+        Ok(()) => PoolInfo { threads: workers, binding, cpus, started_here: true },
+        Err(_) => PoolInfo { threads: rayon::current_num_threads(), binding, cpus: Vec::new(), started_here: false },
+    };
+    Ok(STARTED.get_or_init(|| info).clone())
+}
+
+/// The CPUs this process may run on, ascending (empty where unknown: not Linux).
+pub fn allowed_cpus() -> Vec<usize> {
+    #[cfg(target_os = "linux")]
+    {
+        // SAFETY: cpu_set_t is plain data; sched_getaffinity fills at most its size.
+        unsafe {
+            let mut set: libc::cpu_set_t = std::mem::zeroed();
+            if libc::sched_getaffinity(0, std::mem::size_of::<libc::cpu_set_t>(), &mut set) != 0 {
+                return Vec::new();
+            }
+            (0..libc::CPU_SETSIZE as usize).filter(|&c| libc::CPU_ISSET(c, &set)).collect()
+        }
+    }
+    #[cfg(not(target_os = "linux"))]
+    {
+        Vec::new()
+    }
+}
+
+/// Bind the calling thread to `cpu`; whether the kernel accepted it.
+fn bind_current_thread(cpu: usize) -> bool {
+    #[cfg(target_os = "linux")]
+    {
+        if cpu >= libc::CPU_SETSIZE as usize {
+            return false;
+        }
+        // SAFETY: as in allowed_cpus; pid 0 is the calling thread.
+        unsafe {
+            let mut set: libc::cpu_set_t = std::mem::zeroed();
+            libc::CPU_SET(cpu, &mut set);
+            libc::sched_setaffinity(0, std::mem::size_of::<libc::cpu_set_t>(), &set) == 0
+        }
+    }
+    #[cfg(not(target_os = "linux"))]
+    {
+        let _ = cpu;
+        false
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn binding_values_parse_and_bad_ones_name_the_variable() {
+        assert_eq!(parse_binding(None).unwrap(), Binding::Auto);
+        assert_eq!(parse_binding(Some(" AUTO ")).unwrap(), Binding::Auto);
+        assert_eq!(parse_binding(Some("on")).unwrap(), Binding::On);
+        assert_eq!(parse_binding(Some("0")).unwrap(), Binding::Off);
+        let e = parse_binding(Some("cores")).unwrap_err().to_string();
+        assert!(e.contains(BIND_VAR) && e.contains("auto, on or off") && e.contains("cores"), "{e}");
+    }
+
+    #[test]
+    fn auto_binds_only_a_pool_that_covers_every_allowed_cpu() {
+        // a full pool: worker i on the i-th allowed CPU (which need not be CPU i)
+        assert_eq!(plan(Binding::Auto, 2, &[2, 5]), vec![2, 5]);
+        // narrowed pools, and a single CPU, are left to the kernel
+        assert!(plan(Binding::Auto, 1, &[0, 1]).is_empty());
+        assert!(plan(Binding::Auto, 3, &[0, 1]).is_empty());
+        assert!(plan(Binding::Auto, 1, &[3]).is_empty());
+        // on: round robin in any case; off: never; unknown CPUs: never
+        assert_eq!(plan(Binding::On, 3, &[0, 1]), vec![0, 1, 0]);
+        assert!(plan(Binding::Off, 2, &[0, 1]).is_empty());
+        assert!(plan(Binding::On, 2, &[]).is_empty());
+    }
+
+    #[test]
+    fn the_global_pool_starts_once_and_binds_what_it_planned() {
+        let a = start_global_pool().unwrap();
+        let b = start_global_pool().unwrap();
+        assert_eq!(a, b);
+        // the workers bind as they start: wait for every worker to have run a job
+        rayon::broadcast(|_| ());
+        if a.started_here {
+            assert_eq!(a.threads, rayon::current_num_threads());
+            assert_eq!(a.bound(), a.cpus.len(), "planned {:?}", a.cpus);
+        }
+    }
+}
