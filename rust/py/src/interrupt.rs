@@ -1,10 +1,9 @@
-//! Ctrl-C during long core calls: the call runs with the GIL released on a scoped worker thread
+//! Ctrl-C during long core calls: the call runs with the GIL released on a worker of the pool
 //! while the calling thread runs Python's signal handlers every 50 ms. When one raises (SIGINT:
 //! KeyboardInterrupt), the core's interrupt flag stops the call's loops at their next poll
 //! (a map chunk, a Newton iteration, a batch member) and that exception is returned; work the
 //! Python caller finished in earlier calls is kept by its own chunking.
 
-use std::sync::mpsc;
 use std::time::Duration;
 
 use librate_core::interrupt;
@@ -19,30 +18,18 @@ const POLL: Duration = Duration::from_millis(50);
 pub(crate) fn interruptible<T: Send>(py: Python<'_>, f: impl FnOnce() -> librate_core::Result<T> + Send) -> PyResult<T> {
     interrupt::clear();
     let (out, signal) = py.detach(|| {
-        std::thread::scope(|s| {
-            let (tx, rx) = mpsc::channel();
-            let worker = s.spawn(move || {
-                let r = f();
-                let _ = tx.send(());
-                r
-            });
-            let mut signal: Option<PyErr> = None;
-            while let Err(mpsc::RecvTimeoutError::Timeout) = rx.recv_timeout(POLL) {
-                if signal.is_none() {
-                    if let Err(e) = Python::attach(|py| py.check_signals()) {
-                        interrupt::request();
-                        signal = Some(e);
-                    }
+        let mut signal: Option<PyErr> = None;
+        let out = librate_core::threads::run_polled(f, POLL, || {
+            if signal.is_none() {
+                if let Err(e) = Python::attach(|py| py.check_signals()) {
+                    interrupt::request();
+                    signal = Some(e);
                 }
             }
-            (worker.join(), signal)
-        })
+        });
+        (out, signal)
     });
     interrupt::clear();
-    let out = match out {
-        Ok(r) => r,
-        Err(panic) => std::panic::resume_unwind(panic),
-    };
     match signal {
         // the handler's exception wins over the call's outcome (finished or stopped)
         Some(e) => Err(e),
