@@ -5,19 +5,22 @@
 //! N = 6, [`crate::attitude::tidal_tensor`]).
 //!
 //! The orbit is integrated once at tight tolerance and sampled at the Chebyshev nodes of every
-//! segment (each sample an RK step from the enclosing accepted step); the coefficients are the
+//! segment (each sample an RK step from the enclosing accepted step, the samples taken on all
+//! cores; one integration serves every number of segments tried); the coefficients are the
 //! exact interpolants at those nodes. The number of segments doubles until every component at
 //! the segment quarter points, also sampled from the orbit, matches the series to `tol` relative
 //! to the largest component magnitude, or until doubling no longer halves the error (the
 //! samples' own integration noise, ~1e-13 on orbits grazing a primary) while it is below 1e-10.
 
 use crate::attitude::{forcing_sc, tidal_tensor, Forcing};
-use crate::cr3bp::check_mu;
+use crate::cr3bp::{check_mu, Cr3bp};
 use crate::error::{check_finite, check_positive, invalid, Error, Result};
+use crate::integrate::stepper::Rkf78;
 use crate::integrate::{Options, Output};
 use crate::propagation::{propagate_checked, Collision};
 use crate::scalar::F8;
 use crate::simd::Isa;
+use rayon::prelude::*;
 
 /// Chebyshev degree per segment.
 pub const DEGREE: usize = 12;
@@ -43,6 +46,63 @@ pub type OrbitForcing = OrbitTable<2>;
 /// The synodic-frame tidal tensor (xx, yy, zz, xy, xz, yz) of [`crate::attitude::tidal_tensor`]
 /// over one orbit period (periodic in t): all the 3-D gravity-gradient torque needs of the orbit.
 pub type TidalTable = OrbitTable<6>;
+
+/// The orbit's accepted steps at the table's tolerance, and its states at any times of the period:
+/// each a fresh RK step from the enclosing accepted step (the step's end when it falls there),
+/// exactly as [`Output::At`] samples an integration, so a table's bits do not depend on which
+/// other times were sampled. The samples are independent steps, taken on all cores.
+struct Sampled {
+    mu: f64,
+    t: Vec<f64>,
+    states: Vec<f64>,
+    opts: Options,
+    level: crate::simd::Level,
+}
+
+/// Samples per parallel task (about 0.2 us each).
+const SAMPLES_PER_TASK: usize = 64;
+
+impl Sampled {
+    fn new(mu: f64, state0: &[f64; 6], period: f64, opts: &Options) -> Result<Self> {
+        // an orbit through a primary (within the point-mass sphere) is a typed collision,
+        // never a table of infinite values
+        let tr = propagate_checked(mu, state0, 0.0, period, opts, false, Output::Steps, &[], &Collision::new([0.0, 0.0])?)?;
+        if let Some(hit) = tr.collision {
+            return Err(hit.error(tr.stats.accepted));
+        }
+        Ok(Self { mu, t: tr.t, states: tr.states, opts: *opts, level: crate::simd::active()? })
+    }
+
+    fn state(&self, i: usize) -> [f64; 6] {
+        std::array::from_fn(|k| self.states[6 * i + k])
+    }
+
+    /// The states at `times` (in [0, period]).
+    fn sample(&self, times: &[f64]) -> Vec<[f64; 6]> {
+        let sys = Cr3bp { mu: self.mu };
+        let parts: Vec<Vec<[f64; 6]>> = times
+            .par_chunks(SAMPLES_PER_TASK)
+            .map(|part| {
+                let mut stepper = Rkf78::new(&[0.0; 6], self.level);
+                let mut out = [0.0; 6];
+                part.iter()
+                    .map(|&te| {
+                        // the step (t_i, t_{i+1}] that holds te
+                        let j = self.t.partition_point(|&x| x < te).min(self.t.len() - 1);
+                        if self.t[j] == te || j == 0 {
+                            return self.state(j);
+                        }
+                        let (ti, yi) = (self.t[j - 1], self.state(j - 1));
+                        stepper.prime(&sys, ti, &yi);
+                        stepper.step(&sys, ti, &yi, te - ti, &mut out, self.opts.rtol, self.opts.atol);
+                        out
+                    })
+                    .collect()
+            })
+            .collect();
+        parts.concat()
+    }
+}
 
 fn cheb_nodes() -> [f64; NC] {
     std::array::from_fn(|j| (std::f64::consts::PI * (j as f64 + 0.5) / NC as f64).cos())
@@ -99,9 +159,10 @@ impl<const N: usize> OrbitTable<N> {
         let nodes = cheb_nodes();
         // the discrete Chebyshev transform's weights cos(pi k (j + 1/2) / NC), once
         let weights: [[f64; NC]; NC] = std::array::from_fn(|k| std::array::from_fn(|j| (std::f64::consts::PI * k as f64 * (j as f64 + 0.5) / NC as f64).cos()));
-        let mut segments = 16;
-        let mut previous = f64::INFINITY;
-        loop {
+        // one integration serves every try: its accepted steps are the same whatever is sampled
+        let orbit = Sampled::new(mu, state0, period, &opts)?;
+        // one try: the table with `segments` segments and its error at the check points
+        let attempt = |segments: usize| -> Self {
             let seg_len = period / segments as f64;
             // sample times: nodes of every segment, then the check points (1/4, 1/2, 3/4)
             let mut times = Vec::with_capacity(segments * (NC + 3));
@@ -121,20 +182,8 @@ impl<const N: usize> OrbitTable<N> {
             let (mut fit_t, mut check_t): (Vec<f64>, Vec<f64>) = (times[..n_fit].to_vec(), times[n_fit..].to_vec());
             fit_t.sort_by(f64::total_cmp);
             check_t.sort_by(f64::total_cmp);
-            // one integration samples both sets (merged in time order, then split)
-            let mut all: Vec<(f64, bool)> = fit_t.iter().map(|&t| (t, true)).chain(check_t.iter().map(|&t| (t, false))).collect();
-            all.sort_by(|a, b| a.0.total_cmp(&b.0));
-            let ts: Vec<f64> = all.iter().map(|a| a.0).collect();
-            // an orbit through a primary (within the point-mass sphere) is a typed collision,
-            // never a table of infinite values
-            let tr = propagate_checked(mu, state0, 0.0, period, &opts, false, Output::At(&ts), &[], &Collision::new([0.0, 0.0])?)?;
-            if let Some(hit) = tr.collision {
-                return Err(hit.error(tr.stats.accepted));
-            }
-            let (mut fit, mut check) = (Vec::with_capacity(fit_t.len()), Vec::with_capacity(check_t.len()));
-            for (s, a) in tr.states.chunks_exact(6).zip(&all) {
-                if a.1 { fit.push(g(s)) } else { check.push(g(s)) }
-            }
+            let fit: Vec<[f64; N]> = orbit.sample(&fit_t).iter().map(|s| g(s)).collect();
+            let check: Vec<[f64; N]> = orbit.sample(&check_t).iter().map(|s| g(s)).collect();
             let mut coef = vec![0.0; segments * NC * N];
             for s in 0..segments {
                 // fit_t is sorted: segment s holds samples s*NC .. (s+1)*NC in increasing time,
@@ -165,6 +214,13 @@ impl<const N: usize> OrbitTable<N> {
                 }
             }
             table.max_error = err / scale;
+            table
+        };
+        // the tries double the segments from 16 until one passes
+        let mut segments = 16;
+        let mut previous = f64::INFINITY;
+        loop {
+            let table = attempt(segments);
             let at_noise_floor = table.max_error < 1e-10 && table.max_error > 0.5 * previous;
             if table.max_error <= tol || at_noise_floor {
                 return Ok(table);
@@ -294,5 +350,32 @@ fn clenshaw<T: Copy + std::ops::Sub<Output = T>, const N: usize>(x: T, x2: T, ze
 impl Forcing for OrbitTable<2> {
     fn sc(&self, t: f64) -> (f64, f64) {
         OrbitTable::<2>::sc(self, t)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The sampler against one integration with `Output::At` (what the fit sampled before it
+    /// integrated once for all its tries): the same states bit for bit, at node-like times, at
+    /// t0, and at accepted steps' ends. Reference: the driver's own output; tolerance: exact.
+    #[test]
+    fn samples_equal_the_drivers_output_at_those_times() {
+        let mu = 0.012150585609624;
+        // a DRO of the Earth-Moon system (x0 = 0.70), one period
+        let s0 = [0.70, 0.0, 0.0, 0.0, 0.7886786873660538, 0.0];
+        let period = 4.8;
+        let opts = Options::with_tolerances(1e-14, 1e-14);
+        let orbit = Sampled::new(mu, &s0, period, &opts).unwrap();
+        let mut ts: Vec<f64> = (0..997).map(|i| period * (i as f64 / 997.0).powf(1.3)).collect();
+        ts.extend_from_slice(&orbit.t[1..orbit.t.len() - 1][..5]);
+        ts.sort_by(f64::total_cmp);
+        let want = propagate_checked(mu, &s0, 0.0, period, &opts, false, Output::At(&ts), &[], &Collision::new([0.0, 0.0]).unwrap()).unwrap();
+        let got = orbit.sample(&ts);
+        assert_eq!(got.len(), ts.len());
+        for (i, (g, w)) in got.iter().zip(want.states.chunks_exact(6)).enumerate() {
+            assert_eq!(g.as_slice(), w, "sample {i} at t = {}", ts[i]);
+        }
     }
 }
