@@ -13,7 +13,6 @@ use pyo3::prelude::*;
 use crate::convert::rows;
 use crate::options::LaneOptions;
 use crate::interrupt::interruptible;
-use crate::to_py;
 
 /// The synodic-frame tidal tensor of one periodic orbit (planar or spatial), tabulated once
 /// (piecewise Chebyshev) and shared by every 3-D attitude trajectory on it.
