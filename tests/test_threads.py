@@ -47,14 +47,20 @@ def ok(**env):
 ALLOWED = sorted(os.sched_getaffinity(0))
 
 
-@pytest.mark.skipif(len(ALLOWED) < 2, reason="binding needs at least two allowed CPUs")
 def test_auto_binds_one_worker_per_allowed_cpu():
+    if len(ALLOWED) >= 2:
+        # a pool of one worker per allowed CPU: worker i on the i-th allowed CPU
+        b = ok(RAYON_NUM_THREADS=str(len(ALLOWED)))
+        assert b["threads_binding"] == "auto"
+        assert b["threads_cpus"] == ALLOWED and b["threads_bound"] == len(ALLOWED)
+        # the kernel has exactly these threads on one CPU each
+        assert sorted(int(x) for x in b["lists"] if x.isdigit()) == ALLOWED
+    # the default pool (one worker per CPU the process may use) follows the same rule
     b = ok()
-    assert b["threads_binding"] == "auto" and b["threads"] == len(ALLOWED)
-    assert b["threads_cpus"] == ALLOWED and b["threads_bound"] == len(ALLOWED)
-    # the kernel has exactly these threads on one CPU each
-    singles = sorted(int(x) for x in b["lists"] if x.isdigit())
-    assert singles == ALLOWED
+    if b["threads"] == len(ALLOWED) >= 2:
+        assert b["threads_cpus"] == ALLOWED and b["threads_bound"] == len(ALLOWED)
+    else:  # sized otherwise (a CPU quota below the affinity mask, or one CPU): left to the kernel
+        assert b["threads_cpus"] == [] and b["threads_bound"] == 0
 
 
 def test_auto_leaves_a_narrowed_pool_to_the_kernel():
