@@ -18,8 +18,15 @@ pytestmark = pytest.mark.skipif(not sys.platform.startswith("linux"), reason="CP
 
 PROBE = r"""
 import json, os
+import numpy  # its own threads first
+n_before = len(os.listdir("/proc/self/task"))
 import librate
+from librate.periodicity import orbit_forcing
+imported = len(os.listdir("/proc/self/task")) - n_before, librate.build_info()["threads_started"]
+# the first parallel work starts the pool
+orbit_forcing(librate.dro(librate.System.preset("earth-moon"), x0=0.7))
 b = librate.build_info()
+assert b["threads_started"]
 # every thread's allowed CPUs, as the kernel reports them (the pool's workers included)
 lists = []
 for tid in os.listdir("/proc/self/task"):
@@ -27,7 +34,8 @@ for tid in os.listdir("/proc/self/task"):
         for line in f:
             if line.startswith("Cpus_allowed_list:"):
                 lists.append(line.split(":", 1)[1].strip())
-print(json.dumps({k: b[k] for k in ("threads", "threads_binding", "threads_cpus", "threads_bound")} | {"lists": lists}))
+keys = ("threads", "threads_binding", "threads_cpus", "threads_bound")
+print(json.dumps({k: b[k] for k in keys} | {"lists": lists, "imported": imported}))
 """
 
 
@@ -75,6 +83,24 @@ def test_off_never_binds_and_on_binds_round_robin():
     b = ok(LIBRATE_BIND_THREADS="on", RAYON_NUM_THREADS="3")
     want = [ALLOWED[i % len(ALLOWED)] for i in range(3)]
     assert b["threads_binding"] == "on" and b["threads_cpus"] == want and b["threads_bound"] == 3
+
+
+def test_the_pool_starts_with_the_first_parallel_work_so_a_fork_after_import_works():
+    # importing starts no thread (a pool started at import would be missing in a forked child,
+    # whose first parallel call would then wait forever)
+    assert ok()["imported"] == [0, False]
+    code = """
+import os, librate
+from librate.periodicity import orbit_forcing
+pid = os.fork()
+if pid == 0:
+    orbit_forcing(librate.dro(librate.System.preset("earth-moon"), x0=0.7))
+    os._exit(0)
+_, st = os.waitpid(pid, 0)
+print(os.WEXITSTATUS(st))
+"""
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert r.returncode == 0 and r.stdout.strip() == "0", r.stderr
 
 
 def test_an_invalid_binding_fails_the_import_naming_the_variable():

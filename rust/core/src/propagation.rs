@@ -248,7 +248,10 @@ pub struct FinalState {
 /// Run `f` on a rayon pool of `threads` workers (`None`: the global pool, all cores).
 pub fn with_threads<R: Send>(threads: Option<usize>, f: impl FnOnce() -> R + Send) -> Result<R> {
     match threads {
-        None => Ok(f()),
+        None => {
+            crate::threads::start_global_pool()?;
+            Ok(f())
+        }
         Some(0) => Err(invalid("threads", "must be >= 1 (or None for all cores)")),
         Some(n) => {
             let pool = rayon::ThreadPoolBuilder::new()
@@ -271,7 +274,10 @@ pub fn with_threads<R: Send>(threads: Option<usize>, f: impl FnOnce() -> R + Sen
 pub fn with_threads_rounds<R: Send>(threads: Option<usize>, f: impl FnOnce() -> R + Send) -> Result<R> {
     match threads {
         // on a worker already, rayon::scope runs f in place
-        None => Ok(rayon::scope(|_| f())),
+        None => {
+            crate::threads::start_global_pool()?;
+            Ok(rayon::scope(|_| f()))
+        }
         _ => with_threads(threads, f),
     }
 }

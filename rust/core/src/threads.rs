@@ -1,8 +1,8 @@
 //! The global worker pool and where its threads run.
 //!
 //! Every parallel loop of the core (map sweeps, batch propagation, the correctors' rounds) runs
-//! on rayon's global pool. [`start_global_pool`] builds it (the Python binding does so when it is
-//! imported) with one worker per CPU the process may use and, on Linux, each worker bound to its
+//! on rayon's global pool. [`start_global_pool`] builds it (with the first parallel work: never
+//! at import, so that a process forked after importing librate starts its own) with one worker per CPU the process may use and, on Linux, each worker bound to its
 //! own CPU when the pool covers all of them. Unbound, a short call (a 2-ms map on two cores) can
 //! run at one core's speed: the kernel wakes an idle worker on the CPU of the thread that woke
 //! it, and the pair shares that CPU until the load balancer moves one, a few milliseconds later
@@ -80,6 +80,8 @@ pub struct PoolInfo {
     pub binding: Binding,
     /// The CPU of each worker, when bound (empty: unbound).
     pub cpus: Vec<usize>,
+    /// Whether the pool runs (else this is its plan: [`pool_info`] before the first parallel work).
+    pub started: bool,
     /// False when the pool was already running (built by someone else: left as it is).
     pub started_here: bool,
 }
@@ -94,25 +96,42 @@ impl PoolInfo {
 static BOUND: AtomicUsize = AtomicUsize::new(0);
 static STARTED: OnceLock<PoolInfo> = OnceLock::new();
 
-/// Build rayon's global pool with `LIBRATE_BIND_THREADS`'s binding (module docs), once per
-/// process; later calls return the first one's outcome. An invalid value is an error naming
-/// the variable, and leaves the pool unstarted. If the pool already runs (another library in
-/// the process started it), it is left as it is (`started_here` false, unbound).
-pub fn start_global_pool() -> Result<PoolInfo> {
+/// The binding `LIBRATE_BIND_THREADS` asks for (an error naming it when invalid).
+pub fn binding_from_env() -> Result<Binding> {
+    parse_binding(std::env::var(BIND_VAR).ok().as_deref())
+}
+
+/// The pool [`start_global_pool`] builds (or built): before it starts, its plan
+/// (`started` false, no worker bound yet).
+pub fn pool_info() -> Result<PoolInfo> {
     if let Some(info) = STARTED.get() {
         return Ok(info.clone());
     }
-    let binding = parse_binding(std::env::var(BIND_VAR).ok().as_deref())?;
-    let allowed = allowed_cpus();
+    let binding = binding_from_env()?;
     // rayon's own default size: RAYON_NUM_THREADS, else the available parallelism
     let workers = match std::env::var("RAYON_NUM_THREADS").ok().and_then(|v| v.parse::<usize>().ok()) {
         Some(n) if n > 0 => n,
         _ => std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1),
     };
-    let cpus = plan(binding, workers, &allowed);
-    let to_bind = cpus.clone();
+    let cpus = plan(binding, workers, &allowed_cpus());
+    Ok(PoolInfo { threads: workers, binding, cpus, started: false, started_here: false })
+}
+
+/// Build rayon's global pool with `LIBRATE_BIND_THREADS`'s binding (module docs), once per
+/// process; later calls return the first one's outcome. The core's parallel entry points call
+/// it ([`crate::propagation::with_threads`], [`run_polled`]), so the pool starts with the first
+/// parallel work, not before: a process forked before that starts its own pool. An invalid value
+/// is an error naming the variable, and leaves the pool unstarted. If the pool already runs
+/// (another library in the process started it), it is left as it is (`started_here` false,
+/// unbound).
+pub fn start_global_pool() -> Result<PoolInfo> {
+    if let Some(info) = STARTED.get() {
+        return Ok(info.clone());
+    }
+    let planned = pool_info()?;
+    let to_bind = planned.cpus.clone();
     let built = rayon::ThreadPoolBuilder::new()
-        .num_threads(workers)
+        .num_threads(planned.threads)
         .start_handler(move |i| {
             if let Some(&cpu) = to_bind.get(i) {
                 if bind_current_thread(cpu) {
@@ -122,8 +141,8 @@ pub fn start_global_pool() -> Result<PoolInfo> {
         })
         .build_global();
     let info = match built {
-        Ok(()) => PoolInfo { threads: workers, binding, cpus, started_here: true },
-        Err(_) => PoolInfo { threads: rayon::current_num_threads(), binding, cpus: Vec::new(), started_here: false },
+        Ok(()) => PoolInfo { started: true, started_here: true, ..planned },
+        Err(_) => PoolInfo { threads: rayon::current_num_threads(), cpus: Vec::new(), started: true, started_here: false, ..planned },
     };
     Ok(STARTED.get_or_init(|| info).clone())
 }
@@ -133,8 +152,9 @@ pub fn start_global_pool() -> Result<PoolInfo> {
 /// `f`'s parallel loops split from inside the pool: no thread is started per call, and no job is
 /// injected and waited for per parallel round (a thread started per call cost 30-70 us). A panic
 /// in `f` resumes on the calling thread.
-pub fn run_polled<T: Send>(f: impl FnOnce() -> T + Send, every: std::time::Duration, mut poll: impl FnMut()) -> T {
+pub fn run_polled<T: Send>(f: impl FnOnce() -> T + Send, every: std::time::Duration, mut poll: impl FnMut()) -> Result<T> {
     use std::sync::mpsc::{channel, RecvTimeoutError};
+    start_global_pool()?;
     let (tx, rx) = channel();
     let out = rayon::in_place_scope(|s| {
         s.spawn(move |_| {
@@ -149,7 +169,7 @@ pub fn run_polled<T: Send>(f: impl FnOnce() -> T + Send, every: std::time::Durat
             }
         }
     });
-    out.expect("a job that neither returned nor panicked")
+    Ok(out.expect("a job that neither returned nor panicked"))
 }
 
 /// The CPUs this process may run on, ascending (empty where unknown: not Linux).
@@ -231,11 +251,12 @@ mod tests {
             },
             std::time::Duration::from_millis(5),
             || polls += 1,
-        );
+        )
+        .unwrap();
         // ran on a worker of the global pool, borrowing v; polled meanwhile
         assert_eq!(sum, Some(1000.0));
         assert!(polls >= 2, "{polls}");
-        let r = std::panic::catch_unwind(|| run_polled(|| -> u8 { panic!("boom") }, std::time::Duration::from_millis(5), || ()));
+        let r = std::panic::catch_unwind(|| run_polled(|| -> u8 { panic!("boom") }, std::time::Duration::from_millis(5), || ()).unwrap());
         let msg = r.unwrap_err();
         assert_eq!(msg.downcast_ref::<&str>(), Some(&"boom"));
     }
@@ -245,6 +266,7 @@ mod tests {
         let a = start_global_pool().unwrap();
         let b = start_global_pool().unwrap();
         assert_eq!(a, b);
+        assert!(a.started && pool_info().unwrap() == a);
         // the workers bind as they start: wait for every worker to have run a job
         rayon::broadcast(|_| ());
         if a.started_here {

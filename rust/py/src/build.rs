@@ -22,8 +22,9 @@ fn build_info(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
     d.set_item("profile", option_env!("LIBRATE_PROFILE").unwrap_or("unknown"))?;
     d.set_item("debug_assertions", cfg!(debug_assertions))?;
     d.set_item("target_arch", std::env::consts::ARCH)?;
-    let pool = librate_core::threads::start_global_pool().map_err(to_py)?;
+    let pool = librate_core::threads::pool_info().map_err(to_py)?;
     d.set_item("threads", pool.threads)?;
+    d.set_item("threads_started", pool.started)?;
     d.set_item("threads_binding", pool.binding.name())?;
     d.set_item("threads_cpus", pool.cpus.clone())?;
     d.set_item("threads_bound", pool.bound())?;

@@ -27,7 +27,7 @@ pub(crate) fn interruptible<T: Send>(py: Python<'_>, f: impl FnOnce() -> librate
                 }
             }
         });
-        (out, signal)
+        (out.and_then(|r| r), signal)
     });
     interrupt::clear();
     match signal {

@@ -306,8 +306,9 @@ fn multiple_shooting<'py>(
 
 #[pymodule]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
-    // the global worker pool, bound to CPUs per LIBRATE_BIND_THREADS (an invalid value fails the import, naming it)
-    librate_core::threads::start_global_pool().map_err(to_py)?;
+    // LIBRATE_BIND_THREADS checked (an invalid value fails the import, naming it); the worker pool
+    // itself starts with the first parallel work (librate_core::threads), so a fork after the import is safe
+    librate_core::threads::binding_from_env().map_err(to_py)?;
     errors::register(m)?;
     options::register(m)?;
     m.add_function(wrap_pyfunction!(propagate, m)?)?;
