@@ -27,7 +27,7 @@ impl PyOrbitForcing {
     #[new]
     #[pyo3(signature = (mu, state0, period, *, primaries=[true, true], tol=1e-12))]
     fn new(py: Python<'_>, mu: f64, state0: [f64; 6], period: f64, primaries: [bool; 2], tol: f64) -> PyResult<Self> {
-        let inner = interruptible(py, || OrbitForcing::new(mu, &state0, period, primaries, tol))?;
+        let inner = py.detach(|| OrbitForcing::new(mu, &state0, period, primaries, tol)).map_err(to_py)?;
         Ok(Self { inner })
     }
     #[getter]

@@ -13,6 +13,7 @@ use pyo3::prelude::*;
 use crate::convert::rows;
 use crate::options::LaneOptions;
 use crate::interrupt::interruptible;
+use crate::to_py;
 
 /// The synodic-frame tidal tensor of one periodic orbit (planar or spatial), tabulated once
 /// (piecewise Chebyshev) and shared by every 3-D attitude trajectory on it.
@@ -26,7 +27,7 @@ impl PyTidalTable {
     #[new]
     #[pyo3(signature = (mu, state0, period, *, primaries=[true, true], tol=1e-12))]
     fn new(py: Python<'_>, mu: f64, state0: [f64; 6], period: f64, primaries: [bool; 2], tol: f64) -> PyResult<Self> {
-        let inner = interruptible(py, || TidalTable::tidal(mu, &state0, period, primaries, tol))?;
+        let inner = py.detach(|| TidalTable::tidal(mu, &state0, period, primaries, tol)).map_err(to_py)?;
         Ok(Self { inner })
     }
     #[getter]

@@ -5,8 +5,8 @@
 //! N = 6, [`crate::attitude::tidal_tensor`]).
 //!
 //! The orbit is integrated once at tight tolerance and sampled at the Chebyshev nodes of every
-//! segment (each sample an RK step from the enclosing accepted step, the samples taken on all
-//! cores; one integration serves every number of segments tried); the coefficients are the
+//! segment (each sample an RK step from the enclosing accepted step; one integration serves
+//! every number of segments tried); the coefficients are the
 //! exact interpolants at those nodes. The number of segments doubles until every component at
 //! the segment quarter points, also sampled from the orbit, matches the series to `tol` relative
 //! to the largest component magnitude, or until doubling no longer halves the error (the
@@ -20,7 +20,6 @@ use crate::integrate::{Options, Output};
 use crate::propagation::{propagate_checked, Collision};
 use crate::scalar::F8;
 use crate::simd::Isa;
-use rayon::prelude::*;
 
 /// Chebyshev degree per segment.
 pub const DEGREE: usize = 12;
@@ -50,7 +49,8 @@ pub type TidalTable = OrbitTable<6>;
 /// The orbit's accepted steps at the table's tolerance, and its states at any times of the period:
 /// each a fresh RK step from the enclosing accepted step (the step's end when it falls there),
 /// exactly as [`Output::At`] samples an integration, so a table's bits do not depend on which
-/// other times were sampled. The samples are independent steps, taken on all cores.
+/// other times were sampled. (Taken one after another: spread over the workers, the samples of
+/// a try, 30-150 us of work, ran slower after other work had left the workers asleep.)
 struct Sampled {
     mu: f64,
     t: Vec<f64>,
@@ -58,9 +58,6 @@ struct Sampled {
     opts: Options,
     level: crate::simd::Level,
 }
-
-/// Samples per parallel task (about 0.2 us each).
-const SAMPLES_PER_TASK: usize = 64;
 
 impl Sampled {
     fn new(mu: f64, state0: &[f64; 6], period: f64, opts: &Options) -> Result<Self> {
@@ -80,27 +77,22 @@ impl Sampled {
     /// The states at `times` (in [0, period]).
     fn sample(&self, times: &[f64]) -> Vec<[f64; 6]> {
         let sys = Cr3bp { mu: self.mu };
-        let parts: Vec<Vec<[f64; 6]>> = times
-            .par_chunks(SAMPLES_PER_TASK)
-            .map(|part| {
-                let mut stepper = Rkf78::new(&[0.0; 6], self.level);
-                let mut out = [0.0; 6];
-                part.iter()
-                    .map(|&te| {
-                        // the step (t_i, t_{i+1}] that holds te
-                        let j = self.t.partition_point(|&x| x < te).min(self.t.len() - 1);
-                        if self.t[j] == te || j == 0 {
-                            return self.state(j);
-                        }
-                        let (ti, yi) = (self.t[j - 1], self.state(j - 1));
-                        stepper.prime(&sys, ti, &yi);
-                        stepper.step(&sys, ti, &yi, te - ti, &mut out, self.opts.rtol, self.opts.atol);
-                        out
-                    })
-                    .collect()
+        let mut stepper = Rkf78::new(&[0.0; 6], self.level);
+        let mut out = [0.0; 6];
+        times
+            .iter()
+            .map(|&te| {
+                // the step (t_i, t_{i+1}] that holds te
+                let j = self.t.partition_point(|&x| x < te).min(self.t.len() - 1);
+                if self.t[j] == te || j == 0 {
+                    return self.state(j);
+                }
+                let (ti, yi) = (self.t[j - 1], self.state(j - 1));
+                stepper.prime(&sys, ti, &yi);
+                stepper.step(&sys, ti, &yi, te - ti, &mut out, self.opts.rtol, self.opts.atol);
+                out
             })
-            .collect();
-        parts.concat()
+            .collect()
     }
 }
 
