@@ -147,28 +147,57 @@ pub fn start_global_pool() -> Result<PoolInfo> {
     Ok(STARTED.get_or_init(|| info).clone())
 }
 
-/// Run `f` on a worker of the global pool while the calling thread runs `poll` every `every`
-/// until `f` has returned (the Python binding polls its signal handlers so). Started on a worker,
-/// `f`'s parallel loops split from inside the pool: no thread is started per call, and no job is
-/// injected and waited for per parallel round (a thread started per call cost 30-70 us). A panic
-/// in `f` resumes on the calling thread.
+/// Calls of [`run_polled`] in flight.
+static CALLS: AtomicUsize = AtomicUsize::new(0);
+
+/// Run `f` while the calling thread runs `poll` every `every` until `f` has returned (the Python
+/// binding polls its signal handlers so); a panic in `f` resumes on the calling thread.
+///
+/// A call alone runs `f` as a job on a worker of the global pool: its parallel loops then split
+/// from inside the pool, and no thread is started (a thread started per call cost 30-70 us).
+/// A call made while another is in flight runs `f` on a thread of its own instead, as every call
+/// did before: a worker waiting inside one call's parallel loop takes up whatever job is queued,
+/// and a whole second call queued as one job could run to its end inside the first one, holding
+/// it back; started on its own thread, a call queues only its loops' pieces.
 pub fn run_polled<T: Send>(f: impl FnOnce() -> T + Send, every: std::time::Duration, mut poll: impl FnMut()) -> Result<T> {
     use std::sync::mpsc::{channel, RecvTimeoutError};
     start_global_pool()?;
-    let (tx, rx) = channel();
-    let out = rayon::in_place_scope(|s| {
-        s.spawn(move |_| {
-            let _ = tx.send(f());
-        });
-        loop {
-            match rx.recv_timeout(every) {
-                Ok(out) => return Some(out),
-                Err(RecvTimeoutError::Timeout) => poll(),
-                // f panicked (tx dropped unsent): the scope's end resumes that panic
-                Err(RecvTimeoutError::Disconnected) => return None,
-            }
+    struct InFlight;
+    impl Drop for InFlight {
+        fn drop(&mut self) {
+            CALLS.fetch_sub(1, Ordering::AcqRel);
         }
-    });
+    }
+    let alone = CALLS.fetch_add(1, Ordering::AcqRel) == 0;
+    let _in_flight = InFlight;
+    let (tx, rx) = channel();
+    let wait = |rx: std::sync::mpsc::Receiver<T>, poll: &mut dyn FnMut()| loop {
+        match rx.recv_timeout(every) {
+            Ok(out) => return Some(out),
+            Err(RecvTimeoutError::Timeout) => poll(),
+            // f panicked (tx dropped unsent): the scope's end resumes that panic
+            Err(RecvTimeoutError::Disconnected) => return None,
+        }
+    };
+    let out = if alone {
+        rayon::in_place_scope(|s| {
+            s.spawn(move |_| {
+                let _ = tx.send(f());
+            });
+            wait(rx, &mut poll)
+        })
+    } else {
+        std::thread::scope(|s| {
+            let job = s.spawn(move || {
+                let _ = tx.send(f());
+            });
+            let out = wait(rx, &mut poll);
+            if let Err(panic) = job.join() {
+                std::panic::resume_unwind(panic);
+            }
+            out
+        })
+    };
     Ok(out.expect("a job that neither returned nor panicked"))
 }
 
@@ -240,8 +269,11 @@ mod tests {
         assert!(plan(Binding::On, 2, &[]).is_empty());
     }
 
+    /// One test for every property of run_polled: the calls of concurrent tests would change
+    /// which path each takes.
     #[test]
-    fn run_polled_returns_polls_and_resumes_a_panic() {
+    fn run_polled_returns_polls_resumes_a_panic_and_runs_a_concurrent_call_on_its_own_thread() {
+        let every = std::time::Duration::from_millis(5);
         let v = vec![1.0f64; 1000];
         let mut polls = 0;
         let sum = run_polled(
@@ -249,16 +281,45 @@ mod tests {
                 std::thread::sleep(std::time::Duration::from_millis(30));
                 rayon::current_thread_index().map(|_| v.iter().sum::<f64>())
             },
-            std::time::Duration::from_millis(5),
+            every,
             || polls += 1,
         )
         .unwrap();
-        // ran on a worker of the global pool, borrowing v; polled meanwhile
+        // alone: ran on a worker of the global pool, borrowing v; polled meanwhile
         assert_eq!(sum, Some(1000.0));
         assert!(polls >= 2, "{polls}");
-        let r = std::panic::catch_unwind(|| run_polled(|| -> u8 { panic!("boom") }, std::time::Duration::from_millis(5), || ()).unwrap());
-        let msg = r.unwrap_err();
-        assert_eq!(msg.downcast_ref::<&str>(), Some(&"boom"));
+        for alone in [true, false] {
+            let r = std::thread::scope(|s| {
+                let (hold, held) = std::sync::mpsc::channel::<()>();
+                let (started, has_started) = std::sync::mpsc::channel::<()>();
+                let first = (!alone).then(|| {
+                    s.spawn(move || {
+                        run_polled(
+                            move || {
+                                started.send(()).unwrap();
+                                let _ = held.recv(); // until `hold` is dropped
+                            },
+                            every,
+                            || (),
+                        )
+                    })
+                });
+                if first.is_some() {
+                    has_started.recv().unwrap();
+                }
+                let r = std::panic::catch_unwind(|| run_polled(|| -> u8 { panic!("boom") }, every, || ()).unwrap());
+                // a second call while the first is in flight: on a thread of its own
+                let on_worker = run_polled(|| rayon::current_thread_index().is_some(), every, || ()).unwrap();
+                assert_eq!(on_worker, alone);
+                drop(hold);
+                if let Some(h) = first {
+                    h.join().unwrap().unwrap();
+                }
+                r
+            });
+            let msg = r.unwrap_err();
+            assert_eq!(msg.downcast_ref::<&str>(), Some(&"boom"));
+        }
     }
 
     #[test]
