@@ -2,8 +2,9 @@
 //!
 //! Every parallel loop of the core (map sweeps, batch propagation, the correctors' rounds) runs
 //! on rayon's global pool. [`start_global_pool`] builds it (with the first parallel work: never
-//! at import, so that a process forked after importing librate starts its own) with one worker per CPU the process may use and, on Linux, each worker bound to its
-//! own CPU when the pool covers all of them. Unbound, a short call (a 2-ms map on two cores) can
+//! at import, so that a process forked after importing librate starts its own) with one worker
+//! per CPU the process may use and, on Linux, each worker bound to its own CPU when the pool
+//! covers all of them. Unbound, a short call (a 2-ms map on two cores) can
 //! run at one core's speed: the kernel wakes an idle worker on the CPU of the thread that woke
 //! it, and the pair shares that CPU until the load balancer moves one, a few milliseconds later
 //! (measured on a 2-core Intel Xeon VM: the standard map in 1.9-3.4 ms unbound against 1.8-2.0
