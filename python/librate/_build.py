@@ -29,9 +29,10 @@ def build_info() -> dict[str, Any]:
       whether Rust's debug assertions are on (dev builds); ``target_arch``: the CPU architecture;
     - ``threads``: the workers of the pool every parallel call runs on (``RAYON_NUM_THREADS``, else
       one per CPU); ``threads_started``: whether it runs yet (it starts with the first parallel
-      work, not at import; before, the other entries are its plan); ``threads_binding``: ``LIBRATE_BIND_THREADS`` (``"auto"``, the default,
-      ``"on"`` or ``"off"``); ``threads_cpus``: the CPU each worker is bound to (empty: left to
-      the kernel; ``auto`` binds only a pool with one worker per allowed CPU, on Linux);
+      work, not at import; before, the other entries are its plan); ``threads_binding``:
+      ``LIBRATE_BIND_THREADS`` (``"auto"``, the default, ``"on"`` or ``"off"``); ``threads_cpus``:
+      the CPU each worker is bound to (empty: left to the kernel; ``auto`` binds only a pool with
+      one worker per allowed CPU, on Linux);
       ``threads_bound``: how many workers the kernel accepted on their CPU.
 
     Raises ValueError naming ``LIBRATE_SIMD`` when it asks for an unknown or unavailable level

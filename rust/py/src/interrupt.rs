@@ -1,4 +1,5 @@
 //! Ctrl-C during long core calls: the call runs with the GIL released on a worker of the pool
+//! (on a thread of its own while another call is in flight: `librate_core::threads::run_polled`)
 //! while the calling thread runs Python's signal handlers every 50 ms. When one raises (SIGINT:
 //! KeyboardInterrupt), the core's interrupt flag stops the call's loops at their next poll
 //! (a map chunk, a Newton iteration, a batch member) and that exception is returned; work the

@@ -79,6 +79,9 @@ impl Sampled {
         let sys = Cr3bp { mu: self.mu };
         let mut stepper = Rkf78::new(&[0.0; 6], self.level);
         let mut out = [0.0; 6];
+        // the step whose start the stepper holds the derivative of (consecutive times mostly
+        // share one, as the driver's own samples do)
+        let mut primed = usize::MAX;
         times
             .iter()
             .map(|&te| {
@@ -88,7 +91,10 @@ impl Sampled {
                     return self.state(j);
                 }
                 let (ti, yi) = (self.t[j - 1], self.state(j - 1));
-                stepper.prime(&sys, ti, &yi);
+                if primed != j - 1 {
+                    stepper.prime(&sys, ti, &yi);
+                    primed = j - 1;
+                }
                 stepper.step(&sys, ti, &yi, te - ti, &mut out, self.opts.rtol, self.opts.atol);
                 out
             })
