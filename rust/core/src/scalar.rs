@@ -8,7 +8,10 @@
 //! - [`Arith`]: the field operations common to all three (f64, [`Dual`], [`F8`]; no constants,
 //!   which an [`F8`] cannot make without its instruction-set token), so the 3-D attitude laws
 //!   (kinematics, gravity-gradient torque from the tidal tensor, Euler's equations) are written
-//!   once for the scalar model, its STM and the 3-D map lanes.
+//!   once for the scalar model, its STM and the 3-D map lanes;
+//! - [`Field`]: [`Arith`] with square roots and constants made like a value, so the CR3BP's
+//!   acceleration is written once for the scalar model, its Jacobians and the orbit tables'
+//!   eight samples at a time.
 //!
 //! This module depends on nothing else in the crate but [`crate::simd`]'s instruction-set
 //! markers (cr3bp and attitude both build on it).
@@ -51,10 +54,18 @@ impl<I: Isa> MulBy<F8<I>> for F8<I> {
     }
 }
 
-/// Scalar arithmetic needed by the dynamics.
-pub trait Real: Arith + MulBy<f64> + Send + Sync {
-    fn cst(x: f64) -> Self;
+/// [`Arith`] with square roots and constants made alongside a value (f64, [`Dual`], [`F8`]: an
+/// [`F8`] takes its instruction-set token from the value), so that an equation written over it
+/// (the CR3BP's acceleration) runs on the scalar model, its dual-number Jacobians and the lanes.
+pub trait Field: Arith {
     fn sqrt(self) -> Self;
+    /// The constant x, made like `self` (for a [`Dual`], no partials).
+    fn cst_like(self, x: f64) -> Self;
+}
+
+/// Scalar arithmetic needed by the dynamics.
+pub trait Real: Field + MulBy<f64> + Send + Sync {
+    fn cst(x: f64) -> Self;
     /// The value part.
     fn re(self) -> f64;
 }
@@ -66,14 +77,21 @@ impl Arith for f64 {
     }
 }
 
+impl Field for f64 {
+    #[inline(always)]
+    fn sqrt(self) -> Self {
+        f64::sqrt(self)
+    }
+    #[inline(always)]
+    fn cst_like(self, x: f64) -> Self {
+        x
+    }
+}
+
 impl Real for f64 {
     #[inline(always)]
     fn cst(x: f64) -> Self {
         x
-    }
-    #[inline(always)]
-    fn sqrt(self) -> Self {
-        f64::sqrt(self)
     }
     #[inline(always)]
     fn re(self) -> f64 {
@@ -142,16 +160,23 @@ impl<const N: usize> Arith for Dual<N> {
     }
 }
 
-impl<const N: usize> Real for Dual<N> {
-    #[inline(always)]
-    fn cst(x: f64) -> Self {
-        Self { re: x, eps: [0.0; N] }
-    }
+impl<const N: usize> Field for Dual<N> {
     #[inline(always)]
     fn sqrt(self) -> Self {
         let s = self.re.sqrt();
         let d = 0.5 / s;
         Self { re: s, eps: self.eps.map(|e| e * d) }
+    }
+    #[inline(always)]
+    fn cst_like(self, x: f64) -> Self {
+        Self::cst(x)
+    }
+}
+
+impl<const N: usize> Real for Dual<N> {
+    #[inline(always)]
+    fn cst(x: f64) -> Self {
+        Self { re: x, eps: [0.0; N] }
     }
     #[inline(always)]
     fn re(self) -> f64 {
@@ -337,6 +362,17 @@ impl<I: Isa> Arith for F8<I> {
     #[inline(always)]
     fn scale(self, k: f64) -> Self {
         self * Self::splat(self.isa, k)
+    }
+}
+
+impl<I: Isa> Field for F8<I> {
+    #[inline(always)]
+    fn sqrt(self) -> Self {
+        self.with(self.isa.sqrt8(self.v))
+    }
+    #[inline(always)]
+    fn cst_like(self, x: f64) -> Self {
+        Self::splat(self.isa, x)
     }
 }
 

@@ -184,6 +184,11 @@ pub trait Isa: Copy + Send + Sync + 'static {
     fn div8(self, a: A8, b: A8) -> A8 {
         std::array::from_fn(|l| a[l] / b[l])
     }
+    /// The correctly rounded square root per lane (IEEE 754: the same bits as f64::sqrt).
+    #[inline(always)]
+    fn sqrt8(self, a: A8) -> A8 {
+        a.map(f64::sqrt)
+    }
     #[inline(always)]
     fn neg8(self, a: A8) -> A8 {
         a.map(|x| -x)
@@ -290,6 +295,12 @@ mod x86 {
             sse2!(a, b, _mm_div_pd)
         }
         #[inline(always)]
+        fn sqrt8(self, a: A8) -> A8 {
+            let a = q(a);
+            // SAFETY: as in `sse2!`.
+            uq(unsafe { [_mm_sqrt_pd(a[0]), _mm_sqrt_pd(a[1]), _mm_sqrt_pd(a[2]), _mm_sqrt_pd(a[3])] })
+        }
+        #[inline(always)]
         fn neg8(self, a: A8) -> A8 {
             sse2!(SIGN, a, _mm_xor_pd)
         }
@@ -339,6 +350,11 @@ mod x86 {
         #[inline(always)]
         fn div8(self, a: A8, b: A8) -> A8 {
             avx!(self, a, b, _mm256_div_pd)
+        }
+        #[inline(always)]
+        fn sqrt8(self, a: A8) -> A8 {
+            let a = h(a);
+            uh([self.0.avx._mm256_sqrt_pd(a[0]), self.0.avx._mm256_sqrt_pd(a[1])])
         }
         #[inline(always)]
         fn neg8(self, a: A8) -> A8 {
@@ -391,6 +407,10 @@ mod x86 {
         #[inline(always)]
         fn div8(self, a: A8, b: A8) -> A8 {
             uz(self.0.avx512f._mm512_div_pd(z(a), z(b)))
+        }
+        #[inline(always)]
+        fn sqrt8(self, a: A8) -> A8 {
+            uz(self.0.avx512f._mm512_sqrt_pd(z(a)))
         }
         #[inline(always)]
         fn neg8(self, a: A8) -> A8 {

@@ -1,7 +1,7 @@
 //! Equations of motion and variational equations.
 
 use crate::integrate::System;
-use crate::scalar::Real;
+use crate::scalar::Field;
 
 /// Dimension of the state augmented with the row-major 6x6 state transition matrix.
 pub const STM_DIM: usize = 42;
@@ -14,24 +14,25 @@ pub fn potential(mu: f64, r: &[f64]) -> f64 {
     0.5 * (x * x + y * y) + (1.0 - mu) / r1 + mu / r2
 }
 
-/// Gradient of U, over any [`Real`] scalar (f64, or dual numbers for exact Jacobians).
+/// Gradient of U, over any [`Field`] scalar (f64, dual numbers for exact Jacobians, or eight
+/// lanes).
 #[inline(always)]
-pub fn potential_gradient<R: Real>(mu: f64, r: &[R]) -> [R; 3] {
+pub fn potential_gradient<R: Field>(mu: f64, r: &[R]) -> [R; 3] {
     let (x, y, z) = (r[0], r[1], r[2]);
-    let (dx1, dx2) = (x + R::cst(mu), x - R::cst(1.0) + R::cst(mu));
+    let (dx1, dx2) = (x + x.cst_like(mu), x - x.cst_like(1.0) + x.cst_like(mu));
     let yz = y * y + z * z;
     let r1sq = dx1 * dx1 + yz;
     let r2sq = dx2 * dx2 + yz;
-    let c1 = R::cst(1.0 - mu) / (r1sq * r1sq.sqrt());
-    let c2 = R::cst(mu) / (r2sq * r2sq.sqrt());
+    let c1 = x.cst_like(1.0 - mu) / (r1sq * r1sq.sqrt());
+    let c2 = x.cst_like(mu) / (r2sq * r2sq.sqrt());
     [x - c1 * dx1 - c2 * dx2, y - (c1 + c2) * y, -(c1 + c2) * z]
 }
 
 /// The CR3BP acceleration (xdd, ydd, zdd) = grad U + (2 yd, -2 xd, 0) at position `p` and
-/// velocity `v`, over any [`Real`] scalar: the one definition of the equations of motion,
-/// used by [`Cr3bp`] and by the coupled attitude model.
+/// velocity `v`, over any [`Field`] scalar: the one definition of the equations of motion,
+/// used by [`Cr3bp`], by the coupled attitude model and by the orbit tables' lanes.
 #[inline(always)]
-pub fn acceleration<R: Real>(mu: f64, p: &[R], v: &[R]) -> [R; 3] {
+pub fn acceleration<R: Field>(mu: f64, p: &[R], v: &[R]) -> [R; 3] {
     let g = potential_gradient(mu, p);
     [v[1].scale(2.0) + g[0], v[0].scale(-2.0) + g[1], g[2]]
 }
@@ -71,16 +72,20 @@ pub struct Cr3bp {
     pub mu: f64,
 }
 
+impl Cr3bp {
+    /// The derivative of the state (x, y, z, xd, yd, zd) over any [`Field`] scalar (the orbit
+    /// tables sample eight states at a time with it).
+    #[inline(always)]
+    pub fn derivative_of<R: Field>(&self, y: &[R; 6]) -> [R; 6] {
+        let a = acceleration(self.mu, &y[..3], &y[3..]);
+        [y[3], y[4], y[5], a[0], a[1], a[2]]
+    }
+}
+
 impl System<[f64; 6]> for Cr3bp {
     #[inline(always)]
     fn derivative(&self, _t: f64, y: &[f64; 6], dy: &mut [f64; 6]) {
-        let a = acceleration(self.mu, &y[..3], &y[3..]);
-        dy[0] = y[3];
-        dy[1] = y[4];
-        dy[2] = y[5];
-        dy[3] = a[0];
-        dy[4] = a[1];
-        dy[5] = a[2];
+        *dy = self.derivative_of(y);
     }
 }
 
