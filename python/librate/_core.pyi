@@ -819,7 +819,9 @@ def attitude_correct_3d_across(
 ) -> CorrectionAcross3D: ...
 
 # --- 3-D attitude map engine (rust/py/src/map3d.rs) ---
-__all__ += ["TidalTable", "Sweep3DResult", "map_sweep_3d"]
+__all__ += ["TidalTable", "Sweep3DResult", "map_sweep_3d", "MAP3D_ALIGN"]
+#: Case alignment of the 3-D map engine: every SIMD level's lock-step group size divides it.
+MAP3D_ALIGN: int
 
 @final
 class TidalTable:

@@ -40,9 +40,10 @@ __all__ = ["attitude_map_3d", "find_periodic_attitudes_3d", "Map3DGrid", "map3d_
 
 #: The six residual components.
 COMPONENTS = ("rx", "ry", "rz", "dwx", "dwy", "dwz")
-#: Trajectories per lock-step group: chunks starting at multiples of LANES give results
-#: bit-identical to one call over all cases.
-LANES = 8
+#: Case alignment of the engine's lock-step groups (every SIMD level's group size divides it:
+#: sixteen trajectories at AVX-512, eight elsewhere): chunks starting at multiples of LANES give
+#: results bit-identical to one call over all cases.
+LANES: int = _core.MAP3D_ALIGN
 _RATES = ("wx0", "wy0", "wz0")
 
 

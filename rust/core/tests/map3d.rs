@@ -151,6 +151,49 @@ fn val_determinism_across_threads_and_chunks() {
     }
 }
 
+/// Every SIMD level this CPU has: the groups are sixteen trajectories on two lane vectors at
+/// AVX-512 and eight elsewhere (lanes3d::group_size), so the levels differ by the shared steps
+/// of their groups and by fused against unfused multiply-adds. Reference: the FMA level of eight
+/// (AVX2) where present; tolerance: the six residuals agree to 1e-10 at rtol = atol = 1e-13 over
+/// one halo period (measured on an AVX-512 CPU: 1.2e-12, baseline 1.7e-13 against AVX2),
+/// and each level is bit-identical for any chunking and thread count (the wide groups too: 40
+/// cases, two groups of sixteen and one of eight).
+#[test]
+fn val_levels_agree() {
+    use librate_core::map::sweep_3d_at;
+    use librate_core::simd::Level;
+    let (s0, period) = halo();
+    let f = TidalTable::tidal(MU, &s0, period, [true, true], 1e-13).unwrap();
+    let mut cases = cases3d();
+    cases.extend(cases3d());
+    cases.extend_from_slice(&cases3d()[..2]);
+    let opts = LaneOptions { rtol: 1e-13, atol: 1e-13, ..LaneOptions::default() };
+    let bits = |o: &[librate_core::integrate::lanes3d::Outcome3d]| o.iter().flat_map(|x| x.q_t.iter().chain(&x.w_t).map(|v| v.to_bits()).collect::<Vec<_>>()).collect::<Vec<_>>();
+    let levels = librate_core::simd::available();
+    let runs: Vec<(Level, Vec<_>)> = levels
+        .iter()
+        .map(|&level| {
+            let base = sweep_3d_at(level, &f, period, &cases, &opts, 1000, Some(1)).unwrap();
+            for (chunk, threads) in [(1, Some(2)), (9, None)] {
+                assert_eq!(bits(&sweep_3d_at(level, &f, period, &cases, &opts, chunk, threads).unwrap()), bits(&base), "{level}: chunk {chunk}");
+            }
+            (level, base)
+        })
+        .collect();
+    let (l0, r0) = runs.iter().find(|(l, _)| *l == Level::Avx2).unwrap_or(&runs[0]);
+    for (level, r) in &runs {
+        let mut worst = 0.0f64;
+        for (a, b) in r0.iter().zip(r) {
+            assert_eq!(b.status, LaneStatus::Ok);
+            for (x, y) in a.residual.iter().zip(&b.residual) {
+                worst = worst.max((x - y).abs());
+            }
+        }
+        eprintln!("{level} against {l0}: largest residual difference {worst:.1e}");
+        assert!(worst < 1e-10, "{level} against {l0}: {worst:e}");
+    }
+}
+
 /// Invalid arguments are errors naming the argument, never panics or NaN results.
 #[test]
 fn val_bad_input_is_an_error() {

@@ -115,5 +115,6 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyTidalTable>()?;
     m.add_class::<PySweep3DResult>()?;
     m.add_function(wrap_pyfunction!(map_sweep_3d, m)?)?;
+    m.add("MAP3D_ALIGN", librate_core::integrate::lanes3d::ALIGN)?;
     Ok(())
 }

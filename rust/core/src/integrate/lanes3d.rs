@@ -1,14 +1,15 @@
 //! The 3-D attitude map engine's integrator (issue 15, item 5): the rigid body's attitude
 //! relative to the synodic frame (quaternion q, scalar last) and its inertial rate w in body
-//! axes, 7 states, for eight trajectories in lock step in SIMD lanes, along one periodic orbit
+//! axes, 7 states, for groups of trajectories in lock step in SIMD lanes, along one periodic orbit
 //! (planar or spatial) whose tidal tensor is tabulated once ([`TidalTable`]).
 //!
-//! As in the planar engine ([`super::lanes`]): the eight share the time and the step (the
-//! smallest any of them needs), so the orbit's tidal tensor is evaluated once per stage time
-//! (a step's eight distinct inner nodes in one vector Chebyshev recurrence), broadcast to the
-//! lanes; trajectories are grouped eight by eight in case order from
-//! the start of the slice (chunks are multiples of eight), so results are bit-identical for any
-//! chunking and thread count. The step loop, the RKF7(8) stages and the controller are the
+//! As in the planar engine ([`super::lanes`]): a group's trajectories share the time and the
+//! step (the smallest any of them needs), so the orbit's tidal tensor is evaluated once per stage
+//! time (a step's eight distinct inner nodes in one vector Chebyshev recurrence), broadcast to
+//! the lanes. A group is eight trajectories on one lane vector, or at AVX-512 sixteen on two
+//! ([`group_size`]); groups are taken in case order from the start of the slice (chunks are
+//! multiples of the group), so results are bit-identical for any chunking and thread count, and
+//! differ between levels in their last bits. The step loop, the RKF7(8) stages and the controller are the
 //! planar engine's ([`run_steps`], [`Stages`]); the physics are the scalar 3-D model's own laws
 //! ([`dcm_with`], [`quat_rate`], [`gravity_gradient_torque`], [`euler_rate`]) evaluated over the
 //! lane type, each lane with its own body. No STM: the map needs the end state only.
@@ -90,21 +91,113 @@ impl<I: Isa> Rhs<I, D> for Rigid<'_, I> {
 
     #[inline(always)]
     fn eval_at(&self, at: &(f64, Option<[f64; 6]>), y: &[F8<I>; D], dy: &mut [F8<I>; D]) {
+        let m = self.tensor(at);
+        rigid_rate(&m, y, &self.inertia, &self.inv, self.one, dy);
+    }
+}
+
+impl<I: Isa> Rigid<'_, I> {
+    /// The tidal tensor of a stage's orbit data, broadcast to the lanes.
+    #[inline(always)]
+    fn tensor(&self, at: &(f64, Option<[f64; 6]>)) -> [F8<I>; 6] {
         let m6 = match at.1 {
             Some(m6) => m6,
             None => self.table.eval_at::<I>(at.0),
         };
-        let isa = y[0].isa();
-        let m = [F8::splat(isa, m6[0]), F8::splat(isa, m6[1]), F8::splat(isa, m6[2]), F8::splat(isa, m6[3]), F8::splat(isa, m6[4]), F8::splat(isa, m6[5])];
-        let q = [y[0], y[1], y[2], y[3]];
-        let w = [y[4], y[5], y[6]];
-        let a = dcm_with(&q, self.one);
-        let qd = quat_rate(&q, &a, &w);
-        let tq = gravity_gradient_torque(&a, &m, &self.inertia);
-        let wd = euler_rate(&tq, &w, &self.inertia, &self.inv);
-        dy[..4].copy_from_slice(&qd);
-        dy[4..].copy_from_slice(&wd);
+        let isa = self.one.isa();
+        [F8::splat(isa, m6[0]), F8::splat(isa, m6[1]), F8::splat(isa, m6[2]), F8::splat(isa, m6[3]), F8::splat(isa, m6[4]), F8::splat(isa, m6[5])]
     }
+}
+
+/// The derivative of one lane vector's (q, w) under the tidal tensor m.
+#[inline(always)]
+fn rigid_rate<I: Isa>(m: &[F8<I>; 6], y: &[F8<I>], inertia: &[F8<I>; 3], inv: &[F8<I>; 3], one: F8<I>, dy: &mut [F8<I>]) {
+    let q = [y[0], y[1], y[2], y[3]];
+    let w = [y[4], y[5], y[6]];
+    let a = dcm_with(&q, one);
+    let qd = quat_rate(&q, &a, &w);
+    let tq = gravity_gradient_torque(&a, m, inertia);
+    let wd = euler_rate(&tq, &w, inertia, inv);
+    dy[..4].copy_from_slice(&qd);
+    dy[4..D].copy_from_slice(&wd);
+}
+
+/// States of a wide group: two lane vectors' (q, w).
+const WIDE: usize = 2 * D;
+
+/// Two lane vectors of the rigid body as one state of fourteen components, (q, w) of lanes 0-7
+/// then of lanes 8-15: one step size and one tidal-tensor evaluation per stage for sixteen
+/// trajectories ([`group_size`]).
+struct Wide<'a, I> {
+    a: Rigid<'a, I>,
+    /// The second vector's moments and their inverses.
+    inertia: [F8<I>; 3],
+    inv: [F8<I>; 3],
+}
+
+impl<I: Isa> Rhs<I, WIDE> for Wide<'_, I> {
+    type At = (f64, Option<[f64; 6]>);
+
+    #[inline(always)]
+    fn at(&self, t: f64) -> (f64, Option<[f64; 6]>) {
+        <Rigid<'_, I> as Rhs<I, D>>::at(&self.a, t)
+    }
+
+    #[inline(always)]
+    fn at8(&self, ts: &[f64; 8]) -> [(f64, Option<[f64; 6]>); 8] {
+        <Rigid<'_, I> as Rhs<I, D>>::at8(&self.a, ts)
+    }
+
+    #[inline(always)]
+    fn eval_at(&self, at: &(f64, Option<[f64; 6]>), y: &[F8<I>; WIDE], dy: &mut [F8<I>; WIDE]) {
+        let m = self.a.tensor(at);
+        let (ya, yb) = y.split_at(D);
+        let (da, db) = dy.split_at_mut(D);
+        rigid_rate(&m, ya, &self.a.inertia, &self.a.inv, self.a.one, da);
+        rigid_rate(&m, yb, &self.inertia, &self.inv, self.a.one, db);
+    }
+}
+
+/// Trajectories per lock-step group of the 3-D map at a SIMD level: sixteen on two lane vectors
+/// at AVX-512, whose 32 registers hold a stage's fourteen sums (1.18x on one thread, the 12-day
+/// halo at 5e-11); eight elsewhere (at AVX2 the fourteen sums of two vectors take 28 of its 16
+/// registers, and sixteen were slower). Results thus depend on the level in their last bits, as
+/// between fused and unfused levels (a 3-D map run records its level and resumes only at it);
+/// never on the chunking or the thread count.
+pub fn group_size(level: Level) -> usize {
+    if level == Level::Avx512 {
+        2 * LANES
+    } else {
+        LANES
+    }
+}
+
+/// A multiple of [`group_size`] at every level: slices of a map that start at multiples of it
+/// give the results of one call over all cases, bit for bit, whatever the level.
+pub const ALIGN: usize = 2 * LANES;
+
+/// One lane vector's moments, their inverses, and its (q0, w0) as states; `pick(l)` is lane l's case.
+#[inline(always)]
+fn vector_start<I: Isa>(isa: I, pick: impl Fn(usize) -> Case3d) -> ([F8<I>; 3], [F8<I>; 3], [F8<I>; D]) {
+    let moments = |i: usize| F8::new(isa, std::array::from_fn(|l| pick(l).body.moments()[i]));
+    let inertia = [moments(0), moments(1), moments(2)];
+    let one = F8::splat(isa, 1.0);
+    // written out: array::map's closure would call the division out of line
+    let inv = [one / inertia[0], one / inertia[1], one / inertia[2]];
+    let y: [F8<I>; D] = std::array::from_fn(|i| F8::new(isa, std::array::from_fn(|l| if i < 4 { pick(l).q0[i] } else { pick(l).w0[i - 4] })));
+    (inertia, inv, y)
+}
+
+/// Lane l's outcome from the end states `y` of its vector (`base`: where its (q, w) start).
+#[inline(always)]
+fn outcome<I: Isa>(c: Case3d, y: &[F8<I>], base: usize, l: usize, run: &Run) -> Outcome3d {
+    let (accepted, rejected, status) = (run.accepted, run.rejected, run.status);
+    if status != LaneStatus::Ok {
+        return Outcome3d { q_t: [f64::NAN; 4], w_t: [f64::NAN; 3], residual: [f64::NAN; 6], accepted, rejected, status };
+    }
+    let q_t = [lane(&y[base], l), lane(&y[base + 1], l), lane(&y[base + 2], l), lane(&y[base + 3], l)];
+    let w_t = [lane(&y[base + 4], l), lane(&y[base + 5], l), lane(&y[base + 6], l)];
+    Outcome3d { q_t, w_t, residual: attitude_residual(&c.q0, &c.w0, &q_t, &w_t), accepted, rejected, status }
 }
 
 /// Integrate one group of up to LANES trajectories; missing lanes repeat the last.
@@ -112,23 +205,29 @@ impl<I: Isa> Rhs<I, D> for Rigid<'_, I> {
 fn integrate_group<'a, I: Isa, S: Scheme<I, Rigid<'a, I>, Y = [F8<I>; D]>>(isa: I, table: &'a TidalTable, t_final: f64, group: &[Case3d], opts: &LaneOptions, st: &mut S) -> [Outcome3d; LANES] {
     let n = group.len();
     let pick = |l: usize| group[l.min(n - 1)];
-    let moments = |i: usize| F8::new(isa, std::array::from_fn(|l| pick(l).body.moments()[i]));
-    let inertia = [moments(0), moments(1), moments(2)];
-    let one = F8::splat(isa, 1.0);
-    // written out: array::map's closure would call the division out of line
-    let model = Rigid { table, inertia, inv: [one / inertia[0], one / inertia[1], one / inertia[2]], one, recent: Recent::new([f64::NAN; 6]) };
-    let mut y: [F8<I>; D] = std::array::from_fn(|i| F8::new(isa, std::array::from_fn(|l| if i < 4 { pick(l).q0[i] } else { pick(l).w0[i - 4] })));
+    let (inertia, inv, mut y) = vector_start(isa, pick);
+    let model = Rigid { table, inertia, inv, one: F8::splat(isa, 1.0), recent: Recent::new([f64::NAN; 6]) };
     st.begin();
-    let Run { accepted, rejected, status, .. } = run_steps(isa, st, &model, &mut y, t_final, opts, &mut NoCut);
-    std::array::from_fn(|l| {
-        if status != LaneStatus::Ok {
-            return Outcome3d { q_t: [f64::NAN; 4], w_t: [f64::NAN; 3], residual: [f64::NAN; 6], accepted, rejected, status };
-        }
-        let q_t = [lane(&y[0], l), lane(&y[1], l), lane(&y[2], l), lane(&y[3], l)];
-        let w_t = [lane(&y[4], l), lane(&y[5], l), lane(&y[6], l)];
-        let c = pick(l);
-        Outcome3d { q_t, w_t, residual: attitude_residual(&c.q0, &c.w0, &q_t, &w_t), accepted, rejected, status }
-    })
+    let run = run_steps(isa, st, &model, &mut y, t_final, opts, &mut NoCut);
+    std::array::from_fn(|l| outcome(pick(l), &y, 0, l, &run))
+}
+
+/// Integrate one group of up to 2 x LANES trajectories on two lane vectors in lock step;
+/// missing lanes repeat the last.
+#[inline(always)]
+fn integrate_wide<'a, I: Isa, S: Scheme<I, Wide<'a, I>, Y = [F8<I>; WIDE]>>(isa: I, table: &'a TidalTable, t_final: f64, group: &[Case3d], opts: &LaneOptions, st: &mut S) -> [Outcome3d; 2 * LANES] {
+    let n = group.len();
+    let pick = |l: usize| group[l.min(n - 1)];
+    let (inertia_a, inv_a, ya) = vector_start(isa, pick);
+    let (inertia, inv, yb) = vector_start(isa, |l| pick(LANES + l));
+    let a = Rigid { table, inertia: inertia_a, inv: inv_a, one: F8::splat(isa, 1.0), recent: Recent::new([f64::NAN; 6]) };
+    let model = Wide { a, inertia, inv };
+    let mut y = [ya[0]; WIDE];
+    y[..D].copy_from_slice(&ya);
+    y[D..].copy_from_slice(&yb);
+    st.begin();
+    let run = run_steps(isa, st, &model, &mut y, t_final, opts, &mut NoCut);
+    std::array::from_fn(|l| if l < LANES { outcome(pick(l), &y, 0, l, &run) } else { outcome(pick(l), &y, D, l - LANES, &run) })
 }
 
 /// The 3-D lane engine as a dispatched kernel.
@@ -143,9 +242,11 @@ impl Kernel for Groups3d<'_> {
     type Output = Vec<Outcome3d>;
     #[inline(always)]
     fn run<I: Isa>(self, isa: I) -> Vec<Outcome3d> {
-        match self.opts.method {
-            Method::Dp87 => self.with::<I, Stages<I, D, PrinceDormand>>(isa),
-            _ => self.with::<I, Stages<I, D, Fehlberg>>(isa),
+        match (self.opts.method, group_size(I::LEVEL) > LANES) {
+            (Method::Dp87, false) => self.with::<I, Stages<I, D, PrinceDormand>>(isa),
+            (_, false) => self.with::<I, Stages<I, D, Fehlberg>>(isa),
+            (Method::Dp87, true) => self.wide::<I, Stages<I, WIDE, PrinceDormand>, Stages<I, D, PrinceDormand>>(isa),
+            (_, true) => self.wide::<I, Stages<I, WIDE, Fehlberg>, Stages<I, D, Fehlberg>>(isa),
         }
     }
 }
@@ -158,6 +259,24 @@ impl<'a> Groups3d<'a> {
         for group in self.cases.chunks(LANES) {
             let r = integrate_group::<I, S>(isa, self.table, self.t_final, group, self.opts, &mut st);
             out.extend_from_slice(&r[..group.len()]);
+        }
+        out
+    }
+
+    /// Groups of 2 x LANES in case order on two lane vectors; a chunk's last group of at most
+    /// LANES on one.
+    #[inline(always)]
+    fn wide<I: Isa, W: Scheme<I, Wide<'a, I>, Y = [F8<I>; WIDE]>, S: Scheme<I, Rigid<'a, I>, Y = [F8<I>; D]>>(self, isa: I) -> Vec<Outcome3d> {
+        let (mut st, mut narrow) = (W::new(isa), S::new(isa));
+        let mut out = Vec::with_capacity(self.cases.len());
+        for group in self.cases.chunks(2 * LANES) {
+            if group.len() > LANES {
+                let r = integrate_wide::<I, W>(isa, self.table, self.t_final, group, self.opts, &mut st);
+                out.extend_from_slice(&r[..group.len()]);
+            } else {
+                let r = integrate_group::<I, S>(isa, self.table, self.t_final, group, self.opts, &mut narrow);
+                out.extend_from_slice(&r[..group.len()]);
+            }
         }
         out
     }
@@ -197,7 +316,9 @@ pub fn sweep_3d_at(level: Level, table: &TidalTable, t_final: f64, cases: &[Case
     if !level.is_available() {
         crate::simd::parse(Some(level.name()))?;
     }
-    let chunk = chunk.div_ceil(LANES) * LANES;
+    // chunks are multiples of the level's group size, so the groups do not depend on chunking
+    let group = group_size(level);
+    let chunk = chunk.div_ceil(group) * group;
     let run = |part: &[Case3d]| {
         crate::interrupt::check()?;
         crate::simd::run_at(level, Groups3d { table, t_final, cases: part, opts })
