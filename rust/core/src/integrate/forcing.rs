@@ -5,9 +5,10 @@
 //! N = 6, [`crate::attitude::tidal_tensor`]).
 //!
 //! The orbit is integrated once at tight tolerance and sampled at the Chebyshev nodes of every
-//! segment (each sample an RK step from the enclosing accepted step; one integration serves
-//! every number of segments tried); the coefficients are the
-//! exact interpolants at those nodes. The number of segments doubles until every component at
+//! segment (each sample an RK step from the enclosing accepted step, eight at a time on the SIMD
+//! lanes; one integration serves every number of segments tried); the coefficients are the
+//! exact interpolants at those nodes (the transform and the check below also run eight
+//! segments or points at a time, bit for bit the scalar forms). The number of segments doubles until every component at
 //! the segment quarter points, also sampled from the orbit, matches the series to `tol` relative
 //! to the largest component magnitude, or until doubling no longer halves the error (the
 //! samples' own integration noise, ~1e-13 on orbits grazing a primary) while it is below 1e-10.
@@ -236,35 +237,19 @@ impl<const N: usize> OrbitTable<N> {
             check_t.sort_by(f64::total_cmp);
             let fit: Vec<[f64; N]> = orbit.sample(&fit_t).iter().map(|s| g(s)).collect();
             let check: Vec<[f64; N]> = orbit.sample(&check_t).iter().map(|s| g(s)).collect();
-            let mut coef = vec![0.0; segments * NC * N];
-            for s in 0..segments {
-                // fit_t is sorted: segment s holds samples s*NC .. (s+1)*NC in increasing time,
-                // i.e. nodes j = NC-1 .. 0 (x increasing).
-                for k in 0..NC {
-                    let mut cs = [0.0; N];
-                    for jj in 0..NC {
-                        let j = NC - 1 - jj;
-                        let v = &fit[s * NC + jj];
-                        let w = weights[k][j];
-                        for (c, x) in cs.iter_mut().zip(v) {
-                            *c += x * w;
-                        }
-                    }
-                    let f = if k == 0 { 1.0 } else { 2.0 } / NC as f64;
-                    for (i, c) in cs.iter().enumerate() {
-                        coef[(s * NC + k) * N + i] = c * f;
-                    }
+            // the largest magnitude, one running maximum per component (exact in any order; the
+            // values are finite, a comparison rather than f64::max's NaN handling)
+            let mut top = [0.0f64; N];
+            for v in fit.iter().chain(check.iter()) {
+                for (m, x) in top.iter_mut().zip(v) {
+                    let a = x.abs();
+                    *m = if a > *m { a } else { *m };
                 }
             }
-            let scale = fit.iter().chain(check.iter()).fold(0.0f64, |m, v| v.iter().fold(m, |m, x| m.max(x.abs())));
+            let scale = top.iter().fold(0.0f64, |m, &x| m.max(x));
+            let coef = crate::simd::run_at(orbit.level, Transform { fit: &fit, weights: &weights, segments }).expect("the sampler's SIMD level is available");
             let mut table = Self { period, segments, seg_len, coef, max_error: 0.0, scale };
-            let mut err = 0.0f64;
-            for (t, v) in check_t.iter().zip(&check) {
-                let a = table.eval(*t);
-                for i in 0..N {
-                    err = err.max((a[i] - v[i]).abs());
-                }
-            }
+            let err = crate::simd::run_at(orbit.level, CheckError { table: &table, times: &check_t, values: &check }).expect("the sampler's SIMD level is available");
             table.max_error = err / scale;
             table
         };
@@ -377,6 +362,119 @@ impl<const N: usize> OrbitTable<N> {
     }
 }
 
+/// The discrete Chebyshev transform of every segment's samples at the nodes (`fit`: segment s
+/// holds samples s NC .. (s + 1) NC in increasing time, i.e. nodes j = NC - 1 .. 0):
+/// coef[s][k][i] = f_k sum_jj fit[s NC + jj][i] w[k][NC - 1 - jj], eight segments at a time on
+/// the lanes, each sum formed in jj order by separate multiplies and adds, as for one segment
+/// alone (the same bits at every level).
+struct Transform<'a, const N: usize> {
+    fit: &'a [[f64; N]],
+    weights: &'a [[f64; NC]; NC],
+    segments: usize,
+}
+
+impl<const N: usize> crate::simd::Kernel for Transform<'_, N> {
+    type Output = Vec<f64>;
+    #[inline(always)]
+    fn run<I: Isa>(self, isa: I) -> Vec<f64> {
+        let mut coef = vec![0.0; self.segments * NC * N];
+        let zero = F8::splat(isa, 0.0);
+        for s0 in (0..self.segments).step_by(8) {
+            let m = (self.segments - s0).min(8);
+            // the lanes' samples, [jj][i] (spare lanes zero)
+            let mut x = [[zero; N]; NC];
+            for (jj, xj) in x.iter_mut().enumerate() {
+                for (i, xji) in xj.iter_mut().enumerate() {
+                    let mut v = [0.0; 8];
+                    for (l, vl) in v.iter_mut().enumerate().take(m) {
+                        *vl = self.fit[(s0 + l) * NC + jj][i];
+                    }
+                    *xji = F8::new(isa, v);
+                }
+            }
+            for k in 0..NC {
+                let f = F8::splat(isa, if k == 0 { 1.0 } else { 2.0 } / NC as f64);
+                for i in 0..N {
+                    let mut c = zero;
+                    for (jj, xj) in x.iter().enumerate() {
+                        c += xj[i] * F8::splat(isa, self.weights[k][NC - 1 - jj]);
+                    }
+                    let v = (c * f).to_array();
+                    for (l, &vl) in v.iter().enumerate().take(m) {
+                        coef[((s0 + l) * NC + k) * N + i] = vl;
+                    }
+                }
+            }
+        }
+        coef
+    }
+}
+
+/// The largest |table(t) - value| over the check points, eight times at a time on the lanes:
+/// each lane's Clenshaw recurrence as [`OrbitTable::eval`] forms it ([`fmadd8`]), its
+/// coefficients those of its own segment (the same bits at every level).
+struct CheckError<'a, const N: usize> {
+    table: &'a OrbitTable<N>,
+    times: &'a [f64],
+    values: &'a [[f64; N]],
+}
+
+impl<const N: usize> crate::simd::Kernel for CheckError<'_, N> {
+    type Output = f64;
+    #[inline(always)]
+    fn run<I: Isa>(self, isa: I) -> f64 {
+        let tb = self.table;
+        let mut err = 0.0f64;
+        for (ts, vs) in self.times.chunks(8).zip(self.values.chunks(8)) {
+            let (mut xs, mut base) = ([0.0; 8], [0usize; 8]);
+            for (l, &t) in ts.iter().enumerate() {
+                let (s, x) = tb.locate(t);
+                (base[l], xs[l]) = (s * NC * N, x);
+            }
+            // spare lanes repeat lane 0's point
+            for l in ts.len()..8 {
+                (base[l], xs[l]) = (base[0], xs[0]);
+            }
+            let x = F8::new(isa, xs);
+            let coef = |j: usize| {
+                let mut c = [0.0; 8];
+                for (cl, &b) in c.iter_mut().zip(&base) {
+                    *cl = tb.coef[b + j];
+                }
+                F8::new(isa, c)
+            };
+            let v: [F8<I>; N] = clenshaw(x, F8::splat(isa, 2.0) * x, F8::splat(isa, 0.0), coef, fmadd8);
+            for (i, vi) in v.iter().enumerate() {
+                let a = vi.to_array();
+                for (l, w) in vs.iter().enumerate() {
+                    err = err.max((a[l] - w[i]).abs());
+                }
+            }
+        }
+        err
+    }
+}
+
+/// [`crate::scalar::fmadd`] on the lanes, lane by lane the same rounding: fused where the build's
+/// scalar multiply-add fuses, else a multiply and an add.
+#[inline(always)]
+fn fmadd8<I: Isa>(a: F8<I>, b: F8<I>, c: F8<I>) -> F8<I> {
+    if cfg!(any(target_feature = "fma", target_arch = "aarch64")) {
+        if I::FMA {
+            a.mul_add(b, c)
+        } else {
+            let (x, y, z) = (a.to_array(), b.to_array(), c.to_array());
+            let mut r = [0.0; 8];
+            for l in 0..8 {
+                r[l] = x[l].mul_add(y[l], z[l]);
+            }
+            F8::new(a.isa(), r)
+        }
+    } else {
+        a * b + c
+    }
+}
+
 /// Clenshaw's recurrence for the N components of one segment at x (x2 = 2 x), on a scalar or on
 /// the lanes: coefficient j of the segment's [k][component] layout from `coef(j)`, `fma(a, b, c)`
 /// = a b + c.
@@ -428,6 +526,49 @@ mod tests {
         assert_eq!(got.len(), ts.len());
         for (i, (g, w)) in got.iter().zip(want.states.chunks_exact(6)).enumerate() {
             assert_eq!(g.as_slice(), w, "sample {i} at t = {}", ts[i]);
+        }
+    }
+
+    /// The lanes' Chebyshev transform and check error at every SIMD level this CPU has, against
+    /// one segment and one point at a time in scalar code (the test's reference: the sums in the
+    /// same order, the check by `eval`), on 24 segments of a smooth function (three spare lanes
+    /// in the last group of each). Tolerance: exact.
+    #[test]
+    fn lane_transform_and_check_equal_the_scalar_forms() {
+        let segments = 24;
+        let nodes = cheb_nodes();
+        let weights: [[f64; NC]; NC] = std::array::from_fn(|k| std::array::from_fn(|j| (std::f64::consts::PI * k as f64 * (j as f64 + 0.5) / NC as f64).cos()));
+        let g = |t: f64| [(1.3 * t).sin() + 0.1 * t * t, (0.7 * t).cos() / (1.0 + 0.2 * t)];
+        let (period, seg_len) = (5.0, 5.0 / segments as f64);
+        let fit: Vec<[f64; 2]> = (0..segments).flat_map(|s| (0..NC).rev().map(move |j| s as f64 * seg_len + 0.5 * seg_len * (nodes[j] + 1.0))).map(g).collect();
+        let check_t: Vec<f64> = (0..3 * segments - 3).map(|i| (i as f64 + 0.41) * period / (3 * segments) as f64).collect();
+        let check: Vec<[f64; 2]> = check_t.iter().map(|&t| g(t)).collect();
+        let mut want = vec![0.0; segments * NC * 2];
+        for s in 0..segments {
+            for k in 0..NC {
+                let mut cs = [0.0; 2];
+                for jj in 0..NC {
+                    for (c, x) in cs.iter_mut().zip(&fit[s * NC + jj]) {
+                        *c += x * weights[k][NC - 1 - jj];
+                    }
+                }
+                let f = if k == 0 { 1.0 } else { 2.0 } / NC as f64;
+                for (i, c) in cs.iter().enumerate() {
+                    want[(s * NC + k) * 2 + i] = c * f;
+                }
+            }
+        }
+        for level in crate::simd::available() {
+            let coef = crate::simd::run_at(level, Transform { fit: &fit, weights: &weights, segments }).unwrap();
+            assert_eq!(coef, want, "level {level}");
+            let table = OrbitTable::<2> { period, segments, seg_len, coef, max_error: 0.0, scale: 1.0 };
+            let err = crate::simd::run_at(level, CheckError { table: &table, times: &check_t, values: &check }).unwrap();
+            let want_err = check_t.iter().zip(&check).fold(0.0f64, |m, (&t, v)| {
+                let a = table.eval(t);
+                m.max((a[0] - v[0]).abs()).max((a[1] - v[1]).abs())
+            });
+            assert_eq!(err.to_bits(), want_err.to_bits(), "level {level}: {err} vs {want_err}");
+            assert!(err > 0.0 && err < 1e-6, "{err}");
         }
     }
 
