@@ -158,15 +158,18 @@ impl<I: Isa> Rhs<I, WIDE> for Wide<'_, I> {
     }
 }
 
+/// Trajectories per lock-step group on two lane vectors ([`Wide`]).
+const WIDE_GROUP: usize = 2 * LANES;
+
 /// Trajectories per lock-step group of the 3-D map at a SIMD level: sixteen on two lane vectors
-/// at AVX-512, whose 32 registers hold a stage's fourteen sums (1.18x on one thread, the 12-day
-/// halo at 5e-11); eight elsewhere (at AVX2 the fourteen sums of two vectors take 28 of its 16
+/// at AVX-512, whose 32 registers hold a stage's fourteen sums (the 12-day halo at 5e-11, 2000
+/// trajectories, one thread: 7.4 -> 6.4 ms); eight elsewhere (at AVX2 the fourteen sums of two vectors take 28 of its 16
 /// registers, and sixteen were slower). Results thus depend on the level in their last bits, as
 /// between fused and unfused levels (a 3-D map run records its level and resumes only at it);
 /// never on the chunking or the thread count.
 pub fn group_size(level: Level) -> usize {
     if level == Level::Avx512 {
-        2 * LANES
+        WIDE_GROUP
     } else {
         LANES
     }
@@ -174,7 +177,7 @@ pub fn group_size(level: Level) -> usize {
 
 /// A multiple of [`group_size`] at every level: slices of a map that start at multiples of it
 /// give the results of one call over all cases, bit for bit, whatever the level.
-pub const ALIGN: usize = 2 * LANES;
+pub const ALIGN: usize = WIDE_GROUP;
 
 /// One lane vector's moments, their inverses, and its (q0, w0) as states; `pick(l)` is lane l's case.
 #[inline(always)]
@@ -212,10 +215,10 @@ fn integrate_group<'a, I: Isa, S: Scheme<I, Rigid<'a, I>, Y = [F8<I>; D]>>(isa: 
     std::array::from_fn(|l| outcome(pick(l), &y, 0, l, &run))
 }
 
-/// Integrate one group of up to 2 x LANES trajectories on two lane vectors in lock step;
+/// Integrate one group of up to WIDE_GROUP trajectories on two lane vectors in lock step;
 /// missing lanes repeat the last.
 #[inline(always)]
-fn integrate_wide<'a, I: Isa, S: Scheme<I, Wide<'a, I>, Y = [F8<I>; WIDE]>>(isa: I, table: &'a TidalTable, t_final: f64, group: &[Case3d], opts: &LaneOptions, st: &mut S) -> [Outcome3d; 2 * LANES] {
+fn integrate_wide<'a, I: Isa, S: Scheme<I, Wide<'a, I>, Y = [F8<I>; WIDE]>>(isa: I, table: &'a TidalTable, t_final: f64, group: &[Case3d], opts: &LaneOptions, st: &mut S) -> [Outcome3d; WIDE_GROUP] {
     let n = group.len();
     let pick = |l: usize| group[l.min(n - 1)];
     let (inertia_a, inv_a, ya) = vector_start(isa, pick);
@@ -263,13 +266,13 @@ impl<'a> Groups3d<'a> {
         out
     }
 
-    /// Groups of 2 x LANES in case order on two lane vectors; a chunk's last group of at most
+    /// Groups of WIDE_GROUP in case order on two lane vectors; a chunk's last group of at most
     /// LANES on one.
     #[inline(always)]
     fn wide<I: Isa, W: Scheme<I, Wide<'a, I>, Y = [F8<I>; WIDE]>, S: Scheme<I, Rigid<'a, I>, Y = [F8<I>; D]>>(self, isa: I) -> Vec<Outcome3d> {
         let (mut st, mut narrow) = (W::new(isa), S::new(isa));
         let mut out = Vec::with_capacity(self.cases.len());
-        for group in self.cases.chunks(2 * LANES) {
+        for group in self.cases.chunks(WIDE_GROUP) {
             if group.len() > LANES {
                 let r = integrate_wide::<I, W>(isa, self.table, self.t_final, group, self.opts, &mut st);
                 out.extend_from_slice(&r[..group.len()]);
