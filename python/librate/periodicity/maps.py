@@ -15,6 +15,7 @@ from collections.abc import Callable
 
 import numpy as np
 
+from .. import _core
 from .._checks import as_count, as_float_array, as_number, as_threads, as_tolerance, check_map_cells
 from .._core import __version__
 from .._errors import LibrateError
@@ -27,19 +28,19 @@ from .solutions import (
     MAP_METHOD,
     MAP_RTOL,
     AttitudeSolution,
-    candidates,
+    Refining,
     check_orbit,
     check_srp,
     is_symmetric,
     orbit_forcing,
-    refine,
+    start_refine,
     sweep,
     turns_array,
 )
 
-__all__ = ["periodicity_map", "zero_contours", "orbits_of", "map_grid", "map_coords", "map_dataset", "solutions_from_row",
-           "solutions_from_rows", "row_candidates", "crossing_windows", "map_solutions_dataset", "solution_variables",
-           "REFINE_BATCH_PERIODS", "MAX_CROSSINGS", "QUICK_WINDOW", "RESOLVED"]
+__all__ = ["periodicity_map", "zero_contours", "orbits_of", "map_grid", "map_coords", "map_coordinates", "map_dataset",
+           "solutions_from_row", "solutions_from_rows", "start_row_solutions", "row_candidates", "crossing_windows",
+           "map_solutions_dataset", "solution_variables", "REFINE_BATCH_PERIODS", "MAX_CROSSINGS", "QUICK_WINDOW", "RESOLVED"]
 
 
 def orbits_of(orbits) -> tuple[list[PeriodicOrbit], OrbitFamily | None]:
@@ -165,6 +166,18 @@ def periodicity_map(
     sols: list[tuple[int, AttitudeSolution]] = []
     kz_grid, wz_grid = np.meshgrid(kzs, wz, indexing="ij")
     complete = True
+    coords = None
+    # the last orbit's solutions are refined on the core's pool while the coordinates are built
+    # (the others' at once); a row counts as computed once its solutions are in
+    pending: tuple[int, Refining] | None = None
+
+    def finish(p: tuple[int, Refining]) -> None:
+        j, refining = p
+        sols.extend((j, s) for s in refining.result())
+        done[j] = True
+        if progress is not None:
+            progress(j + 1, no)
+
     try:
         for i, o in enumerate(olist):
             try:
@@ -178,17 +191,29 @@ def periodicity_map(
             dwz[i], dphi[i], phi_t[i] = (r[k].reshape(nk, nw) for k in ("dwz", "dphi", "phi_t"))
             status[i] = r["status"].reshape(nk, nw)
             if solve:
-                sols += [(i, s) for s in solutions_from_rows(o, kzs, phi0, wz, phi_t[i], n_periods, srp)]
-            done[i] = True
-            if progress is not None:
-                progress(i + 1, no)
+                pending = (i, start_row_solutions(o, kzs, phi0, wz, phi_t[i], n_periods, srp))
+                if i < no - 1:
+                    p, pending = pending, None
+                    finish(p)
+            else:
+                done[i] = True
+                if progress is not None:
+                    progress(i + 1, no)
+        coords = map_coordinates(olist, kzs, wz)
+        if pending is not None:
+            p, pending = pending, None
+            finish(p)
     except KeyboardInterrupt:
         complete = False
+        if pending is not None:  # the last orbit's refinement may have finished (else Ctrl-C stopped it too)
+            try:
+                finish(pending)
+            except KeyboardInterrupt:
+                pass
         warnings.warn(f"periodicity_map interrupted: {int(done.sum())} of {no} orbits finished and kept", stacklevel=2)
     grid = {"dwz": dwz, "dphi": dphi, "phi_T": phi_t, "status": status}
     return map_dataset(olist, family, kzs, wz, grid, done, phi0=phi0, n_periods=n_periods, rtol=rtol, atol=atol, srp=srp, complete=complete,
-                       solutions=sols if solve else None, attrs={"integrator": str(method)})
-
+                       solutions=sols if solve else None, attrs={"integrator": str(method)}, coords=coords)
 
 
 def map_grid(kz, wz0, n_periods):
@@ -203,6 +228,13 @@ def map_grid(kz, wz0, n_periods):
         raise ValueError("invalid argument `wz0`: must be a finite, strictly increasing array of at least 2 rates")
     n_periods = as_count(n_periods, "n_periods", 1)
     return kzs, wz
+
+
+def map_coordinates(olist, kzs, wz):
+    """A map's coordinates (:func:`map_coords`) as an xarray Coordinates, with their indexes."""
+    import xarray as xr
+
+    return xr.Coordinates(map_coords(olist, kzs, wz))
 
 
 def map_coords(olist, kzs, wz) -> dict:
@@ -224,10 +256,11 @@ def _common_family(olist) -> str:
     return names.pop() if len(names) == 1 and "symmetric" not in names else ""
 
 
-def map_dataset(olist, family, kzs, wz, grid, done, *, phi0, n_periods, rtol, atol, srp, complete, attrs=None, solutions=None):
+def map_dataset(olist, family, kzs, wz, grid, done, *, phi0, n_periods, rtol, atol, srp, complete, attrs=None, solutions=None, coords=None):
     """The map's Dataset: residual grids over (orbit, kz, wz0), coordinates with units and the
     parameters as attributes (shared by periodicity_map and run_map); ``solutions``: (orbit
-    index, AttitudeSolution) pairs, the ``sol_*`` variables along ``solution``."""
+    index, AttitudeSolution) pairs, the ``sol_*`` variables along ``solution``; ``coords``: the
+    :func:`map_coordinates` of these orbits and grid, when built already."""
     import xarray as xr
 
     dims = ("orbit", "kz", "wz0")
@@ -238,7 +271,7 @@ def map_dataset(olist, family, kzs, wz, grid, done, *, phi0, n_periods, rtol, at
             **{k: (dims, grid[k], dict(MAP_VARIABLES[k])) for k in ("dwz", "dphi", "phi_T", "status")},
             "computed": ("orbit", np.asarray(done, dtype=bool).copy()),
         },
-        coords=map_coords(olist, kzs, wz),
+        coords=map_coordinates(olist, kzs, wz) if coords is None else coords,
         attrs={
             "title": "librate attitude periodicity map",
             "phi0": float(phi0),
@@ -338,30 +371,20 @@ def row_candidates(kzs, phi0, wz, phi_t_rows) -> tuple[list, list[float], int]:
 def crossing_windows(kzs, phi0, wz, phi_t_rows) -> tuple[list, list[float], int, tuple[np.ndarray, np.ndarray]]:
     """:func:`row_candidates` with each candidate's search window (lo, hi) of wz0: its rate
     interval widened by :data:`QUICK_WINDOW` intervals on each side where phi(KT) changes by at
-    most :data:`RESOLVED` pi per interval there, else (-inf, inf)."""
+    most :data:`RESOLVED` pi per interval there, else (-inf, inf) (librate_core::map::windows)."""
     kzs = np.atleast_1d(np.asarray(kzs, dtype=float))
-    rows = np.atleast_2d(phi_t_rows)
-    wz = np.asarray(wz, dtype=float)
+    rows = np.atleast_2d(np.asarray(phi_t_rows, dtype=float))
+    wz = np.ascontiguousarray(wz, dtype=float)
     cands, kk, unresolved, lo, hi = [], [], 0, [], []
-    for j, k in enumerate(kzs):
-        c = candidates(rows[j], phi0, wz, math.pi, max_crossings=MAX_CROSSINGS)
-        cands += c
-        kk += [float(k)] * len(c)
-        u = (np.asarray(rows[j], dtype=float) - phi0) / math.pi
-        a, b = u[:-1], u[1:]
-        with np.errstate(invalid="ignore"):
-            crossed = np.floor(np.maximum(a, b)) - np.ceil(np.minimum(a, b)) + 1  # as candidates() counts them
-        unresolved += int(np.sum(np.isfinite(crossed) & (crossed > MAX_CROSSINGS)))
-        if c:
-            at = np.clip(np.searchsorted(wz, [w for _, w in c], side="right") - 1, 0, wz.size - 2)
-            first, last = np.maximum(at - QUICK_WINDOW, 0), np.minimum(at + QUICK_WINDOW, wz.size - 2)
-            near = np.minimum(first[:, None] + np.arange(2 * QUICK_WINDOW + 1), last[:, None])  # each window's intervals
-            with np.errstate(invalid="ignore"):
-                ok = np.all(np.abs(b - a)[near] <= RESOLVED, axis=1)  # NaN (a failed trajectory): not resolved
-            lo.append(np.where(ok, wz[first], -np.inf))
-            hi.append(np.where(ok, wz[last + 1], np.inf))
-    window = (np.concatenate(lo), np.concatenate(hi)) if lo else (np.empty(0), np.empty(0))
-    return cands, kk, unresolved, window
+    for j, k in enumerate(kzs.tolist()):
+        c = _core.row_crossings(np.ascontiguousarray(rows[j]), wz, phi0=float(phi0), level=math.pi, max_crossings=MAX_CROSSINGS,
+                                window=(QUICK_WINDOW, RESOLVED))
+        cands += zip(c.k.tolist(), c.wz0.tolist())
+        kk += [k] * len(c.k)
+        unresolved += c.unresolved
+        lo.append(c.window[:, 0])
+        hi.append(c.window[:, 1])
+    return cands, kk, unresolved, (np.concatenate(lo), np.concatenate(hi))
 
 
 def solutions_from_rows(orbit, kzs, phi0, wz, phi_t_rows, n_periods, srp=None,
@@ -374,23 +397,40 @@ def solutions_from_rows(orbit, kzs, phi0, wz, phi_t_rows, n_periods, srp=None,
     A batch of more than :data:`REFINE_BATCH_PERIODS` candidate-periods is refined in several
     calls, in order (solutions found twice kept once). ``progress(done, total)``: after each
     call, in candidates."""
+    return start_row_solutions(orbit, kzs, phi0, wz, phi_t_rows, n_periods, srp, progress).result()
+
+
+def start_row_solutions(orbit, kzs, phi0, wz, phi_t_rows, n_periods, srp=None,
+                        progress: Callable[[int, int], None] | None = None) -> Refining:
+    """:func:`solutions_from_rows`, started: a batch within :data:`REFINE_BATCH_PERIODS` runs on
+    the core's pool while the caller goes on, and ``result()`` waits for it (and reports
+    ``progress``); a longer one is refined here, batch by batch."""
     cands, kk, unresolved, (lo, hi) = crossing_windows(kzs, phi0, wz, phi_t_rows)
     if unresolved:
         warnings.warn(f"the rate grid does not resolve phi(KT) on the orbit x0 = {orbit.x0:.6g} LU (K = {int(n_periods)} periods): "
                       f"{unresolved} interval(s) of `wz0` where it turns through more than {MAX_CROSSINGS} half-turns are left out "
-                      "of the solutions; a finer wz0 grid finds them", RuntimeWarning, stacklevel=3)
+                      "of the solutions; a finer wz0 grid finds them", RuntimeWarning, stacklevel=4)
     symmetric = is_symmetric(orbit, phi0) and (srp is None or srp.eps == 0.0)
     size = max(REFINE_BATCH_MIN, REFINE_BATCH_PERIODS // max(int(n_periods), 1))
-    sols: list[AttitudeSolution] = []
-    for a in range(0, len(cands), size):
-        sols += refine(orbit, np.array(kk[a:a + size]), phi0, cands[a:a + size], n_periods=n_periods, srp=srp,
-                       closure="half" if symmetric else "full",
-                       window=(float(wz[0]), float(wz[-1])), search=(lo[a:a + size], hi[a:a + size]) if symmetric else None)
-        if progress is not None:
-            progress(min(a + size, len(cands)), len(cands))
-    if len(cands) > size:  # candidates of two batches that converged onto one solution: kept once
-        sols = _distinct(sols)
-    return sorted(sols, key=lambda s: (s.kz, s.wz0))
+    def batch(a: int) -> Refining:
+        return start_refine(orbit, np.array(kk[a:a + size]), phi0, cands[a:a + size], n_periods=n_periods, srp=srp,
+                            closure="half" if symmetric else "full", window=(float(wz[0]), float(wz[-1])),
+                            search=(lo[a:a + size], hi[a:a + size]) if symmetric else None)
+
+    first = batch(0)  # under way while the caller goes on; later batches start in turn
+
+    def finish() -> list[AttitudeSolution]:
+        sols: list[AttitudeSolution] = []
+        for a in range(0, len(cands), size):
+            b = first if a == 0 else batch(a)
+            sols += [s for _, s in b.result()]
+            if progress is not None:
+                progress(min(a + size, len(cands)), len(cands))
+        if len(cands) > size:  # candidates of two batches that converged onto one solution: kept once
+            sols = _distinct(sols)
+        return sorted(sols, key=lambda s: (s.kz, s.wz0))
+
+    return Refining(finish)
 
 
 def _distinct(sols: list[AttitudeSolution]) -> list[AttitudeSolution]:

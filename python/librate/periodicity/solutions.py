@@ -15,7 +15,7 @@ independently (the orbit integrated alongside instead of the forcing table, tigh
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -31,7 +31,7 @@ from ..orbits.periodic import PeriodicOrbit
 
 __all__ = ["AttitudeSolution", "find_periodic_attitudes", "orbit_forcing", "clear_forcing_cache", "sweep", "candidates",
            "check_orbit", "check_kz", "check_kinds", "KINDS", "check_srp", "is_symmetric", "MAP_RTOL", "MAP_ATOL", "correct", "verified",
-           "refine", "refine_groups",
+           "refine", "refine_groups", "start_refine", "Refining",
            "turns_of", "n_total_of", "per_period", "turns_array", "SOLVE_RTOL", "SOLVE_ATOL", "STEP_MAX_ITER", "MAP_METHOD",
            "STEP_MAX_HALVINGS"]
 
@@ -44,6 +44,11 @@ MAP_ATOL = 1e-12
 #: does not is a step too long (the driver halves it), not worth forty iterations.
 STEP_MAX_ITER = 10
 STEP_MAX_HALVINGS = 4
+#: The corrector's defaults: convergence at a residual max-norm of CORRECT_TOL, at most
+#: CORRECT_MAX_ITER Newton steps and CORRECT_MAX_HALVINGS step halvings of the line search.
+CORRECT_TOL = 1e-12
+CORRECT_MAX_ITER = 40
+CORRECT_MAX_HALVINGS = 10
 #: Integration tolerances of the corrector's trajectories.
 SOLVE_RTOL = 1e-13
 SOLVE_ATOL = 1e-13
@@ -296,8 +301,8 @@ def turns_of(n_total, kind) -> np.ndarray:
 
 
 def correct(orbit: PeriodicOrbit, *, kz, n_total, kind, phi0, wz0, n_periods: int = 1, srp=None, closure: str = "half",
-            free: str = "phi0", theta_sun0=None, eps=None, tol: float = 1e-12, max_iter: int = 40, bordered=None, monodromy: bool = True,
-            max_halvings: int = 10, search=None):
+            free: str = "phi0", theta_sun0=None, eps=None, tol: float = CORRECT_TOL, max_iter: int = CORRECT_MAX_ITER, bordered=None,
+            monodromy: bool = True, max_halvings: int = CORRECT_MAX_HALVINGS, search=None):
     """One call of the Rust corrector for a batch of candidates on ``orbit`` (arrays broadcast
     together: kz, n_total, kind, phi0, wz0, and theta_sun0 / eps overriding the plate's):
     ``closure`` "half" (symmetric, over K T / 2) or "full" (over K T); ``free`` "phi0" or
@@ -305,6 +310,25 @@ def correct(orbit: PeriodicOrbit, *, kz, n_total, kind, phi0, wz0, n_periods: in
     b), or one such row per candidate) for the continuation driver; ``search``: (lo, hi) of
     wz0 per candidate, where a Newton step leaving it stops the candidate ("left_window").
     Returns the core's CorrectionBatch."""
+    cases, options, t_final = _corrector_inputs(orbit, kz=kz, n_total=n_total, kind=kind, phi0=phi0, wz0=wz0, n_periods=n_periods,
+                                                srp=srp, closure=closure, theta_sun0=theta_sun0, eps=eps, tol=tol, max_iter=max_iter,
+                                                monodromy=monodromy, max_halvings=max_halvings, search=search)
+    border = None
+    if bordered is not None:
+        parameter = _choice(_PARAMETERS, bordered[0], "parameter")
+        cond = np.asarray(bordered[1], dtype=float)
+        if cond.ndim == 2:  # one condition per candidate (branches corrected together)
+            border = _core.Bordered(parameter, tuple(cond[0]), conditions=np.ascontiguousarray(np.broadcast_to(cond, (len(cases), 4))))
+        else:
+            border = _core.Bordered(parameter, tuple(float(v) for v in cond))
+    return _core.attitude_correct(orbit_forcing(orbit), cases, t_final=t_final, closure=_choice(_CLOSURES, closure, "closure"),
+                                  free=_choice(_FREE, free, "free"), options=options, bordered=border)
+
+
+def _corrector_inputs(orbit, *, kz, n_total, kind, phi0, wz0, n_periods, srp, closure, theta_sun0, eps, tol, max_iter, monodromy,
+                      max_halvings, search):
+    """The core's PlanarCases, CorrectorOptions and closure time of a batch of candidates (the
+    arrays of :func:`correct` broadcast together)."""
     cols = np.broadcast_arrays(np.asarray(kz, dtype=float), np.asarray(n_total, dtype=float), np.asarray(kind),
                                np.asarray(phi0, dtype=float),
                                np.asarray(wz0, dtype=float), np.asarray(0.0 if eps is None else eps, dtype=float),
@@ -315,21 +339,11 @@ def correct(orbit: PeriodicOrbit, *, kz, n_total, kind, phi0, wz0, n_periods: in
         plates = plates_of(np.full(k.size, srp.eps) if eps is None else e, np.full(k.size, float(srp.cs)), np.full(k.size, float(srp.cd)),
                            np.full(k.size, float(srp.sun.theta0)) if theta_sun0 is None else th)
     T = n_periods * orbit.period
-    border = None
-    if bordered is not None:
-        parameter = _choice(_PARAMETERS, bordered[0], "parameter")
-        cond = np.asarray(bordered[1], dtype=float)
-        if cond.ndim == 2:  # one condition per candidate (branches corrected together)
-            border = _core.Bordered(parameter, tuple(cond[0]), conditions=np.ascontiguousarray(np.broadcast_to(cond, (k.size, 4))))
-        else:
-            border = _core.Bordered(parameter, tuple(float(v) for v in cond))
     options = _core.CorrectorOptions(_core.NewtonOptions(tol=float(tol), max_iter=int(max_iter), max_halvings=int(max_halvings)),
                                      _core.LaneOptions(rtol=SOLVE_RTOL, atol=SOLVE_ATOL), monodromy=bool(monodromy))
     window = None if search is None else np.column_stack([np.broadcast_to(np.asarray(v, dtype=float), k.shape) for v in search])
     cases = _core.PlanarCases(p, w, k, turns=turns_of(nt, kd), plates=plates, window=window)
-    return _core.attitude_correct(orbit_forcing(orbit), cases, t_final=0.5 * T if closure == "half" else T,
-                                  closure=_choice(_CLOSURES, closure, "closure"), free=_choice(_FREE, free, "free"), options=options,
-                                  bordered=border)
+    return cases, options, 0.5 * T if closure == "half" else T
 
 
 def verified(orbit: PeriodicOrbit, *, kz, n_total, kind, phi0, wz0, n_periods: int = 1, plates=None, iterations=None,
@@ -352,15 +366,22 @@ def verified(orbit: PeriodicOrbit, *, kz, n_total, kind, phi0, wz0, n_periods: i
         per_plate = plates_of([pl.eps if pl else 0.0 for pl in plates], [pl.cs if pl else 0.0 for pl in plates],
                               [pl.cd if pl else 0.0 for pl in plates], [pl.sun.theta0 if pl else 0.0 for pl in plates])
     T = n_periods * orbit.period
-    cases = _core.PlanarCases(np.ascontiguousarray(phi0), np.ascontiguousarray(wz0), np.ascontiguousarray(kz), plates=per_plate)
+    cases = _core.PlanarCases(np.ascontiguousarray(phi0), np.ascontiguousarray(wz0), np.ascontiguousarray(kz),
+                              turns=turns_of(n_total, kind), plates=per_plate)
     v = _core.planar_verify(orbit.system.mu, [float(x) for x in orbit.state0], T, cases, threads=threads)
-    # one AttitudeSolution per motion, from plain Python values (numpy scalars cost ~1 us each)
-    turns = turns_of(n_total, kind).tolist()
-    its = [0] * m if iterations is None else np.asarray(iterations).astype(int).tolist()
-    k_, nt_, kd_, p_, w_ = kz.tolist(), n_total.astype(int).tolist(), [str(x) for x in kind.tolist()], phi0.tolist(), wz0.tolist()
-    phi_t, wz_t, stm = np.asarray(v.phi_t).tolist(), np.asarray(v.wz_t).tolist(), np.array(v.stm)
-    return [AttitudeSolution(orbit, k_[i], nt_[i], kd_[i], p_[i], w_[i], phi_t[i] - p_[i] - 2 * math.pi * turns[i], wz_t[i] - w_[i], stm[i],
-                             its[i], plates[i], int(n_periods)) for i in range(m)]
+    its = [0] * m if iterations is None else iterations
+    return _solutions(orbit, kz, n_total, kind, phi0, wz0, v.residual, v.stm, its, plates, n_periods)
+
+
+def _solutions(orbit, kz, n_total, kind, phi0, wz0, residual, stm, iterations, plates, n_periods) -> list[AttitudeSolution]:
+    """One AttitudeSolution per verified motion (arrays over them; ``residual`` (m, 2) and ``stm``
+    (m, 2, 2) of the core's independent re-propagation), made from plain Python values (numpy
+    scalars cost ~1 us each)."""
+    k_, nt_, kd_ = np.asarray(kz).tolist(), np.asarray(n_total).astype(int).tolist(), [str(x) for x in np.asarray(kind).tolist()]
+    p_, w_, its = np.asarray(phi0).tolist(), np.asarray(wz0).tolist(), np.asarray(iterations).astype(int).tolist()
+    res, stm = np.asarray(residual).tolist(), np.asarray(stm)
+    return [AttitudeSolution(orbit, k_[i], nt_[i], kd_[i], p_[i], w_[i], res[i][0], res[i][1], stm[i], its[i], plates[i], int(n_periods))
+            for i in range(len(k_))]
 
 
 def _grid_for(T: float, lo: float, hi: float, n_grid: int | None) -> np.ndarray:
@@ -372,22 +393,11 @@ def _grid_for(T: float, lo: float, hi: float, n_grid: int | None) -> np.ndarray:
 
 def candidates(phi_t, phi0, wz, level, max_crossings: int | None = None):
     """wz0 brackets where (phi(t) - phi0) / level crosses an integer; returns (k, wz_interp) in
-    order of the grid (linear interpolation). ``max_crossings``: an interval that crosses more
-    integers than that is left out (the grid does not resolve it)."""
-    u = (np.asarray(phi_t, dtype=float) - phi0) / level
-    wz = np.asarray(wz, dtype=float)
-    a, b = u[:-1], u[1:]
-    ok = np.isfinite(a) & np.isfinite(b) & (a != b)
-    lo = np.ceil(np.minimum(a, b))
-    hi = np.floor(np.maximum(a, b))
-    if max_crossings is not None:
-        ok &= hi - lo + 1 <= max_crossings
-    out = []
-    for i in np.flatnonzero(ok & (hi >= lo)).tolist():
-        ai, bi, w0, w1 = float(a[i]), float(b[i]), float(wz[i]), float(wz[i + 1])  # the same arithmetic on Python floats
-        for k in range(int(lo[i]), int(hi[i]) + 1):
-            out.append((k, w0 + (k - ai) / (bi - ai) * (w1 - w0)))
-    return out
+    order of the grid (linear interpolation; librate_core::map::crossings). ``max_crossings``: an
+    interval that crosses more integers than that is left out (the grid does not resolve it)."""
+    c = _core.row_crossings(np.ascontiguousarray(phi_t, dtype=float), np.ascontiguousarray(wz, dtype=float), phi0=float(phi0),
+                            level=float(level), max_crossings=None if max_crossings is None else int(max_crossings))
+    return list(zip(c.k.tolist(), c.wz0.tolist()))
 
 
 def refine(orbit, kz, phi0, cands, *, n_periods, srp, closure, window, kinds=KINDS, search=None) -> list[AttitudeSolution]:
@@ -402,41 +412,78 @@ def refine_groups(orbit, kz, phi0, cands, *, n_periods, srp, closure, window, ki
                   group=None) -> list[tuple[int, AttitudeSolution]]:
     """Refine (k, wz0) candidates (k = 2 turns over the K periods, odd k a half turn) in ONE
     corrector call and verify the converged ones in one more; keep those inside ``window``
-    with an independent residual below 1e-8, one per (turns, kind, wz0 to 1e-8), sorted by wz0.
-    ``kz`` and ``phi0`` may be one value or one per candidate. ``search``: (lo, hi), a window
-    of wz0 per candidate: the candidates are a map's crossings, close guesses of the
-    half-period closure, each refined within its window (a Newton step leaving it stops it)
-    and given up after a few Newton steps (see ``periodicity.maps.crossing_windows``). ``group``:
-    one integer label per candidate (default: all 0); duplicates are merged within a group only.
-    Returns (group, solution) pairs, group by group (in order of first appearance), each group
-    sorted by wz0."""
+    with an independent residual below 1e-8, one per (turns, kind, wz0 to 1e-8), sorted by wz0:
+    :func:`start_refine`, waited for."""
+    return start_refine(orbit, kz, phi0, cands, n_periods=n_periods, srp=srp, closure=closure, window=window, kinds=kinds, search=search,
+                        group=group).result()
+
+
+class Refining:
+    """Work under way whose outcome ``result()`` waits for: a refinement started by
+    :func:`start_refine` runs on the core's pool meanwhile. It is waited for once; later calls
+    return that outcome again, or raise that exception again (a KeyboardInterrupt that stopped
+    it)."""
+
+    __slots__ = ("_finish", "_out", "_error")
+
+    def __init__(self, finish: Callable[[], list]):
+        self._finish: Callable[[], list] | None = finish
+        self._out: list = []
+        self._error: BaseException | None = None
+
+    def result(self) -> list:
+        if self._finish is not None:
+            finish, self._finish = self._finish, None
+            try:
+                self._out = finish()
+            except BaseException as err:
+                self._error = err
+                raise
+        if self._error is not None:
+            raise self._error
+        return self._out
+
+
+def start_refine(orbit, kz, phi0, cands, *, n_periods, srp, closure, window, kinds=KINDS, search=None, group=None) -> Refining:
+    """Start refining (k, wz0) candidates (k = 2 turns over the K periods, odd k a half turn) in
+    one core call (librate_core::attitude::refine_planar_attitudes, on the pool while the caller
+    goes on): all corrected together, the converged ones inside ``window`` kept once per
+    (group, Kz, turns, wz0 to 1e-8), re-propagated independently together and kept with a
+    residual of at most 1e-8. ``kz`` and ``phi0`` may be one value or one per candidate.
+    ``search``: (lo, hi), a window of wz0 per candidate: the candidates are a map's crossings,
+    close guesses of the half-period closure, each refined within its window (a Newton step
+    leaving it stops it) and given up after a few Newton steps (see
+    ``periodicity.maps.crossing_windows``). ``group``: one integer label per candidate
+    (default: all 0); duplicates are merged within a group only. ``result()`` gives (group,
+    solution) pairs, group by group (in order of first appearance), each group sorted by Kz and
+    wz0."""
     n = len(cands)
-    grp = np.zeros(n, dtype=int) if group is None else np.asarray(group)
+    grp = np.zeros(n, dtype=np.int64) if group is None else np.asarray(group, dtype=np.int64)
     p0 = np.broadcast_to(np.asarray(phi0, dtype=float), (n,))
     keep = [i for i, (k, _) in enumerate(cands) if ("periodic" if k % 2 == 0 else "half-turn") in kinds]
     if not keep:
-        return []
+        return Refining(list)
     ks = np.array([cands[i][0] for i in keep])
     n_total = ks // 2
     kind = np.where(ks % 2 == 0, "periodic", "half-turn")
     kzs = np.broadcast_to(np.asarray(kz, dtype=float), (n,))[keep]
-    grp, p0 = grp[keep], p0[keep]
-    quick = {} if search is None else {"max_iter": STEP_MAX_ITER, "max_halvings": 3,
-                                       "search": tuple(np.asarray(v, dtype=float)[keep] for v in search)}
-    b = correct(orbit, kz=kzs, n_total=n_total, kind=kind, phi0=p0, wz0=np.array([cands[i][1] for i in keep]), n_periods=n_periods, srp=srp,
-                closure=closure, monodromy=False, **quick)  # the verification brings the monodromy
-    lo, hi = window
-    order = {g: j for j, g in enumerate(dict.fromkeys(grp.tolist()))}
-    # the same comparisons on plain Python values (numpy scalars cost ~1 us each)
-    g_, k_, nt_, kd_, w_ = grp.tolist(), kzs.tolist(), n_total.tolist(), kind.tolist(), b.wz0.tolist()
-    conv = sorted(np.flatnonzero(b.converged & (b.wz0 >= lo) & (b.wz0 <= hi)).tolist(), key=lambda i: (order[g_[i]], k_[i], w_[i]))
-    ok: list[int] = []  # one per solution: candidates that converged onto the same one are verified once
-    for i in conv:
-        if not any(g_[j] == g_[i] and k_[j] == k_[i] and nt_[j] == nt_[i] and kd_[j] == kd_[i] and abs(w_[j] - w_[i]) < 1e-8 for j in ok):
-            ok.append(i)
-    sols = verified(orbit, kz=kzs[ok], n_total=n_total[ok], kind=kind[ok], phi0=b.phi0[ok], wz0=b.wz0[ok], n_periods=n_periods,
-                    plates=None if srp is None else [srp] * len(ok), iterations=b.iterations[ok])
-    return [(int(grp[i]), s) for i, s in zip(ok, sols) if s.residual <= 1e-8]
+    grp, p0 = np.ascontiguousarray(grp[keep]), p0[keep]
+    quick = {"max_iter": CORRECT_MAX_ITER, "max_halvings": CORRECT_MAX_HALVINGS, "search": None} if search is None else {
+        "max_iter": STEP_MAX_ITER, "max_halvings": 3, "search": tuple(np.asarray(v, dtype=float)[keep] for v in search)}
+    # monodromy=False: the verification brings the STM
+    wz0 = np.array([cands[i][1] for i in keep])
+    cases, options, t_final = _corrector_inputs(orbit, kz=kzs, n_total=n_total, kind=kind, phi0=p0, wz0=wz0, n_periods=n_periods, srp=srp,
+                                                closure=closure, theta_sun0=None, eps=None, tol=CORRECT_TOL, monodromy=False, **quick)
+    pending = _core.attitude_refine(orbit_forcing(orbit), cases, t_final=t_final, closure=_choice(_CLOSURES, closure, "closure"),
+                                    options=options, keep=(float(window[0]), float(window[1])), groups=grp)
+
+    def finish() -> list:
+        r = pending.join()
+        i = np.asarray(r.index)
+        sols = _solutions(orbit, kzs[i], n_total[i], kind[i], r.phi0, r.wz0, r.residual, r.stm, r.iterations, [srp] * len(i), n_periods)
+        return list(zip(grp[i].tolist(), sols))
+
+    return Refining(finish)
 
 
 def find_periodic_attitudes(

@@ -148,8 +148,65 @@ pub fn start_global_pool() -> Result<PoolInfo> {
     Ok(STARTED.get_or_init(|| info).clone())
 }
 
-/// Calls of [`run_polled`] in flight.
+/// Calls of [`run_polled`] and [`spawn`]ed work in flight.
 static CALLS: AtomicUsize = AtomicUsize::new(0);
+
+/// One call in flight (counted in [`CALLS`] by its maker), until dropped.
+struct InFlight;
+
+impl Drop for InFlight {
+    fn drop(&mut self) {
+        CALLS.fetch_sub(1, Ordering::AcqRel);
+    }
+}
+
+/// The value from `rx`, running `poll` every `every` while it is not there; None when the
+/// sender was dropped unsent.
+fn receive_polled<T>(rx: &std::sync::mpsc::Receiver<T>, every: std::time::Duration, poll: &mut dyn FnMut()) -> Option<T> {
+    use std::sync::mpsc::RecvTimeoutError;
+    loop {
+        match rx.recv_timeout(every) {
+            Ok(out) => return Some(out),
+            Err(RecvTimeoutError::Timeout) => poll(),
+            Err(RecvTimeoutError::Disconnected) => return None,
+        }
+    }
+}
+
+/// Work started on the global pool by [`spawn`], to be waited for later; dropped unwaited, the
+/// work still runs to its end and its result is discarded.
+pub struct Pending<T> {
+    rx: std::sync::mpsc::Receiver<std::thread::Result<T>>,
+}
+
+/// Start `f` as a job on the global pool and return at once: the caller goes on with other work
+/// (the Python facade builds a result's containers while a map's solutions are refined) and
+/// waits with [`Pending::wait_polled`]. The job counts as a call in flight for [`run_polled`]
+/// until it has returned, so calls made meanwhile run on threads of their own.
+pub fn spawn<T: Send + 'static>(f: impl FnOnce() -> T + Send + 'static) -> Result<Pending<T>> {
+    start_global_pool()?;
+    CALLS.fetch_add(1, Ordering::AcqRel);
+    let (tx, rx) = std::sync::mpsc::channel();
+    rayon::spawn(move || {
+        let in_flight = InFlight;
+        let out = std::panic::catch_unwind(std::panic::AssertUnwindSafe(f));
+        drop(in_flight);
+        let _ = tx.send(out);
+    });
+    Ok(Pending { rx })
+}
+
+impl<T> Pending<T> {
+    /// Wait for the work while running `poll` every `every` (as [`run_polled`]); a panic in the
+    /// work resumes here.
+    pub fn wait_polled(self, every: std::time::Duration, mut poll: impl FnMut()) -> T {
+        match receive_polled(&self.rx, every, &mut poll) {
+            Some(Ok(out)) => out,
+            Some(Err(panic)) => std::panic::resume_unwind(panic),
+            None => unreachable!("a spawned job sends its outcome, value or panic"),
+        }
+    }
+}
 
 /// Run `f` while the calling thread runs `poll` every `every` until `f` has returned (the Python
 /// binding polls its signal handlers so); a panic in `f` resumes on the calling thread.
@@ -161,25 +218,12 @@ static CALLS: AtomicUsize = AtomicUsize::new(0);
 /// and a whole second call queued as one job could run to its end inside the first one, holding
 /// it back; started on its own thread, a call queues only its loops' pieces.
 pub fn run_polled<T: Send>(f: impl FnOnce() -> T + Send, every: std::time::Duration, mut poll: impl FnMut()) -> Result<T> {
-    use std::sync::mpsc::{channel, RecvTimeoutError};
     start_global_pool()?;
-    struct InFlight;
-    impl Drop for InFlight {
-        fn drop(&mut self) {
-            CALLS.fetch_sub(1, Ordering::AcqRel);
-        }
-    }
     let alone = CALLS.fetch_add(1, Ordering::AcqRel) == 0;
     let _in_flight = InFlight;
-    let (tx, rx) = channel();
-    let wait = |rx: std::sync::mpsc::Receiver<T>, poll: &mut dyn FnMut()| loop {
-        match rx.recv_timeout(every) {
-            Ok(out) => return Some(out),
-            Err(RecvTimeoutError::Timeout) => poll(),
-            // f panicked (tx dropped unsent): the scope's end resumes that panic
-            Err(RecvTimeoutError::Disconnected) => return None,
-        }
-    };
+    let (tx, rx) = std::sync::mpsc::channel();
+    // f panicked (tx dropped unsent, None): the scope's end resumes that panic
+    let wait = |rx: std::sync::mpsc::Receiver<T>, poll: &mut dyn FnMut()| receive_polled(&rx, every, poll);
     let out = if alone {
         rayon::in_place_scope(|s| {
             s.spawn(move |_| {
@@ -245,6 +289,23 @@ fn bind_current_thread(cpu: usize) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn spawned_work_returns_its_value_or_resumes_its_panic_on_wait() {
+        use rayon::prelude::*;
+        let every = std::time::Duration::from_millis(1);
+        let pending = spawn(|| (0..1000u64).sum::<u64>()).unwrap();
+        let mut polls = 0;
+        assert_eq!(pending.wait_polled(every, || polls += 1), 499_500);
+        let pending = spawn(|| -> u64 { panic!("boom") }).unwrap();
+        let caught = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| pending.wait_polled(every, || {})));
+        let msg = caught.unwrap_err().downcast_ref::<&str>().copied();
+        assert_eq!(msg, Some("boom"));
+        // dropped unwaited: the work still runs (and its parallel loops too)
+        let (tx, rx) = std::sync::mpsc::channel();
+        drop(spawn(move || tx.send((0..100u64).into_par_iter().sum::<u64>()).unwrap()).unwrap());
+        assert_eq!(rx.recv().unwrap(), 4950);
+    }
 
     #[test]
     fn binding_values_parse_and_bad_ones_name_the_variable() {

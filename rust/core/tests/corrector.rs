@@ -583,3 +583,92 @@ fn val_linearised_family_orbit_is_second_order() {
     assert!(worst < 1e-8 * scale && ev < 1e-10 && et < 1e-10, "{worst} {scale} {ev} {et}");
     assert!(fam.linearised(&centre.0, f64::NAN).is_err());
 }
+
+/// The refinement of candidates into verified solutions (attitude::refine_planar_attitudes) is
+/// the corrector, the selection and the verifier in one call: on the 12.66-day DRO, the 40
+/// candidates of `batch_candidates` in two groups (alternating labels), half closure, rates kept
+/// in [-2.5, 1.5]:
+/// - each kept solution's correction is, bit for bit, the batch correction of its candidate, and
+///   its re-propagation, bit for bit, the verifier's run of the kept starts in the returned order;
+/// - the order is group (first appearance), Kz, wz0; no two kept solutions of a group share Kz
+///   and turns within SAME_SOLUTION (1e-8) in wz0; every converged candidate inside the window
+///   has a kept solution of its group, Kz and turns within 1e-8 (its residual passed the check:
+///   the verifier closes these to < 1e-11, test val_thesis_fig23_solution);
+/// - the kept residuals are the full closure's of the re-propagation and at most 1e-8;
+/// - the outcome is bit-identical on 1 and 2 threads.
+#[test]
+fn val_refine_is_correct_select_verify() {
+    use librate_core::attitude::{full_closure_residual, refine_planar_attitudes, PlanarOrbit, MAX_VERIFIED_RESIDUAL, SAME_SOLUTION};
+    let (s0, t) = dro1266();
+    let f = table(&s0, t);
+    let orbit = PlanarOrbit { mu: MU, state0: s0, primaries: [true, true], forcing: &f };
+    let cands = batch_candidates(t);
+    let groups: Vec<i64> = (0..cands.len()).map(|i| [7, 3][i % 2]).collect();
+    let keep = (-2.5, 1.5);
+    let opts = CorrectorOptions { monodromy: false, threads: Some(2), ..CorrectorOptions::default() };
+    let out = refine_planar_attitudes(&orbit, 0.5 * t, Closure::Half, &cands, &groups, &opts, keep).unwrap();
+    let one = refine_planar_attitudes(&orbit, 0.5 * t, Closure::Half, &cands, &groups, &CorrectorOptions { threads: Some(1), ..opts }, keep).unwrap();
+    // (Debug prints each value's shortest round-trip form: equal strings are equal bits; NaN == NaN)
+    assert!(format!("{out:?}") == format!("{one:?}"), "threads changed the refinement");
+    let batch = correct_planar_attitudes(&f, 0.5 * t, Closure::Half, Free::Phi0, &cands, &opts).unwrap();
+    let starts: Vec<PlanarStart> = out.iter().map(|r| PlanarStart { kz: cands[r.index].case.kz, phi0: r.correction.phi0, wz0: r.correction.wz0, plate: None }).collect();
+    let ends = verify_planar_attitudes(MU, &s0, t, &starts, [true, true], Some(2)).unwrap();
+    assert!(out.len() >= 8, "only {} solutions", out.len());
+    let rank = |g: i64| if g == 7 { 0 } else { 1 };
+    for (j, r) in out.iter().enumerate() {
+        assert_eq!(bits(&r.correction), bits(&batch[r.index]));
+        assert_eq!(r.end, ends[j]);
+        let (c, x) = (&cands[r.index], &r.correction);
+        assert_eq!(r.residual, full_closure_residual(x.phi0, x.wz0, c.turns, r.end.phi_t, r.end.wz_t));
+        assert!(r.residual.iter().all(|v| v.abs() <= MAX_VERIFIED_RESIDUAL), "{r:?}");
+        assert!(x.converged() && x.wz0 >= keep.0 && x.wz0 <= keep.1);
+        if j > 0 {
+            let p = &out[j - 1];
+            let (kp, kr) = ((rank(groups[p.index]), cands[p.index].case.kz, p.correction.wz0), (rank(groups[r.index]), c.case.kz, x.wz0));
+            assert!(kp <= kr, "order: {kp:?} then {kr:?}");
+        }
+        for q in &out[..j] {
+            let same = groups[q.index] == groups[r.index] && cands[q.index].case.kz == c.case.kz && cands[q.index].turns == c.turns;
+            assert!(!same || (q.correction.wz0 - x.wz0).abs() >= SAME_SOLUTION, "kept twice: {q:?} and {r:?}");
+        }
+    }
+    for (i, b) in batch.iter().enumerate() {
+        if b.converged() && b.wz0 >= keep.0 && b.wz0 <= keep.1 {
+            let found = out.iter().any(|r| groups[r.index] == groups[i] && cands[r.index].case.kz == cands[i].case.kz && cands[r.index].turns == cands[i].turns && (r.correction.wz0 - b.wz0).abs() < 1e-8);
+            assert!(found, "converged candidate {i} ({b:?}) has no kept solution");
+        } else {
+            assert!(out.iter().all(|r| r.index != i), "candidate {i} kept: {b:?}");
+        }
+    }
+    // bad arguments name the parameter
+    let name = |r: librate_core::Result<Vec<librate_core::attitude::Refined>>| match r {
+        Err(librate_core::Error::InvalidArgument { name, .. }) => name,
+        other => panic!("expected an invalid argument, got {other:?}"),
+    };
+    assert_eq!(name(refine_planar_attitudes(&orbit, 0.5 * t, Closure::Half, &cands, &groups[1..], &opts, keep)), "groups");
+    assert_eq!(name(refine_planar_attitudes(&orbit, 0.5 * t, Closure::Half, &cands, &groups, &opts, (1.0, -1.0))), "keep");
+    assert_eq!(name(refine_planar_attitudes(&orbit, 0.5 * t, Closure::Half, &cands, &groups, &opts, (f64::NAN, 1.0))), "keep");
+    assert!(refine_planar_attitudes(&orbit, 0.5 * t, Closure::Half, &[], &[], &opts, keep).unwrap().is_empty());
+}
+
+/// Kz = 0 (no torque): the refinement keeps exactly the analytic motions wz0 = 1 + 2 pi N / T
+/// (to 1e-12, as val_torque_free_solutions_are_analytic), once each although every one is found
+/// from two starts (0.2 below and 0.3 above), with the monodromy [[1, T], [0, 1]] of the
+/// re-propagation to 1e-11; full closure with phi0 free.
+#[test]
+fn val_refine_torque_free_keeps_each_analytic_motion_once() {
+    use librate_core::attitude::{refine_planar_attitudes, PlanarOrbit};
+    let (s0, t) = dro(0.8);
+    let f = table(&s0, t);
+    let orbit = PlanarOrbit { mu: MU, state0: s0, primaries: [true, true], forcing: &f };
+    let exact = |n: f64| 1.0 + 2.0 * PI * n / t;
+    let turns = [-1.0, -0.5, 0.0, 0.5, 1.0];
+    let cands: Vec<Candidate> = turns.iter().flat_map(|&n| [Candidate::new(0.4, exact(n) - 0.2, 0.0, n), Candidate::new(0.4, exact(n) + 0.3, 0.0, n)]).collect();
+    let out = refine_planar_attitudes(&orbit, t, Closure::Full, &cands, &vec![0; cands.len()], &CorrectorOptions::default(), (f64::NEG_INFINITY, f64::INFINITY)).unwrap();
+    assert_eq!(out.len(), turns.len());
+    for (r, n) in out.iter().zip(turns) {
+        assert!((r.correction.wz0 - exact(n)).abs() < 1e-12, "N = {n}: {r:?}");
+        let m = r.end.stm;
+        assert!((m[0] - 1.0).abs() < 1e-11 && (m[1] - t).abs() < 1e-10 && m[2].abs() < 1e-11 && (m[3] - 1.0).abs() < 1e-11, "{m:?}");
+    }
+}

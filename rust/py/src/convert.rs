@@ -29,7 +29,7 @@ pub(crate) fn rows<const N: usize>(a: &PyReadonlyArray2<'_, f64>, name: &str, n:
 }
 
 /// A 1-D array as a vector, of length `n` when given.
-pub(crate) fn vector(a: &PyReadonlyArray1<'_, f64>, name: &str, n: Option<usize>) -> PyResult<Vec<f64>> {
+pub(crate) fn vector<T: numpy::Element + Clone>(a: &PyReadonlyArray1<'_, T>, name: &str, n: Option<usize>) -> PyResult<Vec<T>> {
     let v = a.as_array().to_vec();
     match n {
         Some(n) if v.len() != n => Err(invalid(format!("invalid argument `{name}`: must have length {n}, got {}", v.len()))),

@@ -4,22 +4,30 @@ use librate_core::attitude::{FlatPlate, Sun};
 use librate_core::integrate::forcing::OrbitForcing;
 use librate_core::integrate::lanes::Case;
 use librate_core::map;
-use librate_core::attitude::{correct_across_family, correct_bordered, correct_planar_attitudes, verify_planar_attitudes, Candidate, Parameter, PlanarFamily, PlanarStart};
+use std::sync::{Arc, Mutex};
+
+use librate_core::attitude::{correct_across_family, correct_bordered, correct_planar_attitudes, full_closure_residual, refine_planar_attitudes, verify_planar_attitudes, Candidate, Parameter, PlanarFamily, PlanarOrbit, PlanarStart, Refined};
+use librate_core::threads::Pending;
 use numpy::{IntoPyArray, PyArrayMethods, PyReadonlyArray1};
+use pyo3::exceptions::PyRuntimeError;
 use pyo3::exceptions::PyKeyError;
 use pyo3::prelude::*;
 
 use crate::convert::vector;
 use crate::errors::invalid;
 use crate::options::{Bordered, Closure, CorrectorOptions, Free, LaneOptions, PlanarCases};
-use crate::interrupt::interruptible;
+use crate::interrupt::{interruptible, join, start};
 use crate::to_py;
 
 /// Gravity-gradient forcing S(t), C(t) of one planar periodic orbit, tabulated once (piecewise
 /// Chebyshev) and shared by every attitude trajectory on that orbit.
 #[pyclass(frozen, name = "OrbitForcing", module = "librate._core")]
 pub struct PyOrbitForcing {
-    inner: OrbitForcing,
+    inner: Arc<OrbitForcing>,
+    /// The orbit tabulated, for the independent re-propagations of `attitude_refine`.
+    mu: f64,
+    state0: [f64; 6],
+    primaries: [bool; 2],
 }
 
 #[pymethods]
@@ -28,7 +36,7 @@ impl PyOrbitForcing {
     #[pyo3(signature = (mu, state0, period, *, primaries=[true, true], tol=1e-12))]
     fn new(py: Python<'_>, mu: f64, state0: [f64; 6], period: f64, primaries: [bool; 2], tol: f64) -> PyResult<Self> {
         let inner = py.detach(|| OrbitForcing::new(mu, &state0, period, primaries, tol)).map_err(to_py)?;
-        Ok(Self { inner })
+        Ok(Self { inner: Arc::new(inner), mu, state0, primaries })
     }
     #[getter]
     fn period(&self) -> f64 {
@@ -304,6 +312,9 @@ pub struct PyPlanarVerification {
     wz_t: Py<PyAny>,
     /// d(phi, wz)(t_final) / d(phi0, wz0), (n, 2, 2).
     stm: Py<PyAny>,
+    /// The full closure's residuals (phi(t_final) - phi0 - 2 pi turns, wz(t_final) - wz0) with
+    /// the cases' turns, (n, 2).
+    residual: Py<PyAny>,
     /// The integration error message per item, or None.
     error: Vec<Option<String>>,
 }
@@ -345,11 +356,167 @@ fn planar_verify<'py>(
         phi_t: out.iter().map(|o| o.phi_t).collect::<Vec<f64>>().into_pyarray(py).into_any().unbind(),
         wz_t: out.iter().map(|o| o.wz_t).collect::<Vec<f64>>().into_pyarray(py).into_any().unbind(),
         stm: out.iter().flat_map(|o| o.stm).collect::<Vec<f64>>().into_pyarray(py).reshape([n, 2, 2])?.into_any().unbind(),
+        residual: out.iter().zip(&items).zip(&c.turns).flat_map(|((o, it), &turns)| full_closure_residual(it.phi0, it.wz0, turns, o.phi_t, o.wz_t)).collect::<Vec<f64>>().into_pyarray(py).reshape([n, 2])?.into_any().unbind(),
         error: out.iter().map(|o| o.error.as_ref().map(|e| e.to_string())).collect(),
     })
 }
 
+/// The solutions of `attitude_refine`: arrays over the kept solutions.
+#[pyclass(frozen, get_all, name = "PlanarRefinement", module = "librate._core")]
+pub struct PyPlanarRefinement {
+    /// Each solution's candidate index in the batch, int64 (m,).
+    index: Py<PyAny>,
+    /// The corrected phi0 and inertial wz0, (m,).
+    phi0: Py<PyAny>,
+    wz0: Py<PyAny>,
+    /// The corrector's accepted Newton steps, int64 (m,).
+    iterations: Py<PyAny>,
+    /// The independent re-propagation over the full closure time K T: phi and wz at its end,
+    /// (m,), and d(phi, wz)(KT) / d(phi0, wz0), (m, 2, 2).
+    phi_t: Py<PyAny>,
+    wz_t: Py<PyAny>,
+    stm: Py<PyAny>,
+    /// Its full closure's residuals (phi(KT) - phi0 - 2 pi turns, wz(KT) - wz0), (m, 2).
+    residual: Py<PyAny>,
+}
+
+#[pymethods]
+impl PyPlanarRefinement {
+    fn __len__(&self, py: Python<'_>) -> PyResult<usize> {
+        self.index.bind(py).len()
+    }
+    fn __repr__(&self, py: Python<'_>) -> PyResult<String> {
+        Ok(format!("PlanarRefinement(solutions={})", self.__len__(py)?))
+    }
+}
+
+fn refinement_from(py: Python<'_>, out: &[Refined]) -> PyResult<PyPlanarRefinement> {
+    let m = out.len();
+    let col = |g: &dyn Fn(&Refined) -> f64| out.iter().map(g).collect::<Vec<f64>>().into_pyarray(py).into_any().unbind();
+    Ok(PyPlanarRefinement {
+        index: out.iter().map(|r| r.index as i64).collect::<Vec<i64>>().into_pyarray(py).into_any().unbind(),
+        phi0: col(&|r| r.correction.phi0),
+        wz0: col(&|r| r.correction.wz0),
+        iterations: out.iter().map(|r| r.correction.iterations as i64).collect::<Vec<i64>>().into_pyarray(py).into_any().unbind(),
+        phi_t: col(&|r| r.end.phi_t),
+        wz_t: col(&|r| r.end.wz_t),
+        stm: out.iter().flat_map(|r| r.end.stm).collect::<Vec<f64>>().into_pyarray(py).reshape([m, 2, 2])?.into_any().unbind(),
+        residual: out.iter().flat_map(|r| r.residual).collect::<Vec<f64>>().into_pyarray(py).reshape([m, 2])?.into_any().unbind(),
+    })
+}
+
+/// A refinement started by `attitude_refine`, running on the pool: `join()` waits for it (with
+/// the GIL released, Ctrl-C stopping it) and returns its PlanarRefinement, once. Dropped
+/// unjoined, it runs to its end and its result is discarded.
+#[pyclass(frozen, name = "PendingRefinement", module = "librate._core")]
+pub struct PyPendingRefinement {
+    pending: Mutex<Option<Pending<librate_core::Result<Vec<Refined>>>>>,
+}
+
+#[pymethods]
+impl PyPendingRefinement {
+    fn join(&self, py: Python<'_>) -> PyResult<PyPlanarRefinement> {
+        let pending = self.pending.lock().map_err(|_| PyRuntimeError::new_err("PendingRefinement: a join panicked"))?.take();
+        let Some(pending) = pending else {
+            return Err(PyRuntimeError::new_err("PendingRefinement: already joined"));
+        };
+        let out = join(py, pending)?;
+        refinement_from(py, &out)
+    }
+    fn __repr__(&self) -> String {
+        let joined = self.pending.lock().map(|p| p.is_none()).unwrap_or(true);
+        format!("PendingRefinement({})", if joined { "joined" } else { "pending" })
+    }
+}
+
+/// Refine candidates into verified solutions in one core call, started on the pool at once
+/// (librate_core::attitude::refine_planar_attitudes): the cases' phi0, wz0, Kz, turns, plates
+/// and wz0 search windows corrected over `t_final` (`closure`; phi0 the free angle of the full
+/// closure), the converged ones inside `keep` = (lo, hi) kept once per (group, Kz, turns),
+/// re-propagated independently over K T, and kept when that residual is at most 1e-8.
+/// `groups`: one integer label per case (default: all one group). Returns a PendingRefinement.
+#[pyfunction]
+#[pyo3(signature = (forcing, cases, *, t_final, closure, options, keep, groups=None))]
+fn attitude_refine<'py>(
+    forcing: PyRef<'py, PyOrbitForcing>,
+    cases: PyRef<'py, PlanarCases>,
+    t_final: f64,
+    closure: Closure,
+    options: PyRef<'py, CorrectorOptions>,
+    keep: (f64, f64),
+    groups: Option<PyReadonlyArray1<'py, i64>>,
+) -> PyResult<PyPendingRefinement> {
+    let cands = candidates(&cases, None)?;
+    let groups = match &groups {
+        Some(g) => vector(g, "groups", Some(cands.len()))?,
+        None => vec![0; cands.len()],
+    };
+    let (closure, opts) = (closure.into(), options.core());
+    let (table, mu, state0, primaries) = (Arc::clone(&forcing.inner), forcing.mu, forcing.state0, forcing.primaries);
+    let pending = start(move || {
+        let orbit = PlanarOrbit { mu, state0, primaries, forcing: &table };
+        refine_planar_attitudes(&orbit, t_final, closure, &cands, &groups, &opts, keep)
+    })?;
+    Ok(PyPendingRefinement { pending: Mutex::new(Some(pending)) })
+}
+
+/// The crossings of one map row (`row_crossings`): arrays over them.
+#[pyclass(frozen, get_all, name = "RowCrossings", module = "librate._core")]
+pub struct PyRowCrossings {
+    /// The multiple of the level crossed, int64 (m,).
+    k: Py<PyAny>,
+    /// The crossing's rate by linear interpolation, (m,).
+    wz0: Py<PyAny>,
+    /// The rate interval holding it (between wz0[i] and wz0[i + 1]), int64 (m,).
+    interval: Py<PyAny>,
+    /// Each crossing's search window (lo, hi) of wz0, (m, 2) ((-inf, inf) where the row is not
+    /// resolved there), or None when not asked.
+    window: Option<Py<PyAny>>,
+    /// Intervals left out for crossing more than `max_crossings` levels (0 without a limit).
+    unresolved: usize,
+}
+
+/// Where one row's unwrapped final angle phi_t - phi0 crosses a multiple of `level`
+/// (librate_core::map::crossings): an interval with a non-finite end, equal ends, or more than
+/// `max_crossings` levels crossed is left out; `window` = (quick, resolved) adds each crossing's
+/// search window (librate_core::map::windows).
+#[pyfunction]
+#[pyo3(signature = (phi_t, wz0, *, phi0, level, max_crossings=None, window=None))]
+fn row_crossings<'py>(
+    py: Python<'py>,
+    phi_t: PyReadonlyArray1<'py, f64>,
+    wz0: PyReadonlyArray1<'py, f64>,
+    phi0: f64,
+    level: f64,
+    max_crossings: Option<usize>,
+    window: Option<(usize, f64)>,
+) -> PyResult<PyRowCrossings> {
+    let w = vector(&wz0, "wz0", None)?;
+    let p = vector(&phi_t, "phi_t", Some(w.len()))?;
+    if !(level.is_finite() && level > 0.0 && phi0.is_finite()) {
+        return Err(invalid(format!("invalid argument `level`/`phi0`: level must be finite and > 0, phi0 finite; got {level}, {phi0}")));
+    }
+    let c = map::crossings(&p, phi0, &w, level, max_crossings);
+    let m = c.len();
+    let win = window.map(|(quick, resolved)| map::windows(&p, phi0, &w, level, &c, quick, resolved));
+    Ok(PyRowCrossings {
+        k: c.iter().map(|c| c.k).collect::<Vec<i64>>().into_pyarray(py).into_any().unbind(),
+        wz0: c.iter().map(|c| c.wz0).collect::<Vec<f64>>().into_pyarray(py).into_any().unbind(),
+        interval: c.iter().map(|c| c.interval as i64).collect::<Vec<i64>>().into_pyarray(py).into_any().unbind(),
+        window: match win {
+            Some(v) => Some(v.into_iter().flat_map(|(lo, hi)| [lo, hi]).collect::<Vec<f64>>().into_pyarray(py).reshape([m, 2])?.into_any().unbind()),
+            None => None,
+        },
+        unresolved: max_crossings.map_or(0, |mc| map::unresolved(&p, phi0, level, mc)),
+    })
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<PyPlanarRefinement>()?;
+    m.add_class::<PyPendingRefinement>()?;
+    m.add_class::<PyRowCrossings>()?;
+    m.add_function(wrap_pyfunction!(attitude_refine, m)?)?;
+    m.add_function(wrap_pyfunction!(row_crossings, m)?)?;
     m.add_class::<PyOrbitForcing>()?;
     m.add_class::<PySweepResult>()?;
     m.add_class::<PyCorrectionBatch>()?;

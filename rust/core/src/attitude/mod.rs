@@ -11,6 +11,7 @@ pub mod linear;
 mod newton;
 mod periodic;
 mod periodic3d;
+mod refine;
 pub mod planar;
 pub mod propagate;
 pub mod srp;
@@ -26,7 +27,8 @@ pub use torque::{euler_rate, gravity_gradient_by_name, gravity_gradient_torque, 
 pub use periodic::{
     correct_across_family, correct_bordered, correct_planar_attitudes, verify_planar_attitudes, Bordered, Candidate, Closure, Correction, CorrectorOptions, Free, Parameter,
     PlanarEnd, PlanarFamily,
-    PlanarStart, StopReason,
+    PlanarStart, StopReason, full_closure_residual,
 };
+pub use refine::{refine_planar_attitudes, PlanarOrbit, Refined, MAX_VERIFIED_RESIDUAL, SAME_SOLUTION};
 pub(crate) use periodic3d::{conj, lmat, rmat};
 pub use periodic3d::{qexp, qlog, qmul, attitude_residual, correct_attitudes_3d, correct_attitudes_3d_across, Correction3d, CorrectionAcross3d, Options3d, Start3d, StartAcross3d};

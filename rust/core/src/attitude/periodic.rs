@@ -50,6 +50,13 @@ use crate::propagation::{with_threads, with_threads_rounds};
 
 use std::f64::consts::{FRAC_PI_2, PI};
 
+/// The full closure's residuals (phi(KT) - phi0 - 2 pi turns, wz(KT) - wz0) of a motion started
+/// at (phi0, wz0) that ends at (phi_t, wz_t): zero for a periodic motion with `turns` net body
+/// turns (N + 1/2 for a half-turn motion).
+pub fn full_closure_residual(phi0: f64, wz0: f64, turns: f64, phi_t: f64, wz_t: f64) -> [f64; 2] {
+    [phi_t - phi0 - 2.0 * PI * turns, wz_t - wz0]
+}
+
 /// How the periodicity condition is closed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Closure {
@@ -358,10 +365,7 @@ impl Form {
     fn closure_residual(&self, c: &Candidate, x: [f64; 3], o: &Outcome) -> [f64; 2] {
         match self.closure {
             Closure::Half => [o.phi_t - c.case.phi0 - PI * c.turns, f64::NAN],
-            Closure::Full => {
-                let phi0 = if self.free == Free::Phi0 { x[ANGLE] } else { c.case.phi0 };
-                [o.phi_t - phi0 - 2.0 * PI * c.turns, o.wz_t - x[WZ]]
-            }
+            Closure::Full => full_closure_residual(if self.free == Free::Phi0 { x[ANGLE] } else { c.case.phi0 }, x[WZ], c.turns, o.phi_t, o.wz_t),
         }
     }
 

@@ -4,7 +4,10 @@
 //! 3-D counterpart ([`sweep_3d`]): the rigid body's (q, w) along any periodic orbit for many
 //! initial rates and bodies, over the orbit's tidal tensor tabulated once.
 
+pub mod crossings;
+
 pub use crate::integrate::lanes3d::{sweep_3d, sweep_3d_at};
+pub use crossings::{crossings, unresolved, windows, Crossing};
 
 use crate::integrate::forcing::OrbitForcing;
 use crate::integrate::lanes::{self, integrate_cases, Case, LaneOptions, Outcome};
