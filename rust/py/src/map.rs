@@ -496,9 +496,10 @@ fn row_crossings<'py>(
     if !(level.is_finite() && level > 0.0 && phi0.is_finite()) {
         return Err(invalid(format!("invalid argument `level`/`phi0`: level must be finite and > 0, phi0 finite; got {level}, {phi0}")));
     }
-    let c = map::crossings(&p, phi0, &w, level, max_crossings);
+    let u = map::levels(&p, phi0, level);
+    let c = map::crossings(&u, &w, max_crossings);
     let m = c.len();
-    let win = window.map(|(quick, resolved)| map::windows(&p, phi0, &w, level, &c, quick, resolved));
+    let win = window.map(|(quick, resolved)| map::windows(&u, &w, &c, quick, resolved));
     Ok(PyRowCrossings {
         k: c.iter().map(|c| c.k).collect::<Vec<i64>>().into_pyarray(py).into_any().unbind(),
         wz0: c.iter().map(|c| c.wz0).collect::<Vec<f64>>().into_pyarray(py).into_any().unbind(),
@@ -507,7 +508,7 @@ fn row_crossings<'py>(
             Some(v) => Some(v.into_iter().flat_map(|(lo, hi)| [lo, hi]).collect::<Vec<f64>>().into_pyarray(py).reshape([m, 2])?.into_any().unbind()),
             None => None,
         },
-        unresolved: max_crossings.map_or(0, |mc| map::unresolved(&p, phi0, level, mc)),
+        unresolved: max_crossings.map_or(0, |mc| map::unresolved(&u, mc)),
     })
 }
 

@@ -7,7 +7,7 @@
 pub mod crossings;
 
 pub use crate::integrate::lanes3d::{sweep_3d, sweep_3d_at};
-pub use crossings::{crossings, unresolved, windows, Crossing};
+pub use crossings::{crossings, levels, unresolved, windows, Crossing};
 
 use crate::integrate::forcing::OrbitForcing;
 use crate::integrate::lanes::{self, integrate_cases, Case, LaneOptions, Outcome};
