@@ -252,6 +252,7 @@ def test_a_rate_grid_that_does_not_resolve_the_angle_is_named_not_refined(em):
     assert len(candidates(row[0], 0.0, wz, math.pi)) > 300
     kept, _, unresolved = maps.row_candidates([0.8], 0.0, wz, row)
     named = int(str(rec[-1].message).split("periods): ")[1].split(" interval")[0])
+    assert rec[-1].filename == __file__  # the warning names the caller's line
     assert unresolved == named and 5 <= unresolved <= 10 and len(kept) <= 8 * (15 - unresolved)
     fine = np.linspace(-3.0, 2.0, 300)
     row = librate.periodicity_map([o], kz=0.8, wz0=fine, solve=False).phi_T.values[0]

@@ -409,7 +409,7 @@ def start_row_solutions(orbit, kzs, phi0, wz, phi_t_rows, n_periods, srp=None,
     if unresolved:
         warnings.warn(f"the rate grid does not resolve phi(KT) on the orbit x0 = {orbit.x0:.6g} LU (K = {int(n_periods)} periods): "
                       f"{unresolved} interval(s) of `wz0` where it turns through more than {MAX_CROSSINGS} half-turns are left out "
-                      "of the solutions; a finer wz0 grid finds them", RuntimeWarning, stacklevel=4)
+                      "of the solutions; a finer wz0 grid finds them", RuntimeWarning, stacklevel=3)
     symmetric = is_symmetric(orbit, phi0) and (srp is None or srp.eps == 0.0)
     size = max(REFINE_BATCH_MIN, REFINE_BATCH_PERIODS // max(int(n_periods), 1))
     def batch(a: int) -> Refining:
