@@ -290,9 +290,14 @@ fn bind_current_thread(cpu: usize) -> bool {
 mod tests {
     use super::*;
 
+    /// Held by the tests whose calls count in [`CALLS`] (run_polled decides from it where a call
+    /// runs, and one test asserts that): cargo runs a module's tests on parallel threads.
+    static CALLS_TESTS: std::sync::Mutex<()> = std::sync::Mutex::new(());
+
     #[test]
     fn spawned_work_returns_its_value_or_resumes_its_panic_on_wait() {
         use rayon::prelude::*;
+        let _calls = CALLS_TESTS.lock().unwrap_or_else(|e| e.into_inner());
         let every = std::time::Duration::from_millis(1);
         let pending = spawn(|| (0..1000u64).sum::<u64>()).unwrap();
         let mut polls = 0;
@@ -335,6 +340,7 @@ mod tests {
     /// which path each takes.
     #[test]
     fn run_polled_returns_polls_resumes_a_panic_and_runs_a_concurrent_call_on_its_own_thread() {
+        let _calls = CALLS_TESTS.lock().unwrap_or_else(|e| e.into_inner());
         let every = std::time::Duration::from_millis(5);
         let v = vec![1.0f64; 1000];
         let mut polls = 0;
