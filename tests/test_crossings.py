@@ -137,3 +137,18 @@ def test_interrupt_while_the_last_solutions_are_refined_keeps_them(em, monkeypat
     assert ds.attrs["complete"] == 0 and ds.computed.values.tolist() == [True] and len(calls) == 2
     for v in ("dwz", "sol_wz0", "sol_residual", "sol_trace"):
         np.testing.assert_array_equal(ds[v].values, full[v].values)
+
+
+def test_distinct_solutions_merge_by_group_kz_turns_and_wz0():
+    """The merge rule of a batch's refinement (and of solutions from several batches): the same
+    group, Kz and turns with wz0 within 1e-8 are one solution, the first kept; a key is compared
+    with the kept ones only."""
+    g = np.array([0, 0, 0, 1, 0, 0, 0, 0], dtype=np.int64)
+    kz = np.array([0.8, 0.8, 0.8, 0.8, 0.5, 0.8, 0.8, 0.8])
+    turns = np.array([-1.0, -1.0, -1.0, -1.0, -1.0, -0.5, -1.0, -1.0])
+    wz0 = np.array([1.0, 1.0 + 5e-9, 1.0 + 1.2e-8, 1.0, 1.0, 1.0, 1.0 + 1.6e-8, 1.0 + 2.3e-8])
+    # 1: within 1e-8 of 0; 2: 1.2e-8 from 0 (kept); 3: another group; 4: another Kz; 5: another
+    # turns; 6: 0.4e-8 from 2 (merged); 7: 1.1e-8 from 2 and 2.3e-8 from 0 (kept)
+    assert _core.distinct_solutions(g, kz, turns, wz0).tolist() == [0, 2, 3, 4, 5, 7]
+    with pytest.raises(ValueError, match="`kz`"):
+        _core.distinct_solutions(g, kz[:3], turns, wz0)

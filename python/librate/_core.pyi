@@ -618,7 +618,9 @@ def planar_verify(
     mu: float, orbit_state0: list[float], t_final: float, cases: PlanarCases, *, primaries: list[bool] = ..., threads: int | None = None
 ) -> PlanarVerification: ...
 
-__all__ += ["PlanarRefinement", "PendingRefinement", "attitude_refine", "RowCrossings", "row_crossings"]
+__all__ += ["PlanarRefinement", "PendingRefinement", "attitude_refine", "RowCrossings", "row_crossings", "distinct_solutions"]
+
+def distinct_solutions(groups: _I64, kz: _F64, turns: _F64, wz0: _F64) -> _I64: ...
 
 @final
 class PlanarRefinement:

@@ -36,6 +36,7 @@ from .solutions import (
     start_refine,
     sweep,
     turns_array,
+    turns_of,
 )
 
 __all__ = ["periodicity_map", "zero_contours", "orbits_of", "map_grid", "map_coords", "map_coordinates", "map_dataset",
@@ -434,12 +435,14 @@ def start_row_solutions(orbit, kzs, phi0, wz, phi_t_rows, n_periods, srp=None,
 
 
 def _distinct(sols: list[AttitudeSolution]) -> list[AttitudeSolution]:
-    """One solution per (Kz, turns, kind, wz0 to 1e-8), as :func:`refine` keeps within a batch."""
-    out: list[AttitudeSolution] = []
-    for s in sols:
-        if not any(o.kz == s.kz and o.n_total == s.n_total and o.kind == s.kind and abs(o.wz0 - s.wz0) < 1e-8 for o in out):
-            out.append(s)
-    return out
+    """The first of each solution, in order, by the rule a batch's refinement merges by
+    (``_core.distinct_solutions``: the same Kz and turns with wz0 within 1e-8)."""
+    if not sols:
+        return []
+    kz, wz0 = np.array([s.kz for s in sols], dtype=float), np.array([s.wz0 for s in sols], dtype=float)
+    turns = turns_of([s.n_total for s in sols], [s.kind for s in sols])
+    keep = _core.distinct_solutions(np.zeros(len(sols), dtype=np.int64), kz, turns, wz0)
+    return [sols[i] for i in keep.tolist()]
 
 
 def solutions_from_row(orbit, kz, phi0, wz, phi_t_row, n_periods, srp=None) -> list[AttitudeSolution]:

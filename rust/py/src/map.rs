@@ -6,7 +6,7 @@ use librate_core::integrate::lanes::Case;
 use librate_core::map;
 use std::sync::{Arc, Mutex};
 
-use librate_core::attitude::{correct_across_family, correct_bordered, correct_planar_attitudes, full_closure_residual, refine_planar_attitudes, verify_planar_attitudes, Candidate, Parameter, PlanarFamily, PlanarOrbit, PlanarStart, Refined};
+use librate_core::attitude::{correct_across_family, correct_bordered, correct_planar_attitudes, distinct, full_closure_residual, refine_planar_attitudes, verify_planar_attitudes, Candidate, Parameter, PlanarFamily, PlanarOrbit, PlanarStart, Refined, SolutionKey};
 use librate_core::threads::Pending;
 use numpy::{IntoPyArray, PyArrayMethods, PyReadonlyArray1};
 use pyo3::exceptions::PyRuntimeError;
@@ -460,6 +460,25 @@ fn attitude_refine<'py>(
     Ok(PyPendingRefinement { pending: Mutex::new(Some(pending)) })
 }
 
+/// The indices of the first of each distinct solution, in order (librate_core::attitude::distinct,
+/// the rule `attitude_refine` merges by): solutions of one group with the same Kz and turns and
+/// wz0 within 1e-8 are one.
+#[pyfunction]
+#[pyo3(signature = (groups, kz, turns, wz0))]
+fn distinct_solutions<'py>(
+    py: Python<'py>,
+    groups: PyReadonlyArray1<'py, i64>,
+    kz: PyReadonlyArray1<'py, f64>,
+    turns: PyReadonlyArray1<'py, f64>,
+    wz0: PyReadonlyArray1<'py, f64>,
+) -> PyResult<Bound<'py, PyAny>> {
+    let g = vector(&groups, "groups", None)?;
+    let n = g.len();
+    let (k, t, w) = (vector(&kz, "kz", Some(n))?, vector(&turns, "turns", Some(n))?, vector(&wz0, "wz0", Some(n))?);
+    let keys: Vec<SolutionKey> = (0..n).map(|i| SolutionKey { group: g[i], kz: k[i], turns: t[i], wz0: w[i] }).collect();
+    Ok(distinct(&keys).into_iter().map(|i| i as i64).collect::<Vec<i64>>().into_pyarray(py).into_any())
+}
+
 /// The crossings of one map row (`row_crossings`): arrays over them.
 #[pyclass(frozen, get_all, name = "RowCrossings", module = "librate._core")]
 pub struct PyRowCrossings {
@@ -518,6 +537,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyRowCrossings>()?;
     m.add_function(wrap_pyfunction!(attitude_refine, m)?)?;
     m.add_function(wrap_pyfunction!(row_crossings, m)?)?;
+    m.add_function(wrap_pyfunction!(distinct_solutions, m)?)?;
     m.add_class::<PyOrbitForcing>()?;
     m.add_class::<PySweepResult>()?;
     m.add_class::<PyCorrectionBatch>()?;

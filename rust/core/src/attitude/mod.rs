@@ -29,6 +29,6 @@ pub use periodic::{
     PlanarEnd, PlanarFamily,
     PlanarStart, StopReason, full_closure_residual,
 };
-pub use refine::{refine_planar_attitudes, PlanarOrbit, Refined, MAX_VERIFIED_RESIDUAL, SAME_SOLUTION};
+pub use refine::{distinct, refine_planar_attitudes, PlanarOrbit, Refined, SolutionKey, MAX_VERIFIED_RESIDUAL, SAME_SOLUTION};
 pub(crate) use periodic3d::{conj, lmat, rmat};
 pub use periodic3d::{qexp, qlog, qmul, attitude_residual, correct_attitudes_3d, correct_attitudes_3d_across, Correction3d, CorrectionAcross3d, Options3d, Start3d, StartAcross3d};

@@ -17,6 +17,32 @@ pub const SAME_SOLUTION: f64 = 1e-8;
 /// residuals) is at most this.
 pub const MAX_VERIFIED_RESIDUAL: f64 = 1e-8;
 
+/// What tells two solutions apart: the same group, Kz and turns with wz0 within
+/// [`SAME_SOLUTION`] are one solution.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SolutionKey {
+    pub group: i64,
+    pub kz: f64,
+    pub turns: f64,
+    pub wz0: f64,
+}
+
+/// The indices of the first of each solution among `keys`, in order: a key is kept unless a
+/// kept one is the same solution ([`SolutionKey`]).
+pub fn distinct(keys: &[SolutionKey]) -> Vec<usize> {
+    let mut ok: Vec<usize> = Vec::with_capacity(keys.len());
+    for (i, k) in keys.iter().enumerate() {
+        let same = |j: &usize| {
+            let o = &keys[*j];
+            o.group == k.group && o.kz == k.kz && o.turns == k.turns && (o.wz0 - k.wz0).abs() < SAME_SOLUTION
+        };
+        if !ok.iter().any(same) {
+            ok.push(i);
+        }
+    }
+    ok
+}
+
 /// The orbit of a forcing table with what its independent re-propagation needs.
 #[derive(Debug, Clone, Copy)]
 pub struct PlanarOrbit<'a> {
@@ -46,8 +72,8 @@ pub struct Refined {
 /// 1. every candidate corrected in one call (`opts`; `opts.monodromy` is not needed, as the
 ///    verification brings the STM);
 /// 2. the converged ones with `keep.0 <= wz0 <= keep.1`, ordered by group (in order of first
-///    appearance in `groups`, one label per candidate), Kz and wz0, kept once per (group, Kz,
-///    turns) within [`SAME_SOLUTION`] in wz0 (the first);
+///    appearance in `groups`, one label per candidate), Kz and wz0, kept once per solution
+///    ([`distinct`]: (group, Kz, turns) and wz0 within [`SAME_SOLUTION`]; the first);
 /// 3. those re-propagated in that order, together ([`verify_planar_attitudes`] over the full
 ///    closure time, K T = 2 `t_final` for the half closure; a plate where the candidate has
 ///    one), and kept when their residual's max-norm is at most [`MAX_VERIFIED_RESIDUAL`].
@@ -86,15 +112,8 @@ pub fn refine_planar_attitudes(
     // a stable sort (the batch order among equals)
     let key = |i: usize| (rank(groups[i]), candidates[i].case.kz, corrections[i].wz0);
     conv.sort_by(|&i, &j| key(i).partial_cmp(&key(j)).unwrap_or(std::cmp::Ordering::Equal));
-    let mut ok: Vec<usize> = Vec::with_capacity(conv.len());
-    for i in conv {
-        let same = |j: &usize| {
-            groups[*j] == groups[i] && candidates[*j].case.kz == candidates[i].case.kz && candidates[*j].turns == candidates[i].turns && (corrections[*j].wz0 - corrections[i].wz0).abs() < SAME_SOLUTION
-        };
-        if !ok.iter().any(same) {
-            ok.push(i);
-        }
-    }
+    let keys: Vec<SolutionKey> = conv.iter().map(|&i| SolutionKey { group: groups[i], kz: candidates[i].case.kz, turns: candidates[i].turns, wz0: corrections[i].wz0 }).collect();
+    let ok: Vec<usize> = distinct(&keys).into_iter().map(|j| conv[j]).collect();
     let starts = ok
         .iter()
         .map(|&i| {
