@@ -23,6 +23,13 @@ use crate::simd::Isa;
 /// Field arithmetic and scaling by an f64 (f64, [`Dual`], [`F8`]).
 pub trait Arith: Copy + Add<Output = Self> + Sub<Output = Self> + Mul<Output = Self> + Div<Output = Self> + Neg<Output = Self> {
     fn scale(self, k: f64) -> Self;
+    /// self * a + b: two roundings for f64 and [`Dual`] (so an equation written with it has the
+    /// bits of `self * a + b`, or of `b + self * a`: addition commutes), one on the lanes of a
+    /// fused level ([`crate::simd::Isa::FMA`]).
+    #[inline(always)]
+    fn madd(self, a: Self, b: Self) -> Self {
+        self * a + b
+    }
 }
 
 /// Multiplication by a coefficient of type K: an f64 for f64 and [`Dual`] (a scaling), a per-lane
@@ -362,6 +369,10 @@ impl<I: Isa> Arith for F8<I> {
     #[inline(always)]
     fn scale(self, k: f64) -> Self {
         self * Self::splat(self.isa, k)
+    }
+    #[inline(always)]
+    fn madd(self, a: Self, b: Self) -> Self {
+        self.mul_add(a, b)
     }
 }
 

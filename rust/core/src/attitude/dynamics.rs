@@ -55,11 +55,14 @@ pub fn dcm_with<R: Arith>(q: &[R; 4], one: R) -> [[R; 3]; 3] {
     let [q1, q2, q3, q4] = *q;
     let n = one / (q1 * q1 + q2 * q2 + q3 * q3 + q4 * q4);
     let (a, b, c, d) = (q1 * q1, q2 * q2, q3 * q3, q4 * q4);
-    // 2 x n, written out (no closure: see crate::scalar::MulBy)
+    // the off-diagonal terms 2 (qi qj +- qk ql) n as (qi qj +- qk ql) (2 n): the same bits
+    // (doubling is exact); the sums fused on the lanes of FMA levels ([`Arith::madd`])
+    let n2 = n.scale(2.0);
+    let (p12, p13, p23) = (q1 * q2, q1 * q3, q2 * q3);
     [
-        [(a - b - c + d) * n, (q1 * q2 + q3 * q4).scale(2.0) * n, (q1 * q3 - q2 * q4).scale(2.0) * n],
-        [(q1 * q2 - q3 * q4).scale(2.0) * n, (-a + b - c + d) * n, (q2 * q3 + q1 * q4).scale(2.0) * n],
-        [(q1 * q3 + q2 * q4).scale(2.0) * n, (q2 * q3 - q1 * q4).scale(2.0) * n, (-a - b + c + d) * n],
+        [(a - b - c + d) * n, q3.madd(q4, p12) * n2, (-q2).madd(q4, p13) * n2],
+        [(-q3).madd(q4, p12) * n2, (-a + b - c + d) * n, q1.madd(q4, p23) * n2],
+        [q2.madd(q4, p13) * n2, (-q1).madd(q4, p23) * n2, (-a - b + c + d) * n],
     ]
 }
 
@@ -76,11 +79,14 @@ pub fn quat_rate<R: Arith>(q: &[R; 4], a: &[[R; 3]; 3], w: &[R; 3]) -> [R; 4] {
 #[inline(always)]
 pub fn quat_kinematics<R: Arith>(q: &[R; 4], wr: &[R; 3]) -> [R; 4] {
     let [q1, q2, q3, q4] = *q;
+    // 1/2 (q4 w1 - q3 w2 + q2 w3, ...) as (q4 (w1/2) - ...): the same bits (halving is exact);
+    // the sums fused on the lanes of FMA levels ([`Arith::madd`])
+    let h = [wr[0].scale(0.5), wr[1].scale(0.5), wr[2].scale(0.5)];
     [
-        (q4 * wr[0] - q3 * wr[1] + q2 * wr[2]).scale(0.5),
-        (q3 * wr[0] + q4 * wr[1] - q1 * wr[2]).scale(0.5),
-        (-q2 * wr[0] + q1 * wr[1] + q4 * wr[2]).scale(0.5),
-        (-q1 * wr[0] - q2 * wr[1] - q3 * wr[2]).scale(0.5),
+        q2.madd(h[2], (-q3).madd(h[1], q4 * h[0])),
+        (-q1).madd(h[2], q4.madd(h[1], q3 * h[0])),
+        q4.madd(h[2], q1.madd(h[1], -q2 * h[0])),
+        (-q3).madd(h[2], (-q2).madd(h[1], -q1 * h[0])),
     ]
 }
 

@@ -23,7 +23,7 @@ pub use linear::{collinear_equilibrium, Equilibrium};
 pub use planar::{forcing_sc, forcing_scp, gravity_gradient_wzdot, planar_gravity_gradient, Forcing, PlanarAlongOrbit, PlanarForced};
 pub use propagate::{evaluate_torques, propagate_attitude, propagate_planar, AttitudeTrajectory, PlanarTrajectory};
 pub use srp::{flat_plate_wzdot, Facet, FacetBody, FlatPlate, Sun, N_SUN, OMEGA_SUN, P0, SOLAR_PRESSURE_1AU};
-pub use torque::{euler_rate, gravity_gradient_by_name, gravity_gradient_torque, tidal_tensor, tidal_term, GravityGradient, Torque, TorqueInput};
+pub use torque::{euler_rate, gravity_gradient_by_name, gravity_gradient_torque, euler_ratios, gravity_gradient_euler_rate, tidal_tensor, tidal_term, GravityGradient, Torque, TorqueInput};
 pub use periodic::{
     correct_across_family, correct_bordered, correct_planar_attitudes, verify_planar_attitudes, Bordered, Candidate, Closure, Correction, CorrectorOptions, Free, Parameter,
     PlanarEnd, PlanarFamily,

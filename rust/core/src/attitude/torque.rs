@@ -36,12 +36,14 @@ pub(crate) fn mat_vec<R: Arith>(a: &[[R; 3]; 3], v: &[R; 3]) -> [R; 3] {
 
 #[inline(always)]
 pub(crate) fn dot3<R: Arith>(u: &[R; 3], v: &[R; 3]) -> R {
-    u[0] * v[0] + u[1] * v[1] + u[2] * v[2]
+    // u0 v0 + u1 v1 + u2 v2, fused on the lanes of FMA levels ([`Arith::madd`])
+    u[2].madd(v[2], u[1].madd(v[1], u[0] * v[0]))
 }
 
 #[inline(always)]
 pub(crate) fn cross<R: Arith>(a: &[R; 3], b: &[R; 3]) -> [R; 3] {
-    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+    // a1 b2 - a2 b1, ..., fused on the lanes of FMA levels ([`Arith::madd`])
+    [(-a[2]).madd(b[1], a[1] * b[2]), (-a[0]).madd(b[2], a[2] * b[0]), (-a[1]).madd(b[0], a[0] * b[1])]
 }
 
 /// Gravity gradient of both primaries (docs/physics.md, attitude):
@@ -104,12 +106,44 @@ pub fn tidal_term<R: Real>(gm: f64, r: &[R; 3]) -> [R; 6] {
 /// scaling), per-lane values for the SIMD lanes ([`MulBy`]).
 #[inline(always)]
 pub fn gravity_gradient_torque<R: Arith + MulBy<K>, K: Copy + std::ops::Sub<Output = K>>(a: &[[R; 3]; 3], m: &[R; 6], inertia: &[K; 3]) -> [R; 3] {
+    let d = moment_differences(inertia);
+    let [n_yz, n_xz, n_xy] = tidal_in_body(a, m);
+    [n_yz.mul_by(d[0]), n_xz.mul_by(d[1]), n_xy.mul_by(d[2])]
+}
+
+/// The differences of principal moments the gravity-gradient torque scales by:
+/// (Iz - Iy, Ix - Iz, Iy - Ix).
+#[inline(always)]
+fn moment_differences<K: Copy + std::ops::Sub<Output = K>>(inertia: &[K; 3]) -> [K; 3] {
+    [inertia[2] - inertia[1], inertia[0] - inertia[2], inertia[1] - inertia[0]]
+}
+
+/// The off-diagonal components (N_yz, N_xz, N_xy) of the tidal tensor in body axes,
+/// N = A M A', from the synodic tensor `m` ([`tidal_tensor`]) and the attitude matrix `a`.
+#[inline(always)]
+fn tidal_in_body<R: Arith>(a: &[[R; 3]; 3], m: &[R; 6]) -> [R; 3] {
     let [xx, yy, zz, xy, xz, yz] = *m;
     let full = [[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]];
     let v1 = mat_vec(&full, &a[1]);
     let v2 = mat_vec(&full, &a[2]);
-    let (n_xy, n_xz, n_yz) = (dot3(&a[0], &v1), dot3(&a[0], &v2), dot3(&a[1], &v2));
-    [n_yz.mul_by(inertia[2] - inertia[1]), n_xz.mul_by(inertia[0] - inertia[2]), n_xy.mul_by(inertia[1] - inertia[0])]
+    [dot3(&a[1], &v2), dot3(&a[0], &v2), dot3(&a[0], &v1)]
+}
+
+/// The ratios ((Iz - Iy)/Ix, (Ix - Iz)/Iy, (Iy - Ix)/Iz) of [`gravity_gradient_euler_rate`].
+#[inline(always)]
+pub fn euler_ratios<K: Copy + std::ops::Sub<Output = K> + std::ops::Div<Output = K>>(inertia: &[K; 3]) -> [K; 3] {
+    let d = moment_differences(inertia);
+    [d[0] / inertia[0], d[1] / inertia[1], d[2] / inertia[2]]
+}
+
+/// Euler's equations under the gravity gradient alone ([`gravity_gradient_torque`] into
+/// [`euler_rate`]) in the form the 3-D map's lanes integrate: the torque's and the gyroscopic
+/// term's factors are the same difference of moments, Ix wdot_x = (Iz - Iy) (N_yz - wy wz) and
+/// cyclically, so wdot = k (N_yz - wy wz, N_xz - wz wx, N_xy - wx wy) with the [`euler_ratios`] k.
+#[inline(always)]
+pub fn gravity_gradient_euler_rate<R: Arith + MulBy<K>, K: Copy>(a: &[[R; 3]; 3], m: &[R; 6], w: &[R; 3], k: &[K; 3]) -> [R; 3] {
+    let [n_yz, n_xz, n_xy] = tidal_in_body(a, m);
+    [(-w[1]).madd(w[2], n_yz).mul_by(k[0]), (-w[2]).madd(w[0], n_xz).mul_by(k[1]), (-w[0]).madd(w[1], n_xy).mul_by(k[2])]
 }
 
 /// Euler's equations, wdot = I^-1 (T - w x I w), with the moments `inertia` and their inverses

@@ -484,19 +484,19 @@ fn fmadd8<I: Isa>(a: F8<I>, b: F8<I>, c: F8<I>) -> F8<I> {
 /// = a b + c.
 #[inline(always)]
 fn clenshaw<T: Copy + std::ops::Sub<Output = T>, const N: usize>(x: T, x2: T, zero: T, coef: impl Fn(usize) -> T, fma: impl Fn(T, T, T) -> T) -> [T; N] {
-    let (mut b1, mut b2) = ([zero; N], [zero; N]);
-    for k in (1..NC).rev() {
-        for i in 0..N {
-            let tk = fma(x2, b1[i], coef(N * k + i) - b2[i]);
-            b2[i] = b1[i];
-            b1[i] = tk;
-        }
-    }
-    // a loop, not array::from_fn: its closure would be compiled outside the lanes' target
-    // features, and their intrinsics called out of line
+    // component by component: two running values live, not 2 N (on the lanes, 2 N vectors
+    // would not fit the registers); the components' recurrences are independent, so the order
+    // changes no bit. Loops, not array::from_fn: its closure would be compiled outside the
+    // lanes' target features, and their intrinsics called out of line
     let mut out = [zero; N];
     for i in 0..N {
-        out[i] = fma(x, b1[i], coef(i) - b2[i]);
+        let (mut b1, mut b2) = (zero, zero);
+        for k in (1..NC).rev() {
+            let tk = fma(x2, b1, coef(N * k + i) - b2);
+            b2 = b1;
+            b1 = tk;
+        }
+        out[i] = fma(x, b1, coef(i) - b2);
     }
     out
 }

@@ -18,7 +18,7 @@ use rayon::prelude::*;
 
 use super::forcing::TidalTable;
 use super::lanes::{lane, run_steps, Fehlberg, LaneOptions, LaneStatus, Method, NoCut, PrinceDormand, Recent, Rhs, Run, Scheme, Stages, LANES};
-use crate::attitude::{dcm_with, euler_rate, gravity_gradient_torque, quat_rate, RigidBody};
+use crate::attitude::{dcm_with, euler_ratios, gravity_gradient_euler_rate, quat_rate, RigidBody};
 use crate::error::{check_finite, check_positive, invalid, Result};
 use crate::attitude::attitude_residual;
 use crate::propagation::with_threads;
@@ -51,11 +51,12 @@ pub struct Outcome3d {
     pub status: LaneStatus,
 }
 
-/// The rigid body on the lanes: the orbit's tidal-tensor table and each lane's moments.
+/// The rigid body on the lanes: the orbit's tidal-tensor table and each lane's moments (as
+/// their [`euler_ratios`]).
 struct Rigid<'a, I> {
     table: &'a TidalTable,
-    inertia: [F8<I>; 3],
-    inv: [F8<I>; 3],
+    /// Each lane's [`euler_ratios`], formed once per group.
+    k: [F8<I>; 3],
     one: F8<I>,
     /// The tidal tensor at the latest four single times ([`Rhs::at`]): a step's first node (the
     /// previous step's last, or a rejected step's first) and its last.
@@ -91,35 +92,39 @@ impl<I: Isa> Rhs<I, D> for Rigid<'_, I> {
 
     #[inline(always)]
     fn eval_at(&self, at: &(f64, Option<[f64; 6]>), y: &[F8<I>; D], dy: &mut [F8<I>; D]) {
-        let m = self.tensor(at);
-        rigid_rate(&m, y, &self.inertia, &self.inv, self.one, dy);
+        rigid_rate(&self.tensor(at), y, &self.k, self.one, dy);
     }
 }
 
 impl<I: Isa> Rigid<'_, I> {
-    /// The tidal tensor of a stage's orbit data, broadcast to the lanes.
+    /// The tidal tensor of a stage's orbit data.
     #[inline(always)]
-    fn tensor(&self, at: &(f64, Option<[f64; 6]>)) -> [F8<I>; 6] {
-        let m6 = match at.1 {
+    fn tensor(&self, at: &(f64, Option<[f64; 6]>)) -> [f64; 6] {
+        match at.1 {
             Some(m6) => m6,
             None => self.table.eval_at::<I>(at.0),
-        };
-        let isa = self.one.isa();
-        [F8::splat(isa, m6[0]), F8::splat(isa, m6[1]), F8::splat(isa, m6[2]), F8::splat(isa, m6[3]), F8::splat(isa, m6[4]), F8::splat(isa, m6[5])]
+        }
     }
 }
 
-/// The derivative of one lane vector's (q, w) under the tidal tensor m.
+/// The derivative of one lane vector's (q, w) under the tidal tensor m (the same for every lane),
+/// with the lanes' [`euler_ratios`] k ([`gravity_gradient_euler_rate`]).
 #[inline(always)]
-fn rigid_rate<I: Isa>(m: &[F8<I>; 6], y: &[F8<I>], inertia: &[F8<I>; 3], inv: &[F8<I>; 3], one: F8<I>, dy: &mut [F8<I>]) {
+fn rigid_rate<I: Isa>(m: &[f64; 6], y: &[F8<I>], k: &[F8<I>; 3], one: F8<I>, dy: &mut [F8<I>]) {
+    let isa = one.isa();
+    let m = [F8::splat(isa, m[0]), F8::splat(isa, m[1]), F8::splat(isa, m[2]), F8::splat(isa, m[3]), F8::splat(isa, m[4]), F8::splat(isa, m[5])];
     let q = [y[0], y[1], y[2], y[3]];
     let w = [y[4], y[5], y[6]];
     let a = dcm_with(&q, one);
     let qd = quat_rate(&q, &a, &w);
-    let tq = gravity_gradient_torque(&a, m, inertia);
-    let wd = euler_rate(&tq, &w, inertia, inv);
-    dy[..4].copy_from_slice(&qd);
-    dy[4..D].copy_from_slice(&wd);
+    let wd = gravity_gradient_euler_rate(&a, &m, &w, k);
+    // element by element into the stage (no array copied through the stack)
+    for i in 0..4 {
+        dy[i] = qd[i];
+    }
+    for i in 0..3 {
+        dy[4 + i] = wd[i];
+    }
 }
 
 /// States of a wide group: two lane vectors' (q, w).
@@ -130,9 +135,8 @@ const WIDE: usize = 2 * D;
 /// trajectories ([`group_size`]).
 struct Wide<'a, I> {
     a: Rigid<'a, I>,
-    /// The second vector's moments and their inverses.
-    inertia: [F8<I>; 3],
-    inv: [F8<I>; 3],
+    /// The second vector's [`euler_ratios`].
+    k: [F8<I>; 3],
 }
 
 impl<I: Isa> Rhs<I, WIDE> for Wide<'_, I> {
@@ -153,8 +157,8 @@ impl<I: Isa> Rhs<I, WIDE> for Wide<'_, I> {
         let m = self.a.tensor(at);
         let (ya, yb) = y.split_at(D);
         let (da, db) = dy.split_at_mut(D);
-        rigid_rate(&m, ya, &self.a.inertia, &self.a.inv, self.a.one, da);
-        rigid_rate(&m, yb, &self.inertia, &self.inv, self.a.one, db);
+        rigid_rate(&m, ya, &self.a.k, self.a.one, da);
+        rigid_rate(&m, yb, &self.k, self.a.one, db);
     }
 }
 
@@ -179,16 +183,13 @@ pub fn group_size(level: Level) -> usize {
 /// give the results of one call over all cases, bit for bit, whatever the level.
 pub const ALIGN: usize = WIDE_GROUP;
 
-/// One lane vector's moments, their inverses, and its (q0, w0) as states; `pick(l)` is lane l's case.
+/// One lane vector's moments and its (q0, w0) as states; `pick(l)` is lane l's case.
 #[inline(always)]
-fn vector_start<I: Isa>(isa: I, pick: impl Fn(usize) -> Case3d) -> ([F8<I>; 3], [F8<I>; 3], [F8<I>; D]) {
+fn vector_start<I: Isa>(isa: I, pick: impl Fn(usize) -> Case3d) -> ([F8<I>; 3], [F8<I>; D]) {
     let moments = |i: usize| F8::new(isa, std::array::from_fn(|l| pick(l).body.moments()[i]));
     let inertia = [moments(0), moments(1), moments(2)];
-    let one = F8::splat(isa, 1.0);
-    // written out: array::map's closure would call the division out of line
-    let inv = [one / inertia[0], one / inertia[1], one / inertia[2]];
     let y: [F8<I>; D] = std::array::from_fn(|i| F8::new(isa, std::array::from_fn(|l| if i < 4 { pick(l).q0[i] } else { pick(l).w0[i - 4] })));
-    (inertia, inv, y)
+    (euler_ratios(&inertia), y)
 }
 
 /// Lane l's outcome from the end states `y` of its vector (`base`: where its (q, w) start).
@@ -208,8 +209,8 @@ fn outcome<I: Isa>(c: Case3d, y: &[F8<I>], base: usize, l: usize, run: &Run) -> 
 fn integrate_group<'a, I: Isa, S: Scheme<I, Rigid<'a, I>, Y = [F8<I>; D]>>(isa: I, table: &'a TidalTable, t_final: f64, group: &[Case3d], opts: &LaneOptions, st: &mut S) -> [Outcome3d; LANES] {
     let n = group.len();
     let pick = |l: usize| group[l.min(n - 1)];
-    let (inertia, inv, mut y) = vector_start(isa, pick);
-    let model = Rigid { table, inertia, inv, one: F8::splat(isa, 1.0), recent: Recent::new([f64::NAN; 6]) };
+    let (k, mut y) = vector_start(isa, pick);
+    let model = Rigid { table, k, one: F8::splat(isa, 1.0), recent: Recent::new([f64::NAN; 6]) };
     st.begin();
     let run = run_steps(isa, st, &model, &mut y, t_final, opts, &mut NoCut);
     std::array::from_fn(|l| outcome(pick(l), &y, 0, l, &run))
@@ -221,10 +222,10 @@ fn integrate_group<'a, I: Isa, S: Scheme<I, Rigid<'a, I>, Y = [F8<I>; D]>>(isa: 
 fn integrate_wide<'a, I: Isa, S: Scheme<I, Wide<'a, I>, Y = [F8<I>; WIDE]>>(isa: I, table: &'a TidalTable, t_final: f64, group: &[Case3d], opts: &LaneOptions, st: &mut S) -> [Outcome3d; WIDE_GROUP] {
     let n = group.len();
     let pick = |l: usize| group[l.min(n - 1)];
-    let (inertia_a, inv_a, ya) = vector_start(isa, pick);
-    let (inertia, inv, yb) = vector_start(isa, |l| pick(LANES + l));
-    let a = Rigid { table, inertia: inertia_a, inv: inv_a, one: F8::splat(isa, 1.0), recent: Recent::new([f64::NAN; 6]) };
-    let model = Wide { a, inertia, inv };
+    let (k_a, ya) = vector_start(isa, pick);
+    let (k, yb) = vector_start(isa, |l| pick(LANES + l));
+    let a = Rigid { table, k: k_a, one: F8::splat(isa, 1.0), recent: Recent::new([f64::NAN; 6]) };
+    let model = Wide { a, k };
     let mut y = [ya[0]; WIDE];
     y[..D].copy_from_slice(&ya);
     y[D..].copy_from_slice(&yb);
