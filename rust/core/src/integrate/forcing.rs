@@ -489,14 +489,14 @@ fn clenshaw<T: Copy + std::ops::Sub<Output = T>, const N: usize>(x: T, x2: T, ze
     // changes no bit. Loops, not array::from_fn: its closure would be compiled outside the
     // lanes' target features, and their intrinsics called out of line
     let mut out = [zero; N];
-    for i in 0..N {
+    for (i, o) in out.iter_mut().enumerate() {
         let (mut b1, mut b2) = (zero, zero);
         for k in (1..NC).rev() {
             let tk = fma(x2, b1, coef(N * k + i) - b2);
             b2 = b1;
             b1 = tk;
         }
-        out[i] = fma(x, b1, coef(i) - b2);
+        *o = fma(x, b1, coef(i) - b2);
     }
     out
 }

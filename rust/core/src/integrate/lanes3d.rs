@@ -118,13 +118,8 @@ fn rigid_rate<I: Isa>(m: &[f64; 6], y: &[F8<I>], k: &[F8<I>; 3], one: F8<I>, dy:
     let a = dcm_with(&q, one);
     let qd = quat_rate(&q, &a, &w);
     let wd = gravity_gradient_euler_rate(&a, &m, &w, k);
-    // element by element into the stage (no array copied through the stack)
-    for i in 0..4 {
-        dy[i] = qd[i];
-    }
-    for i in 0..3 {
-        dy[4 + i] = wd[i];
-    }
+    dy[..4].copy_from_slice(&qd);
+    dy[4..D].copy_from_slice(&wd);
 }
 
 /// States of a wide group: two lane vectors' (q, w).
