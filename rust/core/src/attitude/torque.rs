@@ -184,3 +184,122 @@ pub fn gravity_gradient_by_name(name: &str) -> crate::error::Result<GravityGradi
     };
     Ok(GravityGradient { primaries })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::attitude::{dcm_with, euler_rate, quat_kinematics};
+
+    // Test references: the attitude laws as written before `Arith::madd` (products summed left to
+    // right, the halving and doubling applied last), over any Arith type.
+    fn dcm_before<R: Arith>(q: &[R; 4], one: R) -> [[R; 3]; 3] {
+        let [q1, q2, q3, q4] = *q;
+        let n = one / (q1 * q1 + q2 * q2 + q3 * q3 + q4 * q4);
+        let (a, b, c, d) = (q1 * q1, q2 * q2, q3 * q3, q4 * q4);
+        [
+            [(a - b - c + d) * n, (q1 * q2 + q3 * q4).scale(2.0) * n, (q1 * q3 - q2 * q4).scale(2.0) * n],
+            [(q1 * q2 - q3 * q4).scale(2.0) * n, (-a + b - c + d) * n, (q2 * q3 + q1 * q4).scale(2.0) * n],
+            [(q1 * q3 + q2 * q4).scale(2.0) * n, (q2 * q3 - q1 * q4).scale(2.0) * n, (-a - b + c + d) * n],
+        ]
+    }
+    fn kinematics_before<R: Arith>(q: &[R; 4], wr: &[R; 3]) -> [R; 4] {
+        let [q1, q2, q3, q4] = *q;
+        [
+            (q4 * wr[0] - q3 * wr[1] + q2 * wr[2]).scale(0.5),
+            (q3 * wr[0] + q4 * wr[1] - q1 * wr[2]).scale(0.5),
+            (-q2 * wr[0] + q1 * wr[1] + q4 * wr[2]).scale(0.5),
+            (-q1 * wr[0] - q2 * wr[1] - q3 * wr[2]).scale(0.5),
+        ]
+    }
+    fn dot_before<R: Arith>(u: &[R; 3], v: &[R; 3]) -> R {
+        u[0] * v[0] + u[1] * v[1] + u[2] * v[2]
+    }
+    fn torque_before<R: Arith + MulBy<f64>>(a: &[[R; 3]; 3], m: &[R; 6], inertia: &[f64; 3]) -> [R; 3] {
+        let [xx, yy, zz, xy, xz, yz] = *m;
+        let full = [[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]];
+        let mv = |v: &[R; 3]| [dot_before(&full[0], v), dot_before(&full[1], v), dot_before(&full[2], v)];
+        let (v1, v2) = (mv(&a[1]), mv(&a[2]));
+        let (n_xy, n_xz, n_yz) = (dot_before(&a[0], &v1), dot_before(&a[0], &v2), dot_before(&a[1], &v2));
+        [n_yz.mul_by(inertia[2] - inertia[1]), n_xz.mul_by(inertia[0] - inertia[2]), n_xy.mul_by(inertia[1] - inertia[0])]
+    }
+    fn cross_before<R: Arith>(a: &[R; 3], b: &[R; 3]) -> [R; 3] {
+        [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+    }
+
+    /// Pseudo-random numbers in [-1, 1) (a fixed linear congruential sequence).
+    fn uniform(seed: &mut u64) -> f64 {
+        *seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        (*seed >> 11) as f64 / (1u64 << 52) as f64 - 1.0
+    }
+
+    fn bits<const N: usize>(x: &Dual<N>) -> Vec<u64> {
+        std::iter::once(x.re).chain(x.eps).map(f64::to_bits).collect()
+    }
+
+    /// The scalar model (f64, and dual numbers for its STM) keeps its bits: the attitude
+    /// matrix, the kinematics, the gravity-gradient torque and the gyroscopic term written with
+    /// `Arith::madd` equal the former expressions exactly (addition commutes, negation and
+    /// scaling by 2 or 1/2 are exact) on 2000 random attitudes, rates and tensors, each with
+    /// derivatives in three directions. Reference: the former expressions above; tolerance:
+    /// none (bit for bit).
+    #[test]
+    fn scalar_attitude_laws_keep_their_bits() {
+        let mut seed = 7u64;
+        let inertia = [0.8, 0.9, 1.0];
+        for _ in 0..2000 {
+            let mut r = || uniform(&mut seed);
+            let dual = |x: f64, k: usize, s: f64| Dual::<3> { re: x, eps: std::array::from_fn(|j| if j == k { s } else { 0.0 }) };
+            let q: [Dual<3>; 4] = std::array::from_fn(|i| dual(r(), i % 3, r()));
+            let w: [Dual<3>; 3] = std::array::from_fn(|i| dual(3.0 * r(), (i + 1) % 3, r()));
+            let m: [Dual<3>; 6] = std::array::from_fn(|i| dual(5.0 * r(), i % 3, r()));
+            let one = Dual::<3> { re: 1.0, eps: [0.0; 3] };
+            let (a, a0) = (dcm_with(&q, one), dcm_before(&q, one));
+            for i in 0..3 {
+                for j in 0..3 {
+                    assert_eq!(bits(&a[i][j]), bits(&a0[i][j]), "A[{i}][{j}]");
+                }
+            }
+            let pairs = [
+                (quat_kinematics(&q, &w).to_vec(), kinematics_before(&q, &w).to_vec()),
+                (gravity_gradient_torque(&a, &m, &inertia).to_vec(), torque_before(&a, &m, &inertia).to_vec()),
+                (cross(&w, &m[..3].try_into().unwrap()).to_vec(), cross_before(&w, &m[..3].try_into().unwrap()).to_vec()),
+            ];
+            for (got, want) in pairs {
+                for (g, e) in got.iter().zip(&want) {
+                    assert_eq!(bits(g), bits(e));
+                }
+            }
+            // f64 too (the scalar model's values)
+            let qf = q.map(|x| x.re);
+            let (af, af0) = (dcm_with(&qf, 1.0), dcm_before(&qf, 1.0));
+            assert_eq!(af.map(|r| r.map(f64::to_bits)), af0.map(|r| r.map(f64::to_bits)));
+        }
+    }
+
+    /// The lanes' form of Euler's equations under the gravity gradient
+    /// (`gravity_gradient_euler_rate` with `euler_ratios`) against the torque into Euler's
+    /// equations (`gravity_gradient_torque`, `euler_rate`), on 2000 random states and three
+    /// bodies: the same equations (Ix wdot_x = (Iz - Iy)(N_yz - wy wz) and cyclically), to
+    /// 1e-14 relative to the largest term. Reference: the analytic identity; tolerance: rounding.
+    #[test]
+    fn euler_ratio_form_equals_torque_then_euler() {
+        let mut seed = 11u64;
+        for inertia in [[0.8, 0.9, 1.0], [12.12e6, 89.68e6, 96.95e6], [1.0, 0.6, 0.7]] {
+            let inv = inertia.map(|v| 1.0 / v);
+            let k = euler_ratios(&inertia);
+            for _ in 0..2000 {
+                let mut r = || uniform(&mut seed);
+                let q = [r(), r(), r(), r()];
+                let w = [3.0 * r(), 3.0 * r(), 3.0 * r()];
+                let m = [5.0 * r(), 5.0 * r(), 5.0 * r(), r(), r(), r()];
+                let a = dcm_with(&q, 1.0);
+                let got = gravity_gradient_euler_rate(&a, &m, &w, &k);
+                let want = euler_rate(&gravity_gradient_torque(&a, &m, &inertia), &w, &inertia, &inv);
+                let scale = 1.0 + w.iter().map(|v| v * v).sum::<f64>() + m.iter().map(|v| v.abs()).sum::<f64>();
+                for i in 0..3 {
+                    assert!((got[i] - want[i]).abs() <= 1e-14 * scale, "{inertia:?}, component {i}: {} vs {}", got[i], want[i]);
+                }
+            }
+        }
+    }
+}
