@@ -11,8 +11,9 @@
 //! multiples of the group), so results are bit-identical for any chunking and thread count, and
 //! differ between levels in their last bits. The step loop, the RKF7(8) stages and the controller are the
 //! planar engine's ([`run_steps`], [`Stages`]); the physics are the scalar 3-D model's own laws
-//! ([`dcm_with`], [`quat_rate`], [`gravity_gradient_torque`], [`euler_rate`]) evaluated over the
-//! lane type, each lane with its own body. No STM: the map needs the end state only.
+//! ([`dcm_with`], [`quat_rate`]; the gravity-gradient torque into Euler's equations in one form,
+//! [`gravity_gradient_euler_rate`]) evaluated over the lane type, each lane with its own body.
+//! No STM: the map needs the end state only.
 
 use rayon::prelude::*;
 
