@@ -304,13 +304,13 @@ impl<const N: usize> OrbitTable<N> {
     fn eval_with(&self, t: f64, fma: impl Fn(f64, f64, f64) -> f64) -> [f64; N] {
         let (s, x) = self.locate(t);
         let c = &self.coef[s * NC * N..(s + 1) * NC * N];
-        clenshaw(x, 2.0 * x, 0.0, |j| c[j], fma)
+        clenshaw(x, 2.0 * x, 0.0, FromFn(|j| c[j]), fma)
     }
 
     /// The N components at eight times at once on the lanes of `isa`: the same values as
     /// [`Self::eval_at`] at each, bit for bit (the same operations per lane). One vector
-    /// Clenshaw recurrence when the times lie in at most two segments (a Runge-Kutta step's
-    /// nodes, unless the step is longer than a segment), the coefficients chosen per lane;
+    /// Clenshaw recurrence when the times lie in at most three segments (a Runge-Kutta step's
+    /// nodes, unless the step spans more than two segments), the coefficients chosen per lane;
     /// otherwise one scalar evaluation per time.
     #[inline(always)]
     pub fn eval8_at<I: Isa>(&self, isa: I, ts: &[f64; 8]) -> [[f64; N]; 8] {
@@ -326,34 +326,59 @@ impl<const N: usize> OrbitTable<N> {
         }
     }
 
-    /// [`Self::eval8_at`]'s vector recurrence, or None when the times lie in more than two
+    /// [`Self::locate`] on the lanes: each lane's segment (as f64) and local coordinate, the
+    /// scalar form's operations lane by lane (`u as usize` saturates at 0, NaN to 0: the max with
+    /// 0, which gives 0 for NaN; then the min with the last segment).
+    #[inline(always)]
+    fn locate8<I: Isa>(&self, isa: I, ts: &[f64; 8]) -> (F8<I>, F8<I>) {
+        let (t, period) = (F8::new(isa, *ts), F8::splat(isa, self.period));
+        let tm = t - (t / period).floor() * period;
+        let u = tm / F8::splat(isa, self.seg_len);
+        let last = F8::splat(isa, (self.segments - 1) as f64);
+        let s0 = u.floor().max(F8::splat(isa, 0.0));
+        let s = s0.le_select(last, s0, last);
+        (s, F8::splat(isa, 2.0) * (u - s) - F8::splat(isa, 1.0))
+    }
+
+    /// [`Self::eval8_at`]'s vector recurrence, or None when the times lie in more than three
     /// segments (the caller then evaluates each time where it needs it).
     #[inline(always)]
     pub fn try_eval8_at<I: Isa>(&self, isa: I, ts: &[f64; 8]) -> Option<[[f64; N]; 8]> {
         // loops, not array::from_fn / map: their closures were compiled out of line, outside the
         // lanes' target features, and called at every step
-        let mut loc = [(0usize, 0.0f64); 8];
-        for l in 0..8 {
-            loc[l] = self.locate(ts[l]);
+        let (seg, x) = self.locate8(isa, ts);
+        let segs = seg.to_array();
+        // the distinct segments, ascending: at most three
+        let mut d = [segs[0]; 3];
+        let mut nd = 1;
+        for &sl in &segs[1..] {
+            if (0..nd).any(|k| d[k] == sl) {
+                continue;
+            }
+            if nd == 3 {
+                return None;
+            }
+            d[nd] = sl;
+            nd += 1;
         }
-        let (lo, hi) = loc.iter().fold((usize::MAX, 0), |(a, b), &(s, _)| (a.min(s), b.max(s)));
-        if loc.iter().any(|&(s, _)| s != lo && s != hi) {
-            return None;
+        // sorted by hand (segment numbers: no NaN), not by a library sort called out of line
+        for (a, b) in [(0, 1), (1, 2), (0, 1)] {
+            if b < nd && d[b] < d[a] {
+                d.swap(a, b);
+            }
         }
-        let (mut xs, mut segs) = ([0.0; 8], [0.0; 8]);
-        for l in 0..8 {
-            (segs[l], xs[l]) = (loc[l].0 as f64, loc[l].1);
-        }
-        let x = F8::new(isa, xs);
-        let (ca, cb) = (&self.coef[lo * NC * N..(lo + 1) * NC * N], &self.coef[hi * NC * N..(hi + 1) * NC * N]);
+        let block = |s: f64| {
+            let s = s as usize;
+            &self.coef[s * NC * N..(s + 1) * NC * N]
+        };
+        let blocks = [block(d[0]), block(d[nd.min(2) - 1]), block(d[nd - 1])];
+        let dv = [F8::splat(isa, d[0]), F8::splat(isa, d[1])];
         let (x2, zero) = (F8::splat(isa, 2.0) * x, F8::splat(isa, 0.0));
         let fma = |a: F8<I>, b: F8<I>, c: F8<I>| a.mul_add(b, c);
-        let v: [F8<I>; N] = if lo == hi {
-            clenshaw(x, x2, zero, |j| F8::splat(isa, ca[j]), fma)
-        } else {
-            let seg = F8::new(isa, segs);
-            let lo_f = F8::splat(isa, lo as f64);
-            clenshaw(x, x2, zero, |j| seg.le_select(lo_f, F8::splat(isa, ca[j]), F8::splat(isa, cb[j])), fma)
+        let v: [F8<I>; N] = match nd {
+            1 => clenshaw(x, x2, zero, Segments::<I, 1> { seg, d: dv, blocks }, fma),
+            2 => clenshaw(x, x2, zero, Segments::<I, 2> { seg, d: dv, blocks }, fma),
+            _ => clenshaw(x, x2, zero, Segments::<I, 3> { seg, d: dv, blocks }, fma),
         };
         let mut out = [[0.0; N]; 8];
         for i in 0..N {
@@ -447,7 +472,7 @@ impl<const N: usize> crate::simd::Kernel for CheckError<'_, N> {
                 }
                 F8::new(isa, c)
             };
-            let v: [F8<I>; N] = clenshaw(x, F8::splat(isa, 2.0) * x, F8::splat(isa, 0.0), coef, fmadd8);
+            let v: [F8<I>; N] = clenshaw(x, F8::splat(isa, 2.0) * x, F8::splat(isa, 0.0), FromFn(coef), fmadd8);
             for (i, vi) in v.iter().enumerate() {
                 let a = vi.to_array();
                 for (l, w) in vs.iter().enumerate() {
@@ -479,11 +504,50 @@ fn fmadd8<I: Isa>(a: F8<I>, b: F8<I>, c: F8<I>) -> F8<I> {
     }
 }
 
+/// Coefficient j of a series in [`clenshaw`]'s layout. A trait with always-inlined methods, not a
+/// closure: the compiler may leave a closure out of line, outside the lanes' target features,
+/// with their intrinsics called there.
+trait Coefs<T> {
+    fn coef(&self, j: usize) -> T;
+}
+
+/// Coefficients from a closure (scalar evaluations; the table check's gathered lanes).
+struct FromFn<F>(F);
+
+impl<T, F: Fn(usize) -> T> Coefs<T> for FromFn<F> {
+    #[inline(always)]
+    fn coef(&self, j: usize) -> T {
+        (self.0)(j)
+    }
+}
+
+/// Each lane's coefficient from its own segment among K = 1, 2 or 3 (`blocks`, ascending segment
+/// numbers; the lanes' segment numbers `seg`, the first two blocks' numbers `d`): a broadcast,
+/// or one or two lane-wise choices.
+struct Segments<'a, I, const K: usize> {
+    seg: F8<I>,
+    d: [F8<I>; 2],
+    blocks: [&'a [f64]; 3],
+}
+
+impl<I: Isa, const K: usize> Coefs<F8<I>> for Segments<'_, I, K> {
+    #[inline(always)]
+    fn coef(&self, j: usize) -> F8<I> {
+        let isa = self.seg.isa();
+        let [a, b, c] = self.blocks;
+        match K {
+            1 => F8::splat(isa, a[j]),
+            2 => self.seg.le_select(self.d[0], F8::splat(isa, a[j]), F8::splat(isa, c[j])),
+            _ => self.seg.le_select(self.d[0], F8::splat(isa, a[j]), self.seg.le_select(self.d[1], F8::splat(isa, b[j]), F8::splat(isa, c[j]))),
+        }
+    }
+}
+
 /// Clenshaw's recurrence for the N components of one segment at x (x2 = 2 x), on a scalar or on
-/// the lanes: coefficient j of the segment's [k][component] layout from `coef(j)`, `fma(a, b, c)`
+/// the lanes: coefficient j of the segment's [k][component] layout from `coef`, `fma(a, b, c)`
 /// = a b + c.
 #[inline(always)]
-fn clenshaw<T: Copy + std::ops::Sub<Output = T>, const N: usize>(x: T, x2: T, zero: T, coef: impl Fn(usize) -> T, fma: impl Fn(T, T, T) -> T) -> [T; N] {
+fn clenshaw<T: Copy + std::ops::Sub<Output = T>, const N: usize>(x: T, x2: T, zero: T, coef: impl Coefs<T>, fma: impl Fn(T, T, T) -> T) -> [T; N] {
     // component by component: two running values live, not 2 N (on the lanes, 2 N vectors
     // would not fit the registers); the components' recurrences are independent, so the order
     // changes no bit. Loops, not array::from_fn: its closure would be compiled outside the
@@ -492,11 +556,11 @@ fn clenshaw<T: Copy + std::ops::Sub<Output = T>, const N: usize>(x: T, x2: T, ze
     for (i, o) in out.iter_mut().enumerate() {
         let (mut b1, mut b2) = (zero, zero);
         for k in (1..NC).rev() {
-            let tk = fma(x2, b1, coef(N * k + i) - b2);
+            let tk = fma(x2, b1, coef.coef(N * k + i) - b2);
             b2 = b1;
             b1 = tk;
         }
-        *o = fma(x, b1, coef(i) - b2);
+        *o = fma(x, b1, coef.coef(i) - b2);
     }
     out
 }
@@ -603,6 +667,54 @@ mod tests {
                     assert_eq!(got[i], want, "level {level}, sample {i} at t = {te}");
                 }
             }
+        }
+    }
+
+    /// The lanes' evaluation at eight times ([`OrbitTable::eval8_at`]: one vector recurrence over
+    /// up to three segments, else one scalar evaluation per time) equals the scalar
+    /// [`OrbitTable::eval_at`] at each time bit for bit, at every SIMD level this CPU has, on a
+    /// six-component table: a step's nodes inside one segment, over two, three (also across the
+    /// period's end) and four segments, at the period's start and end, and a NaN time.
+    /// Reference: the scalar form; tolerance: exact.
+    #[test]
+    fn eval8_equals_the_scalar_form_bit_for_bit() {
+        let (segments, period) = (7, 3.3);
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let coef: Vec<f64> = (0..segments * NC * 6)
+            .map(|_| {
+                state = state.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
+                (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+            })
+            .collect();
+        let table = OrbitTable::<6> { period, segments, seg_len: period / segments as f64, coef, max_error: 0.0, scale: 1.0 };
+        let seg = table.seg_len;
+        // a step's eight inner nodes (RKF7(8)'s) at t + c h: (t, h, segments spanned)
+        let nodes = [2.0 / 27.0, 1.0 / 9.0, 1.0 / 6.0, 5.0 / 12.0, 0.5, 5.0 / 6.0, 2.0 / 3.0, 1.0 / 3.0];
+        let steps = [(1.1 * seg, 0.3 * seg, 1), (1.9 * seg, 0.4 * seg, 2), (0.5 * seg, 2.0 * seg, 3), (period - 1.3 * seg, 1.8 * seg, 3), (0.5 * seg, 3.5 * seg, 4)];
+        let mut cases: Vec<([f64; 8], Option<usize>)> = steps.iter().map(|&(t, h, n)| (nodes.map(|c: f64| c.mul_add(h, t)), Some(n))).collect();
+        cases.push(([0.0, period, 2.0 * period, 1e-300, period - 1e-15, 0.5 * period, period + 1e-15, 7.0 * period + 0.1], None));
+        cases.push(([f64::NAN, 0.1, 0.2, 0.3, 0.1, 0.2, 0.3, 0.1], None));
+        use crate::simd::Kernel;
+        struct Probe<'a>(&'a OrbitTable<6>, Vec<([f64; 8], Option<usize>)>);
+        impl Kernel for Probe<'_> {
+            type Output = ();
+            fn run<I: Isa>(self, isa: I) {
+                for (ts, spanned) in &self.1 {
+                    let got = self.0.eval8_at(isa, ts);
+                    for l in 0..8 {
+                        let want = self.0.eval_at::<I>(ts[l]);
+                        // a NaN's payload is not compared (which operand's it keeps is the instruction's choice)
+                        let bits = |v: [f64; 6]| v.map(|x| if x.is_nan() { u64::MAX } else { x.to_bits() });
+                        assert_eq!(bits(got[l]), bits(want), "{}: lane {l} at t = {}", I::LEVEL, ts[l]);
+                    }
+                    if let Some(n) = *spanned {
+                        assert_eq!(self.0.try_eval8_at(isa, ts).is_some(), n <= 3, "{}: {n} segments", I::LEVEL);
+                    }
+                }
+            }
+        }
+        for &level in &crate::simd::available() {
+            crate::simd::run_at(level, Probe(&table, cases.clone())).unwrap();
         }
     }
 }

@@ -1500,8 +1500,9 @@ mod tests {
 
     /// The orbit data of a step's 13 nodes, eight of them on the lanes ([`stage_data`]), equal
     /// one scalar evaluation per node bit for bit at every SIMD level this CPU has: steps inside
-    /// one segment of the forcing table, across a segment boundary, across the period's end, and
-    /// longer than a segment (the scalar fallback); with the Sun's phase (SRP). The plans take
+    /// one segment of the forcing table, across a segment boundary, across the period's end,
+    /// over three segments (also across the period's end) and over four (the scalar fallback);
+    /// with the Sun's phase (SRP). The plans take
     /// every recurring node (RKF7(8)'s c = 0, 1/6, 1; RK8(7)13M's c = 1) from its first stage.
     #[test]
     fn stage_data_equals_one_evaluation_per_node() {
@@ -1511,9 +1512,17 @@ mod tests {
         let seg = period / f.segments() as f64;
         assert!(f.segments() >= 4, "{} segments", f.segments());
         // (t, h): inside segment 1, across the boundary of segments 1 and 2, across the period's
-        // end, two segments long
-        let steps = [(1.1 * seg, 0.3 * seg), (1.9 * seg, 0.4 * seg), (period - 0.2 * seg, 0.5 * seg), (0.5 * seg, 2.0 * seg)];
-        struct Probe<'a>(&'a OrbitForcing, [(f64, f64); 4]);
+        // end, over three segments (the vector recurrence's three-way choice), over three
+        // segments across the period's end, over four segments (the scalar fallback)
+        let steps = [
+            (1.1 * seg, 0.3 * seg),
+            (1.9 * seg, 0.4 * seg),
+            (period - 0.2 * seg, 0.5 * seg),
+            (0.5 * seg, 2.0 * seg),
+            (period - 1.3 * seg, 1.8 * seg),
+            (0.5 * seg, 3.5 * seg),
+        ];
+        struct Probe<'a>(&'a OrbitForcing, [(f64, f64); 6]);
         impl Kernel for Probe<'_> {
             type Output = ();
             fn run<I: Isa>(self, isa: I) {
