@@ -243,8 +243,16 @@ fn lincomb<I: Isa, const D: usize, const M: usize>(out: &mut [F8<I>; D], y: &[F8
     // term by term across the components: each coefficient broadcast once for all D of them
     // (the D accumulators stay in registers); per component the same operations in the same
     // order as a sum per component
+    // the first term a product: c k + 0 with one or two roundings is c k rounded, but for the
+    // sign of a zero product, which the following terms or y absorb
     let mut acc = [F8::splat(isa, 0.0); D];
-    for m in 0..M {
+    let c = F8::splat(isa, coef[0]);
+    for i in 0..D {
+        if wanted[i] {
+            acc[i] = c * ks[0][i];
+        }
+    }
+    for m in 1..M {
         let c = F8::splat(isa, coef[m]);
         for i in 0..D {
             if wanted[i] {

@@ -66,7 +66,7 @@ struct Rigid<'a, I> {
 
 /// The rigid body's orbit data is the tidal tensor at a stage's time: a step's eight distinct
 /// nodes in one vector Clenshaw recurrence of the table ([`TidalTable::try_eval8_at`], the same
-/// values bit for bit) when they lie in at most two of its segments, else each stage evaluates
+/// values bit for bit) when they lie in at most three of its segments, else each stage evaluates
 /// the table itself, between the lanes' vector work (eight scalar recurrences up front were
 /// slower); a step's first and last node from the memo. The data: (t, the tensor or None).
 impl<I: Isa> Rhs<I, D> for Rigid<'_, I> {
