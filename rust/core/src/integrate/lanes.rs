@@ -1289,13 +1289,11 @@ impl<I: Isa> Rhs<I, 8> for Wide<'_, I> {
 
     #[inline(always)]
     fn eval_at(&self, at: &PlanarAt, y: &[F8<I>; 8], dy: &mut [F8<I>; 8]) {
-        let isa = y[0].isa();
-        let (ya, yb) = ([y[0], y[1], y[2], y[3]], [y[4], y[5], y[6], y[7]]);
-        let (mut da, mut db) = ([F8::splat(isa, 0.0); 4], [F8::splat(isa, 0.0); 4]);
-        rhs::<I, 4, false>(at, &ya, &self.m.p, &mut da);
-        rhs::<I, 4, false>(at, &yb, &self.q, &mut db);
-        dy[..4].copy_from_slice(&da);
-        dy[4..].copy_from_slice(&db);
+        // the halves in place: no copies of the states in, nor of the derivatives out
+        let (ya, yb) = y.split_at(4);
+        let (da, db) = dy.split_at_mut(4);
+        rhs::<I, 4, false>(at, ya.try_into().expect("four components"), &self.m.p, da.try_into().expect("four components"));
+        rhs::<I, 4, false>(at, yb.try_into().expect("four components"), &self.q, db.try_into().expect("four components"));
     }
 }
 
