@@ -245,22 +245,24 @@ pub struct FinalState {
     pub stats: Stats,
 }
 
-/// Run `f` on a rayon pool of `threads` workers (`None`: the global pool, all cores).
-pub fn with_threads<R: Send>(threads: Option<usize>, f: impl FnOnce() -> R + Send) -> Result<R> {
+/// The pool a call asked to run on `threads` workers runs on: None for the global pool (started
+/// here), else a pool of that size kept for every call asking for it
+/// ([`crate::threads::pool_of_size`]).
+fn pool_for(threads: Option<usize>) -> Result<Option<std::sync::Arc<rayon::ThreadPool>>> {
     match threads {
-        None => {
-            crate::threads::start_global_pool()?;
-            Ok(f())
-        }
         Some(0) => Err(invalid("threads", "must be >= 1 (or None for all cores)")),
-        Some(n) => {
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(n)
-                .build()
-                .map_err(|e| invalid("threads", format!("could not start {n} threads: {e}")))?;
-            Ok(pool.install(f))
-        }
+        Some(n) => crate::threads::pool_of_size(n),
+        None => crate::threads::start_global_pool().map(|_| None),
     }
+}
+
+/// Run `f` on a rayon pool of `threads` workers (`None`: the global pool, all cores; see
+/// [`pool_for`]).
+pub fn with_threads<R: Send>(threads: Option<usize>, f: impl FnOnce() -> R + Send) -> Result<R> {
+    Ok(match pool_for(threads)? {
+        Some(pool) => pool.install(f),
+        None => f(),
+    })
 }
 
 /// [`with_threads`] for a loop of many parallel rounds (a Newton driver integrating its
@@ -272,14 +274,11 @@ pub fn with_threads<R: Send>(threads: Option<usize>, f: impl FnOnce() -> R + Sen
 /// (Intel Xeon, 2 cores). A single parallel sweep gains nothing from it (measured: slightly
 /// slower), so [`with_threads`] is unchanged.
 pub fn with_threads_rounds<R: Send>(threads: Option<usize>, f: impl FnOnce() -> R + Send) -> Result<R> {
-    match threads {
+    Ok(match pool_for(threads)? {
+        Some(pool) => pool.install(f),
         // on a worker already, rayon::scope runs f in place
-        None => {
-            crate::threads::start_global_pool()?;
-            Ok(rayon::scope(|_| f()))
-        }
-        _ => with_threads(threads, f),
-    }
+        None => rayon::scope(|_| f()),
+    })
 }
 
 /// Propagate many states from t0 to their final times (one shared, or one per state) on all
@@ -326,9 +325,9 @@ pub fn propagate_many(
 mod tests {
     use super::*;
 
-    /// with_threads_rounds: `None` runs the loop on a worker of the global pool (from outside it),
-    /// `Some(n)` on a pool of n workers, and the loop's parallel rounds give the same results as
-    /// [`with_threads`].
+    /// with_threads_rounds: `None` (or the global pool's size) runs the loop on a worker of the
+    /// global pool (from outside it), another `Some(n)` on a pool of n workers, and the loop's
+    /// parallel rounds give the same results as [`with_threads`].
     #[test]
     fn with_threads_rounds_runs_on_a_pool_worker() {
         let rounds = || -> (bool, Vec<u64>) {
@@ -339,10 +338,13 @@ mod tests {
         let (outside, v0) = with_threads(None, rounds).unwrap();
         let (inside, v1) = with_threads_rounds(None, rounds).unwrap();
         let (inside2, v2) = with_threads_rounds(Some(2), rounds).unwrap();
+        let other = crate::threads::start_global_pool().unwrap().threads + 1;
+        let (inside3, v3) = with_threads_rounds(Some(other), rounds).unwrap();
         assert!(!outside, "the test thread is not a worker");
-        assert!(inside && inside2);
+        assert!(inside && inside2 && inside3);
         assert_eq!(v0, v1);
         assert_eq!(v0, v2);
+        assert_eq!(v0, v3);
         assert!(with_threads_rounds(Some(0), rounds).is_err());
     }
 }
