@@ -387,13 +387,15 @@ pub(crate) trait Rhs<I: Isa, const D: usize> {
 /// the values, and every result, are those of evaluating each time.
 pub(crate) struct Recent<T, const K: usize> {
     /// (t as bits, data at t) in a ring, and where the next one goes; the key u64::MAX (NaN bits
-    /// that no time has) marks an empty entry.
-    entries: std::cell::Cell<([(u64, T); K], usize)>,
+    /// that no time has) marks an empty entry. One cell per entry: a lookup reads the entries it
+    /// passes, not the whole ring.
+    entries: [std::cell::Cell<(u64, T)>; K],
+    next: std::cell::Cell<usize>,
 }
 
 impl<T: Copy, const K: usize> Recent<T, K> {
     pub(crate) fn new(empty: T) -> Self {
-        Recent { entries: std::cell::Cell::new(([(u64::MAX, empty); K], 0)) }
+        Recent { entries: std::array::from_fn(|_| std::cell::Cell::new((u64::MAX, empty))), next: std::cell::Cell::new(0) }
     }
 
     /// The data kept at t, or None, and then the caller evaluates it and [`Self::keep`]s it. (No
@@ -402,15 +404,21 @@ impl<T: Copy, const K: usize> Recent<T, K> {
     #[inline(always)]
     pub(crate) fn find(&self, t: f64) -> Option<T> {
         let key = t.to_bits();
-        self.entries.get().0.iter().find(|e| e.0 == key).map(|e| e.1)
+        for e in &self.entries {
+            let (k, v) = e.get();
+            if k == key {
+                return Some(v);
+            }
+        }
+        None
     }
 
     /// Keep the data v at t, in place of the oldest.
     #[inline(always)]
     pub(crate) fn keep(&self, t: f64, v: T) -> T {
-        let (mut e, next) = self.entries.get();
-        e[next] = (t.to_bits(), v);
-        self.entries.set((e, (next + 1) % K));
+        let next = self.next.get();
+        self.entries[next].set((t.to_bits(), v));
+        self.next.set((next + 1) % K);
         v
     }
 }
@@ -581,30 +589,115 @@ const FEHLBERG_PLAN: [i8; 13] = stage_plan(&C, [1, 2, 3, 4, 5, 6, 8, 9]);
 /// RK8(7)13M's plan: its first eight non-zero nodes on the lanes, the other three once each.
 const DP87_PLAN: [i8; 13] = stage_plan(&DP_C, [1, 2, 3, 4, 5, 6, 7, 8]);
 
+/// Where a stage's orbit data is kept in [`StageData`]: lane l of the step's one [`Rhs::at8`], or
+/// the k-th of its own [`Rhs::at`] evaluations.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Slot {
+    Lane(usize),
+    Own(usize),
+}
+
+/// At most this many stages of a plan evaluate on their own (RK8(7)13M: t and three nodes).
+const OWN_SLOTS: usize = 4;
+
+/// A plan's slots, every recurring stage in its first stage's slot.
+const fn slots(plan: &[i8; 13]) -> [Slot; 13] {
+    let mut out = [Slot::Own(0); 13];
+    let mut own = 0;
+    let mut s = 0;
+    while s < 13 {
+        out[s] = if plan[s] == OWN {
+            own += 1;
+            Slot::Own(own - 1)
+        } else if plan[s] < 0 {
+            Slot::Lane((-1 - plan[s]) as usize)
+        } else {
+            out[plan[s] as usize]
+        };
+        s += 1;
+    }
+    assert!(own <= OWN_SLOTS);
+    out
+}
+
+/// A 13-stage pair's nodes c_s, its plan ([`stage_plan`]) and where each stage's orbit data is
+/// kept ([`stage_data`]).
+trait StagePlan {
+    const C: [f64; 13];
+    const PLAN: [i8; 13];
+    const SLOTS: [Slot; 13] = slots(&Self::PLAN);
+    /// The stages that evaluate on their own, in stage order, and how many there are (the
+    /// entries past that count are unused).
+    const OWN_STAGES: ([usize; OWN_SLOTS], usize) = own_stages(&Self::PLAN);
+}
+
+/// The stages of a plan that evaluate on their own ([`OWN`]), in stage order, and how many.
+const fn own_stages(plan: &[i8; 13]) -> ([usize; OWN_SLOTS], usize) {
+    let mut out = [0; OWN_SLOTS];
+    let mut n = 0;
+    let mut s = 0;
+    while s < 13 {
+        if plan[s] == OWN {
+            out[n] = s;
+            n += 1;
+        }
+        s += 1;
+    }
+    (out, n)
+}
+
+impl StagePlan for Fehlberg {
+    const C: [f64; 13] = C;
+    const PLAN: [i8; 13] = FEHLBERG_PLAN;
+}
+
+impl StagePlan for PrinceDormand {
+    const C: [f64; 13] = DP_C;
+    const PLAN: [i8; 13] = DP87_PLAN;
+}
+
+/// The orbit data of a step's 13 nodes ([`stage_data`]), indexed by stage: each stage reads its
+/// slot in place (the plan is a constant, so an index known at compile time costs nothing), no
+/// record copied per stage.
+struct StageData<A, T> {
+    lanes: [A; 8],
+    own: [A; OWN_SLOTS],
+    plan: std::marker::PhantomData<T>,
+}
+
+impl<A, T: StagePlan> std::ops::Index<usize> for StageData<A, T> {
+    type Output = A;
+    #[inline(always)]
+    fn index(&self, s: usize) -> &A {
+        match T::SLOTS[s] {
+            Slot::Lane(l) => &self.lanes[l],
+            Slot::Own(k) => &self.own[k],
+        }
+    }
+}
+
 /// The orbit data at a 13-stage pair's nodes, t_s = c_s h + t (one fused multiply-add, as
-/// always), by `plan` ([`stage_plan`]): the same values as one [`Rhs::at`] per stage.
+/// always), by its plan ([`stage_plan`]): the same values as one [`Rhs::at`] per stage, its own
+/// evaluations in stage order.
 #[inline(always)]
-fn stage_data<I: Isa, const D: usize, M: Rhs<I, D>>(m: &M, c: &[f64; 13], plan: &[i8; 13], t: f64, h: f64) -> [M::At; 13] {
+fn stage_data<I: Isa, const D: usize, M: Rhs<I, D>, T: StagePlan>(m: &M, t: f64, h: f64) -> StageData<M::At, T> {
     let mut ts = [0.0; 13];
-    for s in 0..13 {
-        ts[s] = c[s].mul_add(h, t);
+    for (ts, c) in ts.iter_mut().zip(T::C) {
+        *ts = c.mul_add(h, t);
     }
     let mut lanes = [0.0; 8];
     for s in 0..13 {
-        if plan[s] < 0 {
-            lanes[(-1 - plan[s]) as usize] = ts[s];
+        if T::PLAN[s] < 0 {
+            lanes[(-1 - T::PLAN[s]) as usize] = ts[s];
         }
     }
-    let v = m.at8(&lanes);
-    let mut out = [v[0]; 13];
-    for s in 0..13 {
-        out[s] = match plan[s] {
-            OWN => m.at(ts[s]),
-            p if p < 0 => v[(-1 - p) as usize],
-            j => out[j as usize],
-        };
+    let lanes = m.at8(&lanes);
+    let mut own = [lanes[0]; OWN_SLOTS];
+    let (stages, n) = T::OWN_STAGES;
+    for k in 0..n {
+        own[k] = m.at(ts[stages[k]]);
     }
-    out
+    StageData { lanes, own, plan: std::marker::PhantomData }
 }
 
 /// A lane integration scheme on the model `M`: its state and one step.
@@ -695,7 +788,7 @@ impl<I: Isa, const D: usize, M: Rhs<I, D>> Scheme<I, M> for Stages<I, D, Fehlber
     #[inline(always)]
     fn step(&mut self, m: &M, t: f64, y: &[F8<I>; D], h: f64, out: &mut [F8<I>; D], rtol: F8<I>, atol: F8<I>) -> F8<I> {
         let isa = y[0].isa();
-        let ats = stage_data(m, &C, &FEHLBERG_PLAN, t, h);
+        let ats = stage_data::<I, D, M, Fehlberg>(m, t, h);
         m.eval_at(&ats[0], y, &mut self.k[0]);
         rkf78_stages!(stage!(A, ats, self, m, y, h));
         let k = &self.k;
@@ -735,7 +828,7 @@ impl<I: Isa, const D: usize, M: Rhs<I, D>> Scheme<I, M> for Stages<I, D, PrinceD
     #[inline(always)]
     fn step(&mut self, m: &M, t: f64, y: &[F8<I>; D], h: f64, out: &mut [F8<I>; D], rtol: F8<I>, atol: F8<I>) -> F8<I> {
         let isa = y[0].isa();
-        let ats = stage_data(m, &DP_C, &DP87_PLAN, t, h);
+        let ats = stage_data::<I, D, M, PrinceDormand>(m, t, h);
         m.eval_at(&ats[0], y, &mut self.k[0]);
         dp87_stages!(stage!(DP_A, ats, self, m, y, h));
         let k = &self.k;
@@ -1514,6 +1607,11 @@ mod tests {
     fn stage_data_equals_one_evaluation_per_node() {
         assert_eq!(FEHLBERG_PLAN, [OWN, -1, -2, -3, -4, -5, -6, 3, -7, -8, OWN, 0, 10]);
         assert_eq!(DP87_PLAN, [OWN, -1, -2, -3, -4, -5, -6, -7, -8, OWN, OWN, OWN, 11]);
+        use Slot::{Lane as L, Own as O};
+        assert_eq!(Fehlberg::SLOTS, [O(0), L(0), L(1), L(2), L(3), L(4), L(5), L(2), L(6), L(7), O(1), O(0), O(1)]);
+        assert_eq!(PrinceDormand::SLOTS, [O(0), L(0), L(1), L(2), L(3), L(4), L(5), L(6), L(7), O(1), O(2), O(3), O(3)]);
+        assert_eq!(Fehlberg::OWN_STAGES, ([0, 10, 0, 0], 2));
+        assert_eq!(PrinceDormand::OWN_STAGES, ([0, 9, 10, 11], 4));
         let (period, f) = dro_forcing();
         let seg = period / f.segments() as f64;
         assert!(f.segments() >= 4, "{} segments", f.segments());
@@ -1536,8 +1634,11 @@ mod tests {
                 let (p, _) = Params::new(isa, |_| case, LaneOptions::default().sun_omega, Sensitivity::None);
                 let m = Planar::<I, true>::new(self.0, p);
                 for (t, h) in self.1 {
-                    for (c, plan) in [(&C, &FEHLBERG_PLAN), (&DP_C, &DP87_PLAN)] {
-                        let got = stage_data::<I, 4, _>(&m, c, plan, t, h);
+                    let fehlberg = stage_data::<I, 4, _, Fehlberg>(&m, t, h);
+                    let prince_dormand = stage_data::<I, 4, _, PrinceDormand>(&m, t, h);
+                    let fehlberg: [PlanarAt; 13] = std::array::from_fn(|s| fehlberg[s]);
+                    let prince_dormand: [PlanarAt; 13] = std::array::from_fn(|s| prince_dormand[s]);
+                    for (c, got) in [(&C, &fehlberg), (&DP_C, &prince_dormand)] {
                         for s in 0..13 {
                             let want = m.orbit_at(c[s].mul_add(h, t));
                             let bits = |a: &PlanarAt| [a.s, a.c, a.swt, a.cwt].map(f64::to_bits);
