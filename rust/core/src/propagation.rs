@@ -246,9 +246,8 @@ pub struct FinalState {
 }
 
 /// The pool a call asked to run on `threads` workers runs on: None for the global pool (started
-/// here), else a pool of that size kept for every call asking for it
-/// ([`crate::threads::pool_of_size`]).
-fn pool_for(threads: Option<usize>) -> Result<Option<std::sync::Arc<rayon::ThreadPool>>> {
+/// here), else a pool of that size lent to this call ([`crate::threads::pool_of_size`]).
+fn pool_for(threads: Option<usize>) -> Result<Option<crate::threads::SizedPool>> {
     match threads {
         Some(0) => Err(invalid("threads", "must be >= 1 (or None for all cores)")),
         Some(n) => crate::threads::pool_of_size(n),

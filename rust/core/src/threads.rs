@@ -148,18 +148,46 @@ pub fn start_global_pool() -> Result<PoolInfo> {
     Ok(STARTED.get_or_init(|| info).clone())
 }
 
-/// Pools of a given size for calls asked to run on `n` threads, built once per size and process
-/// and kept, with the process id that built them (a child forked after they started cannot use
-/// their threads, and builds its own).
-static SIZED: std::sync::Mutex<Vec<(u32, usize, std::sync::Arc<rayon::ThreadPool>)>> = std::sync::Mutex::new(Vec::new());
+/// Idle pools of a given size for calls asked to run on `n` threads, with the process id that
+/// built them (a child forked after they started cannot use their threads, and builds its own).
+static IDLE: std::sync::Mutex<Vec<(u32, usize, rayon::ThreadPool)>> = std::sync::Mutex::new(Vec::new());
+
+/// A pool of `n` workers lent to one call ([`pool_of_size`]); dropped, it waits idle for the
+/// next call asking for `n`.
+pub struct SizedPool {
+    n: usize,
+    pool: Option<rayon::ThreadPool>,
+}
+
+impl SizedPool {
+    /// Run `f` on this pool's workers.
+    pub fn install<R: Send>(&self, f: impl FnOnce() -> R + Send) -> R {
+        self.pool.as_ref().expect("a lent pool until dropped").install(f)
+    }
+
+    /// Its workers.
+    pub fn threads(&self) -> usize {
+        self.n
+    }
+}
+
+impl Drop for SizedPool {
+    fn drop(&mut self) {
+        if let Some(pool) = self.pool.take() {
+            IDLE.lock().unwrap_or_else(|e| e.into_inner()).push((std::process::id(), self.n, pool));
+        }
+    }
+}
 
 /// The pool a call asked to run on `n` threads runs on: None for the global pool (started here)
-/// when it has (or will have) `n` workers, else a pool of `n` workers built with the first such
-/// call and kept for the next ones, its workers bound by [`plan`] as the global pool's are. A
-/// pool built per call cost its threads' start and, unbound, ran a 2-ms map on two threads at
-/// one thread's speed (the standard map: 3.99 ms with `threads=2` against 2.38 ms on the global pool, 2-core
-/// Intel Xeon). `n` is at least 1 (the callers check it).
-pub fn pool_of_size(n: usize) -> Result<Option<std::sync::Arc<rayon::ThreadPool>>> {
+/// when it has (or will have) `n` workers, else a pool of `n` workers of its own, an idle one
+/// kept from an earlier call or, when none is idle (the first call, or calls running at the
+/// same time: each has its own pool, as if it had built it), a new one, its workers bound by
+/// [`plan`] as the global pool's are. A pool built per call cost its threads' start and,
+/// unbound, ran a 2-ms map on two threads at one thread's speed (the standard map: 3.99 ms with
+/// `threads=2` against 2.38 ms on the global pool, 2-core Intel Xeon). `n` is at least 1 (the
+/// callers check it).
+pub fn pool_of_size(n: usize) -> Result<Option<SizedPool>> {
     // the global pool's size, without starting it (a process that only asks for other sizes
     // never starts it, and a child it forks can run its own pools)
     if pool_info()?.threads == n {
@@ -167,14 +195,17 @@ pub fn pool_of_size(n: usize) -> Result<Option<std::sync::Arc<rayon::ThreadPool>
         return Ok(None);
     }
     let pid = std::process::id();
-    let mut pools = SIZED.lock().unwrap_or_else(|e| e.into_inner());
-    // pools inherited through fork have no threads in this process: never dropped (their
-    // registry would wait for workers that do not exist), never used
-    let (here, inherited): (Vec<_>, Vec<_>) = std::mem::take(&mut *pools).into_iter().partition(|p| p.0 == pid);
-    inherited.into_iter().for_each(std::mem::forget);
-    *pools = here;
-    if let Some((_, _, pool)) = pools.iter().find(|p| p.1 == n) {
-        return Ok(Some(pool.clone()));
+    {
+        let mut idle = IDLE.lock().unwrap_or_else(|e| e.into_inner());
+        // pools inherited through fork have no threads in this process: never dropped (their
+        // registry would wait for workers that do not exist), never used
+        let (here, inherited): (Vec<_>, Vec<_>) = std::mem::take(&mut *idle).into_iter().partition(|p| p.0 == pid);
+        inherited.into_iter().for_each(std::mem::forget);
+        *idle = here;
+        if let Some(i) = idle.iter().position(|p| p.1 == n) {
+            let (_, _, pool) = idle.swap_remove(i);
+            return Ok(Some(SizedPool { n, pool: Some(pool) }));
+        }
     }
     let to_bind = plan(binding_from_env()?, n, &allowed_cpus());
     let pool = rayon::ThreadPoolBuilder::new()
@@ -187,9 +218,7 @@ pub fn pool_of_size(n: usize) -> Result<Option<std::sync::Arc<rayon::ThreadPool>
         })
         .build()
         .map_err(|e| invalid("threads", format!("could not start {n} threads: {e}")))?;
-    let pool = std::sync::Arc::new(pool);
-    pools.push((pid, n, pool.clone()));
-    Ok(Some(pool))
+    Ok(Some(SizedPool { n, pool: Some(pool) }))
 }
 
 /// Calls of [`run_polled`] and [`spawn`]ed work in flight.
@@ -434,28 +463,46 @@ mod tests {
         }
     }
 
-    /// pool_of_size: the global pool for its own size; any other size built once and kept (the
-    /// same workers on the next call), one pool per size.
+    /// pool_of_size: the global pool for its own size; any other size a pool of its own per
+    /// call, kept idle between calls (the same workers on the next call), and two calls at the
+    /// same time have two pools (neither waits for the other's workers).
     #[test]
-    fn a_sized_pool_is_built_once_and_the_global_size_is_the_global_pool() {
-        let global = start_global_pool().unwrap();
+    fn a_sized_pool_is_kept_between_calls_and_concurrent_calls_have_their_own() {
+        let global = pool_info().unwrap();
         assert!(pool_of_size(global.threads).unwrap().is_none());
-        let n = global.threads + 1;
-        let a = pool_of_size(n).unwrap().unwrap();
-        let b = pool_of_size(n).unwrap().unwrap();
-        assert!(std::sync::Arc::ptr_eq(&a, &b));
-        assert_eq!(a.current_num_threads(), n);
-        let names = |p: &rayon::ThreadPool| {
-            let mut v = p.broadcast(|_| std::thread::current().name().map(str::to_owned));
-            v.sort();
+        // a size no other test asks for
+        let n = global.threads + 3;
+        let ids = |p: &SizedPool| {
+            let mut v = p.install(|| rayon::broadcast(|_| std::thread::current().id()));
+            v.sort_by_key(|id| format!("{id:?}"));
             v
         };
-        let first = names(&a);
-        assert_eq!(first, names(&b));
-        assert!(first.iter().all(|s| s.as_deref().is_some_and(|s| s.starts_with(&format!("librate-{n}-")))), "{first:?}");
-        let c = pool_of_size(n + 1).unwrap().unwrap();
-        assert!(!std::sync::Arc::ptr_eq(&a, &c));
-        assert_eq!(c.current_num_threads(), n + 1);
+        let a = pool_of_size(n).unwrap().unwrap();
+        assert_eq!(a.threads(), n);
+        assert_eq!(a.install(rayon::current_num_threads), n);
+        let first = ids(&a);
+        let name = a.install(|| std::thread::current().name().map(str::to_owned));
+        assert!(name.as_deref().is_some_and(|s| s.starts_with(&format!("librate-{n}-"))), "{name:?}");
+        // while a is lent, another call gets another pool
+        let b = pool_of_size(n).unwrap().unwrap();
+        let second = ids(&b);
+        assert!(first.iter().all(|id| !second.contains(id)));
+        drop(b);
+        drop(a);
+        // both idle now: the next two calls reuse them, no new threads
+        let c = pool_of_size(n).unwrap().unwrap();
+        let d = pool_of_size(n).unwrap().unwrap();
+        let mut seen = ids(&c);
+        seen.extend(ids(&d));
+        assert!(first.iter().chain(&second).all(|id| seen.contains(id)));
+        // two calls at once run at once: each waits until both have started
+        let barrier = std::sync::Barrier::new(2);
+        std::thread::scope(|s| {
+            for p in [&c, &d] {
+                let barrier = &barrier;
+                s.spawn(move || p.install(|| barrier.wait()));
+            }
+        });
     }
 
     #[test]
