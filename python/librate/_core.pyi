@@ -177,7 +177,8 @@ class IntegrationOptions:
 @final
 class NewtonOptions:
     def __new__(
-        cls, *, tol: float = 1e-12, max_iter: int = 40, max_halvings: int = 10, max_angle_step: float = 0.5, max_rate_step: float = 0.5
+        cls, *, tol: float = 1e-12, max_iter: int = 40, max_halvings: int = 10, max_angle_step: float = 0.5, max_rate_step: float = 0.5,
+        max_contraction: float | None = None,
     ) -> NewtonOptions: ...
     @property
     def tol(self) -> float: ...
@@ -189,6 +190,8 @@ class NewtonOptions:
     def max_angle_step(self) -> float: ...
     @property
     def max_rate_step(self) -> float: ...
+    @property
+    def max_contraction(self) -> float | None: ...
 
 @final
 class LaneMethod:

@@ -30,6 +30,7 @@ from ..solving.continuation import (
 from .solutions import (
     KINDS,
     STEP_MAX_HALVINGS,
+    STEP_MAX_CONTRACTION,
     STEP_MAX_ITER,
     AttitudeSolution,
     check_kz,
@@ -323,7 +324,7 @@ class EpsBranch:
         cond = np.array([[c.a[1], c.a[2], c.a[0], c.b] for _, _, c in requests], dtype=float)  # (a_phi0, a_wz0, a_eps, b)
         return correct(self.orbit, kz=self.kz, n_total=[p.n_total for p, _, _ in requests], kind=[p.kind for p, _, _ in requests],
                        phi0=g[:, 1], wz0=g[:, 2], n_periods=self.n_periods, srp=self.plate, eps=g[:, 0], closure="full", free="phi0",
-                       max_iter=STEP_MAX_ITER, max_halvings=STEP_MAX_HALVINGS, bordered=("eps", cond))
+                       max_iter=STEP_MAX_ITER, max_halvings=STEP_MAX_HALVINGS, max_contraction=STEP_MAX_CONTRACTION, bordered=("eps", cond))
 
     @staticmethod
     def _point(b, i):

@@ -32,7 +32,7 @@ from ..orbits.periodic import PeriodicOrbit
 __all__ = ["AttitudeSolution", "find_periodic_attitudes", "orbit_forcing", "clear_forcing_cache", "sweep", "candidates",
            "check_orbit", "check_kz", "check_kinds", "KINDS", "check_srp", "is_symmetric", "MAP_RTOL", "MAP_ATOL", "correct", "verified",
            "refine", "refine_groups", "start_refine", "Refining",
-           "turns_of", "n_total_of", "per_period", "turns_array", "SOLVE_RTOL", "SOLVE_ATOL", "STEP_MAX_ITER", "MAP_METHOD",
+           "turns_of", "n_total_of", "per_period", "turns_array", "SOLVE_RTOL", "SOLVE_ATOL", "STEP_MAX_ITER", "STEP_MAX_CONTRACTION", "MAP_METHOD",
            "STEP_MAX_HALVINGS"]
 
 MAP_RTOL = 1e-12
@@ -44,6 +44,13 @@ MAP_ATOL = 1e-12
 #: does not is a step too long (the driver halves it), not worth forty iterations.
 STEP_MAX_ITER = 10
 STEP_MAX_HALVINGS = 4
+#: The eps continuation's steps (SRP): a Newton step must leave at most this fraction of the
+#: residual (Deuflhard's contraction test, his usual 1/4), else the correction stops at once
+#: ("slow_convergence") and the driver halves the step. Without it, the long first steps of the
+#: SRP-dominated branches crept (|F| 0.8, 0.7, 0.7, ...) through all STEP_MAX_ITER iterations,
+#: holding every branch of the lock step for those rounds, and one such step of the README's
+#: srp_map converged onto a neighbouring branch (wz0 0.157 -> 0.287 from eps = 2 to 1.5).
+STEP_MAX_CONTRACTION = 0.25
 #: The corrector's defaults: convergence at a residual max-norm of CORRECT_TOL, at most
 #: CORRECT_MAX_ITER Newton steps and CORRECT_MAX_HALVINGS step halvings of the line search.
 CORRECT_TOL = 1e-12
@@ -303,17 +310,20 @@ def turns_of(n_total, kind) -> np.ndarray:
 
 def correct(orbit: PeriodicOrbit, *, kz, n_total, kind, phi0, wz0, n_periods: int = 1, srp=None, closure: str = "half",
             free: str = "phi0", theta_sun0=None, eps=None, tol: float = CORRECT_TOL, max_iter: int = CORRECT_MAX_ITER, bordered=None,
-            monodromy: bool = True, max_halvings: int = CORRECT_MAX_HALVINGS, search=None):
+            monodromy: bool = True, max_halvings: int = CORRECT_MAX_HALVINGS, search=None, max_contraction: float | None = None):
     """One call of the Rust corrector for a batch of candidates on ``orbit`` (arrays broadcast
     together: kz, n_total, kind, phi0, wz0, and theta_sun0 / eps overriding the plate's):
     ``closure`` "half" (symmetric, over K T / 2) or "full" (over K T); ``free`` "phi0" or
     "sun_phase"; ``bordered``: (parameter "kz" or "eps", condition (a_angle, a_wz0, a_parameter,
     b), or one such row per candidate) for the continuation driver; ``search``: (lo, hi) of
-    wz0 per candidate, where a Newton step leaving it stops the candidate ("left_window").
+    wz0 per candidate, where a Newton step leaving it stops the candidate ("left_window");
+    ``max_contraction``: a continuation step's test (a candidate whose accepted Newton step
+    leaves the residual above that fraction of its value stops, "slow_convergence").
     Returns the core's CorrectionBatch."""
     cases, options, t_final = _corrector_inputs(orbit, kz=kz, n_total=n_total, kind=kind, phi0=phi0, wz0=wz0, n_periods=n_periods,
                                                 srp=srp, closure=closure, theta_sun0=theta_sun0, eps=eps, tol=tol, max_iter=max_iter,
-                                                monodromy=monodromy, max_halvings=max_halvings, search=search)
+                                                monodromy=monodromy, max_halvings=max_halvings, search=search,
+                                                max_contraction=max_contraction)
     border = None
     if bordered is not None:
         parameter = _choice(_PARAMETERS, bordered[0], "parameter")
@@ -327,7 +337,7 @@ def correct(orbit: PeriodicOrbit, *, kz, n_total, kind, phi0, wz0, n_periods: in
 
 
 def _corrector_inputs(orbit, *, kz, n_total, kind, phi0, wz0, n_periods, srp, closure, theta_sun0, eps, tol, max_iter, monodromy,
-                      max_halvings, search):
+                      max_halvings, search, max_contraction=None):
     """The core's PlanarCases, CorrectorOptions and closure time of a batch of candidates (the
     arrays of :func:`correct` broadcast together)."""
     cols = [np.asarray(kz, dtype=float), np.asarray(n_total, dtype=float), np.asarray(kind), np.asarray(phi0, dtype=float),
@@ -341,7 +351,8 @@ def _corrector_inputs(orbit, *, kz, n_total, kind, phi0, wz0, n_periods, srp, cl
         plates = plates_of(np.full(k.size, srp.eps) if eps is None else e, np.full(k.size, float(srp.cs)), np.full(k.size, float(srp.cd)),
                            np.full(k.size, float(srp.sun.theta0)) if theta_sun0 is None else th)
     T = n_periods * orbit.period
-    options = _core.CorrectorOptions(_core.NewtonOptions(tol=float(tol), max_iter=int(max_iter), max_halvings=int(max_halvings)),
+    options = _core.CorrectorOptions(_core.NewtonOptions(tol=float(tol), max_iter=int(max_iter), max_halvings=int(max_halvings),
+                                                         max_contraction=max_contraction),
                                      _core.LaneOptions(rtol=SOLVE_RTOL, atol=SOLVE_ATOL), monodromy=bool(monodromy))
     window = None
     if search is not None:

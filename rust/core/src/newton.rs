@@ -46,11 +46,16 @@ pub enum StopReason {
     /// The Newton step left the candidate's search window: no solution nearby (the attitude
     /// driver, for candidates given a window, e.g. a map's crossings refined in place).
     LeftWindow,
+    /// An accepted Newton step left the residual's 2-norm above `max_contraction` times its
+    /// value before the step, while above the noise floor (the attitude driver, where a
+    /// continuation sets it: its predictor then lies outside Newton's fast convergence, and a
+    /// shorter continuation step costs less than more iterations).
+    SlowConvergence,
 }
 
 impl StopReason {
     /// "converged", "max_iterations", "singular_jacobian", "no_descent", "integration_failed",
-    /// "left_window".
+    /// "left_window", "slow_convergence".
     pub fn as_str(&self) -> &'static str {
         match self {
             Self::Converged => "converged",
@@ -59,6 +64,7 @@ impl StopReason {
             Self::NoDescent => "no_descent",
             Self::IntegrationFailed => "integration_failed",
             Self::LeftWindow => "left_window",
+            Self::SlowConvergence => "slow_convergence",
         }
     }
 }

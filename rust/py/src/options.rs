@@ -48,8 +48,11 @@ impl From<&IntegrationOptions> for Options {
 
 /// Settings of the globalised Newton drivers: convergence when the residual max-norm <= tol,
 /// at most max_iter steps, max_halvings line-search halvings, steps scaled down to
-/// |angle step| <= max_angle_step (rad) and |rate step| <= max_rate_step (1/TU). The
-/// correctors without a line search (orbits, flexible) read tol and max_iter only.
+/// |angle step| <= max_angle_step (rad) and |rate step| <= max_rate_step (1/TU); with
+/// max_contraction, a candidate stops ("slow_convergence") when an accepted step leaves the
+/// residual's 2-norm above that fraction of its value before the step (planar attitude
+/// correctors, for a continuation's steps; None: no test). The correctors without a line
+/// search (orbits, flexible) read tol and max_iter only.
 #[pyclass(frozen, get_all, from_py_object, name = "NewtonOptions", module = "librate._core")]
 #[derive(Clone, Copy)]
 pub struct NewtonOptions {
@@ -58,14 +61,15 @@ pub struct NewtonOptions {
     pub max_halvings: u32,
     pub max_angle_step: f64,
     pub max_rate_step: f64,
+    pub max_contraction: Option<f64>,
 }
 
 #[pymethods]
 impl NewtonOptions {
     #[new]
-    #[pyo3(signature = (*, tol=1e-12, max_iter=40, max_halvings=10, max_angle_step=0.5, max_rate_step=0.5))]
-    fn new(tol: f64, max_iter: usize, max_halvings: u32, max_angle_step: f64, max_rate_step: f64) -> Self {
-        Self { tol, max_iter, max_halvings, max_angle_step, max_rate_step }
+    #[pyo3(signature = (*, tol=1e-12, max_iter=40, max_halvings=10, max_angle_step=0.5, max_rate_step=0.5, max_contraction=None))]
+    fn new(tol: f64, max_iter: usize, max_halvings: u32, max_angle_step: f64, max_rate_step: f64, max_contraction: Option<f64>) -> Self {
+        Self { tol, max_iter, max_halvings, max_angle_step, max_rate_step, max_contraction }
     }
     fn __repr__(&self) -> String {
         format!("NewtonOptions(tol={:e}, max_iter={}, max_halvings={})", self.tol, self.max_iter, self.max_halvings)
@@ -163,6 +167,7 @@ impl CorrectorOptions {
             max_wz_step: n.max_rate_step,
             max_angle_step: n.max_angle_step,
             max_halvings: n.max_halvings,
+            max_contraction: n.max_contraction.unwrap_or(f64::INFINITY),
             threads: l.threads,
             chunk: l.chunk,
             monodromy: self.monodromy,

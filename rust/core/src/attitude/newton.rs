@@ -88,6 +88,13 @@ pub(crate) struct Settings {
     /// search that backtracks does not cost a round per halving. 1: no look-ahead (one
     /// trajectory per call of a scalar integrator, or groups the driver cannot see).
     pub group: usize,
+    /// The largest ratio of the residual's 2-norm after an accepted step to before it, while
+    /// above the noise floor; a slower step stops the candidate ([`StopReason::SlowConvergence`]).
+    /// For a continuation's corrections (Deuflhard's contraction test on the predictor): a
+    /// Newton iteration that converges contracts quickly, and one that creeps (damped steps far
+    /// from the solution, 0.8 -> 0.7 -> 0.7 ...) would spend every remaining iteration before
+    /// failing. `f64::INFINITY`: no test.
+    pub max_contraction: f64,
 }
 
 #[derive(Debug, Clone, Copy)]
@@ -204,9 +211,14 @@ impl<const N: usize> Track<N> {
                 let integrated = any_integrated || pt.is_some();
                 match pt.filter(|pt| pt.merit <= (1.0 - ARMIJO * lambda * self.scale) * cur_merit) {
                     Some(pt) => {
+                        let slow = pt.merit > s.max_contraction * cur_merit && pt.norm > s.tol * conditioning(p, &pt);
                         self.cur = Some(pt);
                         self.iterations += 1;
-                        self.next_step(p, c, s);
+                        if slow {
+                            self.phase = Phase::Done(StopReason::SlowConvergence);
+                        } else {
+                            self.next_step(p, c, s);
+                        }
                     }
                     None if halvings >= s.max_halvings => {
                         self.phase = Phase::Done(if integrated && floor {
@@ -379,7 +391,7 @@ mod tests {
         let starts = [0.31, 1.0, 2.5, -4.0, 9.0, 40.0, -150.0];
         let run = |group: usize, max_halvings: u32| {
             let rounds = Cell::new(0usize);
-            let s = Settings { tol: 1e-13, max_iter: 30, max_halvings, group };
+            let s = Settings { tol: 1e-13, max_iter: 30, max_halvings, group, max_contraction: f64::INFINITY };
             let tracks = solve(&Atan, &starts, &s, &|b: &[f64]| {
                 rounds.set(rounds.get() + 1);
                 Ok(b.iter().map(|&x| (x - 0.3).atan()).collect())
@@ -398,5 +410,29 @@ mod tests {
                 assert!(plain.iter().filter(|p| p.2 == StopReason::Converged).count() >= 4, "{plain:?}");
             }
         }
+    }
+
+    #[test]
+    fn contraction_test_stops_creeping_starts_and_leaves_the_converging_ones() {
+        // atan(x - 0.3): from 0.31 and 1.0 Newton contracts at once (1.0: |F| 0.611 -> 0.207 ->
+        // 0.006, ratios 0.34 and 0.03, analytic); from 2.5 on, its full steps overshoot and the
+        // damped steps the line search accepts barely reduce |F|
+        let starts = [0.31, 1.0, 2.5, -4.0, 9.0, 40.0];
+        let run = |max_contraction: f64| {
+            let s = Settings { tol: 1e-13, max_iter: 30, max_halvings: 10, group: 1, max_contraction };
+            solve(&Atan, &starts, &s, &|b: &[f64]| Ok(b.iter().map(|&x| (x - 0.3).atan()).collect()))
+                .unwrap()
+                .iter()
+                .map(|t| (t.x()[0].to_bits(), t.iterations, t.reason()))
+                .collect::<Vec<_>>()
+        };
+        let (free, tested) = (run(f64::INFINITY), run(0.5));
+        assert_eq!(&tested[..2], &free[..2], "the converging starts take the same steps to the same bits");
+        assert!(tested[..2].iter().all(|t| t.2 == StopReason::Converged));
+        for (i, (t, f)) in tested.iter().zip(&free).enumerate().skip(2) {
+            assert_eq!(t.2, StopReason::SlowConvergence, "start {}: {t:?}", starts[i]);
+            assert!(t.1 <= 2 && t.1 < f.1, "start {}: stopped after {} accepted steps, {} without the test", starts[i], t.1, f.1);
+        }
+        assert_eq!(StopReason::SlowConvergence.as_str(), "slow_convergence");
     }
 }

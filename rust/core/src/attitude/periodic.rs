@@ -181,6 +181,10 @@ pub struct CorrectorOptions {
     pub max_angle_step: f64,
     /// Step halvings of the line search before giving up ([`StopReason::NoDescent`]).
     pub max_halvings: u32,
+    /// The largest ratio of the residual's 2-norm after an accepted Newton step to before it
+    /// (above the noise floor) before the candidate stops ([`StopReason::SlowConvergence`]):
+    /// for a continuation's steps; infinite (the default): no test.
+    pub max_contraction: f64,
     /// Central-difference step in theta_sun0 ([`Free::SunPhase`]), rad.
     pub phase_step: f64,
     /// Rate of the Sun direction in the synodic frame (1/TU), for SRP candidates.
@@ -205,6 +209,7 @@ impl Default for CorrectorOptions {
             max_wz_step: 0.5,
             max_angle_step: 0.5,
             max_halvings: 10,
+            max_contraction: f64::INFINITY,
             phase_step: 1e-6,
             sun_omega: OMEGA_SUN,
             threads: None,
@@ -531,6 +536,9 @@ fn validate_options(opts: &CorrectorOptions) -> Result<()> {
     if opts.max_halvings > 60 {
         return Err(invalid("max_halvings", format!("must be in [0, 60], got {}", opts.max_halvings)));
     }
+    if !(opts.max_contraction > 0.0) {
+        return Err(invalid("max_contraction", format!("must be > 0 (infinite: no test), got {}", opts.max_contraction)));
+    }
     if opts.chunk == 0 {
         return Err(invalid("chunk", "must be >= 1"));
     }
@@ -708,7 +716,7 @@ const FAILED: Outcome = Outcome { phi_t: f64::NAN, wz_t: f64::NAN, stm: [f64::NA
 /// candidate; then the full-period monodromy of half-closure corrections.
 /// `group`: the lock-step group of `integrate`'s batches ([`Settings::group`]).
 fn run(form: Form, candidates: &[Candidate], opts: &CorrectorOptions, integrate: &Integrate<'_>, group: usize) -> Result<Vec<Correction>> {
-    let settings = Settings { tol: opts.tol, max_iter: opts.max_iter, max_halvings: opts.max_halvings, group };
+    let settings = Settings { tol: opts.tol, max_iter: opts.max_iter, max_halvings: opts.max_halvings, group, max_contraction: opts.max_contraction };
     with_threads_rounds(opts.threads, || -> Result<Vec<Correction>> {
         let tracks = newton::solve(&form, candidates, &settings, &|b: &[(Case, f64)]| integrate_batch(integrate, b, false))?;
         let stm = |t: &Track<3>| t.cur.as_ref().map_or([f64::NAN; 4], |p| [p.keep[0], p.keep[1], p.keep[2], p.keep[3]]);

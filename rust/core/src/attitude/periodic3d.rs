@@ -369,7 +369,7 @@ pub fn correct_attitudes_3d(mu: f64, body: RigidBody, orbit0: &[f64; 6], t_final
     };
     let t_solve = if opts.half { 0.5 * t_final } else { t_final };
     let one = |y: &Traj| run(y, t_solve);
-    let settings = Settings { tol: opts.tol, max_iter: opts.max_iter, max_halvings: opts.max_halvings, group: 1 };
+    let settings = Settings { tol: opts.tol, max_iter: opts.max_iter, max_halvings: opts.max_halvings, group: 1, max_contraction: f64::INFINITY };
     let cands: Vec<usize> = (0..starts.len()).collect();
     let (tracks, full) = with_threads_rounds(opts.threads, || -> Result<_> {
         let tracks = newton::solve(&form, &cands, &settings, &|b: &[Traj]| Ok(b.par_iter().map(one).collect()))?;
@@ -705,7 +705,7 @@ pub fn correct_attitudes_3d_across(
         let dydt: [f64; 13] = std::array::from_fn(|i| (0..6).map(|j| stm[i * 13 + j] * ds0[j]).sum::<f64>() + k * f[i]);
         Some((yt.to_vec(), stm, dydt, orbit.state0, orbit.period))
     };
-    let settings = Settings { tol: opts.tol, max_iter: opts.max_iter, max_halvings: opts.max_halvings, group: 1 };
+    let settings = Settings { tol: opts.tol, max_iter: opts.max_iter, max_halvings: opts.max_halvings, group: 1, max_contraction: f64::INFINITY };
     let cands: Vec<usize> = (0..starts.len()).collect();
     let tracks = with_threads_rounds(opts.threads, || newton::solve(&form, &cands, &settings, &|b: &[(Traj, f64)]| Ok(b.par_iter().map(one).collect())))??;
     // the member at each final point (cheap: one symmetric shooting, no attitude integration)
