@@ -267,3 +267,42 @@ def test_scans_from_several_attitudes_share_one_sweep(sun12):
         librate.find_periodic_attitudes(sun12, phi0=[], **args)
     with pytest.raises(ValueError, match="`phi0`"):
         librate.find_periodic_attitudes(sun12, phi0=[0.0, float("nan")], **args)
+
+
+def test_srp_map_branches_follow_their_start(sun12):
+    """The README's srp_map (41 eps x 400 rates, K = 2): every branch is the branch of its start.
+    Reference: the same starts (the gravity-only solutions at eps = 0 and the far end's scan at
+    eps = 2) continued with ten times shorter steps (eps_branches, steps = 200) mark the same
+    solutions at the grid's eps values (1e-8 in wz0 and phi0). librate 0.1.4 failed this: with
+    its 4 steps, a long first step from eps = 2 converged onto a neighbouring branch (wz0 0.157
+    at eps = 1.85, then 0.268 at 1.8) within the jump guard, and another (wz0 -0.013 at 1.9,
+    then -0.045 at 1.85)."""
+    from librate.periodicity.branches import eps_branches
+
+    es = np.linspace(0, 2, 41)
+    ds = librate.srp_map(sun12, kz=0.6, wz0=np.linspace(-1.6, 1.2, 400), eps=es, cs=0.4, cd=0.1)
+    plate = librate.FlatPlate(2.0, cs=0.4, cd=0.1)
+    window = dict(kz=0.6, wz0_range=(-1.6, 1.2), kinds=("periodic",), n_periods=2)
+    far = librate.find_periodic_attitudes(sun12, phi0=[0.0, 0.5 * math.pi, math.pi, -0.5 * math.pi], srp=plate, **window)  # srp_map's scan
+    starts = {"gravity": (0.0, librate.find_periodic_attitudes(sun12, phi0=0.0, **window), plate, es[1:]),
+              "end": (2.0, far, plate.with_eps(0.0), es[:-1][::-1])}
+    sol_b, sol_e, sol_w, sol_p = (ds[k].values for k in ("sol_branch", "sol_eps", "sol_wz0", "sol_phi0"))
+    branches, jobs = [], []
+    for b, origin in enumerate(ds.branch_origin.values):
+        e0, found, target, marks = starts[str(origin)]
+        at = np.flatnonzero((sol_b == b) & (sol_e == e0))[0]
+        s = next(s for s in found if abs(s.wz0 - sol_w[at]) < 1e-8 and abs(math.remainder(s.phi0 - sol_p[at], 2 * math.pi)) < 1e-8)
+        branches.append(b)
+        jobs.append((s, target, marks))
+    assert len(branches) == ds.sizes["branch"] >= 25
+    compared = 0
+    for b, br in zip(branches, eps_branches(jobs, steps=200)):
+        ref = {round(float(p.x[0]), 12): p for p in br.marked}
+        for i in np.flatnonzero(sol_b == b):
+            p = ref.get(round(float(sol_e[i]), 12))
+            if p is None:
+                continue
+            assert abs(sol_w[i] - p.x[2]) < 1e-8, f"branch {b} at eps = {sol_e[i]}: wz0 {sol_w[i]} against {p.x[2]}"
+            assert abs(math.remainder(sol_p[i] - p.x[1], 2 * math.pi)) < 1e-8, f"branch {b} at eps = {sol_e[i]}: phi0"
+            compared += 1
+    assert compared >= 0.9 * ds.sizes["solution"]

@@ -68,7 +68,7 @@ def srp_map(
     n_periods: int | None = None,
     solve: bool = True,
     kinds: Sequence[str] = ("periodic",),
-    steps: int = 4,
+    steps: int = 20,
     progress: Callable[[int, int], None] | None = None,
 ):
     """A flat-plate SRP periodicity map of one orbit over (eps, initial rate), with the solution
@@ -77,7 +77,7 @@ def srp_map(
     The grid runs in one engine sweep. With ``solve``: SRP breaks the mirror symmetry, so with
     phi0 fixed there is no curve of solutions in the plane; the solutions shown are branches with
     phi0 free (docs/physics.md, solar radiation pressure), continued by `continue_srp` through the
-    grid's eps values (``steps`` per interval) until the grid ends or the branch folds: from eps =
+    grid's eps values (first step: the eps range over ``steps``) until the grid ends or the branch folds: from eps =
     0, the gravity-only solutions of the listed ``kinds`` in the window (``branch_origin =
     "gravity"``); and from each far end of the grid, the solutions found there that no branch from
     eps = 0 reached, back towards 0 (``"end"``: e.g. the SRP-dominated motions of large eps).
@@ -105,8 +105,12 @@ def srp_map(
         Trace the solution branches.
     kinds : sequence of str, default ("periodic",)
         The closures of the gravity-only starts.
-    steps : int, default 4
-        Continuation steps per eps interval of the grid.
+    steps : int, default 20
+        The continuation's first step is the branch's eps range over ``steps`` (0.1 on the
+        README's map, eps from 0 to 2); steps grow while the branch is easy, to four times that
+        but at most 0.25, and the branch is corrected exactly at each grid value they pass. Shorter
+        steps guard against a step converging onto a neighbouring branch: with 4 (librate
+        0.1.4 and before) two branches of the README's map did so.
     progress : callable, optional
         ``progress(done, total)`` after each branch and after the grid's sweep; ``total`` grows
         as the branches to trace are found.
