@@ -29,8 +29,8 @@ from ..solving.continuation import (
 )
 from .solutions import (
     KINDS,
-    STEP_MAX_HALVINGS,
     STEP_MAX_CONTRACTION,
+    STEP_MAX_HALVINGS,
     STEP_MAX_ITER,
     AttitudeSolution,
     check_kz,

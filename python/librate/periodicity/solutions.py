@@ -32,8 +32,8 @@ from ..orbits.periodic import PeriodicOrbit
 __all__ = ["AttitudeSolution", "find_periodic_attitudes", "orbit_forcing", "clear_forcing_cache", "sweep", "candidates",
            "check_orbit", "check_kz", "check_kinds", "KINDS", "check_srp", "is_symmetric", "MAP_RTOL", "MAP_ATOL", "correct", "verified",
            "refine", "refine_groups", "start_refine", "Refining",
-           "turns_of", "n_total_of", "per_period", "turns_array", "SOLVE_RTOL", "SOLVE_ATOL", "STEP_MAX_ITER", "STEP_MAX_CONTRACTION", "MAP_METHOD",
-           "STEP_MAX_HALVINGS"]
+           "turns_of", "n_total_of", "per_period", "turns_array", "SOLVE_RTOL", "SOLVE_ATOL", "STEP_MAX_ITER", "MAP_METHOD",
+           "STEP_MAX_HALVINGS", "STEP_MAX_CONTRACTION"]
 
 MAP_RTOL = 1e-12
 #: The lanes' method of the maps: RKF7(8); RKN8(6) is within 0.9-1.0x of its time at equal
