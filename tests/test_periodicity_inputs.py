@@ -5,6 +5,7 @@ result or a "did not converge after -5 iterations"."""
 import librate
 import numpy as np
 import pytest
+from librate.periodicity.solutions import correct
 
 EM = librate.System.preset("earth-moon")
 ORBIT = librate.dro(EM, x0=0.85)
@@ -24,6 +25,10 @@ BAD = [
                                                                       free="theta_sun0", method="half"),
      "method"),
     ("n not a whole number of turns over K periods", lambda: librate.periodic_attitude(ORBIT, kz=0.8, n=0.3, n_periods=2), "n"),
+    ("corrector max_contraction = 0", lambda: correct(ORBIT, kz=0.8, n_total=[0], kind=["periodic"], phi0=[0.0], wz0=[0.5],
+                                                      max_contraction=0.0), "max_contraction"),
+    ("corrector max_contraction NaN", lambda: correct(ORBIT, kz=0.8, n_total=[0], kind=["periodic"], phi0=[0.0], wz0=[0.5],
+                                                      max_contraction=float("nan")), "max_contraction"),
 ]
 
 

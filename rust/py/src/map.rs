@@ -164,7 +164,7 @@ pub struct PyCorrectionBatch {
     /// reason == "converged", bool (n,).
     converged: Py<PyAny>,
     /// Why each candidate stopped: "converged", "max_iterations", "singular_jacobian",
-    /// "no_descent", "integration_failed" or "left_window".
+    /// "no_descent", "integration_failed", "left_window" or "slow_convergence".
     reason: Vec<&'static str>,
     /// Full-period (K T) 2x2 monodromy at the final point, (n, 2, 2).
     monodromy: Py<PyAny>,

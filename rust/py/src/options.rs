@@ -72,7 +72,8 @@ impl NewtonOptions {
         Self { tol, max_iter, max_halvings, max_angle_step, max_rate_step, max_contraction }
     }
     fn __repr__(&self) -> String {
-        format!("NewtonOptions(tol={:e}, max_iter={}, max_halvings={})", self.tol, self.max_iter, self.max_halvings)
+        let contraction = self.max_contraction.map_or(String::new(), |c| format!(", max_contraction={c}"));
+        format!("NewtonOptions(tol={:e}, max_iter={}, max_halvings={}{contraction})", self.tol, self.max_iter, self.max_halvings)
     }
 }
 
